@@ -1,0 +1,46 @@
+"""Column names, units and shared constants.
+
+gaitval works in SI units inside: metres, seconds, radians, degrees Celsius for air
+temperature.  Column names carry their unit as a suffix (``_m``, ``_s``, ``_rad``,
+``_mps``) so a tidy table is self-describing.
+"""
+from __future__ import annotations
+
+# -- protocols and sensor kinds (trial sheet vocabulary) ---------------------------------
+PROTOCOLS = ("tug", "mtst", "rollator", "treadmill", "pendulum")
+SENSOR_KINDS = ("lrs", "ultrasonic")
+SIDES = ("L", "R")
+
+# -- trial sheet / subject table columns ---------------------------------------------------
+TRIAL_COLUMNS_REQUIRED = ("study", "protocol", "subject", "trial", "sensor_kind",
+                          "mocap_file", "sensor_file")
+TRIAL_COLUMNS_OPTIONAL = ("annotation_file", "sensor_topic", "sensor_height_m",
+                          "clock_offset_s", "speed", "speed_mps", "stick", "scenario",
+                          "repetition", "notes")
+SUBJECT_COLUMNS_REQUIRED = ("subject", "leg_width_m")
+SUBJECT_COLUMNS_OPTIONAL = ("group", "age_y", "sex", "height_m", "mass_kg",
+                            "leg_length_m", "knee_width_m", "ankle_width_m",
+                            "shank_length_m", "stick")
+
+# -- tidy per-trial tables --------------------------------------------------------------
+T = "t_s"               # time in seconds on the file's own clock
+X, Y, Z = "x_m", "y_m", "z_m"
+VX, VY = "vx_mps", "vy_mps"
+MARKER = "marker"
+FRAME = "frame"
+TRIAL = "trial"
+SUBJECT = "subject"
+SIDE = "side"
+METHOD = "method"
+RANGE = "range_m"
+ANGLE = "angle_rad"
+
+# -- "no return" in laser data ------------------------------------------------------------
+#: Every loader maps inf, NaN, zero, below-range-min and above-range-max returns to NaN in
+#: float metres.  NaN is the one documented "no return" value inside gaitval.
+NO_RETURN = float("nan")
+
+# -- physics -------------------------------------------------------------------------------
+#: Speed of sound in dry air at 0 degC (m/s); seed 003 eq. (2): c = 331.3 sqrt(1 + T/273.15)
+SPEED_OF_SOUND_0C = 331.3
+KELVIN_0C = 273.15

@@ -1,0 +1,72 @@
+"""Atomic file output.
+
+Every file gaitval writes goes through :func:`atomic_path`: the content is written to a
+temporary file in the same folder and renamed over the target only when complete, so an
+interrupted run never leaves a half-written file that looks complete.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+
+import pandas as pd
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path):
+    """Yield a temporary path beside ``path``; rename it over ``path`` on success.
+
+    On an exception the temporary file is removed and ``path`` is left untouched.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    os.close(fd)
+    try:
+        yield Path(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+
+
+def write_text(path: str | Path, text: str) -> Path:
+    """Write ``text`` (UTF-8, ``\\n`` line ends) to ``path`` atomically."""
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8", newline="\n")
+    return Path(path)
+
+
+def write_bytes(path: str | Path, data: bytes) -> Path:
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)
+    return Path(path)
+
+
+def write_parquet(df: pd.DataFrame, path: str | Path, metadata: dict[str, str] | None = None
+                  ) -> Path:
+    """Write a DataFrame as Parquet atomically, optionally with key/value schema metadata.
+
+    The output is deterministic for the same frame (no pandas index, no creation time).
+    """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pandas(df, preserve_index=False)
+    if metadata:
+        md = dict(table.schema.metadata or {})
+        md.update({k.encode(): v.encode() for k, v in metadata.items()})
+        table = table.replace_schema_metadata(md)
+    with atomic_path(path) as tmp:
+        pq.write_table(table, tmp, compression="zstd")
+    return Path(path)
+
+
+def write_csv(df: pd.DataFrame, path: str | Path, float_format: str | None = None) -> Path:
+    """Write a DataFrame as CSV atomically (no index, ``\\n`` line ends)."""
+    with atomic_path(path) as tmp:
+        df.to_csv(tmp, index=False, float_format=float_format, lineterminator="\n")
+    return Path(path)

@@ -1,0 +1,183 @@
+"""gaitval's open laser scan-log format (``*.scan.parquet``), reader and writer.
+
+Format (version 1), documented in full in ``docs/formats.md``
+------------------------------------------------------------
+One Apache Parquet file, one row per scan, in the order the sensor produced them:
+
+* ``t_s`` (float64): the scan's timestamp in seconds on the **sensor's own clock** (time of
+  the first beam, as ``sensor_msgs/LaserScan.header.stamp``).
+* ``ranges`` (fixed-size list of ``n_beams`` values): the ranges, beam 0 first.  Integer
+  millimetres (uint16/uint32) when ``range_unit`` is ``mm`` — 0 means "no return", as a
+  Hokuyo reports it — or float metres when ``range_unit`` is ``m`` (NaN/inf: no return).
+
+The schema metadata key ``gaitval:scanlog`` holds a JSON object::
+
+    {"format": "gaitval-scanlog", "version": 1,
+     "angle_min_rad": -2.356194490192345, "angle_increment_rad": 0.004363323129985824,
+     "n_beams": 1081, "range_unit": "mm", "range_min_m": 0.1, "range_max_m": 30.0,
+     "sensor_model": "Hokuyo UTM-30LX", "mounting_height_m": 0.27,
+     "scan_time_s": 0.025, "frame": "x forward, y left, angles counter-clockwise"}
+
+Beam ``i`` points at ``angle_min_rad + i * angle_increment_rad`` in the sensor frame
+(x forward, y to the left, counter-clockwise positive: the ROS convention).
+
+Reading it without gaitval::
+
+    import json, numpy as np, pyarrow.parquet as pq
+    tab = pq.read_table("trial.scan.parquet")
+    meta = json.loads(tab.schema.metadata[b"gaitval:scanlog"])
+    t = tab["t_s"].to_numpy()
+    ranges = np.stack(tab["ranges"].to_numpy(zero_copy_only=False))  # mm, 0 = no return
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from gaitval.errors import FileFormatError
+from gaitval.io.atomic import atomic_path
+from gaitval.types import ScanSeries
+
+META_KEY = b"gaitval:scanlog"
+FORMAT = "gaitval-scanlog"
+VERSION = 1
+SUFFIX = ".scan.parquet"
+
+
+def clean_ranges(ranges: np.ndarray, range_min: float, range_max: float
+                 ) -> tuple[np.ndarray, int]:
+    """Map every kind of "no return" to NaN (the one documented value).
+
+    inf, NaN, zero/negative, below ``range_min`` and above ``range_max`` all become NaN.
+    Returns the cleaned float64 array and the number of beams mapped.
+    """
+    r = np.asarray(ranges, dtype=np.float64).copy()
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(r) | (r <= 0.0) | (r < range_min) | (r > range_max)
+    r[bad] = np.nan
+    return r, int(bad.sum())
+
+
+def check_timestamps(t: np.ndarray) -> pd.DataFrame:
+    """Report non-monotonic or duplicated timestamps; never reorder.
+
+    Returns a DataFrame ``index, t_s, problem`` with one row per offending scan (the
+    later scan of each bad pair).
+    """
+    t = np.asarray(t, dtype=np.float64)
+    d = np.diff(t)
+    rows = []
+    for i in np.flatnonzero(d == 0.0):
+        rows.append((int(i + 1), float(t[i + 1]), "duplicate"))
+    for i in np.flatnonzero(d < 0.0):
+        rows.append((int(i + 1), float(t[i + 1]), "non-monotonic"))
+    rows.sort()
+    return pd.DataFrame(rows, columns=["index", "t_s", "problem"])
+
+
+def write_scanlog(path: str | Path, series: ScanSeries, *, range_unit: str = "mm",
+                  scan_time_s: float | None = None) -> Path:
+    """Write ``series`` as a gaitval scan log (atomically).
+
+    With ``range_unit="mm"`` ranges are rounded to whole millimetres (the sensor's
+    quantisation) and "no return" (NaN) is written as 0.
+    """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    r = np.asarray(series.ranges, dtype=np.float64)
+    n, nb = r.shape
+    if range_unit == "mm":
+        mm = np.where(np.isfinite(r), np.rint(r * 1000.0), 0.0)
+        dtype = np.uint16 if mm.max(initial=0) < 65535 else np.uint32
+        flat = pa.array(mm.astype(dtype).ravel())
+    elif range_unit == "m":
+        flat = pa.array(r.astype(np.float32).ravel())
+    else:
+        raise ValueError(f"range_unit must be 'mm' or 'm', not {range_unit!r}")
+    meta = {
+        "format": FORMAT, "version": VERSION,
+        "angle_min_rad": float(series.angle_min),
+        "angle_increment_rad": float(series.angle_increment),
+        "n_beams": int(nb), "range_unit": range_unit,
+        "range_min_m": float(series.range_min), "range_max_m": float(series.range_max),
+        "sensor_model": series.sensor_model,
+        "mounting_height_m": (None if series.mounting_height_m is None
+                              else float(series.mounting_height_m)),
+        "scan_time_s": scan_time_s,
+        "frame": "x forward, y left, angles counter-clockwise (ROS LaserScan)",
+    }
+    table = pa.table({
+        "t_s": pa.array(np.asarray(series.t, dtype=np.float64)),
+        "ranges": pa.FixedSizeListArray.from_arrays(flat, nb),
+    })
+    table = table.replace_schema_metadata({META_KEY: json.dumps(meta).encode()})
+    with atomic_path(path) as tmp:
+        pq.write_table(table, tmp, compression="zstd")
+    return Path(path)
+
+
+def read_scanlog(path: str | Path, *, trial: str | None = None) -> ScanSeries:
+    """Read a gaitval scan log into a :class:`~gaitval.types.ScanSeries` (metres, NaN = no return).
+
+    Raises
+    ------
+    FileFormatError
+        Missing file, not Parquet, missing metadata, or a ``ranges`` column whose length
+        does not match ``n_beams``.
+    """
+    import pyarrow.parquet as pq
+    import pyarrow as pa
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileFormatError("scan log not found", path=path, trial=trial)
+    try:
+        tab = pq.read_table(path)
+    except (pa.ArrowInvalid, OSError) as exc:
+        raise FileFormatError(f"not a readable Parquet scan log: {exc}", path=path,
+                              trial=trial) from None
+    md = tab.schema.metadata or {}
+    if META_KEY not in md:
+        raise FileFormatError("Parquet file has no 'gaitval:scanlog' metadata; is it a "
+                              "gaitval scan log?", path=path, trial=trial,
+                              hint="see docs/formats.md")
+    try:
+        meta = json.loads(md[META_KEY])
+        nb = int(meta["n_beams"])
+        unit = meta["range_unit"]
+        amin = float(meta["angle_min_rad"])
+        ainc = float(meta["angle_increment_rad"])
+        rmin = float(meta["range_min_m"])
+        rmax = float(meta["range_max_m"])
+    except (KeyError, ValueError, TypeError) as exc:
+        raise FileFormatError(f"scan-log metadata incomplete: {exc}", path=path,
+                              trial=trial) from None
+    if meta.get("version", 1) > VERSION:
+        raise FileFormatError(f"scan-log version {meta['version']} is newer than this "
+                              f"gaitval reads ({VERSION})", path=path, trial=trial)
+    for col in ("t_s", "ranges"):
+        if col not in tab.column_names:
+            raise FileFormatError(f"scan log has no '{col}' column", path=path, trial=trial)
+    t = tab["t_s"].to_numpy().astype(np.float64)
+    col = tab["ranges"].combine_chunks()
+    values = col.flatten().to_numpy(zero_copy_only=False)
+    if values.size != nb * len(t):
+        raise FileFormatError(f"ranges hold {values.size} values, expected "
+                              f"{len(t)} scans x {nb} beams", path=path, trial=trial)
+    raw = values.reshape(len(t), nb).astype(np.float64)
+    if unit == "mm":
+        raw = raw / 1000.0
+    elif unit != "m":
+        raise FileFormatError(f"unknown range_unit {unit!r} (expected 'mm' or 'm')",
+                              path=path, trial=trial)
+    ranges, n_bad = clean_ranges(raw, rmin, rmax)
+    return ScanSeries(
+        t=t, ranges=ranges, angle_min=amin, angle_increment=ainc, range_min=rmin,
+        range_max=rmax, sensor_model=str(meta.get("sensor_model", "unknown")),
+        mounting_height_m=meta.get("mounting_height_m"), source=str(path),
+        timestamp_issues=check_timestamps(t), n_no_return_raw=n_bad,
+        meta={k: v for k, v in meta.items() if k not in {"n_beams"}})
