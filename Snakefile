@@ -1,0 +1,21 @@
+# gaitval workflow.  The rules live in workflow/rules/*.smk; see ../shared/DESIGN.md and
+# README.md.  Run:  snakemake --profile workflow/profiles/default
+from snakemake.utils import min_version
+
+min_version("8.0")
+
+
+configfile: "config/config.yaml"
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/simulate.smk"
+include: "workflow/rules/ingest.smk"
+include: "workflow/rules/report.smk"
+
+
+rule all:
+    input:
+        f"{REPORTS}/index.md",
+        f"{REPORTS}/index.html",
+    default_target: True

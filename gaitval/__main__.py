@@ -1,0 +1,5 @@
+import sys
+
+from gaitval.cli import main
+
+sys.exit(main())

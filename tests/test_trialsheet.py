@@ -1,0 +1,66 @@
+"""Trial sheet and subject table: a typo or a missing file gives one clear message."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from gaitval.errors import TrialSheetError
+from gaitval.io.trialsheet import load_trial_sheet
+
+HEADER = ("study,protocol,subject,trial,sensor_kind,mocap_file,sensor_file,sensor_topic,"
+          "annotation_file,sensor_height_m,clock_offset_s,speed,speed_mps,stick,scenario,"
+          "repetition\n")
+ROW = "s,tug,S01,tug_S01_1,lrs,m/a.c3d,l/a.scan.parquet,,,0.27,,,,false,,1\n"
+SUBJECTS = "subject,group,leg_width_m,knee_width_m\nS01,young,0.10,0.10\n"
+
+
+def make_study(tmp_path: Path, rows: str = ROW, subjects: str = SUBJECTS,
+               header: str = HEADER) -> Path:
+    for rel in ("m/a.c3d", "l/a.scan.parquet", "m/b.c3d", "l/b.bag"):
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_bytes(b"")
+    (tmp_path / "subjects.csv").write_text(subjects)
+    (tmp_path / "trials.csv").write_text(header + rows)
+    return tmp_path / "trials.csv"
+
+
+def test_valid_sheet_types_and_paths(tmp_path):
+    df = load_trial_sheet(make_study(tmp_path))
+    row = df.loc["tug_S01_1"]
+    assert row["sensor_height_m"] == pytest.approx(0.27)
+    assert row["stick"] is False or row["stick"] == False  # noqa: E712 (numpy bool)
+    assert Path(row["mocap_path"]) == (tmp_path / "m/a.c3d").resolve()
+    assert row["annotation_path"] == ""
+    assert str(df["clock_offset_s"].dtype) == "float64"
+
+
+@pytest.mark.parametrize("rows, expect", [
+    (ROW.replace(",tug,", ",tugg,"), ["row 2", "trial 'tug_S01_1'", "'protocol'", "tugg"]),
+    (ROW.replace("m/a.c3d", "m/zz.c3d"), ["row 2", "'mocap_file'", "m/zz.c3d", "not found"]),
+    (ROW.replace(",0.27,", ",tall,"), ["row 2", "'sensor_height_m'", "tall"]),
+    (ROW.replace(",false,", ",maybe,"), ["row 2", "'stick'", "maybe"]),
+    (ROW.replace(",S01,", ",S99,"), ["row 2", "'subject'", "S99"]),
+    (ROW + ROW, ["tug_S01_1", "rows [2, 3]", "unique"]),
+    (ROW.replace("l/a.scan.parquet", "l/b.bag"), ["'sensor_topic'", "LaserScan topic"]),
+    (ROW.replace(",lrs,", ",,"), ["row 2", "'sensor_kind'"]),
+])
+def test_bad_rows_name_row_and_column(tmp_path, rows, expect):
+    with pytest.raises(TrialSheetError) as ei:
+        load_trial_sheet(make_study(tmp_path, rows=rows))
+    msg = str(ei.value)
+    assert "trials.csv" in msg
+    for piece in expect:
+        assert piece in msg, msg
+
+
+def test_column_typo_suggests_the_right_name(tmp_path):
+    with pytest.raises(TrialSheetError, match=r"unknown column 'protocl'; did you mean 'protocol'"):
+        load_trial_sheet(make_study(tmp_path, header=HEADER.replace("protocol", "protocl")))
+
+
+def test_subject_table_errors(tmp_path):
+    with pytest.raises(TrialSheetError, match=r"subjects.csv.*row 2 \(subject 'S01'\), column 'leg_width_m'"):
+        load_trial_sheet(make_study(tmp_path, subjects=SUBJECTS.replace("0.10,0.10", "wide,0.10")))
+    with pytest.raises(TrialSheetError, match="leg_width_m"):
+        load_trial_sheet(make_study(tmp_path, subjects="subject,group\nS01,young\n"))

@@ -1,0 +1,91 @@
+# Shared by all rule files -- config validation, paths, the trial sheet, provenance.
+import sys
+from pathlib import Path
+
+from snakemake.utils import validate
+
+from gaitval.io.trialsheet import load_trial_sheet
+from gaitval.report.provenance import config_hash
+
+
+validate(config, "../schemas/config.schema.yaml")
+
+RESULTS = config.get("results_dir", "results")
+REPORTS = config.get("reports_dir", "reports")
+# The library is called as `python -m gaitval` with the interpreter running Snakemake, so
+# rules work whether or not the venv's bin/ is on PATH.
+GV = (
+    "python -m gaitval"
+    if "conda" in str(getattr(workflow, "deployment_settings", "")).lower()
+    else f"{sys.executable} -m gaitval"
+)
+CONFIG_HASH = config_hash(config)
+
+# Rule files add functions study -> [report items] here; rule `report` collects them.
+REPORT_ITEM_FUNCS = []
+
+
+def study_cfg(study):
+    try:
+        return config["studies"][study]
+    except KeyError:
+        raise ValueError(
+            f"study {study!r} is not defined under `studies:` in the config "
+            f"(known: {sorted(config['studies'])})"
+        ) from None
+
+
+def is_simulated(study):
+    return "simulate" in study_cfg(study)
+
+
+def sheet_path(study):
+    """Trial sheet path; for a simulated study, wait for the `simulate` checkpoint."""
+    if is_simulated(study):
+        return checkpoints.simulate.get(study=study).output.sheet
+    return study_cfg(study)["trial_sheet"]
+
+
+_SHEETS = {}
+
+
+def trials(study):
+    """The validated trial sheet of a study (DataFrame indexed by trial id)."""
+    path = sheet_path(study)
+    if path not in _SHEETS:
+        _SHEETS[path] = load_trial_sheet(path, study_cfg(study)["subjects"])
+    return _SHEETS[path]
+
+
+def trial_ids(study, protocols=None):
+    df = trials(study)
+    if protocols is not None:
+        df = df[df["protocol"].isin(protocols)]
+    return sorted(df.index)
+
+
+def trial_row(study, trial):
+    return trials(study).loc[trial]
+
+
+def ingest_inputs(wildcards):
+    """Raw files of one trial (the sheet too, so editing it reruns the trial)."""
+    row = trial_row(wildcards.study, wildcards.trial)
+    files = {
+        "sheet": sheet_path(wildcards.study),
+        "mocap": row["mocap_path"],
+        "sensor": row["sensor_path"],
+    }
+    if row["annotation_path"]:
+        files["annotations"] = row["annotation_path"]
+    return files
+
+
+def report_items(wildcards):
+    """Every table/figure the rule files registered, for every study in `run`."""
+    return [item for study in config["run"] for f in REPORT_ITEM_FUNCS for item in f(study)]
+
+
+def parent_of(name, up=0):
+    """Param function: the folder of output `name` (`up` levels higher)."""
+    return lambda wildcards, output: str(Path(output[name]).parents[up])

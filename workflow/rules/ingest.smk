@@ -1,0 +1,57 @@
+# Raw trial files -> tidy per-trial files (one job per trial), and a per-study summary.
+
+
+rule ingest:
+    input:
+        unpack(ingest_inputs),
+    output:
+        mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
+        events=f"{RESULTS}/{{study}}/ingest/{{trial}}/events.csv",
+        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
+        annotations=f"{RESULTS}/{{study}}/ingest/{{trial}}/annotations.csv",
+        summary=f"{RESULTS}/{{study}}/ingest/{{trial}}/ingest.json",
+    params:
+        gv=GV,
+        subjects=lambda w: study_cfg(w.study)["subjects"],
+        out=parent_of("mocap"),
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/ingest/{study}/{trial}.log",
+    shell:
+        "{params.gv} ingest --sheet {input.sheet} --subjects {params.subjects}"
+        " --trial {wildcards.trial} --out {params.out}"
+        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+rule ingest_summary:
+    input:
+        lambda w: expand(
+            f"{RESULTS}/{{study}}/ingest/{{trial}}/ingest.json",
+            study=w.study,
+            trial=trial_ids(w.study),
+        ),
+    output:
+        csv=report(
+            f"{REPORTS}/tables/study_ingest_{{study}}.csv",
+            caption="../report/ingest.rst",
+            category="Study",
+        ),
+        md=f"{REPORTS}/tables/study_ingest_{{study}}.md",
+        tex=f"{REPORTS}/tables/study_ingest_{{study}}.tex",
+    params:
+        gv=GV,
+        stem=lambda w, output: output.csv[: -len(".csv")],
+        reports=parent_of("csv", up=1),
+        chash=CONFIG_HASH,
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/ingest_summary/{study}.log",
+    shell:
+        "{params.gv} ingest-summary {input} --study {wildcards.study} --out-stem {params.stem}"
+        " --reports-dir {params.reports} --config-hash {params.chash}"
+        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+REPORT_ITEM_FUNCS.append(lambda study: [f"{REPORTS}/tables/study_ingest_{study}.csv"])

@@ -1,0 +1,20 @@
+# Gather every table and figure of the studies in `run` into reports/index.{md,html}.
+
+
+rule report:
+    input:
+        report_items,
+    output:
+        md=report(f"{REPORTS}/index.md", caption="../report/index.rst", category="Report"),
+        html=f"{REPORTS}/index.html",
+    params:
+        gv=GV,
+        reports=parent_of("md"),
+        studies=" ".join(config["run"]),
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/report.log",
+    shell:
+        "{params.gv} report --reports-dir {params.reports} --studies {params.studies}"
+        " > {log} 2>&1 || (cat {log} >&2; exit 1)"

@@ -1,0 +1,21 @@
+# The embedded default study: generated once, unless its files are already there.
+
+
+checkpoint simulate:
+    input:
+        preset=lambda w: f"config/studies/{study_cfg(w.study)['simulate']['preset']}.yaml",
+    output:
+        sheet="data/{study}/trials.csv",
+        subjects="data/{study}/subjects.csv",
+        realism="data/{study}/realism.csv",
+    params:
+        gv=GV,
+        seed=lambda w: study_cfg(w.study)["simulate"].get("seed", 0),
+        out=parent_of("sheet"),
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/simulate/{study}.log",
+    shell:
+        "{params.gv} simulate --preset {input.preset} --seed {params.seed} --out {params.out}"
+        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
