@@ -1,0 +1,66 @@
+"""Report spine: atomic outputs, table rendering, provenance in the index, CLI errors."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitval.cli import main
+from gaitval.io.atomic import atomic_path, write_text
+from gaitval.report.index import build_index
+from gaitval.report.provenance import config_hash, stamp
+from gaitval.tables import write_table
+
+
+def test_interrupted_write_leaves_nothing_that_looks_complete(tmp_path):
+    target = tmp_path / "t.csv"
+    write_text(target, "old\n")
+    with pytest.raises(RuntimeError):
+        with atomic_path(target) as tmp:
+            tmp.write_text("half a fi")
+            raise RuntimeError("killed")
+    assert target.read_text() == "old\n"          # previous complete file untouched
+    assert list(tmp_path.iterdir()) == [target]    # no temporary file left behind
+
+
+def test_write_table_three_formats_agree_and_are_deterministic(tmp_path):
+    df = pd.DataFrame({"method": ["Method 1", "Method 2"], "rmse_x_m": [0.0512, np.nan],
+                       "rmse_x_m_published": [0.051, 0.047], "n": [3, 4]})
+    a = write_table(df, tmp_path / "a" / "tug_table9", caption="Test caption", notes=["a note"])
+    b = write_table(df, tmp_path / "b" / "tug_table9", caption="Test caption", notes=["a note"])
+    for pa, pb in zip(a, b):
+        assert pa.read_bytes() == pb.read_bytes()
+    back = pd.read_csv(a[0])
+    assert list(back.columns) == list(df.columns)
+    assert back["rmse_x_m"].iloc[0] == pytest.approx(0.0512)
+    md = a[1].read_text()
+    assert "| Method 1 | 0.051 | 0.051 | 3 |" in md and "a note" in md
+    assert r"rmse\_x\_m" in a[2].read_text()
+
+
+def test_index_lists_items_with_provenance_and_missing_tables(tmp_path):
+    rd = tmp_path / "reports"
+    paths = write_table(pd.DataFrame({"a": [1]}), rd / "tables" / "tug_table4",
+                        caption="Occlusion rate and RMSE")
+    h = config_hash({"run": ["tiny"]})
+    stamp("tug_tables", paths, rd, config_hash_=h, command="gaitval tables tug")
+    md, html = build_index(rd, study_names=["tiny"])
+    text = md.read_text()
+    assert "### tug_table4" in text and "Occlusion rate and RMSE" in text
+    assert f"config {h}" in text and "command: `gaitval tables tug`" in text
+    assert "Not produced yet: tug_table2, tug_table3, tug_table5" in text
+    assert "tug_table4" in html.read_text()
+    rec = json.loads((rd / "provenance" / "tug_tables.json").read_text())
+    assert rec["items"] == ["tables/tug_table4.csv", "tables/tug_table4.md",
+                            "tables/tug_table4.tex"]
+
+
+def test_cli_user_error_is_one_line_and_exit_2(tmp_path, capsys):
+    sheet = tmp_path / "trials.csv"
+    sheet.write_text("study,protocol\nx,tug\n")
+    rc = main(["validate", str(sheet)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1
+    assert err[0].startswith("gaitval: error: [file ") and "missing required column" in err[0]
