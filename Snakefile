@@ -1,11 +1,14 @@
 # gaitval workflow.  The rules live in workflow/rules/*.smk; see ../shared/DESIGN.md and
 # README.md.  Run:  snakemake --profile workflow/profiles/default
+from pathlib import Path
+
 from snakemake.utils import min_version
 
 min_version("8.0")
 
 
-configfile: "config/config.yaml"
+# Relative to the Snakefile, so `snakemake --directory ELSEWHERE` still finds it.
+configfile: Path(workflow.basedir) / "config" / "config.yaml"
 
 
 include: "workflow/rules/common.smk"

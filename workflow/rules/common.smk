@@ -10,7 +10,9 @@ from gaitval.report.provenance import config_hash
 
 validate(config, "../schemas/config.schema.yaml")
 
+DATA = config.get("data_dir", "data")
 RESULTS = config.get("results_dir", "results")
+PRESETS = Path(workflow.basedir) / "config" / "studies"
 REPORTS = config.get("reports_dir", "reports")
 # The library is called as `python -m gaitval` with the interpreter running Snakemake, so
 # rules work whether or not the venv's bin/ is on PATH.
@@ -46,6 +48,12 @@ def sheet_path(study):
     return study_cfg(study)["trial_sheet"]
 
 
+def subjects_path(study):
+    if is_simulated(study):
+        return f"{DATA}/{study}/subjects.csv"
+    return study_cfg(study)["subjects"]
+
+
 _SHEETS = {}
 
 
@@ -53,7 +61,7 @@ def trials(study):
     """The validated trial sheet of a study (DataFrame indexed by trial id)."""
     path = sheet_path(study)
     if path not in _SHEETS:
-        _SHEETS[path] = load_trial_sheet(path, study_cfg(study)["subjects"])
+        _SHEETS[path] = load_trial_sheet(path, subjects_path(study))
     return _SHEETS[path]
 
 

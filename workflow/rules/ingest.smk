@@ -12,7 +12,7 @@ rule ingest:
         summary=f"{RESULTS}/{{study}}/ingest/{{trial}}/ingest.json",
     params:
         gv=GV,
-        subjects=lambda w: study_cfg(w.study)["subjects"],
+        subjects=lambda w: subjects_path(w.study),
         out=parent_of("mocap"),
     conda:
         "../envs/gaitval.yaml"

@@ -3,11 +3,11 @@
 
 checkpoint simulate:
     input:
-        preset=lambda w: f"config/studies/{study_cfg(w.study)['simulate']['preset']}.yaml",
+        preset=lambda w: PRESETS / f"{study_cfg(w.study)['simulate']['preset']}.yaml",
     output:
-        sheet="data/{study}/trials.csv",
-        subjects="data/{study}/subjects.csv",
-        realism="data/{study}/realism.csv",
+        sheet=f"{DATA}/{{study}}/trials.csv",
+        subjects=f"{DATA}/{{study}}/subjects.csv",
+        realism=f"{DATA}/{{study}}/realism.csv",
     params:
         gv=GV,
         seed=lambda w: study_cfg(w.study)["simulate"].get("seed", 0),
