@@ -322,3 +322,35 @@ def test_agreement_by_group_and_missing_column():
     assert list(out["g"]) == ["a", "b"] and list(out["n"]) == [5, 5]
     with pytest.raises(GaitvalError, match="not in the table"):
         agreement(df, "ref", "p")
+
+
+# --------------------------------------------------------------------------- peer table
+def test_peer_agreement_table(realdata, tmp_path):
+    from gaitval.tables.peer import peer_agreement_table, write_peer_table
+    path = realdata / "peer-results" / "gailo_results.parquet"
+    t = peer_agreement_table(path).set_index("statistic")
+    assert list(t.columns[1:]) == ["step_length_cm", "step_time_s", "stride_length_cm",
+                                   "stride_time_s", "velocity_cm_per_s",
+                                   "cadence_steps_per_min"]
+    assert (t.loc["n", t.columns[1:]] == 90).all()
+    df = pd.read_parquet(path)
+    a = agreement(df, "gt_cadence", "us_cadence").iloc[0]
+    for stat in ("bias", "loa_high", "icc_a1", "p"):
+        assert t.loc[stat, "cadence_steps_per_min"] == a[stat]
+    paths = write_peer_table(path, tmp_path / "peer_agreement")
+    assert "Sensors 2024, 24(4), 1172" in paths[1].read_text()
+
+
+def test_peer_table_bad_files_raise_file_format_error(tmp_path):
+    from gaitval.errors import FileFormatError
+    from gaitval.tables.peer import peer_agreement_table
+    with pytest.raises(FileFormatError, match="not found"):
+        peer_agreement_table(tmp_path / "missing.parquet")
+    junk = tmp_path / "junk.parquet"
+    junk.write_text("not parquet")
+    with pytest.raises(FileFormatError, match="cannot read"):
+        peer_agreement_table(junk)
+    nopairs = tmp_path / "nopairs.parquet"
+    pd.DataFrame({"a": [1.0], "gt_b": [2.0]}).to_parquet(nopairs)
+    with pytest.raises(FileFormatError, match="no paired"):
+        peer_agreement_table(nopairs)

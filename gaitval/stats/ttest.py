@@ -31,7 +31,10 @@ def paired_t(x: np.ndarray, y: np.ndarray, alpha: float = 0.05) -> dict[str, flo
     md = float(np.mean(d)) if n else nan
     sd = float(np.std(d, ddof=1)) if n > 1 else nan
     t = p = lo = hi = nan
-    if n > 1 and sd > 0:
+    # differences at round-off level of the data (e.g. identical RMSEs recomputed from
+    # rounded sums) count as equal: relative tolerance 1e-12 of the data's magnitude
+    scale = float(max(np.max(np.abs(x)), np.max(np.abs(y)))) if n else 0.0
+    if n > 1 and sd > 1e-12 * scale:
         se = sd / np.sqrt(n)
         t = md / se                                              # t = mean(d) / (s_d/sqrt(n))
         p = float(2 * sps.t.sf(abs(t), n - 1))

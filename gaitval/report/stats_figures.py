@@ -1,0 +1,162 @@
+"""Statistics figures of seed 003 (Qi et al., Sensors 2014) and Bland–Altman plots.
+
+- :func:`figure_a1_histograms` — like Figure A1: histograms (here of the differences
+  system − reference, per parameter).
+- :func:`figure_b1_boxplots` — like Figure B1: per-subject boxplots of each parameter.
+- :func:`figure5_speed_effects` — like Figure 5: mean ± std at slow / normal / fast speed
+  for reference and system, ``*`` where a paired t-test against normal speed gives
+  p < 0.05 (from :func:`gaitval.tables.ultrasonic.table8`).
+- :func:`bland_altman_figure` — one Bland–Altman plot (bias, limits of agreement and their
+  95% CIs from :func:`gaitval.stats.agreement`).
+
+Every figure is written with :func:`gaitval.report.figures.save_figure` (deterministic
+PNG).  The figures take the tidy tables; they never recompute a statistic the tables hold.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from gaitval.report.figures import plt, save_figure
+from gaitval.stats import agreement
+from gaitval.tables.ultrasonic import (PARAM_INFO, PARAMETERS, SPEEDS, SUMMARY_PARAMETERS,
+                                       _subject_order, check_gait_params, table8)
+
+
+def _label(param: str) -> str:
+    sym, _, unit = PARAM_INFO[param]
+    return f"{param.replace('_', ' ')} {sym}" + (f" ({unit})" if unit != "-" else "")
+
+
+def _grid(n: int, width: float = 4.0, height: float = 3.0):
+    cols = min(n, 3)
+    rows = int(np.ceil(n / cols))
+    fig, axes = plt.subplots(rows, cols, figsize=(width * cols, height * rows),
+                             squeeze=False)
+    for ax in axes.ravel()[n:]:
+        ax.set_visible(False)
+    return fig, axes.ravel()
+
+
+def figure_a1_histograms(gait_params: pd.DataFrame, path: str | Path,
+                         speed: str = "normal", bins: int = 20) -> Path:
+    """Histograms of the differences system − reference per parameter (Figure A1-like)."""
+    df = check_gait_params(gait_params)
+    df = df[df["speed"] == speed]
+    params = [p for p in SUMMARY_PARAMETERS if p in set(df["parameter"])]
+    fig, axes = _grid(max(len(params), 1))
+    for ax, p in zip(axes, params):
+        sub = df[df["parameter"] == p]
+        d = (sub["system"] - sub["reference"]).to_numpy(dtype=float)
+        d = d[np.isfinite(d)]
+        ax.hist(d, bins=bins, color="0.6", edgecolor="k")
+        ax.axvline(0.0, color="k", lw=0.8)
+        ax.set_xlabel(f"difference, {_label(p)}")
+        ax.set_ylabel("strides")
+    fig.suptitle(f"Differences system - reference ({speed} speed; cf. Qi et al. 2014 Fig. A1)")
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def figure_b1_boxplots(gait_params: pd.DataFrame, path: str | Path, speed: str = "normal",
+                       column: str = "system") -> Path:
+    """Per-subject boxplots of each parameter (Figure B1-like)."""
+    df = check_gait_params(gait_params)
+    df = df[df["speed"] == speed]
+    params = [p for p in SUMMARY_PARAMETERS if p in set(df["parameter"])]
+    fig, axes = _grid(max(len(params), 1), width=5.0)
+    for ax, p in zip(axes, params):
+        sub = df[df["parameter"] == p]
+        subjects = _subject_order(sub["subject"])
+        data = [sub.loc[sub["subject"] == s, column].dropna().to_numpy(dtype=float)
+                for s in subjects]
+        ax.boxplot(data)
+        ax.set_xticks(range(1, len(subjects) + 1), subjects, rotation=90, fontsize=7)
+        ax.set_ylabel(_label(p))
+    fig.suptitle(f"{column} estimates per subject ({speed} speed; cf. Qi et al. 2014 Fig. B1)")
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def figure5_speed_effects(table8_df: pd.DataFrame, path: str | Path) -> Path:
+    """Mean ± std of Ref and Pro per speed with ``*`` for p < 0.05 vs normal (Figure 5-like).
+
+    Parameters
+    ----------
+    table8_df : DataFrame
+        Output of :func:`gaitval.tables.ultrasonic.table8`.
+    """
+    params = [p for p in PARAMETERS if p in set(table8_df["parameter"])]
+    fig, axes = _grid(max(len(params), 1), width=3.6)
+    x = np.arange(len(SPEEDS))
+    for ax, p in zip(axes, params):
+        for off, q, color in ((-0.15, "ref", "0.3"), (0.15, "pro", "0.7")):
+            row = table8_df[(table8_df["parameter"] == p) & (table8_df["quantity"] == q)]
+            if row.empty:
+                continue
+            row = row.iloc[0]
+            m = [row[f"{s}_mean"] for s in SPEEDS]
+            e = [row[f"{s}_std"] for s in SPEEDS]
+            ax.bar(x + off, m, width=0.3, yerr=e, color=color, edgecolor="k",
+                   label={"ref": "reference", "pro": "system"}[q], capsize=3)
+            for i, s in enumerate(SPEEDS):
+                if s != "normal" and bool(row.get(f"{s}_significant", False)):
+                    top = m[i] + (e[i] if np.isfinite(e[i]) else 0.0)
+                    ax.text(x[i] + off, top, "*", ha="center", va="bottom")
+        ax.set_xticks(x, SPEEDS)
+        ax.set_ylabel(_label(p))
+        ax.margins(y=0.12)
+    axes[0].legend(fontsize=7)
+    fig.suptitle("Effect of walking speed (* p < 0.05 vs normal; cf. Qi et al. 2014 Fig. 5)")
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def bland_altman_figure(df: pd.DataFrame, ref: str, pro: str, path: str | Path,
+                        title: str = "", unit: str = "") -> Path:
+    """Bland–Altman plot: difference vs mean with bias, limits of agreement and 95% CIs."""
+    a = agreement(df, ref, pro).iloc[0]
+    r = pd.to_numeric(df[ref], errors="coerce").to_numpy(dtype=float)
+    p = pd.to_numeric(df[pro], errors="coerce").to_numpy(dtype=float)
+    ok = np.isfinite(r) & np.isfinite(p)
+    mean, diff = (r[ok] + p[ok]) / 2, p[ok] - r[ok]
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.scatter(mean, diff, s=10, color="k")
+    for key, style in (("bias", "-"), ("loa_low", "--"), ("loa_high", "--")):
+        if np.isfinite(a[key]):
+            ax.axhline(a[key], color="k", ls=style, lw=1)
+    for lo, hi in (("bias_ci_low", "bias_ci_high"), ("loa_low_ci_low", "loa_low_ci_high"),
+                   ("loa_high_ci_low", "loa_high_ci_high")):
+        if np.isfinite(a[lo]) and np.isfinite(a[hi]):
+            ax.axhspan(a[lo], a[hi], color="0.85", zorder=0)
+    u = f" ({unit})" if unit and unit != "-" else ""
+    ax.set_xlabel(f"mean of reference and system{u}")
+    ax.set_ylabel(f"system - reference{u}")
+    ax.set_title(title or f"{pro} vs {ref}: bias {a['bias']:.3g}, "
+                 f"LoA [{a['loa_low']:.3g}, {a['loa_high']:.3g}]", fontsize=9)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def write_ultrasonic_figures(gait_params: pd.DataFrame, out_dir: str | Path,
+                             speed: str = "normal") -> list[Path]:
+    """Write Figure A1-, B1- and 5-like figures and one Bland–Altman plot per parameter.
+
+    Files: ``ultrasonic_figA1.png``, ``ultrasonic_figB1.png``, ``ultrasonic_fig5.png``,
+    ``ultrasonic_bland_altman_<parameter>.png`` (strides at ``speed``).
+    """
+    out_dir = Path(out_dir)
+    df = check_gait_params(gait_params)
+    paths = [figure_a1_histograms(df, out_dir / "ultrasonic_figA1.png", speed),
+             figure_b1_boxplots(df, out_dir / "ultrasonic_figB1.png", speed),
+             figure5_speed_effects(table8(df), out_dir / "ultrasonic_fig5.png")]
+    for p in PARAMETERS:
+        sub = df[(df["parameter"] == p) & (df["speed"] == speed)]
+        if sub.empty:
+            continue
+        paths.append(bland_altman_figure(
+            sub, "reference", "system", out_dir / f"ultrasonic_bland_altman_{p}.png",
+            title=f"Bland-Altman: {_label(p)}, {speed} speed", unit=PARAM_INFO[p][2]))
+    return paths
