@@ -101,10 +101,10 @@ def icc(ratings, alpha: float = 0.05) -> pd.DataFrame:
     df1, df2 = n - 1, (n - 1) * (k - 1)
     q = 1 - alpha / 2
     with np.errstate(divide="ignore", invalid="ignore"):
-        c1 = (msr - mse) / (msr + (k - 1) * mse)
-        a1 = (msr - mse) / (msr + (k - 1) * mse + k * (msc - mse) / n)
-        ck = (msr - mse) / msr
-        ak = (msr - mse) / (msr + (msc - mse) / n)
+        c1 = (msr - mse) / (msr + (k - 1) * mse)                      # ICC(C,1), S&F ICC(3,1)
+        a1 = (msr - mse) / (msr + (k - 1) * mse + k * (msc - mse) / n)  # ICC(A,1), ICC(2,1)
+        ck = (msr - mse) / msr                                        # ICC(C,k), ICC(3,k)
+        ak = (msr - mse) / (msr + (msc - mse) / n)                    # ICC(A,k), ICC(2,k)
         f0 = msr / mse
         p_f0 = float(sps.f.sf(f0, df1, df2))
         fl = f0 / sps.f.ppf(q, df1, df2)

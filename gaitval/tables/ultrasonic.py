@@ -437,5 +437,5 @@ def write_ultrasonic_tables(gait_params_df: pd.DataFrame, out_dir: str | Path) -
     for name, table in build_ultrasonic_tables(gait_params_df).items():
         caption, notes = caps[name]
         paths += write_table(table, out_dir / f"ultrasonic_{name}", caption=caption,
-                             notes=notes)
+                             notes=notes, digits=5 if name == "tableC1" else 3)
     return paths
