@@ -1,0 +1,230 @@
+"""Leg detection with the five observed leg patterns (seed 001 §2.3, seed 000 §4).
+
+Notes
+-----
+Edges, seed 000 eq. (6) (= seed 001 eq. 1): between beams i and i+1 when
+|l_i − l_{i+1}| > w_l/2, with l_i the i-th range counted from the sensor's right (beam 0 at
+``angle_min``, the ROS order).  When l_i > l_{i+1}: e_m^B = i, e_{m+1}^F = i+1; when
+l_i < l_{i+1}: e_m^F = i, e_{m+1}^B = i+1.  "No return" and background count as +∞; the
+scan is padded with +∞ on both ends, so a segment touching the field-of-view border is
+bounded like any other.
+
+Between consecutive edges lies a *segment* of beams.  Its two bounding edges give the
+patterns of seed 001 (w_e = distance between the segment's first and last points):
+
+==============================  =======================  ==================================
+edge sequence around segment    width condition          pattern
+==============================  =======================  ==================================
+{B, F, F, B} (nearer than both  0.2 w_l < w_e ≤ 1.5 w_l  SL: one leg
+neighbours)                     1.5 w_l < w_e < 3.0 w_l  LT: two legs side by side
+{F, B, F, B} or {B, F, B, F}    0.5 w_l ≤ w_e < 1.5 w_l  FS_O: leg partly hidden, observable
+(a step: behind one neighbour,  0.2 w_l < w_e < 0.5 w_l  FS_U: only a sliver is visible
+in front of the other)          1.5 w_l < w_e < 3.0 w_l  LT
+{F, B, B, F}                    —                        a gap between objects, never a leg
+==============================  =======================  ==================================
+
+Leg positions from w_l (a leg is modelled as a circle of diameter w_l, ρ = w_l/2):
+
+* SL, FS_O: the centre lies on the bearing of the segment's middle (mean of its end
+  beams' angles) at range median(l) + (√3/2)ρ — the visible arc of a circle sampled
+  uniformly across its width has its median depth (√3/2)ρ in front of the centre.
+* LT: the segment is split at its middle beam into two halves, each placed like SL.
+* FS_U: only a sliver at the leg's outer edge is visible; the outer end point is taken as
+  the circle's silhouette, so the centre is ρ from it towards the occluding neighbour
+  (perpendicular to the bearing), and behind the sliver by ρ·√(1 − u²), u = 1 − w_e/(2ρ).
+
+``use_fs_u=False`` drops FS_U (the conventional detector, seed 001 Method 1).
+
+References
+----------
+Yorozu, A.; Nishiguchi, S.; Yamada, M.; Aoyama, T.; Moriguchi, T.; Takahashi, M. Gait
+Measurement System for the Multi-Target Stepping Task Using a Laser Range Sensor.
+Sensors 2015, 15, 11151–11168. doi:10.3390/s150511151
+
+Yorozu, A.; Moriguchi, T.; Takahashi, M. Improved Leg Tracking Considering Gait Phase and
+Spline-Based Interpolation during Turning Motion in Walk Tests. Sensors 2015, 15,
+22451–22472. doi:10.3390/s150922451
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from gaitval.detect.background import BACKGROUNDS
+from gaitval.detect.base import DETECTORS, Detector, empty_observations
+from gaitval.errors import GaitvalError
+from gaitval.types import ScanSeries
+
+_SQRT3_2 = math.sqrt(3.0) / 2.0
+
+
+def edges(l: np.ndarray, leg_width_m: float) -> list[tuple[int, str]]:
+    """Edges of one scan as ``(beam index, 'B' | 'F')`` in scan order (eq. 6).
+
+    ``l`` is one scan's ranges (NaN or inf = no return).  No padding is added here.
+    """
+    r = np.where(np.isfinite(l), l, np.inf)
+    out: list[tuple[int, str]] = []
+    with np.errstate(invalid="ignore"):
+        jump = np.abs(r[:-1] - r[1:]) > leg_width_m / 2.0       # eq. (6)
+    for i in np.flatnonzero(jump):
+        if r[i] > r[i + 1]:
+            out += [(int(i), "B"), (int(i) + 1, "F")]
+        else:
+            out += [(int(i), "F"), (int(i) + 1, "B")]
+    return out
+
+
+def classify_segment(nearer_left: bool, nearer_right: bool, width: float,
+                     leg_width_m: float, use_fs_u: bool = True) -> str | None:
+    """Pattern of a segment from its bounding edges and width (seed 001 §2.3).
+
+    Parameters
+    ----------
+    nearer_left, nearer_right : bool
+        Whether the segment is nearer than its neighbour on the lower-index (right-hand)
+        side / on the higher-index side (i.e. the edge there is B on the neighbour).
+    width : float
+        w_e, the segment's width in metres.
+    """
+    w = leg_width_m
+    if nearer_left and nearer_right:                   # {B, F, F, B}
+        if 0.2 * w < width <= 1.5 * w:
+            return "SL"
+        if 1.5 * w < width < 3.0 * w:
+            return "LT"
+        return None
+    if nearer_left != nearer_right:                    # {F, B, F, B} / {B, F, B, F}
+        if 0.5 * w <= width < 1.5 * w:
+            return "FS_O"
+        if 0.2 * w < width < 0.5 * w:
+            return "FS_U" if use_fs_u else None
+        if 1.5 * w < width < 3.0 * w:
+            return "LT"
+        return None
+    return None                                        # {F, B, B, F}: a gap
+
+
+def _centre(r: np.ndarray, a: np.ndarray, rho: float) -> tuple[float, float]:
+    """SL/FS_O centre of a segment with ranges ``r`` and angles ``a``."""
+    bearing = 0.5 * (a[0] + a[-1])
+    rc = float(np.median(r)) + _SQRT3_2 * rho
+    return rc * math.cos(bearing), rc * math.sin(bearing)
+
+
+def _fs_u_centre(r, a, rho, width, occluder_high: bool) -> tuple[float, float]:
+    """FS_U virtual centre: ρ from the outer silhouette towards the occluder."""
+    i_out = 0 if occluder_high else len(r) - 1
+    bx, by = r[i_out] * math.cos(a[i_out]), r[i_out] * math.sin(a[i_out])
+    bearing = a[i_out]
+    er = (math.cos(bearing), math.sin(bearing))
+    sgn = 1.0 if occluder_high else -1.0              # higher index = counter-clockwise
+    el = (-er[1] * sgn, er[0] * sgn)
+    u = max(0.0, 1.0 - width / (2.0 * rho))
+    depth = float(np.median(r)) - r[i_out] + rho * math.sqrt(max(0.0, 1.0 - u * u))
+    return (bx + rho * el[0] + depth * er[0], by + rho * el[1] + depth * er[1])
+
+
+def detect_scan(r: np.ndarray, angles: np.ndarray, leg_width_m: float,
+                use_fs_u: bool = True) -> list[tuple[float, float, str, float, int, int]]:
+    """Leg observations of one (background-masked) scan.
+
+    Parameters
+    ----------
+    r : ndarray (n_beams,)
+        Ranges, +inf (or NaN) for no return / background.
+    angles : ndarray (n_beams,)
+        Beam angles (rad), increasing with the index.
+
+    Returns
+    -------
+    list of (x_m, y_m, pattern, width_m, i_first, i_last), right to left.
+    """
+    n = len(r)
+    rp = np.empty(n + 2)
+    rp[0] = rp[-1] = np.inf
+    rp[1:-1] = np.where(np.isfinite(r), r, np.inf)
+    with np.errstate(invalid="ignore"):
+        jump = np.flatnonzero(np.abs(rp[:-1] - rp[1:]) > leg_width_m / 2.0)   # eq. (6)
+    rho = 0.5 * leg_width_m
+    out = []
+    for s in range(len(jump) - 1):
+        i0 = int(jump[s]) + 1              # first beam of the segment (padded index)
+        i1 = int(jump[s + 1])              # last beam (padded index)
+        if not math.isfinite(rp[i0]):
+            continue
+        nearer_left = rp[i0 - 1] > rp[i0]
+        nearer_right = rp[i1 + 1] > rp[i1]
+        b0, b1 = i0 - 1, i1 - 1            # beam indices
+        seg_r = r[b0:b1 + 1]
+        seg_a = angles[b0:b1 + 1]
+        p0 = (seg_r[0] * math.cos(seg_a[0]), seg_r[0] * math.sin(seg_a[0]))
+        p1 = (seg_r[-1] * math.cos(seg_a[-1]), seg_r[-1] * math.sin(seg_a[-1]))
+        width = math.hypot(p1[0] - p0[0], p1[1] - p0[1])
+        pat = classify_segment(nearer_left, nearer_right, width, leg_width_m, use_fs_u)
+        if pat is None:
+            continue
+        if pat == "LT":
+            m = len(seg_r) // 2
+            if m < 1:
+                continue
+            for lo, hi in ((0, m), (m, len(seg_r))):
+                x, y = _centre(seg_r[lo:hi], seg_a[lo:hi], rho)
+                out.append((x, y, pat, width, b0 + lo, b0 + hi - 1))
+        elif pat == "FS_U":
+            x, y = _fs_u_centre(seg_r, seg_a, rho, width, occluder_high=nearer_left)
+            out.append((x, y, pat, width, b0, b1))
+        else:
+            x, y = _centre(seg_r, seg_a, rho)
+            out.append((x, y, pat, width, b0, b1))
+    return out
+
+
+@DETECTORS.register("leg_patterns")
+class LegPatternDetector(Detector):
+    """Five-pattern leg detector (seed 001 §2.3) after static background removal.
+
+    Parameters
+    ----------
+    background : str or dict
+        A :data:`gaitval.detect.background.BACKGROUNDS` spec (default: per-beam 95th
+        percentile with a 0.10 m margin).
+    use_fs_u : bool
+        Report FS_U observations (True for seed 000's and seed 001's proposed detector).
+    max_range_m : float or None
+        Ignore returns farther than this (None: no limit).
+    """
+
+    def __init__(self, background: str | dict = "percentile", use_fs_u: bool = True,
+                 max_range_m: float | None = None):
+        self.background = background
+        self.use_fs_u = use_fs_u
+        self.max_range_m = max_range_m
+
+    def detect(self, scans: ScanSeries, leg_width_m: float) -> pd.DataFrame:
+        if not (isinstance(leg_width_m, (int, float)) and 0.01 < leg_width_m < 0.5):
+            raise GaitvalError(f"leg width {leg_width_m!r} m is not a plausible shank width",
+                               path=scans.source or None,
+                               hint="set leg_width_m in subjects.csv (about 0.1 m)")
+        ranges = np.asarray(scans.ranges, dtype=float)
+        if self.max_range_m is not None:
+            ranges = np.where(ranges <= self.max_range_m, ranges, np.nan)
+        masked = BACKGROUNDS.build(self.background).mask(ranges)
+        angles = scans.angles
+        rows_k, rows_j, xs, ys, pats, ws, i0s, i1s = [], [], [], [], [], [], [], []
+        for k in range(scans.n_scans):
+            for j, (x, y, p, w, i0, i1) in enumerate(
+                    detect_scan(masked[k], angles, leg_width_m, self.use_fs_u)):
+                rows_k.append(k); rows_j.append(j); xs.append(x); ys.append(y)
+                pats.append(p); ws.append(w); i0s.append(i0); i1s.append(i1)
+        if not rows_k:
+            return empty_observations()
+        k = np.asarray(rows_k, dtype=np.int64)
+        return pd.DataFrame({
+            "k": k, "t_sensor_s": np.asarray(scans.t, dtype=float)[k],
+            "j": np.asarray(rows_j, dtype=np.int64), "x_m": np.asarray(xs),
+            "y_m": np.asarray(ys), "pattern": pd.Series(pats, dtype=object),
+            "width_m": np.asarray(ws), "i_first": np.asarray(i0s, dtype=np.int64),
+            "i_last": np.asarray(i1s, dtype=np.int64)})

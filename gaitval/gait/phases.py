@@ -1,0 +1,125 @@
+"""Gait phase identification from both legs' estimated states (seed 000 §3, §3.2, §5.2).
+
+Six phases (seed 000 §3, Figure 6):
+
+====  ============================================================
+0     both legs in stance
+1     left leg swinging and accelerating, right leg in stance
+2     left leg swinging and decelerating, right leg in stance
+3     left leg in stance, right leg swinging and accelerating
+4     left leg in stance, right leg swinging and decelerating
+5     both legs swinging (unlikely in walking)
+====  ============================================================
+
+Notes
+-----
+Stance condition of the right leg, eq. (3): ‖v^R‖ < ‖v^L‖ ∨ ‖v^R‖ < v_st_th.
+Swing condition, eq. (4): ‖v^R‖ > ‖v^L‖ ∨ ‖v^R‖ > v_sw_th.  (The left leg likewise.)
+
+The two conditions overlap (a leg slower than the other but above v_sw_th satisfies
+both) and can both fail (equal speeds between the thresholds).  gaitval resolves them as
+follows, which keeps every case of the paper's text:
+
+* ‖v‖ < v_st_th → stance and ‖v‖ > v_sw_th → swing (the absolute thresholds win: both
+  legs slow is Phase 0, both fast is Phase 5);
+* between the thresholds the relative test decides: the strictly faster leg swings, the
+  other is in stance (equal speeds: stance).
+
+Acceleration vs deceleration, eq. (5): with the left leg swinging and the right in stance,
+(p^R − p^L)·v^L > 0 (the swing leg is still behind the stance leg: accelerating) is
+Phase 1, otherwise Phase 2 (it has passed the stance leg: decelerating); mirrored for the right leg (Phases 3/4).
+
+Unlikely transitions (§5.2): 0→5; 1→0,3,4,5; 2→1,4,5; 3→0,1,2,5; 4→2,3,5.  Nothing is
+listed for Phase 5, so every transition out of 5 is allowed.
+
+References
+----------
+Yorozu, A.; Moriguchi, T.; Takahashi, M. Improved Leg Tracking Considering Gait Phase and
+Spline-Based Interpolation during Turning Motion in Walk Tests. Sensors 2015, 15,
+22451–22472. doi:10.3390/s150922451
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+#: seed 000 §5.2: phase at k-1 → phases at k that are unlikely in human walking.
+UNLIKELY_TRANSITIONS: dict[int, frozenset[int]] = {
+    0: frozenset({5}),
+    1: frozenset({0, 3, 4, 5}),
+    2: frozenset({1, 4, 5}),
+    3: frozenset({0, 1, 2, 5}),
+    4: frozenset({2, 3, 5}),
+    5: frozenset(),
+}
+
+#: legs swinging in each phase: (left swings, right swings)
+SWINGING = {0: (False, False), 1: (True, False), 2: (True, False),
+            3: (False, True), 4: (False, True), 5: (True, True)}
+
+
+def is_unlikely(prev_phase: int, phase: int) -> bool:
+    """True when ``prev_phase → phase`` is in the list of seed 000 §5.2."""
+    return phase in UNLIKELY_TRANSITIONS.get(prev_phase, frozenset())
+
+
+def leg_swings(speed: float, other_speed: float, v_st_th: float, v_sw_th: float) -> bool:
+    """Swing (True) or stance (False) of one leg, eq. (3)–(4) (resolution in module notes)."""
+    if speed < v_st_th:
+        return False
+    if speed > v_sw_th:
+        return True
+    return speed > other_speed
+
+
+def gait_phase(pl: tuple[float, float], vl: tuple[float, float],
+               pr: tuple[float, float], vr: tuple[float, float],
+               v_st_th: float, v_sw_th: float) -> int:
+    """Gait phase 0–5 from both legs' positions and velocities (seed 000 §3.2).
+
+    Parameters
+    ----------
+    pl, vl, pr, vr : (x, y) tuples
+        Left/right position (m) and velocity (m/s).
+    v_st_th, v_sw_th : float
+        Stance and swing speed thresholds (m/s); seed 000 Table 2: 0.47, 0.93.
+
+    Returns
+    -------
+    int
+        The phase (see the module table).
+    """
+    sl = math.hypot(vl[0], vl[1])
+    sr = math.hypot(vr[0], vr[1])
+    lsw = leg_swings(sl, sr, v_st_th, v_sw_th)
+    rsw = leg_swings(sr, sl, v_st_th, v_sw_th)
+    if lsw and rsw:
+        return 5
+    if not lsw and not rsw:
+        return 0
+    if lsw:
+        # eq. (5): (p^R - p^L) · v^L
+        ip = (pr[0] - pl[0]) * vl[0] + (pr[1] - pl[1]) * vl[1]
+        return 1 if ip > 0.0 else 2
+    ip = (pl[0] - pr[0]) * vr[0] + (pl[1] - pr[1]) * vr[1]
+    return 3 if ip > 0.0 else 4
+
+
+def gait_phases(pl: np.ndarray, vl: np.ndarray, pr: np.ndarray, vr: np.ndarray,
+                v_st_th: float, v_sw_th: float) -> np.ndarray:
+    """Vectorised :func:`gait_phase` over (n, 2) arrays; returns int8 phases (n,)."""
+    sl = np.hypot(vl[:, 0], vl[:, 1])
+    sr = np.hypot(vr[:, 0], vr[:, 1])
+
+    def swings(s, o):
+        return np.where(s < v_st_th, False, np.where(s > v_sw_th, True, s > o))
+
+    lsw, rsw = swings(sl, sr), swings(sr, sl)
+    ipl = np.einsum("ij,ij->i", pr - pl, vl)
+    ipr = np.einsum("ij,ij->i", pl - pr, vr)
+    out = np.zeros(len(sl), dtype=np.int8)
+    out[lsw & ~rsw] = np.where(ipl[lsw & ~rsw] > 0, 1, 2)
+    out[~lsw & rsw] = np.where(ipr[~lsw & rsw] > 0, 3, 4)
+    out[lsw & rsw] = 5
+    return out

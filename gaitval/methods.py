@@ -1,0 +1,162 @@
+"""The named tracking methods of the seed papers, as configuration.
+
+A method is a dict naming one part per role (each a registry spec: a name or
+``{"name": ..., **params}``) plus tracker parameters.  Adding a method is adding an entry
+here or in the workflow config; adding a part is one class plus one registry line.
+
+Seed 000 (TUG), Table 3 definitions, Table 2 parameters as defaults:
+
+=========  =======================  ====================  ===========================
+method     data association         occlusion             everything else
+=========  =======================  ====================  ===========================
+tug_m1     GNN                      predict only          five-pattern detector, KF
+tug_m2     gait phase (§5.2)        predict only          with the gait-phase input
+tug_m3     gait phase (§5.2)        Catmull–Rom (eq. 17)  (eq. 18–20), χ² gate G=13.82
+=========  =======================  ====================  ===========================
+
+Table 2: Δt = 25 ms (here inferred from the scan timestamps unless ``dt_s`` is set),
+Q = diag(15.0², 15.0²), R = diag(0.04², 0.04²), v_st_th = 0.47 m/s, v_sw_th = 0.93 m/s,
+G = 13.82 (P_G = 0.999), N_ac = 40.  N_bo, N_ao: not given; "match" (see
+:mod:`gaitval.track.occlusion`).
+
+Nested parameters can be overridden by path, gaitmap style::
+
+    build_tracker("tug_m3", {"occlusion__n_bo": 5, "gate__g": 9.21})
+
+References
+----------
+Yorozu, A.; Moriguchi, T.; Takahashi, M. Improved Leg Tracking Considering Gait Phase and
+Spline-Based Interpolation during Turning Motion in Walk Tests. Sensors 2015, 15,
+22451–22472. doi:10.3390/s150922451
+"""
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+import pandas as pd
+
+from gaitval.detect import DETECTORS, split_observations
+from gaitval.errors import ConfigError
+from gaitval.track.tracker import Tracker
+from gaitval.types import ScanSeries
+
+ROLES = ("detector", "filter", "motion", "gate", "associator", "occlusion")
+
+_TUG_COMMON: dict[str, Any] = {
+    "paper": "seed 000 (Yorozu et al., Sensors 2015, 15, 22451)",
+    "detector": {"name": "leg_patterns", "use_fs_u": True,
+                 "background": {"name": "percentile", "q": 95.0, "margin_m": 0.10}},
+    "filter": {"name": "kf", "q_accel_sd_mps2": 15.0, "r_sd_m": 0.04,
+               "p0_pos_sd_m": 0.04, "p0_vel_sd_mps": 0.5},
+    "motion": {"name": "gait_phase_accel", "n_ac": 40, "limit_braking": True},
+    "gate": {"name": "chi2", "g": 13.82},
+    "tracker": {"v_st_th": 0.47, "v_sw_th": 0.93, "dt_s": None, "init_max_pair_m": 0.8,
+                "sides": "walking_direction"},
+}
+
+
+def _method(label: str, associator: str, occlusion: dict | str) -> dict[str, Any]:
+    m = copy.deepcopy(_TUG_COMMON)
+    m["label"] = label
+    m["associator"] = {"name": associator, "d_max": 13.82 ** 0.5}
+    m["occlusion"] = occlusion
+    return m
+
+
+#: name → method definition (deep-copied by :func:`get_method`)
+METHODS: dict[str, dict[str, Any]] = {
+    "tug_m1": _method("Method 1 (GNN)", "gnn", {"name": "predict_only"}),
+    "tug_m2": _method("Method 2 (gait-phase association)", "gait_phase",
+                      {"name": "predict_only"}),
+    "tug_m3": _method("Method 3 (gait phase + Catmull-Rom, proposal)", "gait_phase",
+                      {"name": "catmull_rom", "n_bo": "match", "n_ao": "match",
+                       "max_n": 20, "min_n_uo": 1}),
+}
+
+#: seed 000 Table 3 definitions, for tables
+METHOD_DEFINITIONS = {
+    "tug_m1": {"gait_phase_association": False, "catmull_rom_interpolation": False},
+    "tug_m2": {"gait_phase_association": True, "catmull_rom_interpolation": False},
+    "tug_m3": {"gait_phase_association": True, "catmull_rom_interpolation": True},
+}
+
+
+def set_params(method: dict[str, Any], overrides: dict[str, Any] | None) -> dict[str, Any]:
+    """Copy of ``method`` with ``role__param`` (or ``tracker__param``) overrides applied."""
+    m = copy.deepcopy(method)
+    for key, val in (overrides or {}).items():
+        role, sep, param = key.partition("__")
+        if not sep or role not in m:
+            raise ConfigError(f"cannot set {key!r}: use <role>__<param> with role one of "
+                              f"{', '.join(k for k in m if isinstance(m[k], dict))}")
+        if isinstance(m[role], str):
+            m[role] = {"name": m[role]}
+        m[role][param] = val
+    return m
+
+
+def get_method(method: str | dict[str, Any]) -> dict[str, Any]:
+    """The method definition for a name in :data:`METHODS` or a full dict."""
+    if isinstance(method, str):
+        try:
+            return copy.deepcopy(METHODS[method])
+        except KeyError:
+            raise ConfigError(f"unknown tracking method {method!r}",
+                              hint=f"choose one of: {', '.join(sorted(METHODS))}") from None
+    missing = [r for r in ROLES if r not in method]
+    if missing:
+        raise ConfigError(f"tracking method is missing the role(s) {', '.join(missing)}",
+                          hint=f"a method names one part for each of: {', '.join(ROLES)}")
+    return copy.deepcopy(method)
+
+
+def build_tracker(method: str | dict[str, Any], overrides: dict[str, Any] | None = None
+                  ) -> tuple[Any, Tracker]:
+    """Build ``(detector, tracker)`` from a method name or definition.
+
+    Parameters
+    ----------
+    method : str or dict
+        A key of :data:`METHODS` or a dict with one spec per role in :data:`ROLES` and an
+        optional ``tracker`` dict of :class:`~gaitval.track.tracker.Tracker` parameters.
+    overrides : dict, optional
+        ``{"role__param": value}`` applied on top.
+    """
+    m = set_params(get_method(method), overrides)
+    detector = DETECTORS.build(m["detector"])
+    tracker = Tracker(filter=m["filter"], motion=m["motion"], gate=m["gate"],
+                      associator=m["associator"], occlusion=m["occlusion"],
+                      **m.get("tracker", {}))
+    return detector, tracker
+
+
+def track_trial(scans: ScanSeries, method: str | dict[str, Any], leg_width_m: float,
+                cfg: dict[str, Any] | None = None) -> pd.DataFrame:
+    """Detect and track both legs of one trial.
+
+    Parameters
+    ----------
+    scans : ScanSeries
+        The trial's LRS scans (sensor clock).
+    method : str or dict
+        Method name (``tug_m1``, ``tug_m2``, ``tug_m3``) or definition.
+    leg_width_m : float
+        The subject's shank width at sensor height, w_l (subjects.csv ``leg_width_m``).
+    cfg : dict, optional
+        ``{"overrides": {"role__param": value}}`` (e.g. from the workflow config).
+
+    Returns
+    -------
+    DataFrame
+        One row per scan and side, in the sensor frame: ``k, t_sensor_s, side (L|R), x_m,
+        y_m, vx_mps, vy_mps, observed (bool: a real observation was associated), pattern
+        (SL, LT, FS_O, FS_U, or UO), phase (0–5, −1 before initialisation), swing (bool),
+        interpolated (bool: a Catmull–Rom virtual observation was used)``.  Positions are
+        NaN before the track is initialised.
+    """
+    cfg = cfg or {}
+    detector, tracker = build_tracker(method, cfg.get("overrides"))
+    obs = detector.detect(scans, leg_width_m)
+    xy, pats = split_observations(obs, scans.n_scans)
+    return tracker.run(scans.t, xy, pats, leg_width_m).to_frame()

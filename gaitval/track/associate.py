@@ -1,0 +1,93 @@
+"""Data associators: which observation (if any) each leg takes at a scan.
+
+Role ``associator``: ``select(cand_l, cand_r, prev_phase, phase_of) -> (a, b)``.
+
+``cand_l`` / ``cand_r`` list the gated observations of each leg as ``(j, λ)`` with
+j = 1..J (1-based, as in the paper) and λ the Mahalanobis distance of eq. (11);
+``phase_of(a, b)`` returns the gait phase the legs would be in after correcting the left
+leg with observation a and the right with b (0 = no observation, a false alarm).
+The result (a, b) uses the same numbering; a = b only when both are 0.
+
+Notes
+-----
+Cost of an association, eq. (9)–(10): c_{a,b} = d_{L,a} + d_{R,b} with d_{f,j} = λ_{f,j}
+inside the gate and d_max outside it or for j = 0.  Only gated observations are offered,
+so "outside the gate" never needs to be enumerated.  d_max defaults to √G = √13.82 (the
+gate's edge in λ units), so taking any gated observation costs less than leaving it.
+
+GNN (Method 1) picks the least-cost association.  The gait-phase association (Methods 2,
+3, seed 000 §5.2) picks the least-cost association whose phase change from k−1 is not
+in the list of unlikely transitions; when every association is unlikely it falls back to
+the least-cost one (the paper does not say; this keeps tracking rather than dropping both
+legs).  Ties are broken by enumeration order (a, then b, ascending), so results are
+deterministic.
+
+References
+----------
+Yorozu, A.; Moriguchi, T.; Takahashi, M. Sensors 2015, 15, 22451–22472 (seed 000), §5.2.
+Konstantinova, P.; Udvarev, A.; Semerdjiev, T. A Study of a Target Tracking Algorithm Using
+Global Nearest Neighbor Approach. CompSysTech 2003.
+"""
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+from gaitval.gait.phases import UNLIKELY_TRANSITIONS
+from gaitval.track.registry import Registry
+
+ASSOCIATORS = Registry("associator")
+
+D_MAX_DEFAULT = math.sqrt(13.82)
+
+
+class Associator:
+    """Role base."""
+
+    def select(self, cand_l: list[tuple[int, float]], cand_r: list[tuple[int, float]],
+               prev_phase: int, phase_of: Callable[[int, int], int]) -> tuple[int, int]:
+        raise NotImplementedError
+
+
+def ranked_associations(cand_l, cand_r, d_max: float) -> list[tuple[float, int, int]]:
+    """All joint associations as ``(c_{a,b}, a, b)``, cheapest first (eq. 9–10)."""
+    opts_l = [(0, d_max)] + list(cand_l)
+    opts_r = [(0, d_max)] + list(cand_r)
+    out = []
+    for a, da in opts_l:
+        for b, db in opts_r:
+            if a != 0 and a == b:
+                continue
+            out.append((da + db, a, b))                 # eq. (9)
+    out.sort(key=lambda c: c[0])                        # stable: ties keep (a, b) order
+    return out
+
+
+@ASSOCIATORS.register("gnn")
+class GNNAssociator(Associator):
+    """Global nearest neighbour: least total cost (seed 000 Method 1)."""
+
+    def __init__(self, d_max: float = D_MAX_DEFAULT):
+        self.d_max = d_max
+
+    def select(self, cand_l, cand_r, prev_phase, phase_of):
+        if not cand_l and not cand_r:
+            return 0, 0
+        _, a, b = ranked_associations(cand_l, cand_r, self.d_max)[0]
+        return a, b
+
+
+@ASSOCIATORS.register("gait_phase")
+class GaitPhaseAssociator(Associator):
+    """Least-cost association with a likely gait-phase change (seed 000 §5.2)."""
+
+    def __init__(self, d_max: float = D_MAX_DEFAULT):
+        self.d_max = d_max
+
+    def select(self, cand_l, cand_r, prev_phase, phase_of):
+        ranked = ranked_associations(cand_l, cand_r, self.d_max)
+        unlikely = UNLIKELY_TRANSITIONS.get(prev_phase, frozenset())
+        for _, a, b in ranked:
+            if phase_of(a, b) not in unlikely:
+                return a, b
+        return ranked[0][1], ranked[0][2]

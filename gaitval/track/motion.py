@@ -1,0 +1,96 @@
+"""Motion models: the acceleration input u of eq. (1) (seed 000 §3, §5.5).
+
+Role ``motion``: ``inputs(phase, vl, vr, gl, gr, dt) -> ((ulx, uly), (urx, ury))`` and the
+acceleration-gain window ``n_ac``.
+
+Notes
+-----
+Eq. (18): Phase 0 → u^L = u^R = 0.
+Eq. (19): Phase 1 → u^L = g^L v^L/‖v^L‖, u^R = 0.
+Eq. (20): Phase 2 → u^L = −g^L v^L/‖v^L‖, u^R = 0.
+Phases 3 and 4 mirror 1 and 2 for the right leg.  Phase 5 (both legs swinging) has no
+input in the paper; gaitval uses u = 0 there.
+
+Braking limit (gaitval's addition, ``limit_braking=True``): in the decelerating phases the
+input may stop the leg within one step but not reverse it, ‖u‖ ≤ ‖v‖/Δt.  Without it,
+g·Δt (≈ 1 m/s per 25 ms step for a swing acceleration of 40 m/s²) overshoots the stance
+band ‖v‖ < v_st_th at the end of every swing; the reversed velocity then points back
+towards the stance leg, eq. (5) calls that "accelerating" (Phase 1/3), and eq. (19)
+accelerates the leg backwards while it stands still — a runaway seen on simulated TUGs.
+``limit_braking=False`` gives the paper's equations unchanged.
+
+g_k^f, the acceleration function: "the average of the norm of the acceleration vector in
+the swing phase of the previous N_ac steps".  The printed definition a = (ẋ/Δt, ẏ/Δt)
+would be a velocity divided by Δt; gaitval reads it as the finite-difference acceleration
+a_k = (v_k − v_{k−1})/Δt of the filtered velocity, averaged over those of the previous N_ac
+steps in which leg f was in swing (0 when there were none).
+
+References
+----------
+Yorozu, A.; Moriguchi, T.; Takahashi, M. Improved Leg Tracking Considering Gait Phase and
+Spline-Based Interpolation during Turning Motion in Walk Tests. Sensors 2015, 15,
+22451–22472. doi:10.3390/s150922451
+"""
+from __future__ import annotations
+
+import math
+
+from gaitval.track.registry import Registry
+
+MOTION_MODELS = Registry("motion model")
+
+_ZERO = (0.0, 0.0)
+
+
+def _along(v: tuple[float, float], g: float, brake_dt: float = 0.0) -> tuple[float, float]:
+    """g · v/‖v‖; with ``brake_dt`` > 0 a braking input (g < 0) is limited to ‖v‖/Δt."""
+    n = math.hypot(v[0], v[1])
+    if n <= 1e-9 or g == 0.0:
+        return _ZERO
+    if brake_dt > 0.0 and g < 0.0:
+        g = max(g, -n / brake_dt)
+    return (g * v[0] / n, g * v[1] / n)
+
+
+class MotionModel:
+    """Role base.  ``n_ac`` = 0 means the model needs no acceleration gain."""
+
+    n_ac = 0
+
+    def inputs(self, phase: int, vl, vr, gl: float, gr: float, dt: float):
+        raise NotImplementedError
+
+
+@MOTION_MODELS.register("gait_phase_accel")
+class GaitPhaseAcceleration(MotionModel):
+    """Acceleration input per gait phase, eq. (18)–(20).
+
+    Parameters
+    ----------
+    n_ac : int
+        N_ac, steps averaged for the acceleration function g (seed 000 Table 2: 40).
+    """
+
+    def __init__(self, n_ac: int = 40, limit_braking: bool = True):
+        self.n_ac = int(n_ac)
+        self.limit_braking = limit_braking
+
+    def inputs(self, phase, vl, vr, gl, gr, dt):
+        bdt = dt if self.limit_braking else 0.0
+        if phase == 1:
+            return _along(vl, gl), _ZERO          # eq. (19)
+        if phase == 2:
+            return _along(vl, -gl, bdt), _ZERO    # eq. (20)
+        if phase == 3:
+            return _ZERO, _along(vr, gr)
+        if phase == 4:
+            return _ZERO, _along(vr, -gr, bdt)
+        return _ZERO, _ZERO                       # eq. (18); Phase 5: none
+
+
+@MOTION_MODELS.register("constant_velocity")
+class ConstantVelocity(MotionModel):
+    """u = 0: the constant-velocity model of seed 001 eq. (2)."""
+
+    def inputs(self, phase, vl, vr, gl, gr, dt):
+        return _ZERO, _ZERO

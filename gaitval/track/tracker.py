@@ -1,0 +1,379 @@
+"""The leg tracker: wires one part per role and runs seed 000's loop.
+
+Per scan k (seed 000 §5): **predict** both legs (eq. 7–8, input u from the gait phase at
+k−1, eq. 18–20); **gate** every observation (eq. 11–13); **associate** (eq. 9–10, GNN or the
+gait-phase rule of §5.2); **correct** (eq. 14–16; a leg without an observation keeps its
+prediction and gets the UO pattern); identify the **gait phase** (eq. 3–5); **handle
+occlusion** (nothing, or Catmull–Rom virtual observations and re-filtering, eq. 17).
+
+Track initialisation (TUG: both legs at the chair at the start).  The tracker starts at
+the first scan with two observations closer than ``init_max_pair_m`` to each other (the
+closest such pair), both legs at rest (v = 0, Phase 0).  Scans before that have no track
+(NaN).  Which of the two is the *left* leg is decided after the run from the walking
+direction (``sides="walking_direction"``): the left leg is on the left of the mean motion
+of the legs' midpoint, Σ_k (v_mid × (p_L − p_R)) > 0 over the steps where the midpoint moves
+faster than 0.3 m/s; this holds on the way out and on the way back.  If the sum is
+negative the two tracks' labels are exchanged (and Phases 1↔3, 2↔4) — exact, because the
+tracker treats both legs symmetrically.  ``sides="as_initialised"`` keeps the initial
+guess (the observation with the larger bearing angle is the left leg).
+
+Time step.  Δt is the sensor's scan period: ``dt_s`` if configured, else the median
+timestamp difference; a gap of n periods in the timestamps (dropped scans) is predicted
+as one step of n·Δt, so timestamp jitter does not enter the model.
+
+References
+----------
+Yorozu, A.; Moriguchi, T.; Takahashi, M. Improved Leg Tracking Considering Gait Phase and
+Spline-Based Interpolation during Turning Motion in Walk Tests. Sensors 2015, 15,
+22451–22472. doi:10.3390/s150922451
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from gaitval.errors import GaitvalError
+from gaitval.gait.phases import SWINGING, gait_phase
+from gaitval.track.associate import ASSOCIATORS
+from gaitval.track.gate import GATES
+from gaitval.track.kalman import FILTERS
+from gaitval.track.motion import MOTION_MODELS
+from gaitval.track.occlusion import OCCLUSION_HANDLERS
+
+TRACK_COLUMNS = ("k", "t_sensor_s", "side", "x_m", "y_m", "vx_mps", "vy_mps", "observed",
+                 "pattern", "phase", "swing", "interpolated")
+
+_MIRROR_PHASE = np.array([0, 3, 4, 1, 2, 5], dtype=np.int8)
+
+
+@dataclass
+class TrackResult:
+    """Arrays of one run; index [0] = left, [1] = right leg, shape (2, n_scans).
+
+    ``phase`` is -1 before initialisation; ``pattern`` is ``""`` there, else the pattern
+    of the associated observation or ``"UO"``.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    vx: np.ndarray
+    vy: np.ndarray
+    observed: np.ndarray
+    interpolated: np.ndarray
+    pattern: np.ndarray
+    phase: np.ndarray
+    k_init: int
+    swapped_sides: bool = False
+
+    @property
+    def swing(self) -> np.ndarray:
+        ph = np.clip(self.phase, 0, 5)
+        sw = np.array([SWINGING[i] for i in range(6)])        # (6, 2)
+        out = sw[ph].T.copy()
+        out[:, self.phase < 0] = False
+        return out
+
+    def to_frame(self) -> pd.DataFrame:
+        """Tidy table, one row per scan and side (columns :data:`TRACK_COLUMNS`)."""
+        n = len(self.t)
+        sw = self.swing
+        return pd.DataFrame({
+            "k": np.repeat(np.arange(n, dtype=np.int64), 2),
+            "t_sensor_s": np.repeat(np.asarray(self.t, dtype=float), 2),
+            "side": pd.Series(np.tile(np.array(["L", "R"], dtype=object), n), dtype=object),
+            "x_m": self.x.T.ravel(), "y_m": self.y.T.ravel(),
+            "vx_mps": self.vx.T.ravel(), "vy_mps": self.vy.T.ravel(),
+            "observed": self.observed.T.ravel(),
+            "pattern": pd.Series(self.pattern.T.ravel(), dtype=object),
+            "phase": np.repeat(self.phase.astype(np.int64), 2),
+            "swing": sw.T.ravel(),
+            "interpolated": self.interpolated.T.ravel(),
+        })
+
+
+def step_durations(t: np.ndarray, dt_s: float | None) -> tuple[float, np.ndarray]:
+    """Nominal Δt and per-step durations (whole multiples of Δt; see module notes)."""
+    t = np.asarray(t, dtype=float)
+    d = np.diff(t)
+    if dt_s is None:
+        pos = d[d > 0]
+        if len(pos) == 0:
+            raise GaitvalError("scan timestamps do not increase; cannot infer the scan period",
+                               hint="set dt_s in the tracker configuration")
+        dt_s = float(np.median(pos))
+    mult = np.maximum(1, np.rint(d / dt_s))
+    return float(dt_s), np.concatenate([[dt_s], mult * dt_s])
+
+
+class Tracker:
+    """Two-leg tracker composed of one part per role.
+
+    Parameters
+    ----------
+    filter, motion, gate, associator, occlusion : str, dict or part
+        Registry specs (see :mod:`gaitval.methods`) or ready objects.
+    v_st_th, v_sw_th : float
+        Stance/swing speed thresholds of eq. (3)–(4) (seed 000 Table 2: 0.47, 0.93 m/s).
+    dt_s : float or None
+        Scan period; None infers it from the timestamps.
+    init_max_pair_m : float
+        Largest distance between the two legs accepted for initialisation.
+    sides : {"walking_direction", "as_initialised"}
+        How the left/right labels are decided (module notes).
+    """
+
+    def __init__(self, filter="kf", motion="gait_phase_accel", gate="chi2",
+                 associator="gnn", occlusion="predict_only", v_st_th: float = 0.47,
+                 v_sw_th: float = 0.93, dt_s: float | None = None,
+                 init_max_pair_m: float = 0.8, sides: str = "walking_direction"):
+        self.filter = FILTERS.build(filter)
+        self.motion = MOTION_MODELS.build(motion)
+        self.gate = GATES.build(gate)
+        self.associator = ASSOCIATORS.build(associator)
+        self.occlusion = OCCLUSION_HANDLERS.build(occlusion)
+        self.v_st_th = v_st_th
+        self.v_sw_th = v_sw_th
+        self.dt_s = dt_s
+        self.init_max_pair_m = init_max_pair_m
+        self.sides = sides
+
+    # -- initialisation -----------------------------------------------------------------
+    def _initial_pair(self, xy: list[np.ndarray]):
+        for k, obs in enumerate(xy):
+            if len(obs) < 2:
+                continue
+            best = None
+            for i in range(len(obs)):
+                for j in range(i + 1, len(obs)):
+                    d = math.hypot(*(obs[i] - obs[j]))
+                    if d <= self.init_max_pair_m and (best is None or d < best[0]):
+                        best = (d, i, j)
+            if best is not None:
+                _, i, j = best
+                ai = math.atan2(obs[i][1], obs[i][0])
+                aj = math.atan2(obs[j][1], obs[j][0])
+                return (k, i, j) if ai >= aj else (k, j, i)   # left = larger bearing
+        return None
+
+    # -- the run ------------------------------------------------------------------------
+    def run(self, t: np.ndarray, xy: list[np.ndarray], patterns: list[list[str]],
+            leg_width_m: float) -> TrackResult:
+        """Track both legs through a series of per-scan observations.
+
+        Parameters
+        ----------
+        t : ndarray (n_scans,)
+            Scan times (sensor clock, s).
+        xy : list of ndarray (J_k, 2)
+            Observed leg positions per scan (sensor frame, m).
+        patterns : list of list of str
+            Their patterns (SL, LT, FS_O, FS_U).
+        leg_width_m : float
+            w_l, passed to the gate's context.
+
+        Returns
+        -------
+        TrackResult
+        """
+        n = len(t)
+        _, dts = step_durations(t, self.dt_s) if n > 1 else (self.dt_s or 0.025,
+                                                             np.array([self.dt_s or 0.025]))
+        F = self.filter
+        nan = np.full((2, n), np.nan)
+        res = TrackResult(t=np.asarray(t, dtype=float), x=nan.copy(), y=nan.copy(),
+                          vx=nan.copy(), vy=nan.copy(),
+                          observed=np.zeros((2, n), bool), interpolated=np.zeros((2, n), bool),
+                          pattern=np.full((2, n), "", dtype=object),
+                          phase=np.full(n, -1, dtype=np.int8), k_init=-1)
+        init = self._initial_pair(xy)
+        if init is None:
+            return res
+        k0, il, ir = init
+        res.k_init = k0
+        post: list[list] = [[None] * n, [None] * n]
+        z: list[list] = [[None] * n, [None] * n]         # observation used (real or virtual)
+        real = [[False] * n, [False] * n]
+        acc = [[0.0] * n, [0.0] * n]
+        phase = [0] * n
+        pats = [[""] * n, [""] * n]
+        obs0 = xy[k0]
+        for f, i in ((0, il), (1, ir)):
+            post[f][k0] = F.init(float(obs0[i][0]), float(obs0[i][1]))
+            z[f][k0] = (float(obs0[i][0]), float(obs0[i][1]))
+            real[f][k0] = True
+            pats[f][k0] = patterns[k0][i]
+        last_real = [k0, k0]
+        n_unobs = [0, 0]
+        n_ac = self.motion.n_ac
+        gsum = [0.0, 0.0]
+        gcnt = [0, 0]
+        pending: list[tuple[int, int, int, int]] = []
+        v_st, v_sw = self.v_st_th, self.v_sw_th
+        gate, assoc, occ, motion = self.gate, self.associator, self.occlusion, self.motion
+
+        def phase_from(sl, sr):
+            return gait_phase(F.pos(sl), F.vel(sl), F.pos(sr), F.vel(sr), v_st, v_sw)
+
+        def book_accel(f, k, dt):
+            """a_k = ‖v_k − v_{k−1}‖/Δt and the running swing-phase average g (§5.5)."""
+            v1 = F.vel(post[f][k])
+            v0 = F.vel(post[f][k - 1])
+            acc[f][k] = math.hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
+            if n_ac:
+                if SWINGING[phase[k]][f]:
+                    gsum[f] += acc[f][k]
+                    gcnt[f] += 1
+                old = k - n_ac
+                if old > k0 and SWINGING[phase[old]][f]:
+                    gsum[f] -= acc[f][old]
+                    gcnt[f] -= 1
+
+        def gain(f):
+            return gsum[f] / gcnt[f] if gcnt[f] > 0 else 0.0
+
+        def resync_gain(k):
+            for f in (0, 1):
+                lo = max(k0 + 1, k - n_ac + 1)
+                sel = [acc[f][i] for i in range(lo, k + 1) if SWINGING[phase[i]][f]]
+                gsum[f], gcnt[f] = float(sum(sel)), len(sel)
+
+        def refilter(f, ka, m, k_now):
+            """Catmull–Rom virtual observations for leg f, then re-filter (eq. 17, §5.4)."""
+            n_uo = m - ka - 1
+            nbo, nao = occ.n_before(n_uo), occ.n_after(n_uo)
+            p1, p2 = z[f][ka], z[f][m]
+            i0 = ka - nbo
+            p0 = None
+            for i in range(max(i0, k0), k0 - 1, -1):
+                if real[f][i]:
+                    p0 = z[f][i]
+                    break
+            if p0 is None:
+                p0 = F.pos(post[f][max(i0, k0)])
+            p3 = p2
+            for i in range(min(m + nao, k_now), m - 1, -1):
+                if real[f][i]:
+                    p3 = z[f][i]
+                    break
+            virt = occ.virtual_observations(p0, p1, p2, p3, n_uo)
+            for i in range(n_uo):
+                z[f][ka + 1 + i] = (float(virt[i, 0]), float(virt[i, 1]))
+                res.interpolated[f, ka + 1 + i] = True
+            # re-run both legs from ka with the stored associations (§5.4: "all state
+            # parameters are updated")
+            resync_gain(ka)
+            for k in range(ka + 1, k_now + 1):
+                dt = dts[k]
+                ul, ur = motion.inputs(phase[k - 1], F.vel(post[0][k - 1]),
+                                       F.vel(post[1][k - 1]), gain(0), gain(1), dt)
+                for g, u in ((0, ul), (1, ur)):
+                    s = F.predict(post[g][k - 1], dt, u[0], u[1])
+                    if z[g][k] is not None:
+                        s = F.correct(s, z[g][k][0], z[g][k][1])
+                    post[g][k] = s
+                phase[k] = phase_from(post[0][k], post[1][k])
+                for g in (0, 1):
+                    book_accel(g, k, dt)
+
+        for k in range(k0 + 1, n):
+            dt = dts[k]
+            sl_prev, sr_prev = post[0][k - 1], post[1][k - 1]
+            vl, vr = F.vel(sl_prev), F.vel(sr_prev)
+            # predict, eq. (7)–(8) with u_{k-1} from eq. (18)–(20)
+            ul, ur = motion.inputs(phase[k - 1], vl, vr, gain(0), gain(1), dt)
+            prior = (F.predict(sl_prev, dt, ul[0], ul[1]), F.predict(sr_prev, dt, ur[0], ur[1]))
+            # gate, eq. (11)–(13)
+            obs = xy[k]
+            cands = ([], [])
+            for f in (0, 1):
+                px, py = F.pos(prior[f])
+                v = vl if f == 0 else vr
+                ctx = {"leg_width_m": leg_width_m, "dt": dt, "speed": math.hypot(*v),
+                       "swing": SWINGING[phase[k - 1]][f], "n_unobserved": n_unobs[f]}
+                for j in range(len(obs)):
+                    zx, zy = obs[j][0], obs[j][1]
+                    lam2 = F.mahalanobis2(prior[f], zx, zy)
+                    if gate.admits(lam2, math.hypot(zx - px, zy - py), ctx):
+                        cands[f].append((j + 1, math.sqrt(lam2)))
+            # associate, eq. (9)–(10) and §5.2
+            cache: tuple[dict, dict] = ({0: prior[0]}, {0: prior[1]})
+
+            def corrected(f, j):
+                s = cache[f].get(j)
+                if s is None:
+                    s = F.correct(prior[f], obs[j - 1][0], obs[j - 1][1])   # eq. (14)–(16)
+                    cache[f][j] = s
+                return s
+
+            def phase_of(a, b):
+                return phase_from(corrected(0, a), corrected(1, b))
+
+            a, b = assoc.select(cands[0], cands[1], phase[k - 1], phase_of)
+            # correct, eq. (14)–(16)
+            for f, j in ((0, a), (1, b)):
+                post[f][k] = corrected(f, j)
+                if j:
+                    z[f][k] = (float(obs[j - 1][0]), float(obs[j - 1][1]))
+                    real[f][k] = True
+                    pats[f][k] = patterns[k][j - 1]
+                    n_unobs[f] = 0
+                else:
+                    pats[f][k] = "UO"
+                    n_unobs[f] += 1
+            # gait phase, eq. (3)–(5)
+            phase[k] = phase_from(post[0][k], post[1][k])
+            for f in (0, 1):
+                book_accel(f, k, dt)
+            # occlusion handling (eq. 17 for Method 3)
+            for f in (0, 1):
+                if real[f][k] and last_real[f] < k - 1:
+                    d = occ.delay(k - last_real[f] - 1)
+                    if d is not None:
+                        pending.append((k + d, f, last_real[f], k))
+                if real[f][k]:
+                    last_real[f] = k
+            if pending:
+                due = [p for p in pending if p[0] <= k]
+                if due:
+                    pending = [p for p in pending if p[0] > k]
+                    for _, f, ka, m in sorted(due, key=lambda p: (p[2], p[1])):
+                        refilter(f, ka, m, k)
+                    resync_gain(k)
+        for _, f, ka, m in sorted(pending, key=lambda p: (p[2], p[1])):
+            refilter(f, ka, m, n - 1)
+
+        for f in (0, 1):
+            for k in range(k0, n):
+                x, y = F.pos(post[f][k])
+                vx, vy = F.vel(post[f][k])
+                res.x[f, k], res.y[f, k], res.vx[f, k], res.vy[f, k] = x, y, vx, vy
+                res.observed[f, k] = real[f][k]
+                res.pattern[f, k] = pats[f][k]
+        res.phase[k0:] = np.asarray(phase[k0:], dtype=np.int8)
+        if self.sides == "walking_direction" and _handedness(res) < 0:
+            _swap_sides(res)
+        return res
+
+
+def _handedness(res: TrackResult, min_speed: float = 0.3) -> float:
+    """Σ v_mid × (p_L − p_R) over the steps where the legs' midpoint moves (module notes)."""
+    vmx = 0.5 * (res.vx[0] + res.vx[1])
+    vmy = 0.5 * (res.vy[0] + res.vy[1])
+    dx = res.x[0] - res.x[1]
+    dy = res.y[0] - res.y[1]
+    with np.errstate(invalid="ignore"):
+        ok = np.hypot(vmx, vmy) > min_speed
+    return float(np.nansum((vmx * dy - vmy * dx)[ok]))
+
+
+def _swap_sides(res: TrackResult) -> None:
+    for name in ("x", "y", "vx", "vy", "observed", "interpolated", "pattern"):
+        arr = getattr(res, name)
+        setattr(res, name, arr[::-1].copy())
+    ok = res.phase >= 0
+    res.phase[ok] = _MIRROR_PHASE[res.phase[ok]]
+    res.swapped_sides = True
