@@ -1,0 +1,325 @@
+"""Clock synchronisation between a sensor and the mocap system.
+
+Clock model (common brief)::
+
+    t_sensor = clock_offset_s + (1 + clock_drift_ppm * 1e-6) * t_mocap      (+ jitter)
+
+The offset is found, as in seed 003 §4.2 ("temporally delayed ... by finding the maximum
+values of cross-correlation between these two trajectories"), by maximising the normalised
+cross-correlation (NCC) of a motion signal seen by both systems, refined to sub-sample
+precision by a parabola through the peak and its two neighbours.
+
+* :func:`estimate_clock_offset` is generic (any 1-D or multi-channel signals).
+* :func:`lrs_occupancy_signals` builds the LRS signal: for every beam (grouped into bins of
+  about 0.5 deg), the observed "foreground" indicator of each scan (range nearer than the
+  static background, the person) versus the indicator predicted from the mocap leg points
+  at sensor height (two circles of the subject's leg width, ray-cast in the sensor frame).
+  Each beam's sample time is the scan stamp plus ``i * time_increment`` when the scan time
+  is known (``meta['time_increment_s']`` or ``meta['scan_time_s']``), else the stamp.
+* :func:`estimate_clock` adds drift: offsets estimated in ``sync_windows`` windows of the
+  trial are fitted by a line ``offset(t_mocap) = clock_offset_s + drift * t_mocap`` when
+  the trial lasts at least ``drift_min_duration_s``; shorter trials report drift 0 and the
+  offset of the whole trial.
+
+References
+----------
+Qi, Y., Soh, C. B., Gunawan, E., Low, K.-S., Thomas, R. (2014). Estimation of spatial-
+temporal gait parameters using a low-cost ultrasonic motion analysis system. Sensors
+14(8), 15434-15457.
+Padfield, D. (2012). Masked object registration in the Fourier domain. IEEE Trans. Image
+Process. 21(5), 2706-2718 (the masked NCC used here).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import fft as sfft
+
+#: Defaults of the ``registration:`` config keys used here.
+DEFAULTS = {
+    "sync_max_lag_s": 5.0,
+    "sync_min_peak": 0.2,
+    "sync_bin_deg": 0.5,
+    "sync_foreground_margin_m": 0.10,
+    "sync_moving_max_range_m": 1.5,
+    "drift_min_duration_s": 60.0,
+    "sync_windows": 4,
+}
+
+
+@dataclass
+class ClockEstimate:
+    """Result of a clock synchronisation.
+
+    Attributes
+    ----------
+    clock_offset_s : float
+        ``t_sensor - t_mocap`` at ``t_mocap = 0`` (seconds).
+    clock_drift_ppm : float
+        Relative rate error of the sensor clock (parts per million); 0 when not estimated.
+    sync_peak : float
+        Normalised cross-correlation at the peak, clipped to 0..1 (NaN for a manual offset).
+    method : str
+        ``ncc``, ``ncc+drift`` or ``manual``.
+    """
+
+    clock_offset_s: float
+    clock_drift_ppm: float
+    sync_peak: float
+    method: str = "ncc"
+
+
+def _uniform(t, x, t0, dt, n):
+    """Linear resampling of (n_samples, ch) onto t0 + k dt; NaN outside / in gaps."""
+    g = t0 + dt * np.arange(n)
+    out = np.full((n, x.shape[1]), np.nan)
+    for j in range(x.shape[1]):
+        ok = np.isfinite(x[:, j]) & np.isfinite(t)
+        if ok.sum() < 2:
+            continue
+        tj, xj = t[ok], x[ok, j]
+        v = np.interp(g, tj, xj, left=np.nan, right=np.nan)
+        # do not bridge gaps longer than 3 median sample spacings
+        gap = np.diff(tj) > 3 * np.median(np.diff(tj))
+        if gap.any():
+            k = np.searchsorted(tj, g) - 1
+            inside = (k >= 0) & (k < len(gap))
+            bad = np.zeros(n, dtype=bool)
+            bad[inside] = gap[k[inside]]
+            v[bad] = np.nan
+        out[:, j] = v
+    return out
+
+
+def _xcorr(a, b, nfft):
+    """c[k] = sum_i a[i] b[i+k] summed over channels, for k = -(na-1) .. nb-1."""
+    fa = sfft.rfft(a, nfft, axis=0)
+    fb = sfft.rfft(b, nfft, axis=0)
+    full = sfft.irfft(np.sum(np.conj(fa) * fb, axis=1), nfft)
+    na, nb = a.shape[0], b.shape[0]
+    return np.concatenate([full[nfft - (na - 1):], full[:nb]])
+
+
+def estimate_clock_offset(t_a, sig_a, t_b, sig_b, max_lag_s: float, *,
+                          dt: float | None = None, centre_s: float | None = None,
+                          min_overlap: float = 0.3) -> tuple[float, float]:
+    """Offset between two clocks from one motion signal seen on both.
+
+    Finds ``tau`` such that ``sig_b(t + tau) ~= sig_a(t)``, i.e. clock b reads
+    ``t_b = t_a + tau`` (with ``a`` = mocap and ``b`` = sensor, ``tau`` is
+    ``clock_offset_s`` of the common brief when there is no drift).
+
+    Parameters
+    ----------
+    t_a, t_b : ndarray (n_a,), (n_b,)
+        Sample times on each clock (seconds; need not be uniform).  ``t_b`` may also be
+        (n_b, ch) to give every channel its own sample times (beam timing in a scan).
+    sig_a, sig_b : ndarray (n,) or (n, ch)
+        The signals (same channels); NaN marks missing samples.
+    max_lag_s : float
+        Search ``tau`` in ``[centre_s - max_lag_s, centre_s + max_lag_s]``.
+    dt : float, optional
+        Resampling step; default the smaller median sample spacing of the two.
+    centre_s : float, optional
+        Centre of the search; default 0 when the two time ranges overlap, else the
+        difference of the start times (e.g. a sensor stamping in Unix time).
+    min_overlap : float
+        Lags where fewer than this fraction of the shorter signal's samples overlap are
+        ignored.
+
+    Returns
+    -------
+    tau_s : float
+        The offset (seconds), refined by parabolic peak interpolation.
+    peak : float
+        Masked normalised cross-correlation at the peak (Pearson-like, -1..1).
+
+    Notes
+    -----
+    Both signals are linearly resampled onto grids of step ``dt`` starting at their first
+    samples, centred per channel, and correlated over all channels at once::
+
+        NCC(k) = sum a'_i b'_{i+k} / sqrt(sum_overlap a'^2 * sum_overlap b'^2)
+
+    (masked NCC: gaps do not count).  With ``k*`` the best lag,
+    ``delta = (c[k*-1] - c[k*+1]) / (2 (c[k*-1] - 2 c[k*] + c[k*+1]))`` (parabola vertex)
+    and ``tau = t_b0 - t_a0 + (k* + delta) dt``.
+    """
+    t_a = np.asarray(t_a, dtype=float)
+    t_b = np.asarray(t_b, dtype=float)
+    A = np.asarray(sig_a, dtype=float)
+    B = np.asarray(sig_b, dtype=float)
+    A = A[:, None] if A.ndim == 1 else A
+    B = B[:, None] if B.ndim == 1 else B
+    if A.shape[1] != B.shape[1]:
+        raise ValueError("the two signals must have the same number of channels")
+    tb_ch = t_b if t_b.ndim == 2 else np.repeat(t_b[:, None], B.shape[1], axis=1)
+    tb_first = tb_ch[:, 0]
+    if dt is None:
+        dt = float(min(np.median(np.diff(t_a)), np.median(np.diff(tb_first))))
+    ta0, tb0 = float(np.nanmin(t_a)), float(np.nanmin(tb_ch))
+    na = int(np.floor((np.nanmax(t_a) - ta0) / dt)) + 1
+    nb = int(np.floor((np.nanmax(tb_ch) - tb0) / dt)) + 1
+    Ag = _uniform(t_a, A, ta0, dt, na)
+    Bg = np.full((nb, B.shape[1]), np.nan)
+    for j in range(B.shape[1]):
+        Bg[:, j] = _uniform(tb_ch[:, j], B[:, j:j + 1], tb0, dt, nb)[:, 0]
+    wa = np.isfinite(Ag).astype(float)
+    wb = np.isfinite(Bg).astype(float)
+    Ag = np.where(wa > 0, Ag - np.nanmean(np.where(wa > 0, Ag, np.nan), axis=0), 0.0)
+    Bg = np.where(wb > 0, Bg - np.nanmean(np.where(wb > 0, Bg, np.nan), axis=0), 0.0)
+    Ag = np.nan_to_num(Ag)
+    Bg = np.nan_to_num(Bg)
+    nfft = sfft.next_fast_len(na + nb)
+    num = _xcorr(Ag, Bg, nfft)
+    ea = _xcorr(Ag * Ag, wb, nfft)
+    eb = _xcorr(wa, Bg * Bg, nfft)
+    ov = _xcorr(wa, wb, nfft)
+    lags = np.arange(-(na - 1), nb)
+    tau = tb0 - ta0 + lags * dt
+    if centre_s is None:
+        overlap = (np.nanmax(t_a) >= tb0) and (np.nanmax(tb_ch) >= ta0)
+        centre_s = 0.0 if overlap else tb0 - ta0
+    nmin = min(wa.any(axis=1).sum(), wb.any(axis=1).sum()) * A.shape[1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ncc = num / np.sqrt(np.maximum(ea, 0) * np.maximum(eb, 0))
+    usable = (np.abs(tau - centre_s) <= max_lag_s) & (ov >= min_overlap * nmin * 0.999) \
+        & np.isfinite(ncc) & (ea > 1e-12) & (eb > 1e-12)
+    if not usable.any():
+        return float("nan"), float("nan")
+    k = int(np.flatnonzero(usable)[np.argmax(ncc[usable])])
+    delta = 0.0
+    if 0 < k < len(ncc) - 1 and usable[k - 1] and usable[k + 1]:
+        y0, y1, y2 = ncc[k - 1], ncc[k], ncc[k + 1]
+        den = y0 - 2 * y1 + y2
+        if den < 0:
+            delta = float(np.clip(0.5 * (y0 - y2) / den, -0.5, 0.5))
+    return float(tau[k] + delta * dt), float(ncc[k])
+
+
+def beam_times(sensor) -> np.ndarray:
+    """Per-beam sample times (n_scans, n_beams) on the sensor clock.
+
+    ``t[k] + i * time_increment``, with ``time_increment`` from ``meta['time_increment_s']``
+    or ``meta['scan_time_s'] * angle_increment / (2 pi)`` (one revolution per scan, as a
+    Hokuyo); the stamp itself when neither is known.
+    """
+    meta = sensor.meta or {}
+    inc = meta.get("time_increment_s")
+    if inc is None and meta.get("scan_time_s"):
+        inc = float(meta["scan_time_s"]) * abs(sensor.angle_increment) / (2 * np.pi)
+    inc = float(inc or 0.0)
+    return sensor.t[:, None] + inc * np.arange(sensor.n_beams)[None, :]
+
+
+def predicted_occupancy(legs_s: np.ndarray, angles: np.ndarray, radius_m: float) -> np.ndarray:
+    """Which beams hit a leg, from leg centres in the sensor frame.
+
+    Parameters
+    ----------
+    legs_s : ndarray (n, n_legs, 2)
+        Leg centres in the sensor frame (metres); NaN = unknown.
+    angles : ndarray (n_beams,)
+    radius_m : float
+        Leg radius (half the subject's leg width).
+
+    Returns
+    -------
+    ndarray (n, n_beams) of 0/1 floats; NaN for frames where any leg is unknown.
+    A beam with unit vector u hits a circle of centre c when ``c.u > 0`` and
+    ``|c x u| < radius``.
+    """
+    u = np.stack([np.cos(angles), np.sin(angles)], axis=-1)           # (nb, 2)
+    cx, cy = legs_s[..., 0], legs_s[..., 1]
+    along = cx[..., None] * u[:, 0] + cy[..., None] * u[:, 1]          # (n, L, nb)
+    perp = np.abs(cx[..., None] * u[:, 1] - cy[..., None] * u[:, 0])
+    with np.errstate(invalid="ignore"):
+        hit = ((along > 0) & (perp < radius_m)).any(axis=1).astype(float)
+    unknown = ~np.all(np.isfinite(legs_s), axis=(1, 2))
+    hit[unknown] = np.nan
+    return hit
+
+
+def _bin(x: np.ndarray, k: int) -> np.ndarray:
+    if k <= 1:
+        return x
+    n = x.shape[1] // k * k
+    return x[:, :n].reshape(x.shape[0], -1, k).mean(axis=2)
+
+
+def lrs_occupancy_signals(sensor, background: np.ndarray, legs_s: np.ndarray,
+                          radius_m: float, cfg: dict | None = None, *, moving: bool = False):
+    """Observed and predicted per-beam-bin leg occupancy (see the module docstring).
+
+    Returns
+    -------
+    obs : ndarray (n_scans, n_bins)
+    obs_t : ndarray (n_scans, n_bins) sample times on the sensor clock
+    pred : ndarray (n_frames, n_bins) from ``legs_s`` (n_frames, 2, 2) at mocap frames
+    """
+    c = dict(DEFAULTS)
+    c.update(cfg or {})
+    r = sensor.ranges
+    bg = np.where(np.isfinite(background), background, np.inf)
+    with np.errstate(invalid="ignore"):
+        fg = np.isfinite(r) & (r < bg - c["sync_foreground_margin_m"])
+        if moving:
+            fg &= r <= c["sync_moving_max_range_m"]
+    k = max(1, int(round(np.deg2rad(c["sync_bin_deg"]) / abs(sensor.angle_increment))))
+    obs = _bin(fg.astype(float), k)
+    obs_t = _bin(beam_times(sensor), k)
+    pred = _bin(predicted_occupancy(legs_s, sensor.angles, radius_m), k)
+    return obs, obs_t, pred
+
+
+def estimate_clock(t_mocap: np.ndarray, pred: np.ndarray, obs_t: np.ndarray, obs: np.ndarray,
+                   cfg: dict | None = None) -> ClockEstimate:
+    """Offset (and drift for long trials) from mocap-side and sensor-side signals.
+
+    Parameters
+    ----------
+    t_mocap : ndarray (n_frames,)
+        Mocap frame times (seconds).
+    pred : ndarray (n_frames, ch)
+        Mocap-derived signal.
+    obs_t : ndarray (n, ch) or (n,)
+        Sensor-clock sample times.
+    obs : ndarray (n, ch)
+        Sensor-derived signal of the same channels.
+    cfg : dict
+        ``sync_max_lag_s``, ``drift_min_duration_s``, ``sync_windows``.
+
+    Returns
+    -------
+    ClockEstimate
+        ``sync_peak`` is the NCC of the whole-trial peak clipped to 0..1.  With drift
+        (trials of at least ``drift_min_duration_s``), window offsets ``tau_w`` at window
+        mocap-time centres ``c_w`` are fitted by ``tau_w = clock_offset_s + d * c_w``
+        (least squares) and ``clock_drift_ppm = d * 1e6 / (1 + ...)`` to first order.
+    """
+    c = dict(DEFAULTS)
+    c.update(cfg or {})
+    tau, peak = estimate_clock_offset(t_mocap, pred, obs_t, obs, float(c["sync_max_lag_s"]))
+    if not np.isfinite(tau):
+        return ClockEstimate(float("nan"), 0.0, 0.0, "ncc")
+    t_first = obs_t if np.ndim(obs_t) == 1 else obs_t[:, 0]
+    duration = float(np.nanmax(t_first) - np.nanmin(t_first))
+    if duration < float(c["drift_min_duration_s"]) or int(c["sync_windows"]) < 2:
+        return ClockEstimate(tau, 0.0, float(np.clip(peak, 0, 1)), "ncc")
+    nw = int(c["sync_windows"])
+    edges = np.linspace(np.nanmin(t_first), np.nanmax(t_first), nw + 1)
+    centres, taus = [], []
+    for w in range(nw):
+        sel = (t_first >= edges[w]) & (t_first <= edges[w + 1])
+        if sel.sum() < 10:
+            continue
+        tw, pw = estimate_clock_offset(t_mocap, pred, obs_t[sel], obs[sel], 0.05,
+                                       centre_s=tau)
+        if np.isfinite(tw):
+            centres.append(0.5 * (edges[w] + edges[w + 1]) - tw)   # mocap time of centre
+            taus.append(tw)
+    if len(taus) < 2:
+        return ClockEstimate(tau, 0.0, float(np.clip(peak, 0, 1)), "ncc")
+    d, off = np.polyfit(np.asarray(centres), np.asarray(taus), 1)
+    return ClockEstimate(float(off), float(d * 1e6), float(np.clip(peak, 0, 1)), "ncc+drift")

@@ -1,0 +1,317 @@
+"""Register one trial: sensor pose in the field, clock offset/drift, ground-truth summary.
+
+:func:`register_trial` is what the pipeline calls per trial; its result is one row of
+``results/<study>/registration.csv`` (:data:`RECORD_FIELDS`).
+
+* Fixed LRS (TUG, MTST, ...): pose from the calibration poles
+  (:func:`~gaitval.registration.poles.register_poles`).
+* Moving LRS (protocol ``rollator``): per-frame pose from the rollator markers and the mount
+  (:mod:`~gaitval.registration.moving`); the record's ``x_m, y_m, yaw_rad`` and
+  ``pole_residual_m`` are NaN (the per-frame pose is recomputed by the ground truth).
+* Ultrasonic: the ultrasonic system's frame from a 3-D rigid fit of the log's anchor
+  coordinates to the ``ANC1..ANC4`` markers; the record holds its projection on the floor
+  (``x_m, y_m`` of the frame origin, ``yaw_rad`` of its x axis) and ``pole_residual_m`` is
+  the worst anchor residual.  NaN when the C3D has no anchor markers.
+* Clock: a number in the trial sheet's ``clock_offset_s`` overrides the estimate (drift 0,
+  ``sync_peak`` NaN).  Otherwise :mod:`~gaitval.registration.clock` estimates it from leg
+  occupancy (LRS) or from the transmitter-anchor distances (ultrasonic); a peak below
+  ``sync_min_peak`` (0.2) is refused with a :class:`~gaitval.errors.RegistrationError`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import pandas as pd
+
+from gaitval.consts import KELVIN_0C, SPEED_OF_SOUND_0C
+from gaitval.errors import RegistrationError
+from gaitval.groundtruth.build import (as_float, filled_markers, gt_cfg, leg_points, section,
+                                       sensor_height)
+from gaitval.groundtruth.gaps import fill_short_gaps
+from gaitval.registration import clock as CK
+from gaitval.registration import poles as PO
+from gaitval.registration.moving import (ROLLATOR_MARKERS, parse_mount, rollator_pose,
+                                         sensor_pose_from_rollator)
+from gaitval.registration.rigid import field_to_sensor, fit_rigid_3d, wrap_angle
+from gaitval.types import MocapTrial, ScanSeries, UltrasonicLog
+
+#: Columns of ``registration.csv`` (issue 4), in order.
+RECORD_FIELDS = ("trial", "x_m", "y_m", "yaw_rad", "clock_offset_s", "clock_drift_ppm",
+                 "pole_residual_m", "sync_peak", "joint_centre_source", "gt_frames_excluded")
+
+#: Defaults of the ``registration:`` keys read here (plus those of poles and clock).
+DEFAULTS = {
+    "default_leg_width_m": 0.10,
+    "rollator_markers": list(ROLLATOR_MARKERS),
+    "anchor_markers": ["ANC1", "ANC2", "ANC3", "ANC4"],
+    "tx_marker": "TX",
+    "max_anchor_residual_m": 0.02,
+}
+
+
+@dataclass
+class RegistrationRecord:
+    """One row of ``registration.csv``.
+
+    Attributes
+    ----------
+    trial : str
+    x_m, y_m, yaw_rad : float
+        Sensor pose in the field (NaN for a moving sensor).
+    clock_offset_s, clock_drift_ppm : float
+        ``t_sensor = clock_offset_s + (1 + clock_drift_ppm * 1e-6) * t_mocap``.
+    pole_residual_m : float
+        Worst pole (ultrasonic: anchor) residual of the rigid fit, metres.
+    sync_peak : float
+        Normalised cross-correlation at the clock peak, 0..1 (NaN when manual).
+    joint_centre_source : str
+    gt_frames_excluded : int
+        Mocap frames without a ground-truth point (either leg) after short-gap filling.
+    """
+
+    trial: str
+    x_m: float
+    y_m: float
+    yaw_rad: float
+    clock_offset_s: float
+    clock_drift_ppm: float
+    pole_residual_m: float
+    sync_peak: float
+    joint_centre_source: str
+    gt_frames_excluded: int
+
+    def as_row(self) -> dict:
+        return asdict(self)
+
+
+def registration_table(records) -> pd.DataFrame:
+    """Records -> the ``registration.csv`` DataFrame (columns :data:`RECORD_FIELDS`)."""
+    return pd.DataFrame([r.as_row() for r in records], columns=list(RECORD_FIELDS))
+
+
+def reg_cfg(cfg: dict | None) -> dict:
+    c = dict(DEFAULTS)
+    c.update(PO.DEFAULTS)
+    c.update(CK.DEFAULTS)
+    c.update(section(cfg, "registration"))
+    return c
+
+
+def is_moving(trial: dict | None) -> bool:
+    """True for trials whose sensor moves (protocol ``rollator``)."""
+    return str((trial or {}).get("protocol", "")).strip().lower() == "rollator"
+
+
+def rollator_labels(cfg) -> list[str]:
+    return list(reg_cfg(cfg)["rollator_markers"])
+
+
+def mount_from_cfg(cfg: dict | None, trial_id=None):
+    """``rollator.sensor_mount`` (or ``registration.sensor_mount``) as (x, y, yaw)."""
+    cfg = cfg or {}
+    m = None
+    if isinstance(cfg.get("rollator"), dict):
+        m = cfg["rollator"].get("sensor_mount")
+    if m is None:
+        m = section(cfg, "registration").get("sensor_mount")
+    if m is None:
+        from gaitval.errors import ConfigError
+        raise ConfigError("rollator.sensor_mount is not set: the sensor pose on the rollator "
+                          "(x_m, y_m, yaw_rad in the rollator frame) is needed for the "
+                          f"moving-sensor trial {trial_id}",
+                          hint="set rollator.sensor_mount in config/config.yaml")
+    return parse_mount(m)
+
+
+def _manual_offset(trial: dict | None) -> float | None:
+    return as_float((trial or {}).get("clock_offset_s"))
+
+
+def _leg_width(subject, c) -> float:
+    w = as_float((subject or {}).get("leg_width_m"))
+    return w if w is not None else float(c["default_leg_width_m"])
+
+
+def register_trial(mocap: MocapTrial, sensor, trial: dict, subject: dict | None,
+                   cfg: dict | None) -> RegistrationRecord:
+    """Register one trial (pose, clock) and summarise its ground truth.
+
+    Parameters
+    ----------
+    mocap : MocapTrial
+        The trial's C3D (metres, field frame).
+    sensor : ScanSeries or UltrasonicLog
+        The sensor log (sensor clock, metres).
+    trial : dict
+        Trial-sheet row: ``trial``, ``protocol``, ``sensor_height_m``, ``clock_offset_s``
+        (empty = estimate).
+    subject : dict or None
+        Subject-table row (``leg_width_m``, ``knee_width_m``, ``ankle_width_m``).
+    cfg : dict
+        The whole config (sections ``registration``, ``groundtruth``, ``rollator``) or
+        the ``registration`` section alone.
+
+    Returns
+    -------
+    RegistrationRecord
+
+    Raises
+    ------
+    RegistrationError, MarkerError, ConfigError
+        With the file and trial named (poles missing/ambiguous, residual too large,
+        synchronisation peak too weak, markers missing, mount not configured).
+    """
+    tid = str((trial or {}).get("trial", ""))
+    try:
+        if isinstance(sensor, UltrasonicLog):
+            return _register_ultrasonic(mocap, sensor, trial, cfg, tid)
+        if isinstance(sensor, ScanSeries):
+            return _register_lrs(mocap, sensor, trial, subject, cfg, tid)
+    except RegistrationError as e:
+        raise e.with_context(path=getattr(sensor, "source", None) or mocap.path, trial=tid)
+    raise TypeError(f"register_trial: unsupported sensor type {type(sensor).__name__}")
+
+
+def legs_in_sensor_frame(mocap, lp, trial, cfg, pose=None):
+    """Mocap leg points (n, 2, 2) in the sensor frame, fixed ``pose`` or rollator per frame."""
+    P = lp.xyz[..., :2]
+    if pose is not None:
+        return field_to_sensor(P, *pose)
+    labels = rollator_labels(cfg)
+    rp = rollator_pose(mocap, labels, trial=trial.get("trial"),
+                       xyz=filled_markers(mocap, gt_cfg(cfg)["max_gap_s"], labels)[0])
+    pm = sensor_pose_from_rollator(rp, mount_from_cfg(cfg, trial.get("trial")))
+    return field_to_sensor(P, pm[:, None, 0], pm[:, None, 1], pm[:, None, 2])
+
+
+def _register_lrs(mocap, sensor, trial, subject, cfg, tid):
+    c = reg_cfg(cfg)
+    h = sensor_height(sensor, trial)
+    lp = leg_points(mocap, h, subject, cfg, trial=tid)
+    moving = is_moving(trial)
+    if moving:
+        pose = None
+        x = y = yaw = resid = float("nan")
+    else:
+        ok = lp.valid.all(axis=1)
+        pts = lp.xyz[ok][:, :, :2].reshape(-1, 2)
+        if len(pts) > 1000:
+            pts = pts[np.linspace(0, len(pts) - 1, 1000).astype(int)]
+        pf = PO.register_poles(sensor, mocap, c, leg_xy_field=pts, trial=tid)
+        x, y, yaw, resid = pf.x_m, pf.y_m, pf.yaw_rad, pf.worst_residual_m
+        pose = (x, y, yaw)
+    manual = _manual_offset(trial)
+    if manual is not None:
+        ce = CK.ClockEstimate(manual, 0.0, float("nan"), "manual")
+    else:
+        legs_s = legs_in_sensor_frame(mocap, lp, trial, cfg, pose)
+        legs_s[~lp.valid] = np.nan
+        bg, _ = PO.static_background(sensor, {**c, "pole_window_s": None})
+        obs, obs_t, pred = CK.lrs_occupancy_signals(sensor, bg, legs_s,
+                                                    _leg_width(subject, c) / 2.0, c,
+                                                    moving=moving)
+        ce = CK.estimate_clock(lp.t, pred, obs_t, obs, c)
+        _check_peak(ce, c, sensor.source, tid)
+    return RegistrationRecord(tid, x, y, yaw, ce.clock_offset_s, ce.clock_drift_ppm, resid,
+                              ce.sync_peak, lp.source, lp.n_excluded)
+
+
+def _check_peak(ce, c, path, tid):
+    if not np.isfinite(ce.clock_offset_s) or ce.sync_peak < float(c["sync_min_peak"]):
+        raise RegistrationError(
+            f"clock synchronisation failed: correlation peak {ce.sync_peak:.2f} is below "
+            f"registration.sync_min_peak = {c['sync_min_peak']} (offset "
+            f"{ce.clock_offset_s:.3f} s would not be trustworthy)", path=path, trial=tid,
+            hint="give the offset by hand in the trial sheet's clock_offset_s, or widen "
+                 "registration.sync_max_lag_s")
+
+
+def register_anchors(mocap: MocapTrial, log: UltrasonicLog, cfg: dict | None = None, *,
+                     trial=None):
+    """3-D rigid fit of the log's anchor coordinates to the ANC markers.
+
+    Anchors are matched to markers by name when the log's anchor ids equal marker labels,
+    else in order (log anchor k <-> ``anchor_markers[k]``).
+
+    Returns
+    -------
+    R : (3, 3), t : (3,), residuals : (n_anchors,) with ``p_field = R p_us + t`` (metres).
+
+    Raises
+    ------
+    RegistrationError
+        Fewer than three anchor markers, or a residual above ``max_anchor_residual_m``.
+    """
+    c = reg_cfg(cfg)
+    ids = log.anchor_ids
+    labels = ids if all(mocap.has(a) for a in ids) else list(c["anchor_markers"])[:len(ids)]
+    src, dst, used = [], [], []
+    A = log.anchors[["x_m", "y_m", "z_m"]].to_numpy(dtype=float)
+    for k, lb in enumerate(labels):
+        if k < len(A) and mocap.has(lb):
+            p = mocap.marker(lb)
+            ok = np.isfinite(p).all(axis=1)
+            if ok.any():
+                src.append(A[k])
+                dst.append(np.median(p[ok], axis=0))
+                used.append(lb)
+    if len(src) < 3:
+        raise RegistrationError(
+            f"the C3D has {len(src)} usable anchor marker(s) (looked for {labels}); three "
+            "are needed to register the ultrasonic frame", path=mocap.path, trial=trial,
+            hint="label the receiver markers ANC1..ANC4")
+    R, t, res = fit_rigid_3d(np.array(src), np.array(dst))
+    if res.max() > float(c["max_anchor_residual_m"]):
+        raise RegistrationError(
+            f"anchor residual {res.max() * 1000:.1f} mm at {used[int(np.argmax(res))]} "
+            f"exceeds {c['max_anchor_residual_m'] * 1000:.0f} mm", path=mocap.path,
+            trial=trial, hint="check the anchor coordinates in the log metadata")
+    return R, t, res
+
+
+def anchor_distances(log: UltrasonicLog) -> np.ndarray:
+    """Transmitter-anchor distances (n, n_anchors), metres.
+
+    From ``distance_m``, or ``tof_s * c(T)`` with ``c = 331.3 sqrt(1 + T / 273.15)`` m/s
+    (seed 003 eq. (1)-(2)).
+    """
+    if log.distance_m is not None:
+        return np.asarray(log.distance_m, dtype=float)
+    c = SPEED_OF_SOUND_0C * np.sqrt(1.0 + np.asarray(log.temperature_c, float) / KELVIN_0C)  # eq. (2)
+    return np.asarray(log.tof_s, dtype=float) * c[:, None]                                   # eq. (1)
+
+
+def _register_ultrasonic(mocap, log, trial, cfg, tid):
+    c = reg_cfg(cfg)
+    g = gt_cfg(cfg)
+    tx = g["tx_marker"]
+    if not mocap.has(tx):
+        from gaitval.errors import MarkerError
+        raise MarkerError(f"the C3D has no transmitter marker {tx!r}", path=mocap.path,
+                          trial=tid, hint="set groundtruth.tx_marker")
+    X, _ = fill_short_gaps(mocap.marker(tx), mocap.rate_hz, g["max_gap_s"])
+    n_excl = int((~np.isfinite(X).all(axis=1)).sum())
+    try:
+        R, t, res = register_anchors(mocap, log, cfg, trial=tid)
+        yaw = float(wrap_angle(math.atan2(R[1, 0], R[0, 0])))
+        x, y, resid = float(t[0]), float(t[1]), float(res.max())
+        anchors_f = log.anchors[["x_m", "y_m", "z_m"]].to_numpy(float) @ R.T + t
+    except RegistrationError:
+        x = y = yaw = resid = float("nan")
+        anchors_f = None
+    manual = _manual_offset(trial)
+    if manual is not None:
+        ce = CK.ClockEstimate(manual, 0.0, float("nan"), "manual")
+    else:
+        if anchors_f is None:
+            raise RegistrationError(
+                "cannot synchronise the ultrasonic clock: the anchors are not registered "
+                "(no ANC markers) and no clock_offset_s is given", path=mocap.path, trial=tid,
+                hint="fill clock_offset_s in the trial sheet or label ANC1..ANC4")
+        pred = np.linalg.norm(X[:, None, :] - anchors_f[None], axis=2)   # (n, n_anchors)
+        ce = CK.estimate_clock(mocap.t, pred, log.t, anchor_distances(log), c)
+        _check_peak(ce, c, log.source, tid)
+    return RegistrationRecord(tid, x, y, yaw, ce.clock_offset_s, ce.clock_drift_ppm, resid,
+                              ce.sync_peak, "tx_marker", n_excl)
