@@ -73,6 +73,14 @@ def cmd_ingest_summary(a) -> int:
     return 0
 
 
+def cmd_peer(a) -> int:
+    from gaitval.report.provenance import stamp
+    from gaitval.tables.peer import write_peer_table
+    paths = write_peer_table(a.parquet, a.out_stem)
+    stamp(Path(a.out_stem).name, paths, a.reports_dir, config_hash_=a.config_hash)
+    return 0
+
+
 def cmd_report(a) -> int:
     from gaitval.report.index import build_index
     md, html = build_index(a.reports_dir, study_names=a.studies)
@@ -120,6 +128,13 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--reports-dir", default="reports")
     s.add_argument("--config-hash", default="")
     s.set_defaults(func=cmd_ingest_summary)
+
+    s = sub.add_parser("peer", help="agreement statistics of a peer's paired results")
+    s.add_argument("parquet", help="Parquet file with us_<name> / gt_<name> column pairs")
+    s.add_argument("--out-stem", required=True)
+    s.add_argument("--reports-dir", default="reports")
+    s.add_argument("--config-hash", default="")
+    s.set_defaults(func=cmd_peer)
 
     s = sub.add_parser("report", help="write reports/index.md and index.html")
     s.add_argument("--reports-dir", default="reports")

@@ -16,9 +16,10 @@ PRESETS = Path(workflow.basedir) / "config" / "studies"
 REPORTS = config.get("reports_dir", "reports")
 # The library is called as `python -m gaitval` with the interpreter running Snakemake, so
 # rules work whether or not the venv's bin/ is on PATH.
+_METHODS = getattr(getattr(workflow, "deployment_settings", None), "deployment_method", ())
 GV = (
     "python -m gaitval"
-    if "conda" in str(getattr(workflow, "deployment_settings", "")).lower()
+    if any(str(m).lower().endswith("conda") for m in _METHODS)
     else f"{sys.executable} -m gaitval"
 )
 CONFIG_HASH = config_hash(config)

@@ -1,0 +1,36 @@
+# Worked example: gaitval's agreement statistics on a peer's published paired results
+# (config key peer_results; skipped when the file is absent, e.g. without ../shared).
+
+
+rule peer_agreement:
+    input:
+        config.get("peer_results", ""),
+    output:
+        csv=report(
+            f"{REPORTS}/tables/peer_agreement.csv",
+            caption="../report/peer.rst",
+            category="Peer data",
+        ),
+        md=f"{REPORTS}/tables/peer_agreement.md",
+        tex=f"{REPORTS}/tables/peer_agreement.tex",
+    params:
+        gv=GV,
+        stem=lambda w, output: output.csv[: -len(".csv")],
+        reports=parent_of("csv", up=1),
+        chash=CONFIG_HASH,
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/peer_agreement.log",
+    shell:
+        "{params.gv} peer {input} --out-stem {params.stem} --reports-dir {params.reports}"
+        " --config-hash {params.chash} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+REPORT_ITEM_FUNCS.append(
+    lambda study: (
+        [f"{REPORTS}/tables/peer_agreement.csv"]
+        if config.get("peer_results") and Path(config["peer_results"]).is_file()
+        else []
+    )
+)
