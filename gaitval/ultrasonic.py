@@ -347,6 +347,39 @@ def align_xcorr(ref: np.ndarray, sys: np.ndarray, fs: float, *, min_overlap: flo
     return float(lags[i] + frac)
 
 
+def align_ssd(ref: np.ndarray, sys: np.ndarray, *, min_overlap: float = 0.8) -> int:
+    """Lag (samples, ``ref[i]`` ~ ``sys[i - lag]``) of the least mean squared difference.
+
+    Unlike a correlation coefficient this keeps absolute levels and amplitudes, which is
+    what separates the true lag from one a period away in a decaying swing (a pendulum's
+    envelope is exponential, so a correlation coefficient cannot tell them apart).
+    """
+    ref = np.asarray(ref, float)
+    sys = np.asarray(sys, float)
+    if ref.ndim == 1:
+        ref = ref[:, None]
+    if sys.ndim == 1:
+        sys = sys[:, None]
+    N, M = len(ref), len(sys)
+    lags = correlation_lags(N, M, mode="full")
+    lo = np.maximum(0, lags)
+    hi = np.minimum(N, M + lags)
+    n = np.maximum(hi - lo, 1)
+    valid = (hi - lo) >= max(min_overlap * min(N, M), 3)
+    if not valid.any():
+        raise RegistrationError("the ultrasonic and mocap recordings do not overlap enough "
+                                "to align them")
+    ssd = np.zeros(len(lags))
+    for k in range(ref.shape[1]):
+        a, b = ref[:, k], sys[:, k]
+        ca2 = np.concatenate([[0.0], np.cumsum(a * a)])
+        cb2 = np.concatenate([[0.0], np.cumsum(b * b)])
+        sab = correlate(a, b, mode="full", method="fft")
+        ssd += (ca2[hi] - ca2[lo]) + (cb2[hi - lags] - cb2[lo - lags]) - 2.0 * sab
+    ssd = np.where(valid, ssd / n, np.inf)
+    return int(lags[int(np.argmin(ssd))])
+
+
 def _clean_track(track: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     t = track["t_s"].to_numpy(dtype=float)
     xyz = track[["x_m", "y_m", "z_m"]].to_numpy(dtype=float)
@@ -558,7 +591,10 @@ def pendulum_alignment(log: UltrasonicLog, mocap: MocapTrial, cfg: dict | None =
     gs = np.arange(t_us[0], t_us[-1], 1.0 / fs)
     d_fill = np.column_stack([np.interp(gs, t_us[np.isfinite(d[:, k])],
                                         d[np.isfinite(d[:, k]), k]) for k in range(d.shape[1])])
-    lag = align_xcorr(_resample(t_ref, r, gr), d_fill, fs, min_overlap=c["align"]["min_overlap"])
+    from scipy.ndimage import median_filter
+
+    d_fill = median_filter(d_fill, size=(5, 1), mode="nearest")   # isolated late echoes
+    lag = align_ssd(_resample(t_ref, r, gr), d_fill, min_overlap=c["align"]["min_overlap"])
     coarse = float(gs[0] - gr[0] - lag / fs)
     off = _fine_clock(t_us, d, t_ref, r, coarse)
     tm = t_us - off

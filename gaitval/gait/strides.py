@@ -68,7 +68,11 @@ def autocorr_unbiased(a: np.ndarray, max_lag: int | None = None,
 
 def dominant_period(a: np.ndarray, fs: float, min_period_s: float = 0.6,
                     max_period_s: float = 2.5) -> float:
-    """Stride period (s): lag of the highest unbiased-autocorrelation peak in the range."""
+    """Stride period (s) from the unbiased autocorrelation (eq. 16).
+
+    The first autocorrelation peak in ``[min_period_s, max_period_s]`` that reaches at
+    least 90 % of the highest peak there.
+    """
     a = np.asarray(a, dtype=float)
     a = a - np.nanmean(a)
     lo = max(1, int(np.floor(min_period_s * fs)))
@@ -82,7 +86,10 @@ def dominant_period(a: np.ndarray, fs: float, min_period_s: float = 0.6,
     peaks, _ = find_peaks(seg)
     if peaks.size == 0:
         return float("nan")
-    best = peaks[np.argmax(seg[peaks])]
+    # the first peak that is nearly as high as the highest: a periodic signal correlates
+    # as well at two periods as at one, and the stride is the shortest of those lags
+    top = seg[peaks].max()
+    best = peaks[np.flatnonzero(seg[peaks] >= top - 0.1 * abs(top))[0]]
     return float((lo + best) / fs)
 
 

@@ -1,0 +1,116 @@
+"""The TOA unscented Kalman filter (seed 003 eq. 3-13) and its multipath gate."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gaitval.track.ukf import cv_matrices, run_toa_ukf, toa_ranges, trilaterate, ukf_weights
+
+ANCHORS = np.array([[0.0, 0.0, 0.0], [0.324, 0.0, 0.0], [0.324, 0.230, 0.0],
+                    [0.0, 0.230, 0.0]])          # seed 003 §4.1, p1..p4
+SIG = np.sqrt([11.0, 9.3, 9.0, 9.0]) * 1e-3        # seed 003 §4.3.2, V in mm^2
+W = np.array([30.0, 25.0, 10.0])
+GUESS = np.array([0.16, 0.10, -0.30])
+
+
+def _path(n=1500, fs=50.0):
+    t = np.arange(n) / fs
+    pos = np.column_stack([0.16 + 0.3 * np.sin(2 * np.pi * t / 1.2),
+                           0.10 + 0.08 * np.cos(2 * np.pi * t / 1.2),
+                           -0.30 + 0.01 * np.sin(t)])
+    return t, pos
+
+
+def test_weights_by_hand():
+    # eq. (13): lambda = alpha^2 (n + kappa) - n = 1e-6 * 6 - 6
+    Wm, Wc, lam = ukf_weights(6, 1e-3, 2.0, 0.0)
+    assert lam == pytest.approx(6e-6 - 6.0)
+    assert Wm.sum() == pytest.approx(1.0, abs=1e-6)
+    assert Wm[1] == pytest.approx(1.0 / (2 * 6e-6))            # eq. (12)
+    assert Wc[0] - Wm[0] == pytest.approx(1.0 - 1e-6 + 2.0)      # + 1 - alpha^2 + beta
+
+
+def test_cv_matrices_eq5():
+    A, G = cv_matrices(0.02)
+    x = np.array([1.0, 2.0, 3.0, 0.5, -1.0, 2.0])
+    assert A @ x == pytest.approx([1.01, 1.98, 3.04, 0.5, -1.0, 2.0])
+    assert G[0, 0] == pytest.approx(0.0002) and G[3, 0] == pytest.approx(0.02)
+
+
+def test_trilaterate_exact_ranges():
+    p = np.array([0.05, 0.12, -0.25])
+    d = np.linalg.norm(ANCHORS - p, axis=1)
+    assert trilaterate(d, ANCHORS, GUESS) == pytest.approx(p, abs=1e-9)
+    # the mirror solution of the planar array is found from the other side
+    assert trilaterate(d, ANCHORS, GUESS * [1, 1, -1])[2] == pytest.approx(0.25, abs=1e-9)
+
+
+def test_noiseless_constant_velocity_is_recovered():
+    t = np.arange(400) / 50.0
+    pos = np.column_stack([-0.2 + 0.5 * t / 8, 0.05 + 0.02 * t / 8, -0.3 + 0 * t])
+    d = toa_ranges(pos, ANCHORS)
+    r = run_toa_ukf(t, d, ANCHORS, W_sigma=[0.01] * 3, V=np.full(4, 1e-10),
+                    init_guess=GUESS)
+    assert np.abs(r.x[50:, :3] - pos[50:]).max() < 1e-4
+    assert r.x[-1, 3] == pytest.approx(0.5 / 8, abs=1e-3)     # velocity 0.0625 m/s
+
+
+def test_noisy_ranges_track_within_millimetres():
+    rng = np.random.default_rng(3)
+    t, pos = _path()
+    d = toa_ranges(pos, ANCHORS) + rng.standard_normal((len(t), 4)) * SIG
+    r = run_toa_ukf(t, d, ANCHORS, W_sigma=W, V=SIG ** 2, init_guess=GUESS)
+    rmse = np.sqrt(np.mean((r.x[25:, :3] - pos[25:]) ** 2, axis=0))
+    assert np.all(rmse < 0.006), rmse
+    assert not r.rejected[25:].any() or r.rejected[25:].mean() < 0.002
+
+
+def test_multipath_outlier_is_rejected_per_anchor():
+    rng = np.random.default_rng(4)
+    t, pos = _path(600)
+    d = toa_ranges(pos, ANCHORS) + rng.standard_normal((len(t), 4)) * SIG
+    k = 300
+    d[k, 2] += 0.30                                    # a late echo on receiver 3
+    r = run_toa_ukf(t, d, ANCHORS, W_sigma=W, V=SIG ** 2, init_guess=GUESS)
+    assert r.rejected[k, 2] and not r.rejected[k, [0, 1, 3]].any()
+    assert r.used[k].tolist() == [True, True, False, True]
+    err_gated = np.linalg.norm(r.x[k, :3] - pos[k])
+    raw = run_toa_ukf(t, d, ANCHORS, W_sigma=W, V=SIG ** 2, init_guess=GUESS,
+                      gate_sigma=np.inf)
+    err_raw = np.linalg.norm(raw.x[k, :3] - pos[k])
+    assert err_gated < 0.01 and err_raw > 3 * err_gated
+
+
+def test_missing_echo_drops_that_anchor():
+    t, pos = _path(200)
+    d = toa_ranges(pos, ANCHORS)
+    d[100, 1] = np.nan
+    d[101] = np.nan                                   # no echo at all: predict only
+    r = run_toa_ukf(t, d, ANCHORS, W_sigma=W, V=SIG ** 2, init_guess=GUESS)
+    assert r.used[100].tolist() == [True, False, True, True]
+    assert not r.used[101].any()
+    assert np.all(np.isfinite(r.x[100:]))
+
+
+def test_matches_filterpy_unscented_kalman_filter():
+    """Same model and data through filterpy's UKF (outside reference implementation)."""
+    fp = pytest.importorskip("filterpy.kalman")
+    rng = np.random.default_rng(5)
+    t, pos = _path(300)
+    d = toa_ranges(pos, ANCHORS) + rng.standard_normal((len(t), 4)) * SIG
+    r = run_toa_ukf(t, d, ANCHORS, W_sigma=W, V=SIG ** 2, init_guess=GUESS,
+                    gate_sigma=np.inf)
+    pts = fp.MerweScaledSigmaPoints(6, alpha=1e-3, beta=2.0, kappa=0.0)
+    f = fp.UnscentedKalmanFilter(6, 4, 0.02, lambda x: toa_ranges(x[:3], ANCHORS),
+                                 lambda x, dt: cv_matrices(dt)[0] @ x, pts)
+    f.x = r.x[0].copy()
+    f.P = np.diag([0.05 ** 2] * 3 + [1.0] * 3)
+    f.R = np.diag(SIG ** 2)
+    A, G = cv_matrices(0.02)
+    f.Q = G @ np.diag(W ** 2) @ G.T
+    out = [r.x[0]]
+    for k in range(1, len(t)):
+        f.predict()
+        f.update(d[k])
+        out.append(f.x.copy())
+    assert np.abs(np.array(out) - r.x).max() < 1e-6
