@@ -220,9 +220,64 @@ def _precheck(path: Path, trial: str | None) -> dict[str, Any]:
                               "which ezc3d cannot read", path=path, trial=trial,
                               hint="convert it to Intel format, e.g. by opening and saving "
                                    "it in Mokka or Vicon Nexus")
+    problem = _walk_parameters(path)
+    if problem:
+        raise FileFormatError(f"the C3D parameter section is corrupt: {problem}",
+                              path=path, trial=trial,
+                              hint="re-export the file from the capture software")
     # header words 4 and 5 (1-based, 16-bit): first and last frame of the 3-D data
     first_w, last_w = (int.from_bytes(head[i:i + 2], "little") for i in (6, 8))
     return {"processor": proc, "first_frame_word": first_w, "last_frame_word": last_w}
+
+
+def _walk_parameters(path: Path) -> str | None:
+    """Walk the parameter section's linked list; return the first structural problem.
+
+    C3D User Guide: each group/parameter record is ``name length (int8, negative = locked),
+    id (int8, negative = group), name, offset to the next record (int16)``; a parameter
+    then has ``type (int8), n_dims (uint8), dims, data``.  ezc3d 1.7.2 spends tens of
+    seconds (or crashes) on some corrupt sections, so gaitval checks the chain first:
+    printable names, pointers that stay inside the file, data that fits before the next
+    record.  Little-endian (Intel/DEC) files only; returns None when the chain is sound.
+    """
+    b = path.read_bytes()
+    i = (b[0] - 1) * 512 + 4
+    last = "the section start"
+    groups: dict[int, str] = {}
+    for _ in range(100_000):
+        if i + 2 > len(b):
+            return f"the record after {last} lies beyond the end of the file"
+        nch = int.from_bytes(b[i:i + 1], "little", signed=True)
+        gid = int.from_bytes(b[i + 1:i + 2], "little", signed=True)
+        if nch == 0 or gid == 0:
+            return None                                   # end of the parameter section
+        name = b[i + 2:i + 2 + abs(nch)]
+        if len(name) < abs(nch) or not all(0x20 <= c <= 0x7E for c in name):
+            return f"the record after {last} has an unreadable name {name!r}"
+        p = i + 2 + abs(nch)
+        nxt = int.from_bytes(b[p:p + 2], "little", signed=True)
+        label = name.decode("ascii")
+        if gid < 0:
+            groups[-gid] = label
+        else:
+            label = f"{groups.get(gid, f'group {gid}')}:{label}"
+            t = int.from_bytes(b[p + 2:p + 3], "little", signed=True)
+            nd = b[p + 3] if p + 3 < len(b) else 0
+            size = abs(t)
+            for d in b[p + 4:p + 4 + nd]:
+                size *= d
+            end = p + 4 + nd + size
+            if nxt > 0 and end > p + nxt:
+                return (f"parameter {label} holds {size} bytes of data, "
+                        f"more than the {nxt - 4 - nd} bytes before the next record "
+                        "(bad parameter offset)")
+        if nxt == 0:
+            return None                                   # last record
+        if nxt < 0 or p + nxt >= len(b):
+            return f"record {label} points to the next record at offset {nxt}, outside the file"
+        last = f"{'group' if gid < 0 else 'parameter'} {label}"
+        i = p + nxt
+    return "the parameter section does not end"
 
 
 def _ezc3d_reason(exc: Exception) -> str:
@@ -267,8 +322,8 @@ def _strings(value) -> list[str]:
     if value is None:
         return []
     if isinstance(value, str):
-        return [value.strip()]
-    return [str(v).strip() for v in np.asarray(value, dtype=object).ravel()]
+        return [value.strip("\x00 \t")]
+    return [str(v).strip("\x00 \t") for v in np.asarray(value, dtype=object).ravel()]
 
 
 def _first_number(value, default=None):
@@ -317,10 +372,17 @@ def clean_labels(raw: list[str], *, duplicates: str = "suffix"
     if dups and duplicates == "error":
         raise ValueError(", ".join(f"{lab} x{counts[lab]}" for lab in dups))
     seen: dict[str, int] = {}
+    taken = set(stripped)
     out = []
     for lab in stripped:
         seen[lab] = seen.get(lab, 0) + 1
-        new = lab if seen[lab] == 1 else f"{lab}#{seen[lab]}"
+        new = lab
+        if seen[lab] > 1:
+            k = seen[lab]
+            while f"{lab}#{k}" in taken:                 # never collide with a real label
+                k += 1
+            new = f"{lab}#{k}"
+            taken.add(new)
         out.append(new)
         if lab in dups:
             dups[lab].append(new)
