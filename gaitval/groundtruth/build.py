@@ -8,7 +8,9 @@ Pipeline (LRS trials)
 2. Knee and ankle centres (:mod:`~gaitval.groundtruth.joints`), then the leg point at the
    scan height ``h`` (:func:`~gaitval.groundtruth.shank.point_at_height`), or, for the
    rollator (or ``leg_point: cylinder``), the tibia-cylinder cross-section
-   (:func:`~gaitval.groundtruth.shank.fit_cylinder`).
+   (:func:`~gaitval.groundtruth.shank.fit_cylinder_cluster`: one cylinder in the tibia
+   cluster's frame, axis direction from knee - ankle, carried per frame by the cluster's
+   rigid motion).
 3. Mocap frames where either leg point is missing are counted
    (``gt_frames_excluded``).
 4. Sensor timestamps are mapped to mocap time with the clock record,
@@ -44,7 +46,7 @@ from gaitval.errors import MarkerError, RegistrationError
 from gaitval.groundtruth.filters import differentiate, lowpass
 from gaitval.groundtruth.gaps import MAX_GAP_S, fill_short_gaps
 from gaitval.groundtruth.joints import joint_centre, source_label
-from gaitval.groundtruth.shank import cylinder_at_height, fit_cylinder, point_at_height
+from gaitval.groundtruth.shank import cylinder_at_height, fit_cylinder_cluster, point_at_height
 from gaitval.types import MocapTrial, ScanSeries, UltrasonicLog
 
 SIDES = ("L", "R")
@@ -201,7 +203,7 @@ def leg_points(mocap: MocapTrial, h: float, subject: dict | None = None,
                                        "knee-ankle axis instead")
             M = np.stack([markers[lb] for lb in tl], axis=1)
             axis = knee - ankle
-            cen, d, _ = fit_cylinder(M, axis, c["cylinder_marker_offset_m"])
+            cen, d, _ = fit_cylinder_cluster(M, axis, c["cylinder_marker_offset_m"])
             p, ok = cylinder_at_height(cen, d, h)
         else:
             p, ok = point_at_height(knee, ankle, h)

@@ -125,3 +125,57 @@ def cylinder_at_height(centre: np.ndarray, direction: np.ndarray, h: float
     p = centre + s[:, None] * direction
     p[~valid] = np.nan
     return p, valid
+
+
+def fit_cylinder_cluster(markers: np.ndarray, axis_dir: np.ndarray | None = None,
+                         marker_offset_m: float = 0.009
+                         ) -> tuple[np.ndarray, np.ndarray, float]:
+    """Tibia cylinder fitted once in the marker cluster's own frame, moved per frame.
+
+    The tibia markers form a (near) rigid cluster, so the cylinder is fixed in the
+    cluster's frame: the mean cluster shape (after per-frame Kabsch alignment) gets one
+    circle fit (:func:`fit_cylinder` on the mean shape) with the axis direction averaged
+    over the frames where ``axis_dir`` (knee - ankle) is known, expressed in the cluster
+    frame; every frame with all markers present then carries that axis by its rigid
+    transform.  This averages marker noise over the whole trial and keeps the axis through
+    gaps of the knee/ankle markers.
+
+    Returns
+    -------
+    centre : ndarray (n, 3), point on the axis (NaN where a tibia marker is missing)
+    direction : ndarray (n, 3), unit axis direction
+    skin_radius : float, metres
+    """
+    from gaitval.registration.rigid import batch_kabsch_3d
+
+    M = np.asarray(markers, dtype=float)
+    n = len(M)
+    ok = np.all(np.isfinite(M), axis=(1, 2))
+    centre = np.full((n, 3), np.nan)
+    direction = np.full((n, 3), np.nan)
+    if ok.sum() < 1:
+        return centre, direction, float("nan")
+    V = M[ok]
+    ref = V[0] - V[0].mean(axis=0)
+    for _ in range(2):
+        R, t = batch_kabsch_3d(ref, V)
+        local = np.einsum("nji,nkj->nki", R, V - t[:, None, :])       # R^T (p - t)
+        ref = local.mean(axis=0)
+    R, t = batch_kabsch_3d(ref, V)
+    d_loc = None
+    if axis_dir is not None:
+        A = np.asarray(axis_dir, dtype=float)[ok]
+        good = np.all(np.isfinite(A), axis=1)
+        if good.any():
+            a = A[good] / np.linalg.norm(A[good], axis=1, keepdims=True)
+            dl = np.einsum("nji,nj->ni", R[good], a).mean(axis=0)
+            d_loc = dl / np.linalg.norm(dl)
+    if d_loc is None:                      # principal axis of the cluster shape
+        _, _, Vt = np.linalg.svd(ref - ref.mean(axis=0))
+        d_loc = Vt[0]
+    c_loc, d_fit, skin = fit_cylinder(ref[None], d_loc[None], marker_offset_m)
+    centre[ok] = np.einsum("nij,j->ni", R, c_loc[0]) + t
+    d_f = np.einsum("nij,j->ni", R, d_loc)
+    d_f[d_f[:, 2] < 0] *= -1
+    direction[ok] = d_f
+    return centre, direction, float(skin[0])

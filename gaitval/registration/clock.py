@@ -14,8 +14,9 @@ precision by a parabola through the peak and its two neighbours.
   about 0.5 deg), the observed "foreground" indicator of each scan (range nearer than the
   static background, the person) versus the indicator predicted from the mocap leg points
   at sensor height (two circles of the subject's leg width, ray-cast in the sensor frame).
-  Each beam's sample time is the scan stamp plus ``i * time_increment`` when the scan time
-  is known (``meta['time_increment_s']`` or ``meta['scan_time_s']``), else the stamp.
+  Each beam's sample time is the scan stamp plus ``i * time_increment`` when the log states
+  it (``meta['time_increment_s']``), else the stamp (``sync_beam_timing: false`` always
+  uses the stamp).
 * :func:`estimate_clock` adds drift: offsets estimated in ``sync_windows`` windows of the
   trial are fitted by a line ``offset(t_mocap) = clock_offset_s + drift * t_mocap`` when
   the trial lasts at least ``drift_min_duration_s``; shorter trials report drift 0 and the
@@ -45,6 +46,7 @@ DEFAULTS = {
     "sync_moving_max_range_m": 1.5,
     "drift_min_duration_s": 60.0,
     "sync_windows": 4,
+    "sync_beam_timing": True,
 }
 
 
@@ -201,15 +203,14 @@ def estimate_clock_offset(t_a, sig_a, t_b, sig_b, max_lag_s: float, *,
 def beam_times(sensor) -> np.ndarray:
     """Per-beam sample times (n_scans, n_beams) on the sensor clock.
 
-    ``t[k] + i * time_increment``, with ``time_increment`` from ``meta['time_increment_s']``
-    or ``meta['scan_time_s'] * angle_increment / (2 pi)`` (one revolution per scan, as a
-    Hokuyo); the stamp itself when neither is known.
+    ``t[k] + i * time_increment`` when the log states the time between beams
+    (``meta['time_increment_s']``, ROS ``LaserScan.time_increment``); otherwise every beam
+    is taken at the stamp.  ``scan_time_s`` (the scan period) alone is not used: it does
+    not say whether the logger swept the beams or stamped a snapshot (gaitval's simulator
+    casts all beams at the stamp).
     """
     meta = sensor.meta or {}
-    inc = meta.get("time_increment_s")
-    if inc is None and meta.get("scan_time_s"):
-        inc = float(meta["scan_time_s"]) * abs(sensor.angle_increment) / (2 * np.pi)
-    inc = float(inc or 0.0)
+    inc = float(meta.get("time_increment_s") or 0.0)
     return sensor.t[:, None] + inc * np.arange(sensor.n_beams)[None, :]
 
 
@@ -268,7 +269,9 @@ def lrs_occupancy_signals(sensor, background: np.ndarray, legs_s: np.ndarray,
             fg &= r <= c["sync_moving_max_range_m"]
     k = max(1, int(round(np.deg2rad(c["sync_bin_deg"]) / abs(sensor.angle_increment))))
     obs = _bin(fg.astype(float), k)
-    obs_t = _bin(beam_times(sensor), k)
+    bt = beam_times(sensor) if c["sync_beam_timing"] else \
+        np.repeat(sensor.t[:, None], sensor.n_beams, axis=1)
+    obs_t = _bin(bt, k)
     pred = _bin(predicted_occupancy(legs_s, sensor.angles, radius_m), k)
     return obs, obs_t, pred
 
