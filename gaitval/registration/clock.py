@@ -299,7 +299,8 @@ def estimate_clock(t_mocap: np.ndarray, pred: np.ndarray, obs_t: np.ndarray, obs
         ``sync_peak`` is the NCC of the whole-trial peak clipped to 0..1.  With drift
         (trials of at least ``drift_min_duration_s``), window offsets ``tau_w`` at window
         mocap-time centres ``c_w`` are fitted by ``tau_w = clock_offset_s + d * c_w``
-        (least squares) and ``clock_drift_ppm = d * 1e6 / (1 + ...)`` to first order.
+        (least squares; exact for the clock model, since ``t_sensor - t_mocap =
+        clock_offset_s + drift * 1e-6 * t_mocap``) and ``clock_drift_ppm = d * 1e6``.
     """
     c = dict(DEFAULTS)
     c.update(cfg or {})
