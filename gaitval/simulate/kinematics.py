@@ -1,0 +1,420 @@
+"""Gait kinematics of the simulated participants: footstep plans → shanks → leg point at sensor height.
+
+The model is deliberately small and physical:
+
+1. A **path** (straight lines and arcs) is walked by a sequence of **body poses**, one per
+   step, spaced by the step length (shorter in turns); feet land left and right of the
+   pose at half the step width, plus placement scatter (:func:`plan_steps`).
+2. **Timing**: contact times advance by the step time (with subject variability);
+   each foot lifts off ``(1 - stance_frac) * stride`` before its next contact, so the
+   stance phase is ``stance_frac`` (≈ 0.6) of the gait cycle.
+3. **Feet and shanks** (:func:`leg_kinematics`): the ankle joint centre rests at its
+   foothold during stance (rising and moving forward with the heel in terminal stance),
+   and follows a minimum-jerk path to the next foothold during swing with a clearance
+   bump.  The shank (ankle → knee joint centre) tilts in the sagittal plane of the foot
+   following a periodic curve of the gait phase, so the shank point at sensor height is
+   nearly still in mid-stance and moves several times faster than the body in swing.
+
+References
+----------
+Yorozu A, Moriguchi T, Takahashi M. Improved leg tracking considering gait phase and
+spline-based interpolation during turning motion in walk tests. Sensors 2015;15:22451–22472.
+
+Yorozu A, Nishiguchi S, Yamada M, Aoyama T, Moriguchi T, Takahashi M. Gait measurement
+system for the multi-target stepping task using a laser range sensor. Sensors 2015;15:11151–11168.
+
+Perry J, Burnfield JM. Gait Analysis: Normal and Pathological Function, 2nd ed. SLACK 2010
+(shank and knee angles over the gait cycle used for the tilt curve).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+#: Shank tilt (knee ahead of ankle, degrees) over the gait cycle at a nominal step length of
+#: 0.70 m; contact at phase 0, toe off at phase 0.6.  Shank-to-vertical angles after Perry &
+#: Burnfield (2010): about 20° with the ankle ahead of the knee at initial contact, near
+#: vertical in mid-stance (the "leg perpendicular to the floor" of seed 001 §2.5.1),
+#: about 45° knee-ahead at toe off, back through vertical late in swing.
+_TILT_PHASE = np.array([0.00, 0.10, 0.22, 0.32, 0.45, 0.60, 0.72, 0.85, 0.93, 1.00])
+_TILT_DEG = np.array([-18.0, -9.0, -1.5, 2.0, 12.0, 42.0, 36.0, 2.0, -17.0, -18.0])
+_TILT = CubicSpline(_TILT_PHASE, _TILT_DEG, bc_type="periodic")
+TOE_OFF_PHASE = 0.60
+MID_STANCE_PHASE = 0.27
+
+
+@dataclass
+class GaitParams:
+    """One walker's gait (SI units).
+
+    ``step_cv`` is the coefficient of variation of step time and length; ``place_sd_m``
+    the standard deviation of foot placement around the plan (elderly > young).
+    """
+
+    step_length_m: float = 0.70
+    step_width_m: float = 0.10
+    step_time_s: float = 0.50
+    stance_frac: float = 0.60
+    step_cv: float = 0.03
+    place_sd_m: float = 0.015
+    shank_length_m: float = 0.42
+    ankle_height_m: float = 0.08
+    hip_height_m: float = 0.90
+    turn_step_factor: float = 0.6       # step length in a tight turn / straight step length
+    turn_time_factor: float = 1.15      # step time in a tight turn / straight step time
+    knee_half_sep_m: float = 0.08       # knee joint centre from the body midline (frontal plane)
+
+
+@dataclass
+class Path2D:
+    """A densely sampled walking path: arc length ``s``, points ``xy``, heading, curvature."""
+
+    s: np.ndarray
+    xy: np.ndarray
+    heading: np.ndarray
+    curvature: np.ndarray
+    labels: np.ndarray = field(default_factory=lambda: np.array([], dtype=object))
+
+    @property
+    def length(self) -> float:
+        return float(self.s[-1])
+
+    def at(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        s = np.clip(np.asarray(s, dtype=float), 0.0, self.length)
+        x = np.interp(s, self.s, self.xy[:, 0])
+        y = np.interp(s, self.s, self.xy[:, 1])
+        h = np.interp(s, self.s, np.unwrap(self.heading))
+        k = np.interp(s, self.s, self.curvature)
+        return np.column_stack([x, y]), h, k
+
+
+def make_path(start_xy, start_heading: float, segments: list[tuple], ds: float = 0.005
+              ) -> Path2D:
+    """Build a path from ``("line", length, label)`` and ``("arc", radius, dtheta, label)``.
+
+    ``dtheta`` > 0 turns left (counter-clockwise).  Each sample keeps the segment label
+    (e.g. ``forward``, ``turning``) so phases can be read off the path.
+    """
+    xy = [np.asarray(start_xy, dtype=float)]
+    hd = [float(start_heading)]
+    kk = [0.0]
+    lab = [segments[0][-1]]
+    for seg in segments:
+        if seg[0] == "line":
+            n = max(1, int(np.ceil(seg[1] / ds)))
+            step = seg[1] / n
+            for _ in range(n):
+                p = xy[-1] + step * np.array([np.cos(hd[-1]), np.sin(hd[-1])])
+                xy.append(p)
+                hd.append(hd[-1])
+                kk.append(0.0)
+                lab.append(seg[-1])
+        elif seg[0] == "arc":
+            r, dth = float(seg[1]), float(seg[2])
+            n = max(1, int(np.ceil(abs(dth) * r / ds)))
+            for _ in range(n):
+                h0 = hd[-1]
+                h1 = h0 + dth / n
+                chord = 2 * r * np.sin(abs(dth / n) / 2)
+                hm = 0.5 * (h0 + h1)
+                xy.append(xy[-1] + chord * np.array([np.cos(hm), np.sin(hm)]))
+                hd.append(h1)
+                kk.append(np.sign(dth) / r)
+                lab.append(seg[-1])
+        else:
+            raise ValueError(f"unknown path segment {seg[0]!r}")
+    xy = np.array(xy)
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(xy, axis=0).T))])
+    return Path2D(s=s, xy=xy, heading=np.array(hd), curvature=np.array(kk),
+                  labels=np.array(lab, dtype=object))
+
+
+@dataclass
+class StepPlan:
+    """Footholds in time order.
+
+    Arrays of length ``n`` (one entry per foot contact, the first two are the initial
+    stance of L and R at ``t_contact = -inf``-like start times): ``side`` (0 = L, 1 = R),
+    ``t_contact``, ``t_off`` (lift-off time of this foot *before* this contact; NaN for
+    the initial stance), ``xy`` (n, 2), ``heading`` (n,), ``label`` (path label),
+    ``cross`` (True when the foot landed across the line of the other, stance foot).
+    """
+
+    side: np.ndarray
+    t_contact: np.ndarray
+    t_off: np.ndarray
+    xy: np.ndarray
+    heading: np.ndarray
+    label: np.ndarray
+    cross: np.ndarray
+    t_start: float
+    t_end: float
+
+    def foot(self, side: int) -> dict:
+        m = self.side == side
+        return {k: getattr(self, k)[m] for k in ("t_contact", "t_off", "xy", "heading",
+                                                   "label", "cross")}
+
+
+def plan_steps(path: Path2D, gp: GaitParams, rng: np.random.Generator, *, t0: float = 0.0,
+               first_side: int = 1, end_pose: tuple | None = None,
+               targets: np.ndarray | None = None, start_half_width: float | None = None
+               ) -> StepPlan:
+    """Footholds and contact times along ``path``.
+
+    Parameters
+    ----------
+    path : Path2D
+    gp : GaitParams
+    rng : Generator
+    t0 : float
+        Time of the first foot lift-off (gait initiation).
+    first_side : int
+        Foot that steps first (0 = L, 1 = R).
+    end_pose : (x, y, heading, n_steps), optional
+        After the path, pivot in ``n_steps`` small steps to this pose (turn to sit, TUG).
+    targets : ndarray (m, 2), optional
+        Foot placements to aim at instead of the nominal ones (MTST); one per step in order.
+    start_half_width : float, optional
+        Half distance between the feet before the first step (default: half step width;
+        seated people keep their feet about hip width apart).
+
+    Notes
+    -----
+    Step length is shortened and step time lengthened with the largest path curvature
+    ``k`` under the coming step: ``L = L0 (1 - (1 - turn_step_factor) min(1, 0.35 |k|))``.  A tight turn (radius ≤ 0.35 m) uses the
+    full factor.  Cross steps are not scripted: a step is flagged ``cross`` when the
+    landing foot ends up on the far side of the stance foot in the stance foot's heading
+    frame (the definition of seed 001 §2.5.3 applied to the truth).
+    """
+    sides, tc, xy, hd, lab = [], [], [], [], []
+    # initial stance: both feet beside the path start
+    p0, h0, _ = path.at(np.array([0.0]))
+    nrm0 = np.array([-np.sin(h0[0]), np.cos(h0[0])])
+    for side in (0, 1):
+        sgn = 1.0 if side == 0 else -1.0
+        sides.append(side)
+        tc.append(-np.inf)
+        hw = gp.step_width_m / 2 if start_half_width is None else start_half_width
+        xy.append(p0[0] + sgn * nrm0 * hw)
+        hd.append(h0[0])
+        lab.append(path.labels[0])
+    s = 0.0
+    t = t0
+    side = first_side
+    k_step = 0
+    step_times = []
+    while True:
+        # the curvature under the coming step sets its length and duration
+        _, _, kap = path.at(s + np.linspace(0.0, gp.step_length_m, 9))
+        turn = min(1.0, float(np.abs(kap).max()) * 0.35)
+        L = gp.step_length_m * (1 - (1 - gp.turn_step_factor) * turn)
+        L *= 1 + gp.step_cv * rng.standard_normal()
+        if k_step == 0:
+            L *= 0.5                                # first step starts from standing
+        T = gp.step_time_s * (1 + (gp.turn_time_factor - 1) * turn)
+        T *= 1 + gp.step_cv * rng.standard_normal()
+        s_new = s + L
+        last = s_new >= path.length - 0.5 * gp.step_length_m * 0.5
+        if last:
+            s_new = path.length
+        p, h, _ = path.at(np.array([s_new]))
+        nrm = np.array([-np.sin(h[0]), np.cos(h[0])])
+        sgn = 1.0 if side == 0 else -1.0
+        foot = p[0] + sgn * nrm * gp.step_width_m / 2
+        if targets is not None and k_step < len(targets) and np.all(np.isfinite(targets[k_step])):
+            foot = np.asarray(targets[k_step], dtype=float).copy()
+        foot = foot + gp.place_sd_m * rng.standard_normal(2)
+        t = t + T if k_step > 0 else t + T * 0.9
+        sides.append(side)
+        tc.append(t)
+        xy.append(foot)
+        hd.append(h[0] + 0.03 * rng.standard_normal())
+        lab.append(path.labels[int(np.searchsorted(path.s, s_new).clip(0, len(path.s) - 1))])
+        step_times.append(T)
+        side = 1 - side
+        s = s_new
+        k_step += 1
+        if last:
+            break
+    if end_pose is not None:
+        ex, ey, eh, n_piv = end_pose
+        start_c = 0.5 * (np.array(xy[-1]) + np.array(xy[-2]))
+        h_start = hd[-1]
+        for j in range(1, int(n_piv) + 1):
+            f = j / n_piv
+            c = (1 - f) * start_c + f * np.array([ex, ey])
+            h = (1 - f) * h_start + f * eh
+            nrm = np.array([-np.sin(h), np.cos(h)])
+            sgn = 1.0 if side == 0 else -1.0
+            T = gp.step_time_s * gp.turn_time_factor * 1.2 * (1 + gp.step_cv * rng.standard_normal())
+            t = t + T
+            sides.append(side)
+            tc.append(t)
+            xy.append(c + sgn * nrm * gp.step_width_m / 2 + gp.place_sd_m * rng.standard_normal(2))
+            hd.append(h)
+            lab.append(path.labels[-1])
+            step_times.append(T)
+            side = 1 - side
+    # closing step: the trailing foot joins the other one
+    h = hd[-1]
+    nrm = np.array([-np.sin(h), np.cos(h)])
+    sgn = 1.0 if side == 0 else -1.0
+    other = np.array(xy[-1])
+    T = gp.step_time_s * (1 + gp.step_cv * rng.standard_normal())
+    t = t + T
+    sides.append(side)
+    tc.append(t)
+    xy.append(other + (2 * sgn * nrm * gp.step_width_m / 2))
+    hd.append(h)
+    lab.append(lab[-1])
+    step_times.append(T)
+
+    return plan_from_footholds(np.array(sides), np.array(tc, dtype=float), np.array(xy),
+                               np.array(hd), np.array(lab, dtype=object),
+                               np.array(step_times), gp, t0)
+
+
+def plan_from_footholds(sides, tc, xy, hd, lab, step_times, gp: GaitParams, t0: float
+                        ) -> StepPlan:
+    """Complete a foothold list (first two = initial stance) with lift-off times and cross flags.
+
+    Lift-off of the foot landing at contact ``i``: ``t_off = t_c - (1 - stance_frac) * stride``
+    with ``stride = T_i + T_{i-1}`` (two step times), so stance is ``stance_frac`` of the cycle.
+    """
+    t_off = np.full(len(tc), np.nan)
+    st = np.concatenate([[np.nan, np.nan], np.asarray(step_times, dtype=float)])
+    for i in range(2, len(tc)):
+        prev_T = st[i - 1] if np.isfinite(st[i - 1]) else st[i]
+        swing = (1 - gp.stance_frac) * (st[i] + prev_T)
+        t_off[i] = t0 if i == 2 else max(tc[i] - swing, tc[i - 2] + 0.05)
+    # cross-step truth (seed 001 §2.5.3): landing foot on the far side of the stance foot
+    cross = np.zeros(len(tc), dtype=bool)
+    for i in range(2, len(tc)):
+        j = i - 1
+        while j >= 0 and sides[j] == sides[i]:
+            j -= 1
+        if j < 0:
+            continue
+        # walking direction: bisector of the stance and the landing foot's headings
+        h = float(np.angle(np.exp(1j * hd[j]) + np.exp(1j * hd[i])))
+        nrm = np.array([-np.sin(h), np.cos(h)])
+        lateral = float((xy[i] - xy[j]) @ nrm)      # + = left of the stance foot
+        want = 1.0 if sides[i] == 0 else -1.0
+        cross[i] = lateral * want < 0.0
+    return StepPlan(side=sides, t_contact=tc, t_off=t_off, xy=xy, heading=hd,
+                    label=lab, cross=cross, t_start=t0, t_end=float(tc[-1]))
+
+
+def _minjerk(tau: np.ndarray) -> np.ndarray:
+    tau = np.clip(tau, 0.0, 1.0)
+    return tau ** 3 * (10 - 15 * tau + 6 * tau ** 2)
+
+
+def _smoothstep(x: np.ndarray) -> np.ndarray:
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3 - 2 * x)
+
+
+@dataclass
+class LegState:
+    """Per-frame state of one leg (arrays over the requested times).
+
+    ``ankle``, ``knee`` (n, 3) joint centres; ``heading`` (n,) foot heading; ``stance``
+    (n,) bool; ``tilt`` (n,) shank tilt (rad, knee ahead positive); ``heel_rise`` (n,)
+    in [0, 1]; ``swing_tau`` (n,) progress through swing (NaN in stance).
+    """
+
+    ankle: np.ndarray
+    knee: np.ndarray
+    heading: np.ndarray
+    stance: np.ndarray
+    tilt: np.ndarray
+    heel_rise: np.ndarray
+
+    def point_at_height(self, h: float) -> np.ndarray:
+        """(n, 2) horizontal position of the shank axis at height ``h`` (the "leg centre")."""
+        dz = self.knee[:, 2] - self.ankle[:, 2]
+        u = (h - self.ankle[:, 2]) / np.where(np.abs(dz) < 1e-6, 1e-6, dz)
+        return self.ankle[:, :2] + u[:, None] * (self.knee[:, :2] - self.ankle[:, :2])
+
+
+def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
+                   posture_tilt: np.ndarray | None = None) -> LegState:
+    """Ankle and knee joint centres of one leg at times ``t`` (vectorised over frames).
+
+    Notes
+    -----
+    Stance: ankle at the foothold; heel rise after 70 % of stance lifts the ankle by up to
+    0.05 m and moves it 0.03 m forward (rotation about the forefoot).  Swing: minimum-jerk
+    horizontal path ``x(τ) = x0 + (x1 - x0)(10τ³ - 15τ⁴ + 6τ⁵)`` and a clearance bump
+    ``0.09 sin(πτ)^1.5`` m.  Shank tilt ``θ(φ)`` from the periodic spline of the gait phase
+    ``φ`` (0 contact, 0.6 toe off), scaled by step length / 0.70 m (shank excursion grows
+    with step length); before gait initiation and after the last contact the phase is
+    clamped to mid-stance (standing), plus an optional posture tilt (sit-to-stand).
+    """
+    f = plan.foot(side)
+    tc, toff, fxy, fh = f["t_contact"], f["t_off"], f["xy"], f["heading"]
+    n = len(t)
+    m = len(tc)
+    # event timeline: contact j at tc[j] (j=0 initial, tc=-inf), lift-off j at toff[j]
+    j = np.searchsorted(tc, t, side="right") - 1            # last contact <= t
+    j = np.clip(j, 0, m - 1)
+    jn = np.clip(j + 1, 0, m - 1)
+    has_next = (j + 1) < m
+    off_next = np.where(has_next, toff[jn], np.inf)
+    swing = has_next & (t >= off_next)
+    # swing: from foothold j to foothold j+1
+    tau = np.where(swing, (t - off_next) / np.maximum(tc[jn] - off_next, 1e-6), 0.0)
+    # stance progress for heel rise / phase
+    t_c = np.where(np.isfinite(tc[j]), tc[j], -1e9)
+    st_dur = np.where(has_next, off_next - t_c, np.inf)
+    stance_prog = np.clip((t - t_c) / np.where(np.isfinite(st_dur), st_dur, 1.0), 0, 1)
+    heel = np.where(~swing & has_next & np.isfinite(st_dur) & np.isfinite(tc[j]),
+                    _smoothstep((stance_prog - 0.7) / 0.3), 0.0)
+    # heel rise also before the first lift-off (gait initiation from standing)
+    first = ~swing & has_next & ~np.isfinite(tc[j])
+    heel = np.where(first, _smoothstep(1 - (off_next - t) / 0.25), heel)
+    hdg0 = fh[j]
+    hdg1 = fh[jn]
+    dh = (hdg1 - hdg0 + np.pi) % (2 * np.pi) - np.pi
+    g = _minjerk(tau)
+    heading = np.where(swing, hdg0 + dh * g, hdg0)
+    fwd0 = np.column_stack([np.cos(hdg0), np.sin(hdg0)])
+    heel_off = fxy[j] + (0.03 * 1.0) * fwd0              # ankle position at toe off
+    ax = np.where(swing[:, None], heel_off + (fxy[jn] - heel_off) * g[:, None],
+                  fxy[j] + 0.03 * heel[:, None] * fwd0)
+    az = gp.ankle_height_m + 0.05 * heel
+    bump = 0.09 * np.sin(np.pi * tau) ** 1.5
+    az = np.where(swing, gp.ankle_height_m + 0.05 * (1 - _smoothstep(tau / 0.3)) + bump, az)
+    # gait phase phi: stance 0..0.6, swing 0.6..1
+    phi = np.where(swing, TOE_OFF_PHASE + (1 - TOE_OFF_PHASE) * tau,
+                   TOE_OFF_PHASE * stance_prog)
+    # standing before initiation: hold mid-stance, ramp into terminal stance in 0.35 s
+    pre = ~swing & ~np.isfinite(tc[j])
+    ramp = _smoothstep(1 - (off_next - t) / 0.35)
+    phi = np.where(pre, MID_STANCE_PHASE + (TOE_OFF_PHASE - MID_STANCE_PHASE) * ramp, phi)
+    # after the last contact: go to mid-stance and stay
+    post = ~has_next
+    phi = np.where(post, np.minimum(MID_STANCE_PHASE,
+                                    TOE_OFF_PHASE * (t - t_c) / (gp.step_time_s * 2 * gp.stance_frac)),
+                   phi)
+    amp = np.clip(gp.step_length_m / 0.70, 0.4, 1.2)
+    tilt_deg = _TILT(phi) * amp
+    # blend the last step's approach to standing (no tilt) so the body ends upright
+    tilt = np.deg2rad(tilt_deg - np.where(post | pre, _TILT(MID_STANCE_PHASE) * amp, 0.0))
+    if posture_tilt is not None:
+        tilt = tilt + posture_tilt
+    fwd = np.column_stack([np.cos(heading), np.sin(heading)])
+    outward = (1.0 if side == 0 else -1.0) * np.column_stack([-np.sin(heading), np.cos(heading)])
+    ankle = np.column_stack([ax, az])
+    knee = ankle.copy()
+    knee[:, :2] += gp.shank_length_m * np.sin(tilt)[:, None] * fwd
+    # frontal plane: knees sit about under the hip joint centres (± knee_half_sep_m from the
+    # midline) while the feet land at ± step_width/2, so each shank leans outward upward
+    knee[:, :2] += max(0.0, gp.knee_half_sep_m - gp.step_width_m / 2) * outward
+    knee[:, 2] += gp.shank_length_m * np.cos(tilt)
+    return LegState(ankle=ankle, knee=knee, heading=heading, stance=~swing, tilt=tilt,
+                    heel_rise=heel)
