@@ -100,7 +100,7 @@ def read_ultrasonic(path: str | Path, *, trial: str | None = None) -> Ultrasonic
         raise FileFormatError(f"ultrasonic log lacks columns {missing}", path=path,
                               trial=trial)
     df = tab.select(need).to_pandas()
-    data = df[need[2:]].to_numpy(dtype=np.float64)
+    data = df[need[2:]].to_numpy(dtype=np.float64, copy=True)
     with np.errstate(invalid="ignore"):
         data[~np.isfinite(data) | (data <= 0)] = np.nan
     t = df["t_s"].to_numpy(dtype=np.float64)
