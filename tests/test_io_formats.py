@@ -1,0 +1,200 @@
+"""gaitval's own formats (scan log, ultrasonic log, annotations): round trips, the
+no-return mapping, timestamp reporting, bad files, and ``describe`` on each kind."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitval.errors import FileFormatError
+from gaitval.io.annotations import read_annotations, write_annotations
+from gaitval.io.inspect import describe, format_description, kind_of
+from gaitval.io.scanlog import read_scanlog, write_scanlog
+from gaitval.io.ultrasonic import read_ultrasonic, write_ultrasonic
+from gaitval.types import ScanSeries, UltrasonicLog
+
+
+def make_series() -> ScanSeries:
+    rng = np.random.default_rng(3)
+    r = rng.uniform(0.2, 8.0, size=(6, 11))
+    r[0, 3] = np.nan                      # no return already NaN
+    r[1, 4] = np.inf                      # driver's inf
+    r[2, 5] = 0.0                         # zero
+    r[3, 6] = 45.0                        # beyond range_max
+    r[4, 7] = 0.05                        # below range_min
+    t = np.array([0.0, 0.025, 0.05, 0.05, 0.075, 0.07])   # duplicate at 3, going back at 5
+    return ScanSeries(t=t, ranges=r, angle_min=-np.pi / 2, angle_increment=np.pi / 10,
+                      range_min=0.1, range_max=30.0, sensor_model="Hokuyo UTM-30LX",
+                      mounting_height_m=0.27)
+
+
+@pytest.mark.parametrize("unit,tol", [("mm", 0.0005), ("m", 1e-6)])
+def test_scanlog_roundtrip(tmp_path, unit, tol):
+    s = make_series()
+    p = write_scanlog(tmp_path / f"a_{unit}.scan.parquet", s, range_unit=unit)
+    r = read_scanlog(p)
+    bad = np.zeros(s.ranges.shape, dtype=bool)
+    bad[0, 3] = bad[1, 4] = bad[2, 5] = bad[3, 6] = bad[4, 7] = True
+    assert np.array_equal(np.isnan(r.ranges), bad)
+    assert r.n_no_return_raw == 5
+    assert np.max(np.abs(r.ranges[~bad] - s.ranges[~bad])) <= tol
+    assert np.array_equal(r.t, s.t)                                 # never reordered
+    assert list(r.timestamp_issues["problem"]) == ["duplicate", "non-monotonic"]
+    assert list(r.timestamp_issues["index"]) == [3, 5]
+    assert (r.angle_min, r.angle_increment) == (s.angle_min, s.angle_increment)
+    assert r.sensor_model == "Hokuyo UTM-30LX" and r.mounting_height_m == 0.27
+    assert r.meta["range_unit"] == unit
+
+
+def test_scanlog_mm_is_readable_without_gaitval(tmp_path):
+    import pyarrow.parquet as pq
+
+    p = write_scanlog(tmp_path / "b.scan.parquet", make_series())
+    tab = pq.read_table(p)
+    meta = json.loads(tab.schema.metadata[b"gaitval:scanlog"])
+    mm = np.stack(tab["ranges"].to_numpy(zero_copy_only=False))
+    assert meta["range_unit"] == "mm" and meta["n_beams"] == 11
+    assert mm[1, 4] == 0 and mm[0, 3] == 0                          # 0 = no return on disk
+    assert mm.dtype.kind == "u"
+
+
+def test_scanlog_bad_files(tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    plain = tmp_path / "plain.scan.parquet"
+    pq.write_table(pa.table({"t_s": [0.0], "ranges": [[1, 2]]}), plain)
+    with pytest.raises(FileFormatError, match="no 'gaitval:scanlog' metadata"):
+        read_scanlog(plain, trial="T1")
+    junk = tmp_path / "junk.scan.parquet"
+    junk.write_text("not parquet")
+    with pytest.raises(FileFormatError, match="junk.scan.parquet"):
+        read_scanlog(junk)
+    partial = tmp_path / "partial.scan.parquet"
+    tab = pa.table({"t_s": [0.0], "ranges": [[1, 2]]}).replace_schema_metadata(
+        {b"gaitval:scanlog": json.dumps({"format": "gaitval-scanlog"}).encode()})
+    pq.write_table(tab, partial)
+    with pytest.raises(FileFormatError, match="metadata incomplete"):
+        read_scanlog(partial)
+
+
+def make_us() -> UltrasonicLog:
+    tof = np.array([[1.0e-3, 2.0e-3, 3.0e-3], [1.1e-3, np.nan, 3.1e-3],
+                    [1.2e-3, 2.2e-3, 0.0], [1.3e-3, 2.3e-3, 3.3e-3]])
+    anchors = pd.DataFrame({"anchor": ["ANC1", "ANC2", "ANC3"], "x_m": [0.0, 2.0, 0.0],
+                            "y_m": [0.0, 0.0, 1.5], "z_m": [0.0, 0.0, 0.0]})
+    return UltrasonicLog(t=np.array([0.0, 0.02, 0.02, 0.06]),
+                         temperature_c=np.array([21.0, 21.0, 21.5, 21.5]),
+                         anchors=anchors, tof_s=tof)
+
+
+def test_ultrasonic_roundtrip(tmp_path):
+    u = make_us()
+    p = write_ultrasonic(tmp_path / "a.us.parquet", u, sensor_model="MB1360")
+    r = read_ultrasonic(p)
+    assert r.anchor_ids == ["ANC1", "ANC2", "ANC3"]
+    assert np.allclose(r.anchors[["x_m", "y_m", "z_m"]], u.anchors[["x_m", "y_m", "z_m"]])
+    nan = np.isnan(r.tof_s)
+    assert nan[1, 1] and nan[2, 2] and nan.sum() == 2                # NaN and 0 -> no echo
+    assert np.allclose(r.tof_s[~nan], u.tof_s[~nan])
+    assert np.array_equal(r.t, u.t) and np.array_equal(r.temperature_c, u.temperature_c)
+    assert list(r.meta["timestamp_issues"]["problem"]) == ["duplicate"]
+
+
+def test_ultrasonic_bad_file(tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    p = tmp_path / "x.us.parquet"
+    pq.write_table(pa.table({"t_s": [0.0]}), p)
+    with pytest.raises(FileFormatError, match="gaitval:ultrasonic"):
+        read_ultrasonic(p)
+
+
+EVENTS = pd.DataFrame({
+    "t_s": [1.25, 1.8, 2.4, 3.0],
+    "event": ["foot_contact", "target_step", "target_step", "cross_step"],
+    "side": ["L", "R", "L", "R"],
+    "target": ["", "T3", "T5", ""],
+    "value": ["", "hit", "miss", "yes"],
+})
+
+
+def test_annotations_roundtrip(tmp_path):
+    p = write_annotations(tmp_path / "s1.annotations.csv", EVENTS, time_base="video",
+                          time_offset_s=-0.5, rater="R2", fps=30.0)
+    ev, meta = read_annotations(p)
+    assert meta["time_base"] == "video" and float(meta["time_offset_s"]) == -0.5
+    assert list(ev["event"]) == list(EVENTS["event"])
+    assert list(ev["value"]) == list(EVENTS["value"])
+    assert list(ev["target"]) == list(EVENTS["target"])
+    assert list(ev["rater"]) == ["R2"] * 4
+    assert np.allclose(ev["t_mocap_s"], EVENTS["t_s"] - 0.5)
+
+
+def test_annotations_bad_files(tmp_path):
+    p = tmp_path / "a.annotations.csv"
+    p.write_text("t_s,event,side\n1.0,foot_contact,L\n")
+    with pytest.raises(FileFormatError, match="gaitval-annotations v1"):
+        read_annotations(p)
+    p.write_text("# gaitval-annotations v1\nt_s,event,side\n1.0,foot_contact,X\n")
+    with pytest.raises(FileFormatError, match="line 3"):
+        read_annotations(p)
+    p.write_text("# gaitval-annotations v1\nt_s,event,side\nabc,foot_contact,L\n")
+    with pytest.raises(FileFormatError, match="not a number"):
+        read_annotations(p)
+
+
+# -- describe() on each kind ---------------------------------------------------------------
+
+def test_describe_scanlog(tmp_path):
+    p = write_scanlog(tmp_path / "d.scan.parquet", make_series())
+    d = describe(p)
+    json.dumps(d, allow_nan=False)
+    assert d["kind"] == "scanlog" and d["n_scans"] == 6 and d["n_beams"] == 11
+    assert d["angle_min_deg"] == pytest.approx(-90.0)
+    assert d["angle_max_deg"] == pytest.approx(90.0)
+    assert d["angle_increment_deg"] == pytest.approx(18.0)
+    assert d["n_no_return"] == 5 and d["n_timestamp_issues"] == 2
+    assert d["rate_hz"] == pytest.approx(40.0)                  # median of positive steps
+    assert d["sensor_model"] == "Hokuyo UTM-30LX" and d["mounting_height_m"] == 0.27
+    text = format_description(d)
+    assert "6" in text and "11" in text and "Hokuyo" in text and "non-monotonic" in text
+
+
+def test_describe_ultrasonic(tmp_path):
+    p = write_ultrasonic(tmp_path / "d.us.parquet", make_us())
+    d = describe(p)
+    json.dumps(d, allow_nan=False)
+    assert d["kind"] == "ultrasonic" and d["n_samples"] == 4 and d["quantity"] == "tof"
+    assert [a["anchor"] for a in d["anchors"]] == ["ANC1", "ANC2", "ANC3"]
+    assert d["no_echo"] == {"ANC1": 0, "ANC2": 1, "ANC3": 1}
+    assert d["duration_s"] == pytest.approx(0.06)
+    assert "ANC2" in format_description(d)
+
+
+def test_describe_annotations(tmp_path):
+    p = write_annotations(tmp_path / "d.annotations.csv", EVENTS)
+    d = describe(p)
+    json.dumps(d, allow_nan=False)
+    assert d["kind"] == "annotations" and d["n_events"] == 4
+    assert d["events"] == {"cross_step": 1, "foot_contact": 1, "target_step": 2}
+    assert d["target_steps"] == {"hit": 1, "miss": 1}
+    assert d["time_base"] == "video"
+    assert "target_step 2" in format_description(d)
+
+
+def test_unknown_and_missing_files(tmp_path):
+    f = tmp_path / "notes.txt"
+    f.write_text("hello")
+    with pytest.raises(FileFormatError, match="unknown file kind") as exc:
+        describe(f)
+    assert "notes.txt" in str(exc.value)
+    with pytest.raises(FileFormatError, match="not found"):
+        kind_of(tmp_path / "gone.c3d")
+    folder = tmp_path / "folder"
+    folder.mkdir()
+    with pytest.raises(FileFormatError, match="unknown file kind"):
+        describe(folder)
