@@ -56,7 +56,8 @@ to the board about 0.3 m in front of it; held at 25-35 degrees, released after 1
 to swing (nonlinear pendulum, damping ratio 0.03) for ``pendulum_duration_s``.
 
 Truth (for tests only, never read by the pipeline) goes to ``out_dir/truth/<trial>/``:
-``tx.parquet`` (true transmitter path in field and ultrasonic frames on the mocap clock),
+``tx.parquet`` (true transmitter path in field and ultrasonic frames on the mocap clock,
+100 Hz, float32 coordinates),
 ``strides.csv`` (true right-heel strikes, durations, belt-relative stride lengths) and
 ``meta.json`` (clock offset and drift, board pose, noise settings); and one row per trial
 in ``out_dir/truth/ultrasonic_truth.csv``.
@@ -293,7 +294,10 @@ def _write_trial(out_dir: Path, folder: str, trial: str, labels, xyz, mocap_rate
     write_ultrasonic(out_dir / us_rel, log, transmitter="right heel" if strides is not None
                      else "pendulum", sensor_model="simulated 40 kHz TOA system (seed 003)")
     tdir = out_dir / "truth" / trial
-    write_parquet(truth_tx, tdir / "tx.parquet")
+    step = max(1, int(round(mocap_rate / 100.0)))       # truth path at 100 Hz, float32
+    small = truth_tx.iloc[::step].reset_index(drop=True)
+    small = small.astype({c: np.float32 for c in small.columns if c != "t_s"})
+    write_parquet(small, tdir / "tx.parquet")
     write_text(tdir / "meta.json", json.dumps(truth_meta, indent=1, sort_keys=True) + "\n")
     if strides is not None:
         write_csv(strides, tdir / "strides.csv", float_format="%.6f")
@@ -390,8 +394,8 @@ def _pendulum_theta(t: np.ndarray, L: float, theta0: float, zeta: float, t_relea
         return [s[1], -w * w * np.sin(s[0]) - 2 * zeta * w * s[1]]
 
     t_end = max(float(t.max()) - t_release, 0.0) + 0.1
-    sol = solve_ivp(f, (0.0, t_end), [theta0, 0.0], method="DOP853", rtol=1e-10,
-                    atol=1e-12, dense_output=True)
+    sol = solve_ivp(f, (0.0, t_end), [theta0, 0.0], method="DOP853", rtol=1e-9,
+                    atol=1e-11, dense_output=True)
     tau = np.clip(t - t_release, 0.0, None)
     return sol.sol(tau)[0]
 
@@ -407,15 +411,17 @@ def simulate_pendulum_trial(rng: np.random.Generator, cfg: dict, R: np.ndarray,
     theta0 = np.deg2rad(rng.uniform(25, 35)) * (1 if rng.random() < 0.5 else -1)
     t_rel = 1.0
 
-    def tx_at(t):
-        th = _pendulum_theta(t, L, theta0, 0.03, t_rel)
+    def tx_at(th):
         s = L * np.sin(th)
         p = np.column_stack([pivot_u[0] + s * np.cos(tilt), pivot_u[1] - L * np.cos(th),
                              pivot_u[2] + s * np.sin(tilt)])
         return p
 
     t_m = np.arange(int(round(dur * rate))) / rate
-    tx_u = tx_at(t_m)
+    t_us, t_true, offset, drift = _clock(rng, dur, us_rate)
+    # one integration of the swing for both clocks' sample instants
+    th_all = _pendulum_theta(np.concatenate([t_m, t_true]), L, theta0, 0.03, t_rel)
+    tx_u = tx_at(th_all[:len(t_m)])
     tx_f = _to_field(tx_u, R, o)
     anchors_f = _to_field(PAPER_ANCHORS, R, o)
     labels = ["TX"] + ANCHOR_IDS
@@ -423,8 +429,7 @@ def simulate_pendulum_trial(rng: np.random.Generator, cfg: dict, R: np.ndarray,
     xyz[:, 0] = tx_f
     xyz[:, 1:] = anchors_f[None]
     xyz = xyz + cfg["mocap_noise_m"] * rng.standard_normal(xyz.shape)
-    t_us, t_true, offset, drift = _clock(rng, dur, us_rate)
-    p_true = tx_at(t_true)
+    p_true = tx_at(th_all[len(t_m):])
     d_true = np.linalg.norm(p_true[:, None, :] - PAPER_ANCHORS[None], axis=2)
     temp_true, temp_log = _temperature(rng, t_us)
     tof, counts = _ranges_to_tof(d_true, temp_true, rng, np.asarray(cfg["noise_V_m2"]),

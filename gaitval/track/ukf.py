@@ -218,72 +218,78 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     Q3[:3, 3:] = Q3[3:, :3] = np.diag(q)
     Q2 = np.zeros((N_STATE, N_STATE))
     Q2[3:, 3:] = np.diag(q)
+    # sigma-point offsets chi_i - X = S B^T with S = [0; I; -I] (eq. 7)
+    S = np.vstack([np.zeros((1, N_STATE)), I6, -I6])
     Wc_col = Wc[:, None]
-    gate = float(gate_sigma)
-    use_gate = np.isfinite(gate)
+    gate2 = float(gate_sigma) ** 2
+    use_gate = np.isfinite(gate_sigma)
+    finite = np.isfinite(d)
+    n_finite = finite.sum(axis=1)
+    used[:] = finite
 
     x = None
     P = None
     starved = 0
-    dX = np.zeros((2 * N_STATE + 1, N_STATE))
+    last_dt = None
+    A = AT = Q = None
     for k in range(n_s):
         dk = d[k]
         if x is None or starved >= reinit_after:
             p0 = trilaterate(dk, anchors, guess if x is None else x[:3])
             if not np.all(np.isfinite(p0)):
                 if x is None:
+                    used[k] = False
                     continue                       # wait for a sample with >= 3 ranges
             else:
                 x = np.concatenate([p0, np.zeros(3)])
                 P = P0.copy()
                 reinit[k] = True
                 starved = 0
-                used[k] = np.isfinite(dk)
                 out_x[k] = x
-                out_p[k] = P.ravel()[::N_STATE + 1]
+                out_p[k] = P.diagonal()
                 continue
         # -- a-priori statistics, eq. (8) (closed form of the unscented transform for A)
         dt = t[k] - t[k - 1]
-        A = I6 + dt * E
+        if dt != last_dt:
+            A = I6 + dt * E
+            AT = A.T
+            Q = (0.25 * dt ** 4) * Q4 + (0.5 * dt ** 3) * Q3 + (dt * dt) * Q2  # G W G^T
+            last_dt = dt
         x = A @ x                                                # X_{k+1/k} = A X_{k/k}
-        P = A @ P @ A.T + ((0.25 * dt ** 4) * Q4 + (0.5 * dt ** 3) * Q3
-                           + (dt * dt) * Q2)                     # A P A^T + G W G^T
-        ok = dk == dk                                            # finite (not NaN)
-        n_ok = int(ok.sum())
+        P = A @ P @ AT + Q                                       # A P A^T + G W G^T
+        n_ok = int(n_finite[k])
         if n_ok == 0:
             starved += 1
             out_x[k] = x
-            out_p[k] = P.ravel()[::N_STATE + 1]
+            out_p[k] = P.diagonal()
             continue
         # -- sigma points from the predicted covariance, eq. (9) with eq. (7)
         B, info = _potrf(scale * P, lower=1)
         if info != 0:
             P = 0.5 * (P + P.T) + 1e-12 * I6
             B, info = _potrf(scale * P, lower=1)
-        dX[1:N_STATE + 1] = B.T
-        dX[N_STATE + 1:] = -B.T
-        # Y_i = h(chi_i), eq. (6): |D0 + delta_i|, expanded around the mean position
-        D0 = x[:3] - anchors
-        dpos = dX[:, :3]
-        Ysig = np.sqrt((D0 * D0).sum(1) + 2.0 * (dpos @ D0.T)
-                       + (dpos * dpos).sum(1)[:, None])
+        dX = S @ B.T
+        diff = (x[:3] + dX[:, :3])[:, None, :] - anchors
+        Ysig = np.sqrt((diff * diff).sum(axis=2))                # Y_i = h(chi_i), eq. (6)
         ybar = Wm @ Ysig                                         # eq. (9)
         dY = Ysig - ybar
         WdY = Wc_col * dY
         Pyy = dY.T @ WdY + Vm                                    # eq. (10)
         Pxy = dX.T @ WdY                                         # eq. (10)
         nu = dk - ybar
+        ok = None
         # -- per-anchor innovation gate (multipath), see module notes
-        if use_gate:
-            z = np.abs(nu) / np.sqrt(Pyy.ravel()[::m + 1])
-            z[~ok] = 0.0
-            bad = np.flatnonzero(z > gate)
-            if bad.size:
-                bad = bad[np.argsort(-z[bad])][:max_reject]
-                rejected[k, bad] = True
-                ok = ok.copy()
-                ok[bad] = False
-                n_ok -= bad.size
+        if use_gate and (nu * nu > gate2 * Pyy.diagonal()).any():
+            z = np.abs(nu) / np.sqrt(Pyy.diagonal())
+            z[~finite[k]] = 0.0
+            bad = np.flatnonzero(z * z > gate2)
+            bad = bad[np.argsort(-z[bad])][:max_reject]
+            rejected[k, bad] = True
+            used[k, bad] = False
+            n_ok -= bad.size
+            ok = used[k]
+        elif n_ok < m:
+            ok = finite[k]
         if n_ok == m:
             _, KT, info = _posv(Pyy, Pxy.T)                      # K = Pxy Pyy^-1, eq. (10)
             x = x + nu @ KT                                      # eq. (11)
@@ -294,9 +300,9 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
             _, KT, info = _posv(Pyy[np.ix_(s, s)], Pxy_s.T)
             x = x + nu[s] @ KT
             P = P - KT.T @ Pxy_s.T
-        P = 0.5 * (P + P.T)
-        used[k] = ok
+        P += P.T
+        P *= 0.5
         starved = starved + 1 if n_ok < min_anchors else 0
         out_x[k] = x
-        out_p[k] = P.ravel()[::N_STATE + 1]
+        out_p[k] = P.diagonal()
     return ToaUkfResult(x=out_x, P_diag=out_p, used=used, rejected=rejected, reinit=reinit)
