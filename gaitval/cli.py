@@ -81,6 +81,20 @@ def cmd_peer(a) -> int:
     return 0
 
 
+def cmd_register(a) -> int:
+    from gaitval.steps import register_step
+    rec = register_step(a.ingest, a.sheet, a.subjects, a.trial, a.config, a.out)
+    print(json.dumps(rec, sort_keys=True, default=str))
+    return 0
+
+
+def cmd_registration_summary(a) -> int:
+    from gaitval.steps import registration_summary
+    registration_summary(a.inputs, a.study, a.out_csv, a.out_stem, a.reports_dir,
+                         a.config_hash)
+    return 0
+
+
 def cmd_report(a) -> int:
     from gaitval.report.index import build_index
     md, html = build_index(a.reports_dir, study_names=a.studies)
@@ -135,6 +149,24 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--reports-dir", default="reports")
     s.add_argument("--config-hash", default="")
     s.set_defaults(func=cmd_peer)
+
+    s = sub.add_parser("register", help="register one trial and build its ground truth")
+    s.add_argument("--ingest", required=True, help="the trial's ingest folder")
+    s.add_argument("--sheet", required=True)
+    s.add_argument("--subjects", required=True)
+    s.add_argument("--trial", required=True)
+    s.add_argument("--config", required=True, help="results/<study>/config.json")
+    s.add_argument("--out", required=True)
+    s.set_defaults(func=cmd_register)
+
+    s = sub.add_parser("registration-summary", help="registration.csv + report table")
+    s.add_argument("inputs", nargs="+", help="registration.json files")
+    s.add_argument("--study", required=True)
+    s.add_argument("--out-csv", required=True)
+    s.add_argument("--out-stem", required=True)
+    s.add_argument("--reports-dir", default="reports")
+    s.add_argument("--config-hash", default="")
+    s.set_defaults(func=cmd_registration_summary)
 
     s = sub.add_parser("report", help="write reports/index.md and index.html")
     s.add_argument("--reports-dir", default="reports")

@@ -6,6 +6,7 @@ from snakemake.utils import validate
 
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash
+from gaitval.steps import ANALYSIS_SECTIONS
 
 
 validate(config, "../schemas/config.schema.yaml")

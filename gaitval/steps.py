@@ -1,0 +1,154 @@
+"""Pipeline steps at file level: read the files of one rule, call the library, write files.
+
+One function per rule family; :mod:`gaitval.cli` exposes each as a verb and the Snakemake
+rules call those verbs.  The library functions they call take objects and return objects;
+only this module and :mod:`gaitval.io` know where files live.
+
+Per-study configuration (``results/<study>/config.json``) is the workflow config's
+analysis sections merged with the study's own calibration file ``study.yaml`` beside
+the trial sheet (pole diameter, the sensor mount on the rollator, ...): a calibration
+belongs to the study, not to gaitval.
+"""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import yaml
+
+from gaitval.errors import GaitvalError
+from gaitval.io.atomic import write_csv, write_parquet, write_text
+from gaitval.io.trialsheet import load_subjects, load_trial_sheet
+
+#: Config sections that parameterise the analysis (copied into the per-study config).
+ANALYSIS_SECTIONS = ("registration", "groundtruth", "rollator", "tracking", "tug",
+                     "ultrasonic", "evaluation")
+
+
+def _deep_merge(base: dict, over: dict) -> dict:
+    out = dict(base)
+    for k, v in (over or {}).items():
+        out[k] = _deep_merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def study_config(config: dict, sheet: str | Path, out: str | Path) -> dict:
+    """Write the effective analysis config of one study (JSON) and return it.
+
+    The workflow config's :data:`ANALYSIS_SECTIONS` are the base; ``study.yaml`` beside the
+    trial sheet, when present, overrides them (the study's calibration).
+    """
+    cfg = {k: config[k] for k in ANALYSIS_SECTIONS if k in config}
+    cal = Path(sheet).parent / "study.yaml"
+    if cal.is_file():
+        with open(cal, encoding="utf-8") as fh:
+            study = yaml.safe_load(fh) or {}
+        cfg = _deep_merge(cfg, {k: v for k, v in study.items() if k in ANALYSIS_SECTIONS})
+        cfg["calibration_file"] = str(cal)
+    write_text(out, json.dumps(cfg, indent=1, sort_keys=True) + "\n")
+    return cfg
+
+
+def load_json(path: str | Path) -> dict:
+    return json.loads(Path(path).read_text(encoding="utf-8"))
+
+
+def _clean(v):
+    if isinstance(v, (np.floating, float)):
+        return None if not math.isfinite(float(v)) else float(v)
+    if isinstance(v, np.integer):
+        return int(v)
+    if isinstance(v, (np.bool_,)):
+        return bool(v)
+    return v
+
+
+def trial_and_subject(sheet, subjects, trial: str) -> tuple[dict, dict]:
+    df = load_trial_sheet(sheet, subjects, check_files=False)
+    if trial not in df.index:
+        raise GaitvalError(f"trial {trial!r} is not in the trial sheet", path=sheet)
+    row = df.loc[trial].to_dict()
+    subj = load_subjects(subjects).loc[row["subject"]].to_dict()
+    return row, subj
+
+
+def load_ingested(ingest_dir: str | Path, row: dict):
+    """The ingested mocap and sensor of a trial (see :mod:`gaitval.io.ingest`)."""
+    from gaitval.io.ingest import read_mocap_parquet
+    d = Path(ingest_dir)
+    mocap = read_mocap_parquet(d / "mocap.parquet", d / "events.csv")
+    if row["sensor_kind"] == "ultrasonic":
+        from gaitval.io.ultrasonic import read_ultrasonic
+        sensor = read_ultrasonic(d / "sensor.parquet", trial=row["trial"])
+    else:
+        from gaitval.io.scanlog import read_scanlog
+        sensor = read_scanlog(d / "sensor.parquet", trial=row["trial"])
+    return mocap, sensor
+
+
+# -- register + ground truth ------------------------------------------------------------
+def register_step(ingest_dir, sheet, subjects, trial: str, config_json, out_dir) -> dict:
+    """Register one trial and build its ground truth.
+
+    Writes ``registration.json`` (the record, plus ``status`` ``ok`` or ``refused`` and the
+    ``reason``) and ``groundtruth.parquet`` (empty when refused).  A refusal
+    (:class:`~gaitval.errors.GaitvalError` from registration or ground truth: a pole not
+    found, a residual too large, a weak clock peak, missing markers) is recorded, not
+    hidden: the registration table shows it and later steps skip the trial.  Set
+    ``registration.on_error: raise`` to stop the run instead.
+    """
+    from gaitval.groundtruth import GT_COLUMNS, ground_truth
+    from gaitval.registration import RECORD_FIELDS, register_trial
+
+    cfg = load_json(config_json)
+    row, subj = trial_and_subject(sheet, subjects, trial)
+    mocap, sensor = load_ingested(ingest_dir, row)
+    out = Path(out_dir)
+    rec: dict = {"trial": trial, "protocol": row["protocol"], "subject": row["subject"]}
+    try:
+        reg = register_trial(mocap, sensor, row, subj, cfg)
+        gt = ground_truth(mocap, sensor, reg, row, subj, cfg)
+        rec.update({k: _clean(v) for k, v in reg.as_row().items()})
+        rec.update(status="ok", reason="")
+    except GaitvalError as exc:
+        if cfg.get("registration", {}).get("on_error", "record") == "raise":
+            raise exc.with_context(trial=trial) from None
+        rec.update({k: None for k in RECORD_FIELDS if k != "trial"})
+        rec.update(status="refused", reason=str(exc.with_context(trial=trial)))
+        gt = pd.DataFrame(columns=GT_COLUMNS)
+    write_parquet(gt.reset_index(drop=True), out / "groundtruth.parquet")
+    write_text(out / "registration.json", json.dumps(rec, indent=1, sort_keys=True) + "\n")
+    return rec
+
+
+def registration_summary(inputs: list[str | Path], study: str, out_csv, out_stem,
+                         reports_dir, config_hash: str = "") -> pd.DataFrame:
+    """Gather ``registration.json`` records into ``registration.csv`` and a report table."""
+    from gaitval.registration import RECORD_FIELDS
+    from gaitval.report.provenance import stamp
+    from gaitval.tables import write_table
+
+    rows = [load_json(p) for p in inputs]
+    cols = list(RECORD_FIELDS) + ["protocol", "subject", "status", "reason"]
+    df = pd.DataFrame(rows).reindex(columns=cols).sort_values("trial").reset_index(drop=True)
+    write_csv(df, out_csv, float_format="%.6g")
+    show = df.copy()
+    show["yaw_deg"] = np.degrees(show["yaw_rad"].astype(float))
+    show = show[["trial", "protocol", "x_m", "y_m", "yaw_deg", "clock_offset_s",
+                 "clock_drift_ppm", "pole_residual_m", "sync_peak", "joint_centre_source",
+                 "gt_frames_excluded", "status", "reason"]]
+    n_ref = int((df["status"] != "ok").sum())
+    notes = [f"{n_ref} trial(s) refused; their reason is given and later tables leave them "
+             "out."] if n_ref else []
+    paths = write_table(show, out_stem, digits=4, notes=notes, caption=(
+        f"Registration of each trial of study '{study}': estimated sensor pose in the mocap "
+        "field (from the calibration poles; rollator trials have a per-frame pose, shown "
+        "empty; ultrasonic trials show the receiver frame), clock offset and drift (sensor "
+        "minus mocap), worst pole residual, correlation peak of the clock synchronisation, "
+        "which joint-centre source built the ground truth, and mocap frames excluded for "
+        "gaps longer than groundtruth.max_gap_s. Reviewers read this table first."))
+    stamp(Path(out_stem).name, paths, reports_dir, config_hash_=config_hash)
+    return df

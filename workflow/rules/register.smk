@@ -1,0 +1,75 @@
+# Per-study analysis config, then registration + ground truth per trial, then the
+# registration table reviewers read first.
+
+
+rule study_config:
+    input:
+        sheet=lambda w: sheet_path(w.study),
+    output:
+        f"{RESULTS}/{{study}}/config.json",
+    params:
+        sections=lambda w: {k: config[k] for k in ANALYSIS_SECTIONS if k in config},
+    log:
+        "logs/study_config/{study}.log",
+    run:
+        from gaitval.steps import study_config
+
+        study_config(params.sections, input.sheet, output[0])
+
+
+rule register:
+    input:
+        mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
+        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
+        config=f"{RESULTS}/{{study}}/config.json",
+        sheet=lambda w: sheet_path(w.study),
+    output:
+        record=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
+        gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
+    params:
+        gv=GV,
+        subjects=lambda w: subjects_path(w.study),
+        ingest=lambda w, input: str(Path(input.mocap).parent),
+        out=parent_of("record"),
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/register/{study}/{trial}.log",
+    shell:
+        "{params.gv} register --ingest {params.ingest} --sheet {input.sheet}"
+        " --subjects {params.subjects} --trial {wildcards.trial} --config {input.config}"
+        " --out {params.out} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+rule registration_summary:
+    input:
+        lambda w: expand(
+            f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
+            study=w.study,
+            trial=trial_ids(w.study),
+        ),
+    output:
+        csv=f"{RESULTS}/{{study}}/registration.csv",
+        table=report(
+            f"{REPORTS}/tables/study_registration_{{study}}.csv",
+            caption="../report/registration.rst",
+            category="Study",
+        ),
+        md=f"{REPORTS}/tables/study_registration_{{study}}.md",
+        tex=f"{REPORTS}/tables/study_registration_{{study}}.tex",
+    params:
+        gv=GV,
+        stem=lambda w, output: output.table[: -len(".csv")],
+        reports=parent_of("table", up=1),
+        chash=CONFIG_HASH,
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/registration_summary/{study}.log",
+    shell:
+        "{params.gv} registration-summary {input} --study {wildcards.study}"
+        " --out-csv {output.csv} --out-stem {params.stem} --reports-dir {params.reports}"
+        " --config-hash {params.chash} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+REPORT_ITEM_FUNCS.append(lambda study: [f"{REPORTS}/tables/study_registration_{study}.csv"])
