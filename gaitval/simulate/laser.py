@@ -227,9 +227,10 @@ def measure(R: np.ndarray, I: np.ndarray, spec: LaserSpec, rng: np.random.Genera
 
     Notes
     -----
-    Mixed pixel: ``r = mean(r_sub)`` over the sub-rays that hit a surface, when their
-    spread exceeds ``mixed_jump_m``; a beam whose footprint is less than half on a
-    surface returns nothing.  Noise ``σ = sigma_m + sigma_rel·r``; quantisation
+    Mixed pixel: ``r = mean(r_sub)`` when the sub-rays hit *different* surfaces whose
+    depths differ by more than ``mixed_jump_m`` (a smooth wall seen obliquely is not a
+    depth discontinuity); a beam whose footprint is less than half on a surface returns
+    nothing.  Noise ``σ = sigma_m + sigma_rel·r``; quantisation
     ``r_q = round(r / 1 mm) · 1 mm``.
     """
     ns = R.shape[0]
@@ -244,7 +245,9 @@ def measure(R: np.ndarray, I: np.ndarray, spec: LaserSpec, rng: np.random.Genera
     rmin = np.where(fin, Rs, np.inf).min(axis=2)
     spread = np.where(nfin > 0, rmax - rmin, 0.0)
     centre = Rs[:, :, k // 2]
-    mixed = (nfin * 2 > k) & (spread > spec.mixed_jump_m)
+    ids_differ = np.any(np.where(fin, Is, -2) != np.where(fin[:, :, :1], Is[:, :, :1], -2),
+                        axis=2) & fin.all(axis=2)
+    mixed = (nfin * 2 > k) & ids_differ & (spread > spec.mixed_jump_m)
     true = np.where(nfin * 2 > k, np.where(mixed, mean, centre), np.inf)
     # the central sub-ray may miss while the majority hits: use the mean then
     true = np.where(np.isfinite(true) & ~np.isfinite(centre), mean, true)

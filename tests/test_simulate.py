@@ -1,0 +1,359 @@
+"""The simulated default study: each realism property the issue asks for, on the tiny preset."""
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitval.errors import ConfigError, GaitvalError
+from gaitval.simulate import generate_study
+from gaitval.simulate import laser as L
+from gaitval.simulate.kinematics import GaitParams, leg_kinematics, make_path, plan_steps
+from gaitval.simulate.scene import to_field
+from gaitval.simulate.study import SUBJECT_COLUMNS, TRIAL_COLUMNS, load_preset
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("tiny")
+    generate_study(out, "tiny")
+    return out
+
+
+@pytest.fixture(scope="module")
+def sheet(tiny) -> pd.DataFrame:
+    return pd.read_csv(tiny / "trials.csv", keep_default_na=False)
+
+
+def _lrs(sheet, protocol=None):
+    s = sheet[sheet["sensor_kind"] == "lrs"]
+    return s if protocol is None else s[s["protocol"] == protocol]
+
+
+# ----------------------------------------------------------------- sheet and files
+def test_trial_sheet_validates_and_points_at_files(tiny, sheet):
+    from gaitval.io.trialsheet import load_trial_sheet
+    assert list(sheet.columns) == TRIAL_COLUMNS
+    subjects = pd.read_csv(tiny / "subjects.csv", keep_default_na=False)
+    assert list(subjects.columns) == SUBJECT_COLUMNS
+    load_trial_sheet(tiny / "trials.csv", tiny / "subjects.csv")   # raises when invalid
+    assert set(_lrs(sheet)["protocol"]) == {"tug", "mtst", "rollator"}
+    for _, r in sheet.iterrows():
+        for col in ("mocap_file", "sensor_file", "annotation_file"):
+            if r[col]:
+                assert (tiny / r[col]).exists(), r[col]
+    # the pipeline must estimate the clock: no manual offsets in the sheet
+    assert (_lrs(sheet)["clock_offset_s"] == "").all()
+    assert set(sheet["subject"]) <= set(subjects["subject"])
+
+
+def test_realism_table_has_every_figure(tiny):
+    r = pd.read_csv(tiny / "realism.csv")
+    need = {"occlusion_rate", "mixed_pixel_frac", "dropout_frac", "stance_speed_mps",
+            "swing_speed_mps", "steps_per_trial", "cross_steps_per_100"}
+    assert need <= set(r.columns)
+    tug = r[r["protocol"] == "tug"].set_index("phase")
+    assert {"all", "forward", "turning", "return"} <= set(tug.index)
+    assert tug.loc["forward", "occlusion_rate_published"] == pytest.approx(0.035)
+    assert ((r["occlusion_rate"] >= 0) & (r["occlusion_rate"] < 0.5)).all()
+
+
+# ----------------------------------------------------------------- kinematics
+def test_stance_is_about_sixty_percent_of_the_cycle():
+    gp = GaitParams(stance_frac=0.60, step_cv=0.0, place_sd_m=0.0)
+    path = make_path((0, 0), 0.0, [("line", 8.0, "walk")])
+    plan = plan_steps(path, gp, np.random.default_rng(0), t0=0.5)
+    t = np.arange(0, plan.t_end, 0.002)
+    leg = leg_kinematics(plan, 0, t, gp)
+    tc = plan.foot(0)["t_contact"]
+    tc = tc[np.isfinite(tc)]
+    # full gait cycles in steady walking: between the 2nd and the 2nd-to-last contact
+    w = (t >= tc[1]) & (t < tc[-2])
+    assert leg.stance[w].mean() == pytest.approx(0.60, abs=0.02)
+
+
+def test_stance_fraction_in_the_study_truth(tiny, sheet):
+    for trial in _lrs(sheet)["trial"]:
+        legs = pd.read_parquet(tiny / "truth" / trial / "legs.parquet")
+        ev = pd.read_csv(tiny / "truth" / trial / "events.csv")
+        t0 = ev.loc[ev["event"] == "foot_off", "t_s"].min()
+        t1 = ev.loc[ev["event"] == "foot_contact", "t_s"].max()
+        walk = legs[(legs["t_s"] > t0 + 1.0) & (legs["t_s"] < t1 - 1.0)]
+        frac = (walk["phase"] == "stance").mean()
+        assert 0.52 < frac < 0.75, (trial, frac)
+
+
+def test_shin_moves_fast_in_swing_and_barely_in_stance(tiny, sheet):
+    """Seed 001 §2.5.1: the leg point at shin height is slowest in stance; in swing it moves
+    several times faster than the walker."""
+    for _, r in _lrs(sheet, "tug").iterrows():
+        legs = pd.read_parquet(tiny / "truth" / r["trial"] / "legs.parquet")
+        for _, g in legs.groupby("side"):
+            v = np.hypot(*np.gradient(g[["x_m", "y_m"]].to_numpy(), g["t_s"].to_numpy(),
+                                      axis=0).T)
+            st = g["phase"].to_numpy() == "stance"
+            walking = float(r["speed_mps"])
+            assert np.median(v[st]) < 0.3 * walking
+            assert np.mean(v[~st]) > 1.8 * walking
+            assert np.percentile(v[~st], 95) > 3.0 * walking
+
+
+def test_elderly_walk_slower_than_young(sheet):
+    lrs = _lrs(sheet)
+    young = lrs.loc[lrs["protocol"] == "tug", "speed_mps"].astype(float)
+    elderly = lrs.loc[lrs["protocol"] == "mtst", "speed_mps"].astype(float)
+    assert young.min() > elderly.max()
+
+
+def test_cross_step_truth_is_geometric():
+    """A right foot landing left of the left (stance) foot is a cross step, nothing else is."""
+    gp = GaitParams(step_cv=0.0, place_sd_m=0.0, step_width_m=0.12)
+    path = make_path((0, 0), 0.0, [("line", 4.0, "walk")])
+    plan = plan_steps(path, gp, np.random.default_rng(1), t0=0.5, first_side=0)
+    assert not plan.cross.any()
+    targets = np.full((20, 2), np.nan)
+    targets[3] = [plan.xy[5, 0], plan.xy[4, 1] + 0.10]   # contact 5 is step 3 (index 2 = step 0)
+    plan2 = plan_steps(path, gp, np.random.default_rng(1), t0=0.5, first_side=0,
+                       targets=targets)
+    assert plan2.side[5] == 1 and plan2.cross[5]
+    assert plan2.cross.sum() == 1 + int(plan2.cross[6])
+
+
+# ----------------------------------------------------------------- laser
+def _spec(**kw):
+    base = dict(model="test", angle_min=-np.pi / 2, angle_increment=np.deg2rad(0.25),
+                n_beams=721, scan_period_s=0.025, range_min=0.05, range_max=30.0,
+                sigma_m=0.0, sigma_rel=0.0, dropout_prob=0.0)
+    base.update(kw)
+    return L.LaserSpec(**base)
+
+
+def _scene(circles, wall_x=None):
+    ell = np.array([[[x, y, r, r, 0.0] for x, y, r in circles]])
+    seg = np.empty((1, 0, 4)) if wall_x is None else np.array([[[wall_x, -10, wall_x, 10]]])
+    return L.Scene(ell=ell, ell_id=np.arange(len(circles), dtype=np.int16), seg=seg,
+                   seg_id=np.array([9] * seg.shape[1], dtype=np.int16))
+
+
+def test_a_leg_behind_the_other_gets_no_beams():
+    spec = _spec()
+    R, I = L.cast(_scene([(1.0, 0.0, 0.05), (1.3, 0.0, 0.05)]), spec)
+    m = L.measure(R, I, spec, np.random.default_rng(0))
+    assert (m["id"] == 0).sum() > 5
+    assert (m["id"] == 1).sum() == 0
+    # moved sideways by more than the two radii it reappears
+    R, I = L.cast(_scene([(1.0, 0.0, 0.05), (1.3, 0.15, 0.05)]), spec)
+    assert (L.measure(R, I, spec, np.random.default_rng(0))["id"] == 1).sum() >= 3
+
+
+def test_ray_cast_range_matches_hand_computation():
+    spec = _spec(n_sub=1)
+    R, _ = L.cast(_scene([(2.0, 0.0, 0.05)], wall_x=5.0), spec)
+    beam0 = int(round((0.0 - spec.angle_min) / spec.angle_increment))
+    assert R[0, beam0] == pytest.approx(1.95)                 # 2.0 - radius
+    a = spec.angles[beam0 + 200]                                # misses the circle
+    assert R[0, beam0 + 200] == pytest.approx(5.0 / np.cos(a))  # wall at x = 5
+
+
+def test_mixed_pixels_lie_between_foreground_and_background():
+    spec = _spec()
+    R, I = L.cast(_scene([(1.5, 0.02, 0.05)], wall_x=4.0), spec)   # edges inside beams
+    m = L.measure(R, I, spec, np.random.default_rng(0))
+    mixed = m["mixed"][0]
+    assert 1 <= mixed.sum() <= 4                                # the two edges only
+    ang = spec.angles[mixed]
+    wall = 4.0 / np.cos(ang)
+    r = m["ranges"][0, mixed]
+    assert np.all(r > 1.45 + 0.01) and np.all(r < wall - 0.01)
+
+
+def test_ranges_are_quantised_to_a_millimetre_with_spec_noise(tiny, sheet):
+    import pyarrow.parquet as pq
+    from gaitval.io.scanlog import read_scanlog
+    r = _lrs(sheet, "tug").iloc[0]
+    tab = pq.read_table(tiny / r["sensor_file"])
+    assert json.loads(tab.schema.metadata[b"gaitval:scanlog"])["range_unit"] == "mm"
+    s = read_scanlog(tiny / r["sensor_file"])
+    mm = s.ranges[np.isfinite(s.ranges)] * 1000
+    assert np.allclose(mm, np.round(mm), atol=1e-6)
+    # a wall beam far from the walker: spread ≈ the UTM-30LX repeatability (σ 10 mm)
+    col = np.nanstd(s.ranges, axis=0)
+    quiet = np.nanmedian(col[np.isfinite(col)])
+    assert 0.007 < quiet < 0.013
+
+
+def test_dropouts_and_mixed_pixels_occur_at_plausible_rates(tiny):
+    r = pd.read_csv(tiny / "realism.csv")
+    a = r[r["phase"] == "all"]
+    assert (a["dropout_frac"].between(0.0005, 0.01)).all()
+    assert (a["mixed_pixel_frac"].between(0.001, 0.2)).all()
+
+
+def test_occlusion_in_the_study_comes_from_geometry(tiny, sheet):
+    """Every scan where a leg returns < 3 beams has something in front of it along its bearing."""
+    from gaitval.io.scanlog import read_scanlog
+    for _, r in _lrs(sheet, "tug").iterrows():
+        sc = pd.read_parquet(tiny / "truth" / r["trial"] / "scans_legs.parquet")
+        s = read_scanlog(tiny / r["sensor_file"])
+        occ = sc[sc["occluded"]]
+        assert len(occ) > 0
+        for _, o in occ.iterrows():
+            bearing = np.arctan2(o["y_m"], o["x_m"])
+            dist = np.hypot(o["x_m"], o["y_m"])
+            k = int(round((bearing - s.angle_min) / s.angle_increment))
+            centre = s.ranges[int(o["scan"]), k]
+            other = sc[(sc["scan"] == o["scan"]) & (sc["side"] != o["side"])].iloc[0]
+            d_other = np.hypot(other["x_m"], other["y_m"])
+            sep = abs(np.angle(np.exp(1j * (np.arctan2(other["y_m"], other["x_m"]) - bearing))))
+            # hidden behind the other leg (nearer, angular extents overlap) ...
+            behind_leg = d_other < dist and sep < 0.06 / d_other + 0.06 / dist
+            # ... or behind something else: the centre beam stops well short of the leg
+            behind_other = np.isnan(centre) or centre < dist - 0.10
+            assert behind_leg or behind_other, (r["trial"], o["scan"])
+
+
+# ----------------------------------------------------------------- pose and clock
+def test_pose_and_clock_are_unknown_to_the_pipeline_but_recorded(tiny, sheet):
+    truth = pd.read_csv(tiny / "truth" / "sensor_pose.csv")
+    cfg = load_preset("tiny")
+    tug = truth[truth["trial"].str.startswith("tug")]
+    nominal = cfg["tug"]["sensor_nominal_pose"]
+    assert not np.allclose(tug[["x_m", "y_m", "yaw_rad"]].to_numpy()[0], nominal)
+    assert (truth["clock_offset_s"].abs() > 0.1).all()
+    for _, r in _lrs(sheet).iterrows():
+        text = (tiny / r["sensor_file"]).read_bytes()
+        assert b"clock_offset" not in text and b"yaw" not in text
+    # the truth is self-consistent: sensor-frame leg centres map back onto the field legs
+    for _, p in tug.iterrows():
+        sc = pd.read_parquet(tiny / "truth" / p["trial"] / "scans_legs.parquet")
+        legs = pd.read_parquet(tiny / "truth" / p["trial"] / "legs.parquet")
+        sc = sc[(sc["t_mocap_s"] > 0.1) & (sc["t_mocap_s"] < legs["t_s"].max() - 0.1)]
+        for side in "LR":
+            a = sc[sc["side"] == side]
+            g = legs[legs["side"] == side]
+            f = to_field(a[["x_m", "y_m"]].to_numpy(), (p["x_m"], p["y_m"], p["yaw_rad"]))
+            gx = np.interp(a["t_mocap_s"], g["t_s"], g["x_m"])
+            gy = np.interp(a["t_mocap_s"], g["t_s"], g["y_m"])
+            assert np.nanmax(np.hypot(f[:, 0] - gx, f[:, 1] - gy)) < 0.02
+        # clock: t_sensor = offset + (1 + drift) t_mocap + jitter (common brief)
+        pred = p["clock_offset_s"] + (1 + p["clock_drift_ppm"] * 1e-6) * sc["t_mocap_s"]
+        resid = sc["t_s"].to_numpy() - pred.to_numpy()
+        assert 0.0001 < np.std(resid) < 0.002
+        assert abs(np.mean(resid)) < 0.001
+
+
+def test_rollator_sensor_pose_per_frame(tiny, sheet):
+    for _, r in _lrs(sheet, "rollator").iterrows():
+        sp = pd.read_parquet(tiny / "truth" / r["trial"] / "sensor_pose.parquet")
+        assert list(sp.columns) == ["t_s", "x_m", "y_m", "yaw_rad"]
+        assert np.ptp(sp["x_m"]) > 2.0                          # the sensor travels
+        if r["scenario"] == "straight":
+            assert np.ptp(sp["yaw_rad"]) > np.deg2rad(150)      # the 180° turn
+
+
+# ----------------------------------------------------------------- mocap
+def test_markers_are_millimetres_in_the_c3d(tiny, sheet):
+    import ezc3d
+    r = _lrs(sheet, "tug").iloc[0]
+    c = ezc3d.c3d(str(tiny / r["mocap_file"]))
+    assert c["parameters"]["POINT"]["UNITS"]["value"][0].strip() == "mm"
+    assert c["parameters"]["POINT"]["RATE"]["value"][0] == 200
+    labels = [s.strip() for s in c["parameters"]["POINT"]["LABELS"]["value"]]
+    pole = c["data"]["points"][:3, labels.index("POLE1"), :]
+    assert np.nanmedian(pole[2]) == pytest.approx(1200.0, abs=2.0)
+    for lab in ("LASI", "RASI", "LPSI", "RPSI", "LTHI", "RTHI", "LKNE", "RKNE", "LTIB",
+                "RTIB", "LANK", "RANK", "LHEE", "RHEE", "LTOE", "RTOE"):
+        assert lab in labels
+
+
+def test_markers_have_gaps_and_subject_specific_sets(tiny, sheet):
+    from gaitval.io.c3d import read_c3d
+    with_bones, gaps = [], 0
+    for _, r in _lrs(sheet).iterrows():
+        m = read_c3d(tiny / r["mocap_file"])
+        with_bones.append(m.has("LFEO") or m.has("LKJC"))
+        gaps += int(np.isnan(m.xyz[..., 0]).sum())
+        assert not np.isnan(m.marker("POLE1")).any()
+        if r["protocol"] == "rollator":
+            for lab in ("RLT_FL", "RLT_FR", "RLT_RL", "RLT_RR", "LTB1", "RTB4"):
+                assert m.has(lab)
+        # sub-millimetre noise: a static pole marker jitters by well under a millimetre
+        assert 0.00005 < np.std(m.marker("POLE1")[:, 0]) < 0.001
+    assert gaps > 0
+    assert any(with_bones) and not all(with_bones)
+
+
+def test_mtst_annotations_follow_the_video_clock(tiny, sheet):
+    from gaitval.io.annotations import read_annotations
+    for _, r in _lrs(sheet, "mtst").iterrows():
+        ev, meta = read_annotations(tiny / r["annotation_file"])
+        assert meta["time_base"] == "video" and float(meta["time_offset_s"]) != 0.0
+        truth = pd.read_csv(tiny / "truth" / r["trial"] / "events.csv")
+        tc = truth.loc[truth["event"] == "foot_contact", "t_s"].to_numpy()
+        fc = ev.loc[ev["event"] == "foot_contact", "t_mocap_s"].to_numpy()
+        err = fc[:, None] - tc[None, :]
+        nearest = err[np.arange(len(fc)), np.abs(err).argmin(axis=1)]
+        assert len(fc) == len(tc)
+        assert 0.01 < np.std(nearest) < 0.08                     # rater timing noise
+        assert set(ev.loc[ev["event"] == "target_step", "value"]) <= {"hit", "miss"}
+
+
+# ----------------------------------------------------------------- determinism, errors
+def _hashes(folder: Path) -> dict:
+    return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_same_preset_and_seed_give_byte_identical_files(tiny, tmp_path):
+    generate_study(tmp_path / "again", "tiny")
+    assert _hashes(tiny) == _hashes(tmp_path / "again")
+
+
+def test_seed_changes_the_study(tmp_path):
+    cfg = load_preset("tiny")
+    for k in ("mtst", "rollator", "ultrasonic"):
+        cfg.pop(k)
+    cfg["tug"]["n_trials"] = 1
+    a = generate_study(tmp_path / "a", cfg, seed=1).parent
+    b = generate_study(tmp_path / "b", cfg, seed=2).parent
+    assert (a / "lrs/tug_Y01_t1.scan.parquet").read_bytes() != \
+        (b / "lrs/tug_Y01_t1.scan.parquet").read_bytes()
+
+
+def test_unknown_preset_is_a_config_error(tmp_path):
+    with pytest.raises(ConfigError, match="unknown simulation preset"):
+        generate_study(tmp_path, "no_such_preset")
+
+
+def test_replay_without_the_real_files_fails_clearly(tmp_path):
+    cfg = load_preset("replay")
+    cfg["replay"]["trials"] = [{"file": str(tmp_path / "missing.c3d"), "subject": "X",
+                                "trial": "x"}]
+    with pytest.raises(GaitvalError, match="real C3D for the replay study not found"):
+        generate_study(tmp_path / "out", cfg)
+
+
+def test_replay_of_a_real_walk(realdata, tmp_path):
+    from gaitval.io.c3d import read_c3d
+    cfg = load_preset("replay")
+    cfg["replay"]["trials"] = [{"file": str(realdata / "c3d" / "PiG_Motion-FlatFoot-Full.c3d"),
+                                "subject": "RW2", "trial": "replay_pig"}]
+    out = generate_study(tmp_path / "rp", cfg).parent
+    m = read_c3d(out / "mocap" / "replay_pig.c3d")
+    real = read_c3d(realdata / "c3d" / "PiG_Motion-FlatFoot-Full.c3d")
+    assert m.has("POLE1") and m.has("POLE2") and m.first_frame == real.first_frame
+    np.testing.assert_allclose(m.marker("LTIO"), real.marker("LTIO"), atol=1e-5)
+    sc = pd.read_parquet(out / "truth" / "replay_pig" / "scans_legs.parquet")
+    assert len(sc) > 100
+    assert (sc["n_beams"] >= 3).mean() > 0.8                    # both legs mostly in view
+    # the true leg centre at 0.27 m lies on the real shank (between LTIO and LFEO)
+    legs = pd.read_parquet(out / "truth" / "replay_pig" / "legs.parquet")
+    lft = legs[legs["side"] == "L"]
+    a, k = real.marker("LTIO"), real.marker("LFEO")
+    u = (0.27 - a[:, 2]) / (k[:, 2] - a[:, 2])
+    exp = a[:, :2] + u[:, None] * (k[:, :2] - a[:, :2])
+    np.testing.assert_allclose(lft[["x_m", "y_m"]].to_numpy(), exp, atol=1e-9)
