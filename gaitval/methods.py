@@ -45,7 +45,7 @@ ROLES = ("detector", "filter", "motion", "gate", "associator", "occlusion")
 
 _TUG_COMMON: dict[str, Any] = {
     "paper": "seed 000 (Yorozu et al., Sensors 2015, 15, 22451)",
-    "detector": {"name": "leg_patterns", "use_fs_u": True,
+    "detector": {"name": "leg_patterns", "use_fs_u": True, "max_occluder_m": 0.15,
                  "background": {"name": "percentile", "q": 95.0, "margin_m": 0.10}},
     "filter": {"name": "kf", "q_accel_sd_mps2": 15.0, "r_sd_m": 0.04,
                "p0_pos_sd_m": 0.04, "p0_vel_sd_mps": 0.5},

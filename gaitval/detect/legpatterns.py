@@ -35,6 +35,15 @@ Leg positions from w_l (a leg is modelled as a circle of diameter w_l, ρ = w_l/
 
 ``use_fs_u=False`` drops FS_U (the conventional detector, seed 001 Method 1).
 
+Static occluders in front of a leg.  Background removal (:mod:`gaitval.detect.background`)
+turns a chair leg or a pole into "no return"; a seated shank right behind a chair leg
+would then fall apart into two narrow segments, i.e. two "legs".  Before the edge search,
+a run of background beams is therefore *seen through* — filled with the ranges of the
+foreground on both sides, linearly interpolated — when (i) it is narrower than
+``max_occluder_m`` (0.15 m) at its own range, (ii) its returns are nearer than the
+foreground on both sides by more than w_l/2 (an occluder, not a gap), and (iii) the two
+sides differ by less than w_l/2 (the same surface continues behind it).
+
 References
 ----------
 Yorozu, A.; Nishiguchi, S.; Yamada, M.; Aoyama, T.; Moriguchi, T.; Takahashi, M. Gait
@@ -127,6 +136,36 @@ def _fs_u_centre(r, a, rho, width, occluder_high: bool) -> tuple[float, float]:
     return (bx + rho * el[0] + depth * er[0], by + rho * el[1] + depth * er[1])
 
 
+def see_through_occluders(masked: np.ndarray, raw: np.ndarray, angles: np.ndarray,
+                          leg_width_m: float, max_occluder_m: float = 0.15) -> np.ndarray:
+    """Fill thin static occluders in front of foreground (module notes); one scan."""
+    out = masked
+    hidden = np.isinf(masked) & np.isfinite(raw)
+    if not hidden.any():
+        return out
+    m = np.concatenate([[False], hidden, [False]])
+    d = np.diff(m.astype(np.int8))
+    starts, stops = np.flatnonzero(d == 1), np.flatnonzero(d == -1)
+    half = 0.5 * leg_width_m
+    n = len(masked)
+    for i0, i1 in zip(starts, stops):               # beams i0 .. i1-1
+        if i0 == 0 or i1 >= n:
+            continue
+        left, right = masked[i0 - 1], masked[i1]
+        if not (math.isfinite(left) and math.isfinite(right)) or abs(left - right) >= half:
+            continue
+        occ = raw[i0:i1]
+        if np.nanmax(occ) >= min(left, right) - half:
+            continue
+        width = float(np.nanmean(occ)) * (angles[i1 - 1] - angles[i0])
+        if width > max_occluder_m:
+            continue
+        if out is masked:
+            out = masked.copy()
+        out[i0:i1] = np.interp(angles[i0:i1], [angles[i0 - 1], angles[i1]], [left, right])
+    return out
+
+
 def detect_scan(r: np.ndarray, angles: np.ndarray, leg_width_m: float,
                 use_fs_u: bool = True) -> list[tuple[float, float, str, float, int, int]]:
     """Leg observations of one (background-masked) scan.
@@ -195,13 +234,16 @@ class LegPatternDetector(Detector):
         Report FS_U observations (True for seed 000's and seed 001's proposed detector).
     max_range_m : float or None
         Ignore returns farther than this (None: no limit).
+    max_occluder_m : float
+        Widest static occluder that is seen through (module notes); 0 disables it.
     """
 
     def __init__(self, background: str | dict = "percentile", use_fs_u: bool = True,
-                 max_range_m: float | None = None):
+                 max_range_m: float | None = None, max_occluder_m: float = 0.15):
         self.background = background
         self.use_fs_u = use_fs_u
         self.max_range_m = max_range_m
+        self.max_occluder_m = max_occluder_m
 
     def detect(self, scans: ScanSeries, leg_width_m: float) -> pd.DataFrame:
         if not (isinstance(leg_width_m, (int, float)) and 0.01 < leg_width_m < 0.5):
@@ -215,8 +257,12 @@ class LegPatternDetector(Detector):
         angles = scans.angles
         rows_k, rows_j, xs, ys, pats, ws, i0s, i1s = [], [], [], [], [], [], [], []
         for k in range(scans.n_scans):
+            mk = masked[k]
+            if self.max_occluder_m > 0:
+                mk = see_through_occluders(mk, ranges[k], angles, leg_width_m,
+                                           self.max_occluder_m)
             for j, (x, y, p, w, i0, i1) in enumerate(
-                    detect_scan(masked[k], angles, leg_width_m, self.use_fs_u)):
+                    detect_scan(mk, angles, leg_width_m, self.use_fs_u)):
                 rows_k.append(k); rows_j.append(j); xs.append(x); ys.append(y)
                 pats.append(p); ws.append(w); i0s.append(i0); i1s.append(i1)
         if not rows_k:

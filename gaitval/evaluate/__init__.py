@@ -1,0 +1,1 @@
+"""Evaluation of tracker output against registered ground truth."""

@@ -1,0 +1,390 @@
+"""Automatic evaluation of TUG leg tracking against mocap ground truth (seed 000 §6).
+
+Everything is computed from the tracker output (:func:`gaitval.methods.track_trial`) and
+the ground truth at sensor height in the sensor frame (a DataFrame with ``t_sensor_s,
+side, xs_m, ys_m, valid``, from the registration/ground-truth step); no manual inspection.
+
+Rules (all thresholds in :data:`DEFAULTS`, overridable by the ``cfg`` argument)
+--------------------------------------------------------------------------------
+Alignment
+    The truth of each side is linearly interpolated to the scan times; a scan is *valid*
+    when both neighbouring truth samples are valid and it is inside the truth's time span.
+TUG phases (forward / turning / return)
+    From the truth midpoint m(t) of both legs (positions smoothed over
+    ``smooth_s`` = 0.5 s, about one step, so the left–right sway averages out): the
+    farthest point from the start position splits out from back; the straight heading
+    h = unit(m_far − m_start).  *Turning* is the interval around the farthest point where
+    the walking heading (direction of the smoothed midpoint velocity, only where the
+    midpoint moves faster than ``heading_min_speed_mps`` = 0.2 m/s) differs by more than
+    ``turn_angle_deg`` = 30° from h (before) and from −h (after): it starts at the last
+    such in-line sample before the farthest point and ends at the first one after it.
+    Before: *forward* (including rising from the chair); after: *return* (including
+    sitting down), as in seed 000 Figure 3a.
+False tracking
+    A scan is *bad* for leg f if its track is farther than ``lost_m`` = 0.30 m from the
+    leg's truth, or closer to the other leg's truth by more than ``swap_margin_m`` = 0.05 m
+    while ``swap_min_m`` = 0.10 m from its own (a leg swap).  A false-tracking event is a
+    run of ≥ ``min_bad_s`` = 0.20 s (8 scans at 40 Hz) of bad scans; its kind is
+    ``swap`` if most of its scans are closer to the other leg, else ``lost``; its TUG phase
+    is the phase at its first scan.  Brief crossings (the legs pass each other every step)
+    and short prediction errors during occlusions stay below these limits.
+Stance-phase identification
+    Ground-truth stance: the truth leg speed (central differences of the 0.05 s-smoothed
+    track) is below ``stance_speed_mps`` = 0.70 m/s (between the tracker's thresholds
+    v_st_th = 0.47 and v_sw_th = 0.93) for ≥ ``min_stance_s`` = 0.10 s.  A truth stance
+    interval within the tracked, valid time is *identified* if the tracker reports that
+    leg in stance (not swinging) for ≥ ``min_stance_scans`` = 2 consecutive scans inside
+    it — enough for a foot-contact position, which is what the stance phase is needed for.
+    Otherwise it is a stance-phase identification failure, placed in the TUG phase of its
+    midpoint.
+Tracking success (seed 000 §6.2)
+    "tracking both legs without false tracking and identifying the stance phase
+    correctly": no false-tracking event and no stance failure.  Each failed trial gets
+    one category, the false tracking if there is one (else the stance failure), in the TUG
+    phase of the first such event — the paper's Table 3 counts add up this way
+    (e.g. Method 1: 12 + 2 failures = 28 − 14 successes).
+RMSE, occlusion rate
+    Over the valid scans of both legs (leg-steps, as the paper's time steps: Table 4's
+    counts are about twice the scans of a 7-s TUG); occlusion = the UO pattern (no
+    observation associated; Catmull–Rom steps are UO too).
+
+References
+----------
+Yorozu, A.; Moriguchi, T.; Takahashi, M. Improved Leg Tracking Considering Gait Phase and
+Spline-Based Interpolation during Turning Motion in Walk Tests. Sensors 2015, 15,
+22451–22472. doi:10.3390/s150922451
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from gaitval.errors import GaitvalError
+
+DEFAULTS: dict[str, Any] = {
+    "smooth_s": 0.5,
+    "heading_min_speed_mps": 0.2,
+    "turn_angle_deg": 30.0,
+    "lost_m": 0.30,
+    "swap_margin_m": 0.05,
+    "swap_min_m": 0.10,
+    "min_bad_s": 0.20,
+    "stance_speed_mps": 0.70,
+    "stance_smooth_s": 0.05,
+    "min_stance_s": 0.10,
+    "min_stance_scans": 2,
+}
+
+TUG_PHASES = ("forward", "turning", "return")
+TRUTH_COLUMNS = ("t_sensor_s", "side", "xs_m", "ys_m", "valid")
+
+FRAME_COLUMNS = ("trial", "method", "k", "t_sensor_s", "side", "x_m", "y_m", "xs_m", "ys_m",
+                 "valid", "err_x_m", "err_y_m", "observed", "interpolated", "pattern",
+                 "phase", "swing", "tug_phase", "bad")
+
+
+def _cfg(cfg: dict | None) -> dict:
+    out = dict(DEFAULTS)
+    out.update(cfg or {})
+    return out
+
+
+def _check_truth(truth: pd.DataFrame) -> None:
+    missing = [c for c in TRUTH_COLUMNS if c not in truth.columns]
+    if missing:
+        raise GaitvalError(f"ground truth lacks column(s) {', '.join(missing)}",
+                           hint="pass the sensor-frame truth of gaitval.groundtruth")
+
+
+def _smooth(y: np.ndarray, n: int) -> np.ndarray:
+    """Centred moving average over n samples, NaN-aware, same length."""
+    if n <= 1:
+        return y.copy()
+    ok = np.isfinite(y)
+    v = np.where(ok, y, 0.0)
+    ker = np.ones(n)
+    num = np.convolve(v, ker, mode="same")
+    den = np.convolve(ok.astype(float), ker, mode="same")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(den > 0, num / den, np.nan)
+
+
+def _truth_side(truth: pd.DataFrame, side: str):
+    d = truth[truth["side"].astype(str) == side].sort_values("t_sensor_s")
+    t = d["t_sensor_s"].to_numpy(float)
+    valid = d["valid"].to_numpy(bool) & np.isfinite(d["xs_m"].to_numpy(float)) \
+        & np.isfinite(d["ys_m"].to_numpy(float))
+    x = np.where(valid, d["xs_m"].to_numpy(float), np.nan)
+    y = np.where(valid, d["ys_m"].to_numpy(float), np.nan)
+    return t, x, y, valid
+
+
+def _rate(t: np.ndarray) -> float:
+    d = np.diff(t)
+    d = d[d > 0]
+    return 1.0 / float(np.median(d)) if len(d) else float("nan")
+
+
+def tug_phase_bounds(truth: pd.DataFrame, cfg: dict | None = None) -> dict[str, float]:
+    """Turning interval of a TUG from the truth midpoint (rule in the module notes).
+
+    Returns
+    -------
+    dict
+        ``t_start_s, t_turn_start_s, t_far_s, t_turn_end_s, t_end_s`` (sensor clock).
+    """
+    _check_truth(truth)
+    c = _cfg(cfg)
+    tl, xl, yl, _ = _truth_side(truth, "L")
+    tr, xr, yr, _ = _truth_side(truth, "R")
+    if len(tl) < 3 or len(tr) < 3:
+        raise GaitvalError("ground truth has too few samples to find the TUG phases")
+    t = tl
+    xr_i, yr_i = np.interp(t, tr, xr), np.interp(t, tr, yr)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)      # all-NaN columns → NaN
+        mx = np.nanmean(np.vstack([xl, xr_i]), axis=0)
+        my = np.nanmean(np.vstack([yl, yr_i]), axis=0)
+    ok = np.isfinite(mx) & np.isfinite(my)
+    if ok.sum() < 3:
+        raise GaitvalError("ground truth has no valid samples to find the TUG phases")
+    t, mx, my = t[ok], mx[ok], my[ok]
+    n = max(1, int(round(c["smooth_s"] * _rate(t))))
+    sx, sy = _smooth(mx, n), _smooth(my, n)
+    start = np.array([sx[0], sy[0]])
+    dist = np.hypot(sx - start[0], sy - start[1])
+    i_far = int(np.argmax(dist))
+    h = np.array([sx[i_far] - start[0], sy[i_far] - start[1]])
+    h = h / (np.linalg.norm(h) or 1.0)
+    vx, vy = np.gradient(sx, t), np.gradient(sy, t)
+    speed = np.hypot(vx, vy)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cosang = (vx * h[0] + vy * h[1]) / speed
+    cos_lim = math.cos(math.radians(c["turn_angle_deg"]))
+    moving = speed > c["heading_min_speed_mps"]
+    out_ok = moving & (cosang >= cos_lim)
+    back_ok = moving & (-cosang >= cos_lim)
+    before = np.flatnonzero(out_ok[:i_far + 1])
+    after = np.flatnonzero(back_ok[i_far:]) + i_far
+    i0 = int(before[-1]) if len(before) else i_far
+    i1 = int(after[0]) if len(after) else i_far
+    return {"t_start_s": float(t[0]), "t_turn_start_s": float(t[i0]),
+            "t_far_s": float(t[i_far]), "t_turn_end_s": float(t[i1]),
+            "t_end_s": float(t[-1])}
+
+
+def tug_phase_of(t: np.ndarray, bounds: dict[str, float]) -> np.ndarray:
+    """Label times with forward / turning / return (object array)."""
+    t = np.asarray(t, dtype=float)
+    out = np.full(len(t), "forward", dtype=object)
+    out[t >= bounds["t_turn_start_s"]] = "turning"
+    out[t > bounds["t_turn_end_s"]] = "return"
+    return out
+
+
+def align_truth(track: pd.DataFrame, truth: pd.DataFrame) -> pd.DataFrame:
+    """Track rows with ``xs_m, ys_m, valid, err_x_m, err_y_m`` (truth at the scan times)."""
+    _check_truth(truth)
+    out = track.copy()
+    xs = np.full(len(out), np.nan)
+    ys = np.full(len(out), np.nan)
+    valid = np.zeros(len(out), bool)
+    side = out["side"].astype(str).to_numpy()
+    tt = out["t_sensor_s"].to_numpy(float)
+    for s in ("L", "R"):
+        sel = side == s
+        t, x, y, v = _truth_side(truth, s)
+        if len(t) < 2:
+            continue
+        q = tt[sel]
+        inside = (q >= t[0]) & (q <= t[-1])
+        vi = np.interp(q, t, v.astype(float)) > 0.999
+        xi = np.interp(q, t, np.where(v, x, 0.0))
+        yi = np.interp(q, t, np.where(v, y, 0.0))
+        ok = inside & vi
+        xs[sel] = np.where(ok, xi, np.nan)
+        ys[sel] = np.where(ok, yi, np.nan)
+        valid[sel] = ok
+    out["xs_m"] = xs
+    out["ys_m"] = ys
+    valid &= np.isfinite(out["x_m"].to_numpy(float))
+    out["valid"] = valid
+    out["err_x_m"] = np.where(valid, out["x_m"].to_numpy(float) - xs, np.nan)
+    out["err_y_m"] = np.where(valid, out["y_m"].to_numpy(float) - ys, np.nan)
+    return out
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(start, stop) index pairs of the True runs of a boolean array."""
+    m = np.concatenate([[False], np.asarray(mask, bool), [False]])
+    d = np.diff(m.astype(np.int8))
+    return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1)))
+
+
+def false_tracking(frames: pd.DataFrame, cfg: dict | None = None
+                   ) -> tuple[np.ndarray, pd.DataFrame]:
+    """Per-row bad flags and the false-tracking events (rule in the module notes).
+
+    Parameters
+    ----------
+    frames : DataFrame
+        :func:`align_truth` output with ``tug_phase`` (rows per scan and side).
+
+    Returns
+    -------
+    bad : ndarray of bool, aligned with ``frames`` rows
+    events : DataFrame
+        ``side, kind (swap|lost), k_start, k_end, t_start_s, t_end_s, tug_phase,
+        max_error_m``.
+    """
+    c = _cfg(cfg)
+    bad = np.zeros(len(frames), bool)
+    rows = []
+    f = frames.reset_index(drop=True)
+    side = f["side"].astype(str).to_numpy()
+    t_all = f["t_sensor_s"].to_numpy(float)
+    rate = _rate(np.unique(t_all)) if len(t_all) > 1 else 40.0
+    min_n = max(1, int(math.ceil(c["min_bad_s"] * rate - 1e-9)))
+    idx = {s: np.flatnonzero(side == s) for s in ("L", "R")}
+    if len(idx["L"]) != len(idx["R"]):
+        raise GaitvalError("track has a different number of rows for L and R")
+    for s, o in (("L", "R"), ("R", "L")):
+        a, b = idx[s], idx[o]
+        x, y = f["x_m"].to_numpy(float)[a], f["y_m"].to_numpy(float)[a]
+        e_own = np.hypot(x - f["xs_m"].to_numpy(float)[a], y - f["ys_m"].to_numpy(float)[a])
+        e_oth = np.hypot(x - f["xs_m"].to_numpy(float)[b], y - f["ys_m"].to_numpy(float)[b])
+        ok = f["valid"].to_numpy(bool)[a] & f["valid"].to_numpy(bool)[b]
+        closer_other = (e_oth + c["swap_margin_m"] < e_own) & (e_own > c["swap_min_m"])
+        b_s = ok & ((e_own > c["lost_m"]) | closer_other)
+        for i0, i1 in _runs(b_s):
+            if i1 - i0 < min_n:
+                continue
+            bad[a[i0:i1]] = True
+            kind = "swap" if closer_other[i0:i1].mean() > 0.5 else "lost"
+            rows.append({"side": s, "kind": kind,
+                         "k_start": int(f["k"].iloc[a[i0]]), "k_end": int(f["k"].iloc[a[i1 - 1]]),
+                         "t_start_s": float(t_all[a[i0]]), "t_end_s": float(t_all[a[i1 - 1]]),
+                         "tug_phase": str(f["tug_phase"].iloc[a[i0]]),
+                         "max_error_m": float(np.nanmax(e_own[i0:i1]))})
+    ev = pd.DataFrame(rows, columns=["side", "kind", "k_start", "k_end", "t_start_s",
+                                     "t_end_s", "tug_phase", "max_error_m"])
+    return bad, ev.sort_values(["t_start_s", "side"], kind="stable").reset_index(drop=True)
+
+
+def truth_stance_intervals(truth: pd.DataFrame, cfg: dict | None = None) -> pd.DataFrame:
+    """Ground-truth stance intervals per side: ``side, t_start_s, t_end_s``."""
+    c = _cfg(cfg)
+    rows = []
+    for s in ("L", "R"):
+        t, x, y, v = _truth_side(truth, s)
+        if len(t) < 3:
+            continue
+        n = max(1, int(round(c["stance_smooth_s"] * _rate(t))))
+        sx, sy = _smooth(x, n), _smooth(y, n)
+        speed = np.hypot(np.gradient(sx, t), np.gradient(sy, t))
+        st = v & np.isfinite(speed) & (speed < c["stance_speed_mps"])
+        for i0, i1 in _runs(st):
+            if t[i1 - 1] - t[i0] >= c["min_stance_s"]:
+                rows.append({"side": s, "t_start_s": float(t[i0]), "t_end_s": float(t[i1 - 1])})
+    return pd.DataFrame(rows, columns=["side", "t_start_s", "t_end_s"])
+
+
+def stance_failures(frames: pd.DataFrame, stance: pd.DataFrame, cfg: dict | None = None
+                    ) -> pd.DataFrame:
+    """Match truth stance intervals to the tracker's stance (module notes).
+
+    Returns
+    -------
+    DataFrame
+        One row per truth stance interval inside the tracked, valid time:
+        ``side, t_start_s, t_end_s, tug_phase, identified (bool), n_stance_scans``.
+    """
+    c = _cfg(cfg)
+    rows = []
+    for s in ("L", "R"):
+        d = frames[frames["side"].astype(str) == s]
+        tt = d["t_sensor_s"].to_numpy(float)
+        tracked = d["valid"].to_numpy(bool)
+        st = ~d["swing"].to_numpy(bool) & tracked
+        ph = d["tug_phase"].to_numpy(object)
+        if not tracked.any():
+            continue
+        t_lo, t_hi = tt[tracked].min(), tt[tracked].max()
+        for r in stance[stance["side"] == s].itertuples(index=False):
+            if r.t_start_s < t_lo or r.t_end_s > t_hi:
+                continue
+            sel = (tt >= r.t_start_s) & (tt <= r.t_end_s)
+            if not sel.any():
+                continue
+            longest = max((b - a for a, b in _runs(st[sel])), default=0)
+            mid = 0.5 * (r.t_start_s + r.t_end_s)
+            rows.append({"side": s, "t_start_s": r.t_start_s, "t_end_s": r.t_end_s,
+                         "tug_phase": str(ph[np.argmin(np.abs(tt - mid))]),
+                         "identified": bool(longest >= c["min_stance_scans"]),
+                         "n_stance_scans": int(st[sel].sum())})
+    return pd.DataFrame(rows, columns=["side", "t_start_s", "t_end_s", "tug_phase",
+                                       "identified", "n_stance_scans"])
+
+
+def evaluate_tug_trial(track: pd.DataFrame, truth: pd.DataFrame, *, trial: str = "",
+                       method: str = "", cfg: dict | None = None) -> dict[str, pd.DataFrame]:
+    """Evaluate one tracked TUG trial.
+
+    Parameters
+    ----------
+    track : DataFrame
+        :func:`gaitval.methods.track_trial` output (sensor frame).
+    truth : DataFrame
+        Ground truth ``t_sensor_s, side, xs_m, ys_m, valid`` (sensor frame, sensor clock).
+    trial, method : str
+        Identifiers copied into every output.
+    cfg : dict, optional
+        Overrides of :data:`DEFAULTS`.
+
+    Returns
+    -------
+    dict of DataFrame
+        ``frames`` (columns :data:`FRAME_COLUMNS`, one row per scan and side),
+        ``events`` (false tracking, see :func:`false_tracking`, plus trial/method),
+        ``stance`` (see :func:`stance_failures`, plus trial/method) and ``summary`` (one
+        row: ``trial, method, n_scans, n_leg_steps, n_uo, false_tracking, ft_phase,
+        n_ft_events, stance_failure, sf_phase, n_stance_true, n_stance_failures, success,
+        category, t_turn_start_s, t_turn_end_s``).
+    """
+    bounds = tug_phase_bounds(truth, cfg)
+    fr = align_truth(track, truth)
+    fr["tug_phase"] = tug_phase_of(fr["t_sensor_s"].to_numpy(float), bounds)
+    bad, events = false_tracking(fr, cfg)
+    fr["bad"] = bad
+    fr.insert(0, "method", method)
+    fr.insert(0, "trial", trial)
+    for col in ("observed", "interpolated", "swing"):
+        if col not in fr:
+            fr[col] = False
+    fr = fr[list(FRAME_COLUMNS)]
+    stance = stance_failures(fr, truth_stance_intervals(truth, cfg), cfg)
+    for d in (events, stance):
+        d.insert(0, "method", method)
+        d.insert(0, "trial", trial)
+    ft = len(events) > 0
+    failed = stance[~stance["identified"]] if len(stance) else stance
+    sf = len(failed) > 0
+    ft_phase = str(events["tug_phase"].iloc[0]) if ft else ""
+    sf_phase = str(failed.sort_values("t_start_s")["tug_phase"].iloc[0]) if sf else ""
+    category = (f"false_tracking_{ft_phase}" if ft else
+                f"stance_failure_{sf_phase}" if sf else "success")
+    v = fr[fr["valid"]]
+    summary = pd.DataFrame([{
+        "trial": trial, "method": method, "n_scans": int(fr["k"].nunique()),
+        "n_leg_steps": int(len(v)), "n_uo": int((v["pattern"] == "UO").sum()),
+        "false_tracking": ft, "ft_phase": ft_phase, "n_ft_events": int(len(events)),
+        "stance_failure": sf, "sf_phase": sf_phase, "n_stance_true": int(len(stance)),
+        "n_stance_failures": int(len(failed)), "success": not ft and not sf,
+        "category": category, "t_turn_start_s": bounds["t_turn_start_s"],
+        "t_turn_end_s": bounds["t_turn_end_s"]}])
+    return {"frames": fr.reset_index(drop=True), "events": events, "stance": stance,
+            "summary": summary}

@@ -1,0 +1,91 @@
+"""Seed 000 Tables 2–5 from per-trial evaluation frames (gaitval.tables.tug)."""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitval.tables.tug import (PUBLISHED_T3, tug_table2, tug_table3, tug_table4,
+                                tug_table5, write_tug_tables)
+
+
+def summary(trial, method, category):
+    return {"trial": trial, "method": method, "category": category,
+            "success": category == "success"}
+
+
+def frames(trial, method, errs, phases, patterns):
+    n = len(errs)
+    return pd.DataFrame({"trial": trial, "method": method, "k": np.arange(n),
+                         "t_sensor_s": np.arange(n) * 0.025, "side": "L",
+                         "err_x_m": errs, "err_y_m": np.asarray(errs) / 2, "valid": True,
+                         "tug_phase": phases, "pattern": patterns})
+
+
+@pytest.fixture
+def data():
+    s = pd.DataFrame([summary("a", "tug_m2", "success"), summary("b", "tug_m2", "success"),
+                      summary("a", "tug_m1", "false_tracking_turning"),
+                      summary("b", "tug_m1", "stance_failure_turning")])
+    f = pd.concat([
+        frames("a", "tug_m2", [0.03, 0.04], ["forward", "turning"], ["SL", "UO"]),
+        frames("b", "tug_m2", [0.0, 0.0], ["return", "turning"], ["SL", "SL"]),
+        frames("a", "tug_m1", [1.0, 1.0], ["forward", "turning"], ["SL", "SL"]),
+        frames("b", "tug_m1", [0.5, 0.5], ["forward", "turning"], ["SL", "SL"]),
+    ], ignore_index=True)
+    return f, s
+
+
+def test_table3_counts_and_published(data):
+    _, s = data
+    t = tug_table3(s).set_index("method")
+    assert t.loc["tug_m1", "ft_turning"] == 1 and t.loc["tug_m1", "sf_turning"] == 1
+    assert t.loc["tug_m1", "n_success"] == 0 and t.loc["tug_m2", "success_rate"] == 1.0
+    # seed 000 Table 3: 50.0 % (14/28), 89.3 % (25/28), 96.4 % (27/28)
+    assert t.loc["tug_m1", "success_rate_published"] == pytest.approx(0.5)
+    assert t.loc["tug_m2", "success_rate_published"] == pytest.approx(25 / 28)
+    assert PUBLISHED_T3["tug_m3"]["ft_return"] == 1
+    assert list(t.index) == ["tug_m1", "tug_m2"]
+
+
+def test_table4_only_success_trials(data):
+    f, s = data
+    t = tug_table4(f, s)
+    m2 = t[t.method == "tug_m2"].set_index("tug_phase")
+    # turning: errors 0.04 (UO) and 0.0 → RMSE = sqrt((0.04² + 0)/2)
+    assert m2.loc["turning", "rmse_x_m"] == pytest.approx(np.sqrt(0.04 ** 2 / 2))
+    assert (m2.loc["turning", "n_uo"], m2.loc["turning", "n_steps"]) == (1, 2)
+    assert m2.loc["total", "n_steps"] == 4 and m2.loc["total", "occlusion_rate"] == 0.25
+    # published seed 000 Table 4, Method 2 turning: 11.3 % (255/2264), 0.069, 0.062
+    assert m2.loc["turning", "occlusion_rate_published"] == pytest.approx(255 / 2264)
+    assert m2.loc["turning", "rmse_y_m_published"] == 0.062
+    m1 = t[t.method == "tug_m1"]
+    assert (m1["n_steps"] == 0).all() and m1["rmse_x_m"].isna().all()
+
+
+def test_table5_observation_states(data):
+    f, s = data
+    t = tug_table5(f, s)
+    m2 = t[t.method == "tug_m2"].set_index("observation_state")
+    assert m2.loc["unobservable", "time_steps"] == 1
+    assert m2.loc["unobservable", "rmse_x_m"] == pytest.approx(0.04)
+    assert m2.loc["observable", "time_steps_published"] == 14490
+
+
+def test_table2_parameters():
+    t = tug_table2(dt_measured_s=0.025)
+    g = t[(t.symbol == "G") & (t.method == "tug_m1")].iloc[0]
+    assert (g.value, g.value_published) == ("13.82", "13.82")
+    nbo = t[(t.symbol == "N_bo")].set_index("method")["value"]
+    assert nbo["tug_m1"] == "" and nbo["tug_m3"] == "match"
+
+
+def test_write_tug_tables(tmp_path, data):
+    f, s = data
+    paths = write_tug_tables(f, s, tmp_path)
+    names = sorted(p.name for p in paths)
+    assert names == sorted(f"tug_table{i}.{e}" for i in range(2, 6) for e in ("csv", "md", "tex"))
+    md = (tmp_path / "tug_table3.md").read_text()
+    assert "ordering" in md
+    again = write_tug_tables(f, s, tmp_path / "again")
+    assert [p.read_bytes() for p in paths] == [p.read_bytes() for p in again]
