@@ -235,22 +235,31 @@ def measure(R: np.ndarray, I: np.ndarray, spec: LaserSpec, rng: np.random.Genera
     """
     ns = R.shape[0]
     nb, k = spec.n_beams, spec.n_sub
+    c = k // 2
     Rs = R.reshape(ns, nb, k)
     Is = I.reshape(ns, nb, k)
-    fin = np.isfinite(Rs)
-    nfin = fin.sum(axis=2)
-    Rz = np.where(fin, Rs, 0.0)
-    mean = Rz.sum(axis=2) / np.maximum(nfin, 1)
-    rmax = np.where(fin, Rs, -np.inf).max(axis=2)
-    rmin = np.where(fin, Rs, np.inf).min(axis=2)
-    spread = np.where(nfin > 0, rmax - rmin, 0.0)
-    centre = Rs[:, :, k // 2]
-    ids_differ = np.any(np.where(fin, Is, -2) != np.where(fin[:, :, :1], Is[:, :, :1], -2),
-                        axis=2) & fin.all(axis=2)
-    mixed = (nfin * 2 > k) & ids_differ & (spread > spec.mixed_jump_m)
-    true = np.where(nfin * 2 > k, np.where(mixed, mean, centre), np.inf)
-    # the central sub-ray may miss while the majority hits: use the mean then
-    true = np.where(np.isfinite(true) & ~np.isfinite(centre), mean, true)
+    centre = Rs[:, :, c]
+    cid = Is[:, :, c]
+    # only beams whose sub-rays disagree on the surface need the footprint model
+    differ = np.zeros((ns, nb), dtype=bool)
+    for j in range(k):
+        if j != c:
+            differ |= Is[:, :, j] != cid
+    true = centre.copy()
+    mixed = np.zeros((ns, nb), dtype=bool)
+    idx = np.nonzero(differ)
+    if idx[0].size:
+        sub = Rs[idx]                                        # (m, k)
+        fin = np.isfinite(sub)
+        nfin = fin.sum(axis=1)
+        mean = np.where(fin, sub, 0.0).sum(axis=1) / np.maximum(nfin, 1)
+        spread = np.where(fin, sub, -np.inf).max(axis=1) - np.where(fin, sub, np.inf).min(axis=1)
+        majority = nfin * 2 > k
+        mix = majority & fin.all(axis=1) & (spread > spec.mixed_jump_m)
+        # partly on a surface: the majority's mean (the centre ray may have missed)
+        val = np.where(mix, mean, np.where(np.isfinite(sub[:, c]), sub[:, c], mean))
+        true[idx] = np.where(majority, val, np.inf)
+        mixed[idx] = mix
     sigma = spec.sigma_m + spec.sigma_rel * np.where(np.isfinite(true), true, 0.0)
     noisy = true + sigma * rng.standard_normal(true.shape)
     drop = np.isfinite(true) & (rng.random(true.shape) < spec.dropout_prob)
