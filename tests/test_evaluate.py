@@ -60,11 +60,16 @@ def test_false_tracking_rule_by_hand():
     assert (e.side, e.kind, e.k_start, e.k_end, e.tug_phase) == ("L", "swap", 30, 45, "turning")
     assert e.max_error_m == pytest.approx(0.2)
     assert bad.sum() == 16
-    # long enough, the lost run is an event of kind "lost"
+    # long enough, the run is an event: "lost" while taking observations ...
     lost = (f["side"] == "R") & f["k"].between(60, 75)
     f.loc[lost, "x_m"] = 1.5
+    f["observed"] = True
     _, ev = false_tracking(f)
     assert ev["kind"].tolist() == ["swap", "lost"]
+    # ... "drift" when the leg was hidden (UO) and the prediction ran off
+    f.loc[lost, "observed"] = False
+    _, ev = false_tracking(f)
+    assert ev["kind"].tolist() == ["swap", "drift"]
 
 
 def test_legs_passing_each_other_is_not_false_tracking():

@@ -90,20 +90,25 @@ def gait_phase(pl: tuple[float, float], vl: tuple[float, float],
     int
         The phase (see the module table).
     """
-    sl = math.hypot(vl[0], vl[1])
-    sr = math.hypot(vr[0], vr[1])
-    lsw = leg_swings(sl, sr, v_st_th, v_sw_th)
-    rsw = leg_swings(sr, sl, v_st_th, v_sw_th)
+    return gait_phase_xy(pl[0], pl[1], vl[0], vl[1], pr[0], pr[1], vr[0], vr[1],
+                         v_st_th, v_sw_th)
+
+
+def gait_phase_xy(xl, yl, vxl, vyl, xr, yr, vxr, vyr, v_st_th, v_sw_th) -> int:
+    """:func:`gait_phase` on plain floats (the tracker's inner loop)."""
+    sl = math.hypot(vxl, vyl)
+    sr = math.hypot(vxr, vyr)
+    # eq. (3)–(4) with the resolution of the module notes
+    lsw = False if sl < v_st_th else (True if sl > v_sw_th else sl > sr)
+    rsw = False if sr < v_st_th else (True if sr > v_sw_th else sr > sl)
     if lsw and rsw:
         return 5
     if not lsw and not rsw:
         return 0
     if lsw:
         # eq. (5): (p^R - p^L) · v^L
-        ip = (pr[0] - pl[0]) * vl[0] + (pr[1] - pl[1]) * vl[1]
-        return 1 if ip > 0.0 else 2
-    ip = (pl[0] - pr[0]) * vr[0] + (pl[1] - pr[1]) * vr[1]
-    return 3 if ip > 0.0 else 4
+        return 1 if (xr - xl) * vxl + (yr - yl) * vyl > 0.0 else 2
+    return 3 if (xl - xr) * vxr + (yl - yr) * vyr > 0.0 else 4
 
 
 def gait_phases(pl: np.ndarray, vl: np.ndarray, pr: np.ndarray, vr: np.ndarray,

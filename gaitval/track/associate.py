@@ -63,6 +63,23 @@ def ranked_associations(cand_l, cand_r, d_max: float) -> list[tuple[float, int, 
     return out
 
 
+def _GNN_FAST(d_max, cand_l, cand_r) -> tuple[int, int]:
+    """The least-cost association when it is obvious, else (-1, -1).
+
+    With at most one gated observation per leg, different ones, and every λ < d_max,
+    taking them costs less than any alternative (same result as the full ranking).
+    """
+    if len(cand_l) > 1 or len(cand_r) > 1:
+        return -1, -1
+    a = cand_l[0][0] if cand_l else 0
+    b = cand_r[0][0] if cand_r else 0
+    if a and a == b:
+        return -1, -1
+    if (cand_l and cand_l[0][1] >= d_max) or (cand_r and cand_r[0][1] >= d_max):
+        return -1, -1
+    return a, b
+
+
 @ASSOCIATORS.register("gnn")
 class GNNAssociator(Associator):
     """Global nearest neighbour: least total cost (seed 000 Method 1)."""
@@ -71,8 +88,9 @@ class GNNAssociator(Associator):
         self.d_max = d_max
 
     def select(self, cand_l, cand_r, prev_phase, phase_of):
-        if not cand_l and not cand_r:
-            return 0, 0
+        a, b = _GNN_FAST(self.d_max, cand_l, cand_r)
+        if a >= 0:
+            return a, b
         _, a, b = ranked_associations(cand_l, cand_r, self.d_max)[0]
         return a, b
 
@@ -85,8 +103,11 @@ class GaitPhaseAssociator(Associator):
         self.d_max = d_max
 
     def select(self, cand_l, cand_r, prev_phase, phase_of):
-        ranked = ranked_associations(cand_l, cand_r, self.d_max)
         unlikely = UNLIKELY_TRANSITIONS.get(prev_phase, frozenset())
+        a, b = _GNN_FAST(self.d_max, cand_l, cand_r)
+        if a >= 0 and phase_of(a, b) not in unlikely:
+            return a, b                      # the cheapest association is likely: done
+        ranked = ranked_associations(cand_l, cand_r, self.d_max)
         for _, a, b in ranked:
             if phase_of(a, b) not in unlikely:
                 return a, b

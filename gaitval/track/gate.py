@@ -18,7 +18,9 @@ GATES = Registry("gate")
 
 
 class Gate:
-    """Role base."""
+    """Role base.  ``needs_context = False`` lets the tracker pass ``ctx=None`` (faster)."""
+
+    needs_context = True
 
     def admits(self, lam2: float, dist: float, ctx: dict) -> bool:
         raise NotImplementedError
@@ -33,6 +35,8 @@ class ChiSquareGate(Gate):
     g : float
         G; seed 000 Table 2: 13.82 (χ² with 2 degrees of freedom, P_G = 0.999).
     """
+
+    needs_context = False
 
     def __init__(self, g: float = 13.82):
         self.g = g

@@ -85,6 +85,10 @@ class LegFilter:
     def vel(self, s) -> tuple[float, float]:
         raise NotImplementedError
 
+    def posvel(self, s) -> tuple[float, float, float, float]:
+        """(x, y, vx, vy) of a state."""
+        return self.pos(s) + self.vel(s)
+
     def with_state(self, s, x: float, y: float, vx: float, vy: float):
         """``s`` with its mean replaced (covariance kept); used to rewrite a history."""
         raise NotImplementedError
@@ -146,6 +150,9 @@ class AxisKalmanFilter(LegFilter):
 
     def vel(self, s):
         return s[2], s[3]
+
+    def posvel(self, s):
+        return s[:4]
 
     def with_state(self, s, x, y, vx, vy):
         return (float(x), float(y), float(vx), float(vy), s[4], s[5], s[6])

@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from gaitval.errors import GaitvalError
-from gaitval.gait.phases import SWINGING, gait_phase
+from gaitval.gait.phases import SWINGING, gait_phase_xy
 from gaitval.track.associate import ASSOCIATORS
 from gaitval.track.gate import GATES
 from gaitval.track.kalman import FILTERS
@@ -54,7 +54,8 @@ class TrackResult:
     """Arrays of one run; index [0] = left, [1] = right leg, shape (2, n_scans).
 
     ``phase`` is -1 before initialisation; ``pattern`` is ``""`` there, else the pattern
-    of the associated observation or ``"UO"``.
+    of the associated observation or ``"UO"``; ``obs_index`` is the 0-based index of the
+    associated observation in its scan (-1: none).
     """
 
     t: np.ndarray
@@ -68,6 +69,7 @@ class TrackResult:
     phase: np.ndarray
     k_init: int
     swapped_sides: bool = False
+    obs_index: np.ndarray | None = None     # (2, n): associated observation j (0-based), -1
 
     @property
     def swing(self) -> np.ndarray:
@@ -183,12 +185,16 @@ class Tracker:
         _, dts = step_durations(t, self.dt_s) if n > 1 else (self.dt_s or 0.025,
                                                              np.array([self.dt_s or 0.025]))
         F = self.filter
+        # plain Python floats in the loop (numpy scalars are several times slower)
+        xyl = [np.asarray(o, dtype=float).reshape(-1, 2).tolist() for o in xy]
+        needs_ctx = getattr(self.gate, "needs_context", True)
         nan = np.full((2, n), np.nan)
         res = TrackResult(t=np.asarray(t, dtype=float), x=nan.copy(), y=nan.copy(),
                           vx=nan.copy(), vy=nan.copy(),
                           observed=np.zeros((2, n), bool), interpolated=np.zeros((2, n), bool),
                           pattern=np.full((2, n), "", dtype=object),
-                          phase=np.full(n, -1, dtype=np.int8), k_init=-1)
+                          phase=np.full(n, -1, dtype=np.int8), k_init=-1,
+                          obs_index=np.full((2, n), -1, dtype=np.int64))
         init = self._initial_pair(xy)
         if init is None:
             return res
@@ -200,12 +206,13 @@ class Tracker:
         acc = [[0.0] * n, [0.0] * n]
         phase = [0] * n
         pats = [[""] * n, [""] * n]
-        obs0 = xy[k0]
+        obs0 = xyl[k0]
         for f, i in ((0, il), (1, ir)):
             post[f][k0] = F.init(float(obs0[i][0]), float(obs0[i][1]))
             z[f][k0] = (float(obs0[i][0]), float(obs0[i][1]))
             real[f][k0] = True
             pats[f][k0] = patterns[k0][i]
+            res.obs_index[f, k0] = i
         last_real = [k0, k0]
         n_unobs = [0, 0]
         n_ac = self.motion.n_ac
@@ -215,22 +222,29 @@ class Tracker:
         v_st, v_sw = self.v_st_th, self.v_sw_th
         gate, assoc, occ, motion = self.gate, self.associator, self.occlusion, self.motion
 
-        def phase_from(sl, sr):
-            return gait_phase(F.pos(sl), F.vel(sl), F.pos(sr), F.vel(sr), v_st, v_sw)
+        posvel = F.posvel
 
-        def book_accel(f, k, dt):
-            """a_k = ‖v_k − v_{k−1}‖/Δt and the running swing-phase average g (§5.5)."""
-            v1 = F.vel(post[f][k])
-            v0 = F.vel(post[f][k - 1])
-            acc[f][k] = math.hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
-            if n_ac:
-                if SWINGING[phase[k]][f]:
-                    gsum[f] += acc[f][k]
-                    gcnt[f] += 1
-                old = k - n_ac
-                if old > k0 and SWINGING[phase[old]][f]:
-                    gsum[f] -= acc[f][old]
-                    gcnt[f] -= 1
+        def phase_from(sl, sr):
+            return gait_phase_xy(*posvel(sl), *posvel(sr), v_st, v_sw)
+
+        def book_accel(k, dt):
+            """a_k = ‖v_k − v_{k−1}‖/Δt of both legs and the running swing-phase average g
+            over the previous N_ac steps (§5.5)."""
+            sw_now = SWINGING[phase[k]]
+            old = k - n_ac
+            sw_old = SWINGING[phase[old]] if (n_ac and old > k0) else (False, False)
+            for f in (0, 1):
+                v1 = F.vel(post[f][k])
+                v0 = F.vel(post[f][k - 1])
+                a = math.hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
+                acc[f][k] = a
+                if n_ac:
+                    if sw_now[f]:
+                        gsum[f] += a
+                        gcnt[f] += 1
+                    if sw_old[f]:
+                        gsum[f] -= acc[f][old]
+                        gcnt[f] -= 1
 
         def gain(f):
             return gsum[f] / gcnt[f] if gcnt[f] > 0 else 0.0
@@ -276,8 +290,7 @@ class Tracker:
                         s = F.correct(s, z[g][k][0], z[g][k][1])
                     post[g][k] = s
                 phase[k] = phase_from(post[0][k], post[1][k])
-                for g in (0, 1):
-                    book_accel(g, k, dt)
+                book_accel(k, dt)
 
         for k in range(k0 + 1, n):
             dt = dts[k]
@@ -287,18 +300,20 @@ class Tracker:
             ul, ur = motion.inputs(phase[k - 1], vl, vr, gain(0), gain(1), dt)
             prior = (F.predict(sl_prev, dt, ul[0], ul[1]), F.predict(sr_prev, dt, ur[0], ur[1]))
             # gate, eq. (11)–(13)
-            obs = xy[k]
+            obs = xyl[k]
             cands = ([], [])
-            for f in (0, 1):
-                px, py = F.pos(prior[f])
-                v = vl if f == 0 else vr
-                ctx = {"leg_width_m": leg_width_m, "dt": dt, "speed": math.hypot(*v),
-                       "swing": SWINGING[phase[k - 1]][f], "n_unobserved": n_unobs[f]}
-                for j in range(len(obs)):
-                    zx, zy = obs[j][0], obs[j][1]
-                    lam2 = F.mahalanobis2(prior[f], zx, zy)
-                    if gate.admits(lam2, math.hypot(zx - px, zy - py), ctx):
-                        cands[f].append((j + 1, math.sqrt(lam2)))
+            if obs:
+                for f in (0, 1):
+                    px, py = F.pos(prior[f])
+                    ctx = None
+                    if needs_ctx:
+                        v = vl if f == 0 else vr
+                        ctx = {"leg_width_m": leg_width_m, "dt": dt, "speed": math.hypot(*v),
+                               "swing": SWINGING[phase[k - 1]][f], "n_unobserved": n_unobs[f]}
+                    for j, (zx, zy) in enumerate(obs):
+                        lam2 = F.mahalanobis2(prior[f], zx, zy)
+                        if gate.admits(lam2, math.hypot(zx - px, zy - py), ctx):
+                            cands[f].append((j + 1, math.sqrt(lam2)))
             # associate, eq. (9)–(10) and §5.2
             cache: tuple[dict, dict] = ({0: prior[0]}, {0: prior[1]})
 
@@ -309,25 +324,30 @@ class Tracker:
                     cache[f][j] = s
                 return s
 
+            pcache: dict = {}
+
             def phase_of(a, b):
-                return phase_from(corrected(0, a), corrected(1, b))
+                ph = pcache.get((a, b))
+                if ph is None:
+                    ph = pcache[(a, b)] = phase_from(corrected(0, a), corrected(1, b))
+                return ph
 
             a, b = assoc.select(cands[0], cands[1], phase[k - 1], phase_of)
             # correct, eq. (14)–(16)
             for f, j in ((0, a), (1, b)):
                 post[f][k] = corrected(f, j)
                 if j:
-                    z[f][k] = (float(obs[j - 1][0]), float(obs[j - 1][1]))
+                    z[f][k] = (obs[j - 1][0], obs[j - 1][1])
                     real[f][k] = True
                     pats[f][k] = patterns[k][j - 1]
+                    res.obs_index[f, k] = j - 1
                     n_unobs[f] = 0
                 else:
                     pats[f][k] = "UO"
                     n_unobs[f] += 1
             # gait phase, eq. (3)–(5)
-            phase[k] = phase_from(post[0][k], post[1][k])
-            for f in (0, 1):
-                book_accel(f, k, dt)
+            phase[k] = phase_of(a, b)
+            book_accel(k, dt)
             # occlusion handling (eq. 17 for Method 3)
             for f in (0, 1):
                 if real[f][k] and last_real[f] < k - 1:
@@ -347,12 +367,11 @@ class Tracker:
             refilter(f, ka, m, n - 1)
 
         for f in (0, 1):
-            for k in range(k0, n):
-                x, y = F.pos(post[f][k])
-                vx, vy = F.vel(post[f][k])
-                res.x[f, k], res.y[f, k], res.vx[f, k], res.vy[f, k] = x, y, vx, vy
-                res.observed[f, k] = real[f][k]
-                res.pattern[f, k] = pats[f][k]
+            pv = np.array([F.pos(p) + F.vel(p) for p in post[f][k0:]], dtype=float)
+            res.x[f, k0:], res.y[f, k0:] = pv[:, 0], pv[:, 1]
+            res.vx[f, k0:], res.vy[f, k0:] = pv[:, 2], pv[:, 3]
+            res.observed[f, k0:] = real[f][k0:]
+            res.pattern[f, k0:] = pats[f][k0:]
         res.phase[k0:] = np.asarray(phase[k0:], dtype=np.int8)
         if self.sides == "walking_direction" and _handedness(res) < 0:
             _swap_sides(res)
@@ -371,7 +390,7 @@ def _handedness(res: TrackResult, min_speed: float = 0.3) -> float:
 
 
 def _swap_sides(res: TrackResult) -> None:
-    for name in ("x", "y", "vx", "vy", "observed", "interpolated", "pattern"):
+    for name in ("x", "y", "vx", "vy", "observed", "interpolated", "pattern", "obs_index"):
         arr = getattr(res, name)
         setattr(res, name, arr[::-1].copy())
     ok = res.phase >= 0
