@@ -152,7 +152,7 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     0.06 m radius at shin height) at (3.0, 0.45) on a 0.45 m radius (body centre line:
     the trunk's half width ≈ 0.2 m plus clearance from the cone), comes back along
     y = 0.90, turns left again by 180° on a 0.45 m radius in front of the chair (the turn
-    to sit) and ends with two small backward steps to the seat before sitting down.
+    to sit) and ends with a small backward step to the seat before sitting down.
     """
     t_rise = float(rng.uniform(0.5, 0.9))
     rise_dur = float(rng.normal(0.9, 0.08))
@@ -163,10 +163,10 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
                                          ("arc", r_turn, np.pi, "turning"),
                                          ("line", TUG_MARKER_XY[0] - 0.50, "return"),
                                          ("arc", r_sit, np.pi, "return")])
-    # after the turn to sit the walker stands 0.38 m in front of the seat: two small
-    # backward steps to the chair
+    # after the turn to sit the walker stands 0.38 m in front of the seat: one small
+    # backward step to the chair, then the other foot joins
     plan = plan_steps(path, gp, rng, t0=t0, first_side=int(rng.integers(0, 2)),
-                      end_pose=(0.12, 0.0, 2 * np.pi, 2), start_half_width=0.10)
+                      end_pose=(0.12, 0.0, 2 * np.pi, 1), start_half_width=0.10)
     t_sit = plan.t_end + 0.15
     sit_dur = float(rng.normal(1.0, 0.08))
     t_end = t_sit + sit_dur + float(rng.uniform(0.4, 0.7))
@@ -241,7 +241,9 @@ def plan_mtst(rng, gp: GaitParams, targets: pd.DataFrame, color: str, t0: float
     number of steps (nominal count ± 2, step length within 0.6–1.35 of nominal) that
     brings the foot on the target's side onto it; when no count fits (targets too close),
     the foot that arrives takes the target even across the midline — a cross step
-    arises from the geometry.  Placement scatter is ``place_sd_m`` around the aim.
+    arises from the geometry.  Placement scatter is ``place_sd_m`` around the aim, plus
+    for target steps 2 cm and 10 % of the distance between the target and the foothold
+    the walker would have chosen without it (endpoint error grows with the correction).
     """
     tg = targets[targets["color"] == color].sort_values("x_m").reset_index(drop=True)
     sides = [0, 1]
@@ -255,9 +257,9 @@ def plan_mtst(rng, gp: GaitParams, targets: pd.DataFrame, color: str, t0: float
     L0 = gp.step_length_m
     goal = MAT_LENGTH + 0.35
 
-    def add(aim, label, first=False):
+    def add(aim, label, first=False, extra_sd=0.0):
         nonlocal side, x
-        p = np.asarray(aim, float) + gp.place_sd_m * rng.standard_normal(2)
+        p = np.asarray(aim, float) + np.hypot(gp.place_sd_m, extra_sd) * rng.standard_normal(2)
         T = gp.step_time_s * (1 + gp.step_cv * rng.standard_normal())
         sides.append(side)
         xy.append(p)
@@ -293,7 +295,11 @@ def plan_mtst(rng, gp: GaitParams, targets: pd.DataFrame, color: str, t0: float
             add((x + d / n, own_side()), "walk", nstep == 0)
             nstep += 1
         which[len(sides)] = row["target"]
-        add((row["x_m"], row["y_m"]), "target", nstep == 0)
+        # endpoint scatter grows with the adjustment away from the natural foothold
+        # (Fitts-like: SD ≈ 10 % of the corrective movement's amplitude)
+        natural = np.array([x + d / n, own_side()])
+        amp = float(np.hypot(*(np.array([row["x_m"], row["y_m"]]) - natural)))
+        add((row["x_m"], row["y_m"]), "target", nstep == 0, extra_sd=0.10 * amp + 0.02)
         nstep += 1
     while goal - x > 0.3 * L0:
         d = goal - x
