@@ -99,8 +99,8 @@ def pig_markers(legs, pelvis: np.ndarray, pelvis_heading: np.ndarray, subj: dict
 
 
 def add_noise_and_gaps(xy: dict[str, np.ndarray], rng: np.random.Generator, *,
-                       noise_m: float = 0.0003, short_rate_per_s: float = 0.03,
-                       long_prob: float = 0.08, rate_hz: float = 100.0,
+                       noise_m: float = 0.0003, short_rate_per_s: float = 0.15,
+                       long_prob: float = 0.12, rate_hz: float = 100.0,
                        no_gaps: tuple[str, ...] = ()) -> dict[str, np.ndarray]:
     """Sub-millimetre white noise and Vicon-like gaps (NaN).
 

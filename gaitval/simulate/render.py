@@ -209,6 +209,12 @@ def render_mocap(sim: TrialSim, subj: dict, rng: np.random.Generator):
                               "yaw_rad": np.unwrap(sp[:, 2])})
     keep = tuple(BONES + JOINT_CENTRES) + ("POLE1", "POLE2")
     mk = add_noise_and_gaps(mk, rng, rate_hz=sim.mocap_rate_hz, no_gaps=keep)
+    if sim.walker.sit is not None:
+        # seated, the flexed trunk and the hands hide the ASIS markers from most cameras
+        seated = sim.walker.sit(t) > 0.8
+        for lab in ("LASI", "RASI"):
+            if rng.random() < 0.6:
+                mk[lab][seated] = np.nan
     labels = sorted(mk, key=_label_order)
     xyz = np.stack([mk[lab] for lab in labels], axis=1)
     rows = []
