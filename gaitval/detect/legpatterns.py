@@ -42,7 +42,9 @@ a run of background beams is therefore *seen through* — filled with the ranges
 foreground on both sides, linearly interpolated — when (i) it is narrower than
 ``max_occluder_m`` (0.15 m) at its own range, (ii) its returns are nearer than the
 foreground on both sides by more than w_l/2 (an occluder, not a gap), and (iii) the two
-sides differ by less than w_l/2 (the same surface continues behind it).
+sides differ by less than w_l/2 (the same surface continues behind it).  "The foreground
+on a side" is the median of up to three beams there, so a mixed pixel at the occluder's
+edge does not break the test.
 
 References
 ----------
@@ -151,8 +153,15 @@ def see_through_occluders(masked: np.ndarray, raw: np.ndarray, angles: np.ndarra
     for i0, i1 in zip(starts, stops):               # beams i0 .. i1-1
         if i0 == 0 or i1 >= n:
             continue
-        left, right = masked[i0 - 1], masked[i1]
-        if not (math.isfinite(left) and math.isfinite(right)) or abs(left - right) >= half:
+        if not (math.isfinite(masked[i0 - 1]) and math.isfinite(masked[i1])):
+            continue
+        # the surface on either side: median of up to 3 beams (robust to a mixed pixel at
+        # the occluder's edge)
+        lo = masked[max(0, i0 - 3):i0]
+        hi = masked[i1:i1 + 3]
+        left = float(np.median(lo[np.isfinite(lo)]))
+        right = float(np.median(hi[np.isfinite(hi)]))
+        if abs(left - right) >= half:
             continue
         occ = raw[i0:i1]
         if np.nanmax(occ) >= min(left, right) - half:

@@ -43,7 +43,7 @@ def plot_trial_trajectories(frames: pd.DataFrame, trial: str, path: str | Path,
             ax.plot(uo["x_m"], uo["y_m"], "o", mfc="none", ms=3, color=COLORS[side])
         ax.set_title(m)
         ax.set_xlabel("x (sensor frame) [m]")
-        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_aspect("equal", adjustable="box")
         ax.grid(True, lw=0.3)
     axes[0][0].set_ylabel("y (sensor frame) [m]")
     axes[0][0].legend(fontsize=7, loc="best")

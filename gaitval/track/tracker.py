@@ -7,7 +7,8 @@ prediction and gets the UO pattern); identify the **gait phase** (eq. 3–5); **
 occlusion** (nothing, or Catmull–Rom virtual observations and re-filtering, eq. 17).
 
 Track initialisation (TUG: both legs at the chair at the start).  The tracker starts at
-the first scan with two observations closer than ``init_max_pair_m`` to each other (the
+the first scan with two observations between 0.7 w_l (two shanks cannot be closer; two
+observations nearer than that are one leg seen twice) and ``init_max_pair_m`` apart (the
 closest such pair), both legs at rest (v = 0, Phase 0).  Scans before that have no track
 (NaN).  Which of the two is the *left* leg is decided after the run from the walking
 direction (``sides="walking_direction"``): the left leg is on the left of the mean motion
@@ -144,7 +145,8 @@ class Tracker:
         self.sides = sides
 
     # -- initialisation -----------------------------------------------------------------
-    def _initial_pair(self, xy: list[np.ndarray]):
+    def _initial_pair(self, xy: list[np.ndarray], leg_width_m: float):
+        d_min = 0.7 * leg_width_m
         for k, obs in enumerate(xy):
             if len(obs) < 2:
                 continue
@@ -152,7 +154,7 @@ class Tracker:
             for i in range(len(obs)):
                 for j in range(i + 1, len(obs)):
                     d = math.hypot(*(obs[i] - obs[j]))
-                    if d <= self.init_max_pair_m and (best is None or d < best[0]):
+                    if d_min <= d <= self.init_max_pair_m and (best is None or d < best[0]):
                         best = (d, i, j)
             if best is not None:
                 _, i, j = best
@@ -195,7 +197,7 @@ class Tracker:
                           pattern=np.full((2, n), "", dtype=object),
                           phase=np.full(n, -1, dtype=np.int8), k_init=-1,
                           obs_index=np.full((2, n), -1, dtype=np.int64))
-        init = self._initial_pair(xy)
+        init = self._initial_pair(xy, leg_width_m)
         if init is None:
             return res
         k0, il, ir = init
