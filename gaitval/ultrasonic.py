@@ -720,6 +720,18 @@ def identify_noise(trials: list[tuple[UltrasonicLog, MocapTrial]], cfg: dict | N
             "_aligned": aligned}
 
 
+def noise_to_config(noise: dict) -> dict:
+    """The plain-number part of :func:`identify_noise`'s result, ready for YAML/JSON.
+
+    Returns ``{"ukf": {"W_sigma_mps2": [...], "V_m2": [...]}, "bias_m": [...],
+    "rmse_m": float}``; merge the ``ukf`` part into the ``ultrasonic`` config to track
+    with the identified noise.
+    """
+    return {"ukf": {"W_sigma_mps2": [float(w) for w in noise["W_sigma_mps2"]],
+                    "V_m2": [float(v) for v in noise["V_m2"]]},
+            "bias_m": [float(b) for b in noise["bias_m"]], "rmse_m": float(noise["rmse_m"])}
+
+
 def pendulum_errors(trials: list[tuple[UltrasonicLog, MocapTrial]], cfg: dict | None = None,
                     *, names: list[str] | None = None, aligned: list[dict] | None = None
                     ) -> pd.DataFrame:

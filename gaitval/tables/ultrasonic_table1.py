@@ -79,3 +79,31 @@ def write_ultrasonic_table1(errors: pd.DataFrame, stem: str | Path,
     caption = ("Errors of the pendulum experiment in 3D space compared with the motion "
                "capture system (seed 003 Table 1), reproduced beside the published values.")
     return write_table(df, stem, caption=caption, notes=notes)
+
+
+def build_ultrasonic_table1(trials, stem: str | Path, cfg: dict | None = None, *,
+                            names: list[str] | None = None) -> tuple[list[Path], dict]:
+    """Identify V and W from the pendulum trials, then render Table 1 with them.
+
+    Parameters
+    ----------
+    trials : list of (UltrasonicLog, MocapTrial)
+        The pendulum trials.
+    stem : path without suffix, e.g. ``reports/tables/ultrasonic_table1``.
+    cfg : dict
+        The ``ultrasonic`` configuration (see :data:`gaitval.ultrasonic.DEFAULT_CFG`).
+
+    Returns
+    -------
+    paths : list of Path
+        The CSV, Markdown and LaTeX files.
+    noise : dict
+        :func:`gaitval.ultrasonic.noise_to_config` of the identification (plain numbers).
+    """
+    from gaitval import ultrasonic as U
+
+    res = U.identify_noise(trials, cfg, names=names)
+    ucfg = U._merge(U.resolve_cfg(cfg), {"ukf": {"W_sigma_mps2": res["W_sigma_mps2"],
+                                                 "V_m2": res["V_m2"]}})
+    err = U.pendulum_errors(trials, ucfg, names=names, aligned=res["_aligned"])
+    return write_ultrasonic_table1(err, stem, res), U.noise_to_config(res)
