@@ -14,8 +14,7 @@ from gaitval.simulate.markers import (BONES, JOINT_CENTRES, add_noise_and_gaps,
                                       pig_markers)
 from gaitval.simulate.protocols import (POLE_TOP_M, RLT_CORNERS, RLT_TOP_M, TrialSim,
                                         rollator_tubes)
-from gaitval.simulate.scene import (ID_ATTENDANT, ID_LEFT, ID_RIGHT, ID_STICK, ID_WALL,
-                                    to_field, to_sensor)
+from gaitval.simulate.scene import ID_ATTENDANT, ID_LEFT, ID_RIGHT, ID_STICK, ID_WALL, to_sensor
 from gaitval.types import ScanSeries
 
 BLOCK = 256

@@ -56,7 +56,6 @@ def _interp_gaps(x: np.ndarray, t: np.ndarray, max_gap_s: float = 0.25) -> np.nd
             continue
         filled = np.interp(t, t[ok], x[ok, c])
         # leave long gaps and the ends empty
-        idx = np.flatnonzero(ok)
         prev = np.maximum.accumulate(np.where(ok, np.arange(len(t)), -1))
         nxt = np.minimum.accumulate(np.where(ok, np.arange(len(t)), len(t))[::-1])[::-1]
         inside = (prev >= 0) & (nxt < len(t))
@@ -64,7 +63,6 @@ def _interp_gaps(x: np.ndarray, t: np.ndarray, max_gap_s: float = 0.25) -> np.nd
                         np.inf)
         fill = ~ok & inside & (span <= max_gap_s)
         x[fill, c] = filled[fill]
-        del idx
     return x
 
 
@@ -197,11 +195,8 @@ def replay_trial(out: Path, study: str, spec: dict, cfg: dict, seed: int, idx: i
     clock = {"clock_offset_s": round(float(rng.uniform(lo_off, hi_off)), 6),
              "clock_drift_ppm": round(float(rng.normal(0, clock_cfg.get("drift_ppm_sd", 30.0))), 3),
              "jitter_s": float(clock_cfg.get("jitter_s", 0.0005))}
-    # the log covers the capture only: shift the offset by the capture's start time
-    t0 = float(t[0])
-    clock_eff = dict(clock)
-    clock_eff["clock_offset_s"] = clock["clock_offset_s"]
-    series, scans, stats, _ = _render_window(sim, clock_eff, rng, t0)
+    # the log is cut to the capture: no legs are known outside it
+    series, scans, stats, _ = _render_window(sim, clock, rng, float(t[0]))
     # markers: the real ones plus the two poles
     keep = [i for i, lab in enumerate(m.labels) if not _NOT_A_MARKER.search(lab)]
     labels = [m.labels[i] for i in keep] + ["POLE1", "POLE2"]
