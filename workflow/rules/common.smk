@@ -23,7 +23,8 @@ GV = (
     if any(str(m).lower().endswith("conda") for m in _METHODS)
     else f"{sys.executable} -m gaitval"
 )
-CONFIG_HASH = config_hash(config)
+# Hash of the analysis sections only: changing `run` or paths must not rerun the tables.
+CONFIG_HASH = config_hash({k: config[k] for k in ANALYSIS_SECTIONS if k in config})
 
 # Rule files add functions study -> [report items] here; rule `report` collects them.
 REPORT_ITEM_FUNCS = []
