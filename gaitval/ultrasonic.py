@@ -48,7 +48,7 @@ DEFAULT_CFG: dict = {
         # and a heel needs tens of m/s^2, so the numbers are read as m/s^2 (see report).
         "W_sigma_mps2": [30.0, 25.0, 10.0],
         "V_m2": [11e-6, 9.3e-6, 9e-6, 9e-6],          # seed 003 §4.3.2, diag(11, 9.3, 9, 9) mm^2
-        "gate_sigma": 4.0, "max_reject": 1, "min_anchors": 3, "reinit_after": 10,
+        "gate_sigma": 4.0, "max_reject": 2, "min_anchors": 3, "reinit_after": 10,
         "init_guess_m": [0.16, 0.10, -0.30], "init_sigma_pos_m": 0.05,
         "init_sigma_vel_mps": 1.0,
     },
@@ -181,6 +181,7 @@ def track_ultrasonic_trial(log: UltrasonicLog, cfg: dict | None = None, *,
                        "rejected_anchors": res.rejected.sum(axis=1).astype(np.int64)})
     df.attrs["anchors"] = log.anchors.to_dict("records")
     df.attrs["n_reinit"] = int(res.reinit.sum())
+    df.attrs["n_reflected"] = int(res.reflected.sum())
     return df
 
 

@@ -43,7 +43,8 @@ occasional multipath (a late echo: path longer by 0.05-0.5 m, probability
 ``multipath_prob`` per anchor and sample) and missing echoes (``dropout_prob``).  Air
 temperature drifts slowly around 22-26 degC and is logged with 0.0625 degC resolution.
 
-*Clocks*: the ultrasonic log starts 0.3-3 s after the mocap capture, on its own clock:
+*Clocks*: the ultrasonic log starts between 1.5 s before and 3 s after the mocap capture
+(and may outlast it by up to 1 s), on its own clock:
 ``t_us = clock_offset_s + (1 + clock_drift_ppm 1e-6) t_mocap`` with drift up to 10 ppm
 (the common brief's convention).  The pipeline must find the offset by cross-correlation.
 
@@ -142,10 +143,11 @@ def _smooth(u):
 def stride_plan(rng: np.random.Generator, duration_s: float, T_mean: float, v: float,
                 cv: float, t0: float) -> dict:
     """Foot-strike times and places of one foot on the treadmill (field x, metres)."""
-    n = int(np.ceil((duration_s - t0) / (T_mean * (1 - 3 * cv)))) + 3
+    n = int(np.ceil((duration_s + 2.0 - t0) / (T_mean * (1 - 3 * cv)))) + 5
     T = T_mean * (1.0 + cv * rng.standard_normal(n))
-    # the plan starts two strides before t0 so that every time >= 0 lies inside it
-    t_hs = t0 - T[0] - T[1] + np.concatenate([[0.0], np.cumsum(T)])
+    # the plan starts three strides before t0 so that the whole ultrasonic log (which may
+    # start before the capture) lies inside it
+    t_hs = t0 - T[0] - T[1] - T[2] + np.concatenate([[0.0], np.cumsum(T)])
     # slow wander of the strike position along the belt (AR(1), sd 3 cm)
     wander = np.zeros(n + 1)
     for j in range(1, n + 1):
@@ -259,8 +261,10 @@ def _mocap_noise_and_gaps(rng, xyz: np.ndarray, labels: list[str], rate: float,
 
 
 def _clock(rng: np.random.Generator, duration_s: float, us_rate: float):
-    start = rng.uniform(0.3, 3.0)                            # log starts after the capture
-    stop = duration_s - rng.uniform(0.3, 1.5)
+    # the operator starts and stops the two systems by hand: the log may start up to 1.5 s
+    # before or 3 s after the capture, and stop up to 1 s after or 1.5 s before it
+    start = rng.uniform(-1.5, 3.0)
+    stop = duration_s - rng.uniform(-1.0, 1.5)
     drift_ppm = rng.uniform(-10.0, 10.0)
     offset = -(1.0 + drift_ppm * 1e-6) * start               # t_us = 0 at t_mocap = start
     n = int(np.floor((stop - start) * us_rate))

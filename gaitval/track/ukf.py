@@ -11,14 +11,21 @@ Two things the paper leaves open are made explicit here:
 * **Per-anchor outlier handling (multipath).**  A late echo (a reflected path) makes one
   receiver's range too long while the others stay good.  Before the update, each anchor's
   innovation ``nu_j = d_j - y_j`` is normalised by its predicted standard deviation
-  ``sqrt(Pyy_jj)`` (eq. 10); an anchor whose ``|nu_j| / sqrt(Pyy_jj)`` exceeds
-  ``gate_sigma`` is dropped from this update (its row and column are removed from
-  ``Pyy`` and ``Pxy``).  At most ``max_reject`` anchors are dropped per step (the worst
-  ones first): when many anchors disagree at once the motion model, not multipath, is the
-  likely culprit (e.g. the heel stopping abruptly at heel strike), and the measurements are
-  trusted.  A missing echo (NaN) drops that anchor the same way.  When fewer than
-  ``min_anchors`` anchors were usable for ``reinit_after`` consecutive steps, the state is
-  re-initialised by trilateration.
+  ``sqrt(Pyy_jj)`` (eq. 10); the anchors whose ``|nu_j| / sqrt(Pyy_jj)`` exceeds
+  ``gate_sigma`` are dropped from this update (their rows and columns are removed from
+  ``Pyy`` and ``Pxy``) when there are at most ``max_reject`` of them.  When more anchors
+  disagree at once, the motion model, not multipath, is the likely culprit (e.g. the heel
+  stopping abruptly at heel strike), and all measurements are kept.  When fewer than
+  ``min_anchors`` anchors were usable, or more than ``max_reject`` failed the gate, for
+  ``reinit_after`` consecutive steps (the filter has lost the transmitter), the state is
+  re-initialised by trilateration.  A missing echo (NaN) drops that anchor like a gated one.
+* **The mirror solution of a planar array.**  Four receivers in one plane (the paper's
+  p1..p4) cannot tell a transmitter in front of the plane from its mirror image behind it;
+  the ranges fit both equally.  After an abrupt manoeuvre the linearised update can carry
+  the state through the plane, and it then tracks the mirror image.  When the anchors are
+  coplanar, the side of ``init_guess`` is taken as the physical side (the transmitter faces
+  the receivers) and a state that ends an update on the other side is reflected back
+  (position and velocity); this is counted in ``reflected``.
 * **The a-priori step for a linear model.**  Passing sigma points through the linear
   transition ``A`` (eq. 8) gives exactly ``A P A^T`` (the unscented transform is exact for
   linear maps), so eq. (8) is evaluated in that closed form, which is cheaper and free of
@@ -129,6 +136,9 @@ class ToaUkfResult:
         Anchors dropped by the innovation gate (finite range judged an outlier).
     reinit : ndarray, shape (n,), bool
         Samples at which the filter was (re-)initialised by trilateration.
+    reflected : ndarray, shape (n,), bool
+        Samples at which the state was reflected back to the physical side of a planar
+        receiver array (see module notes).
     """
 
     x: np.ndarray
@@ -136,13 +146,14 @@ class ToaUkfResult:
     used: np.ndarray
     rejected: np.ndarray
     reinit: np.ndarray
+    reflected: np.ndarray
 
 
 def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
                 W_sigma: np.ndarray, V: np.ndarray, alpha: float = 1e-3, beta: float = 2.0,
                 kappa: float = 0.0, init_guess: np.ndarray | None = None,
                 init_sigma_pos: float = 0.05, init_sigma_vel: float = 1.0,
-                gate_sigma: float = 4.0, max_reject: int = 1, min_anchors: int = 3,
+                gate_sigma: float = 4.0, max_reject: int = 2, min_anchors: int = 3,
                 reinit_after: int = 10) -> ToaUkfResult:
     """Track one transmitter from its ranges to fixed receivers with a UKF.
 
@@ -169,7 +180,7 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     gate_sigma : float
         Innovation gate in predicted standard deviations; ``inf`` disables gating.
     max_reject : int
-        Most anchors dropped by the gate in one step.
+        Most anchors the gate may drop in one step; when more fail it, none is dropped.
     min_anchors : int
         Fewer usable anchors than this for ``reinit_after`` steps triggers a re-initialisation.
     reinit_after : int
@@ -206,6 +217,13 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     used = np.zeros((n_s, m), dtype=bool)
     rejected = np.zeros((n_s, m), dtype=bool)
     reinit = np.zeros(n_s, dtype=bool)
+    reflected = np.zeros(n_s, dtype=bool)
+    # planar array: the plane's normal pointing to the physical side (that of the guess)
+    centre = anchors.mean(axis=0)
+    _, sv, vt = np.linalg.svd(anchors - centre)
+    normal = None
+    if m >= 3 and sv[-1] < 1e-3 * max(sv[0], 1e-12) and init_guess is not None:
+        normal = vt[-1] * np.sign(vt[-1] @ (guess - centre) or 1.0)
 
     # constant pieces of eq. (5): A = I + dt E,  G W G^T = dt^4/4 Q4 + dt^3/2 Q3 + dt^2 Q2
     E = np.zeros((N_STATE, N_STATE))
@@ -235,7 +253,7 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     for k in range(n_s):
         dk = d[k]
         if x is None or starved >= reinit_after:
-            p0 = trilaterate(dk, anchors, guess if x is None else x[:3])
+            p0 = trilaterate(dk, anchors, guess)   # from the guess: its side of the array
             if not np.all(np.isfinite(p0)):
                 if x is None:
                     used[k] = False
@@ -278,16 +296,21 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
         Pxy = dX.T @ WdY                                         # eq. (10)
         nu = dk - ybar
         ok = None
+        mismatch = False
         # -- per-anchor innovation gate (multipath), see module notes
         if use_gate and (nu * nu > gate2 * Pyy.diagonal()).any():
             z = np.abs(nu) / np.sqrt(Pyy.diagonal())
             z[~finite[k]] = 0.0
             bad = np.flatnonzero(z * z > gate2)
-            bad = bad[np.argsort(-z[bad])][:max_reject]
-            rejected[k, bad] = True
-            used[k, bad] = False
-            n_ok -= bad.size
-            ok = used[k]
+            if bad.size <= max_reject:        # else: the model, not multipath (keep all)
+                rejected[k, bad] = True
+                used[k, bad] = False
+                n_ok -= bad.size
+                ok = used[k]
+            else:
+                mismatch = True
+                if n_ok < m:
+                    ok = finite[k]
         elif n_ok < m:
             ok = finite[k]
         if n_ok == m:
@@ -302,7 +325,17 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
             P = P - KT.T @ Pxy_s.T
         P += P.T
         P *= 0.5
-        starved = starved + 1 if n_ok < min_anchors else 0
+        if normal is not None:
+            h = normal @ (x[:3] - centre)
+            if h < 0.0:                       # behind the receiver plane: the mirror image
+                x = x.copy()
+                x[:3] -= 2.0 * h * normal
+                x[3:] -= 2.0 * (normal @ x[3:]) * normal
+                reflected[k] = True
+        starved = starved + 1 if (n_ok < min_anchors or mismatch) else 0
+        if not np.isfinite(P[0, 0]) or abs(x[0]) > 1e3:        # numerically lost
+            starved = reinit_after
         out_x[k] = x
         out_p[k] = P.diagonal()
-    return ToaUkfResult(x=out_x, P_diag=out_p, used=used, rejected=rejected, reinit=reinit)
+    return ToaUkfResult(x=out_x, P_diag=out_p, used=used, rejected=rejected, reinit=reinit,
+                        reflected=reflected)
