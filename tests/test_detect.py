@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from gaitval.detect import BACKGROUNDS, DETECTORS, split_observations
-from gaitval.detect.legpatterns import classify_segment, detect_scan, edges
+from gaitval.detect.legpatterns import (classify_segment, detect_scan, edges,
+                                        see_through_occluders)
 from gaitval.errors import GaitvalError
 from gaitval.types import ScanSeries
 from tug_synth import raycast, tug_scans
@@ -161,3 +162,20 @@ def test_real_bag_scans_do_not_crash(realdata):
     assert len(obs) > 0
     assert np.isfinite(obs[["x_m", "y_m"]].to_numpy()).all()
     assert (np.hypot(obs.x_m, obs.y_m) <= s.range_max + W).all()
+
+
+def test_one_leg_cut_by_an_occluder_gives_one_observation():
+    # a thin pole (r = 1.5 cm, background) 0.3 m straight in front of a leg at 1.3 m
+    leg = scan_of((1.3, 0.0))
+    pole = raycast(np.zeros(1), [np.array([[1.0, 0.0]])], 0.015, noise_m=0.0,
+                   background=False)[0]
+    in_front = np.isfinite(pole) & (pole < leg)
+    masked = np.where(in_front, np.inf, leg)           # the pole removed as background
+    # without help the leg falls into two SL pieces 7 cm apart: one of them is kept
+    obs = detect_scan(masked, ANG, W)
+    assert len(obs) == 1 and math.hypot(obs[0][0] - 1.3, obs[0][1]) < 0.04
+    # seeing through the pole restores the whole leg
+    raw = np.where(in_front, pole, leg)
+    filled = see_through_occluders(masked, raw, ANG, W)
+    obs = detect_scan(filled, ANG, W)
+    assert [o[2] for o in obs] == ["SL"] and math.hypot(obs[0][0] - 1.3, obs[0][1]) < 0.01

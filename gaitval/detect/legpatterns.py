@@ -35,6 +35,12 @@ Leg positions from w_l (a leg is modelled as a circle of diameter w_l, ρ = w_l/
 
 ``use_fs_u=False`` drops FS_U (the conventional detector, seed 001 Method 1).
 
+One leg, one observation.  Two observations closer than 0.7 w_l cannot be two shanks
+(their centres are at least about one shank width apart); they are one leg cut in two by
+an occluder (typically a chair leg in front of a seated shank: an FS_O and an FS_U piece).
+Only the more reliable is kept (SL, then FS_O, then LT, then FS_U, the virtual one; ties:
+the wider segment).
+
 Static occluders in front of a leg.  Background removal (:mod:`gaitval.detect.background`)
 turns a chair leg or a pole into "no return"; a seated shank right behind a chair leg
 would then fall apart into two narrow segments, i.e. two "legs".  Before the edge search,
@@ -227,7 +233,23 @@ def detect_scan(r: np.ndarray, angles: np.ndarray, leg_width_m: float,
         else:
             x, y = _centre(seg_r, seg_a, rho)
             out.append((x, y, pat, width, b0, b1))
+    if len(out) > 1:
+        out = _one_per_leg(out, 0.7 * leg_width_m)
     return out
+
+
+_RELIABILITY = {"SL": 0, "FS_O": 1, "LT": 2, "FS_U": 3}
+
+
+def _one_per_leg(obs: list, d_min: float) -> list:
+    """Drop the less reliable of two observations closer than ``d_min`` (module notes)."""
+    order = sorted(range(len(obs)), key=lambda i: (_RELIABILITY[obs[i][2]], -obs[i][3], i))
+    kept: list[int] = []
+    for i in order:
+        if all(math.hypot(obs[i][0] - obs[j][0], obs[i][1] - obs[j][1]) >= d_min
+               for j in kept):
+            kept.append(i)
+    return [obs[i] for i in sorted(kept)]
 
 
 @DETECTORS.register("leg_patterns")
