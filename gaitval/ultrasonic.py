@@ -34,8 +34,9 @@ import numpy as np
 import pandas as pd
 from scipy.signal import butter, correlate, correlation_lags, sosfiltfilt
 
-from gaitval.errors import ConfigError, MarkerError, RegistrationError, TimestampError
-from gaitval.gait.strides import autocorr_symmetry, stride_maxima, stride_table
+from gaitval.errors import (ConfigError, GaitvalError, MarkerError, RegistrationError,
+                            TimestampError)
+from gaitval.gait.strides import autocorr_symmetry, stride_table
 from gaitval.track.ukf import run_toa_ukf
 from gaitval.types import MocapTrial, UltrasonicLog
 
@@ -513,6 +514,12 @@ def gait_parameters(track_df: pd.DataFrame, mocap: MocapTrial, trial: dict, subj
         st_r = st_r[~np.asarray(bad, dtype=bool)].reset_index(drop=True)
     pairs = _match(st_r, st_s, float(sc["match_tolerance"]))
     n = len(pairs)
+    if n == 0:
+        raise GaitvalError(f"no stride found in both systems (reference {len(st_r)}, "
+                           f"ultrasonic {len(st_s)} strides)", path=mocap.path, trial=tname,
+                           hint="check the track (a process noise ultrasonic.ukf.W_sigma_mps2 "
+                                "far below the heel's accelerations makes the filter lag) and "
+                                "the clock offset")
     rows = []
     base = {"study": trial.get("study", ""), "trial": tname,
             "subject": trial.get("subject", subject.get("subject", "")),
@@ -680,7 +687,8 @@ def identify_noise(trials: list[tuple[UltrasonicLog, MocapTrial]], cfg: dict | N
         anchor), ``W_sigma_mps2`` ([sx, sy, sz], minimum-RMSE search), ``rmse_m`` (3-D RMSE
         of the UKF track at that W), ``noise`` (DataFrame of :func:`measurement_noise`),
         ``search`` (DataFrame ``sx, sy, sz, rmse_m`` of every candidate tried),
-        ``clock`` (DataFrame ``trial, clock_offset_s``).
+        ``clock`` (DataFrame ``trial, clock_offset_s``), ``_aligned`` (the per-trial
+        :func:`pendulum_alignment` dicts, to pass on to :func:`pendulum_errors`).
 
     Notes
     -----

@@ -201,3 +201,11 @@ def test_end_to_end_through_files(tmp_path):
     sl = g[g["parameter"] == "stride_duration"]
     assert len(sl) >= 15
     assert np.sqrt(np.mean((sl["system"] - sl["reference"]) ** 2)) < 0.05
+
+
+def test_track_that_never_finds_a_stride_is_an_error_not_an_empty_table(treadmill):
+    from gaitval.errors import GaitvalError
+    tr = U.track_ultrasonic_trial(treadmill["log"], {})
+    tr[["x_m", "y_m", "z_m"]] = 0.1                      # a track that never moves
+    with pytest.raises(GaitvalError, match="no stride"):
+        U.gait_parameters(tr, treadmill["mocap"], {"trial": "t1"}, SUBJECT, {})
