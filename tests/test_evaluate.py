@@ -144,3 +144,16 @@ def test_align_truth_interpolates_and_flags_gaps():
 def test_truth_without_required_columns_is_a_user_error():
     with pytest.raises(GaitvalError, match="lacks column"):
         tug_phase_bounds(pd.DataFrame({"t_sensor_s": [0.0], "side": ["L"]}))
+
+
+def test_a_prediction_running_off_by_more_than_a_stride_is_lost():
+    f = static_frames()
+    f["observed"] = True
+    run = (f["side"] == "R") & f["k"].between(20, 40)
+    f.loc[run, "observed"] = False                   # hidden ...
+    f.loc[run, "x_m"] = 1.5                          # ... 0.5 m off: drift
+    _, ev = false_tracking(f)
+    assert ev["kind"].tolist() == ["drift"]
+    f.loc[run, "x_m"] = 2.5                          # 1.5 m off: the leg is lost
+    _, ev = false_tracking(f)
+    assert ev["kind"].tolist() == ["lost"]

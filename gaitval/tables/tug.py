@@ -57,6 +57,19 @@ PUBLISHED_T5 = {
 PHASES = ("forward", "turning", "return")
 
 
+def _int_or_blank(values) -> pd.Series:
+    """Counts with gaps as Python ints / None (renders as "25" and "", not "25.000")."""
+    return pd.Series([None if v is None or (isinstance(v, float) and np.isnan(v)) else int(v)
+                      for v in values], dtype=object)
+
+
+def _tidy_counts(df: pd.DataFrame, cols) -> pd.DataFrame:
+    for c in cols:
+        if c in df:
+            df[c] = _int_or_blank(df[c].tolist())
+    return df
+
+
 def _concat(x) -> pd.DataFrame:
     if isinstance(x, pd.DataFrame):
         return x
@@ -166,7 +179,9 @@ def tug_table3(summaries) -> pd.DataFrame:
             "success_rate": ns / n if n else np.nan,
             "success_rate_published": (pub["n_success"] / pub["n_trials"]) if pub else np.nan,
         })
-    return pd.DataFrame(rows)
+    return _tidy_counts(pd.DataFrame(rows), ["ft_turning_published", "ft_return_published",
+                                             "sf_turning_published", "n_success_published",
+                                             "n_trials_published"])
 
 
 def _success_frames(frames: pd.DataFrame, summaries: pd.DataFrame) -> pd.DataFrame:
@@ -206,7 +221,8 @@ def tug_table4(frames, summaries) -> pd.DataFrame:
                 "rmse_x_m": _rmse(e["err_x_m"]), "rmse_x_m_published": pub[2] if pub else np.nan,
                 "rmse_y_m": _rmse(e["err_y_m"]), "rmse_y_m_published": pub[3] if pub else np.nan,
             })
-    return pd.DataFrame(rows)
+    return _tidy_counts(pd.DataFrame(rows), ["n_success_trials_published", "n_uo_published",
+                                             "n_steps_published"])
 
 
 def tug_table5(frames, summaries) -> pd.DataFrame:
@@ -232,7 +248,7 @@ def tug_table5(frames, summaries) -> pd.DataFrame:
                 "rmse_x_m": _rmse(e["err_x_m"]), "rmse_x_m_published": pub[1] if pub else np.nan,
                 "rmse_y_m": _rmse(e["err_y_m"]), "rmse_y_m_published": pub[2] if pub else np.nan,
             })
-    return pd.DataFrame(rows)
+    return _tidy_counts(pd.DataFrame(rows), ["time_steps_published"])
 
 
 def _ordering_notes(t3: pd.DataFrame, t4: pd.DataFrame, t5: pd.DataFrame) -> list[str]:
