@@ -29,7 +29,7 @@ def plot_trial_trajectories(frames: pd.DataFrame, trial: str, path: str | Path,
     """
     f = frames[frames["trial"].astype(str) == trial]
     methods = methods or list(dict.fromkeys(f["method"].astype(str)))
-    fig, axes = plt.subplots(1, len(methods), figsize=(4.2 * len(methods), 4.2),
+    fig, axes = plt.subplots(1, len(methods), figsize=(4.6 * len(methods), 3.0),
                              squeeze=False, sharex=True, sharey=True)
     for ax, m in zip(axes[0], methods):
         d = f[f["method"].astype(str) == m]
@@ -81,8 +81,8 @@ def plot_false_tracking(frames: pd.DataFrame, event: pd.Series, path: str | Path
 def write_tug_figures(frames: pd.DataFrame, summaries: pd.DataFrame, events: pd.DataFrame,
                       out_dir: str | Path) -> list[Path]:
     """``tug_trajectories.png`` (the first trial, sorted by id, that every method tracked
-    successfully, else the first trial) and ``tug_false_tracking.png`` (the first event of
-    the lowest-numbered method with any) when false tracking occurred."""
+    successfully, else the first trial) and ``tug_false_tracking.png`` (the first swap or
+    lost event of the lowest-numbered method with any) when false tracking occurred."""
     out = Path(out_dir)
     paths = []
     s = summaries
@@ -92,7 +92,8 @@ def write_tug_figures(frames: pd.DataFrame, summaries: pd.DataFrame, events: pd.
         good = [t for t in trials if ok.get(t, False)]
         paths.append(plot_trial_trajectories(frames, (good or trials)[0],
                                              out / "tug_trajectories.png"))
-    if events is not None and len(events):
-        ev = events.sort_values(["method", "trial", "t_start_s"], kind="stable").iloc[0]
+    ft = events[events["kind"].isin(["swap", "lost"])] if events is not None else None
+    if ft is not None and len(ft):
+        ev = ft.sort_values(["method", "trial", "t_start_s"], kind="stable").iloc[0]
         paths.append(plot_false_tracking(frames, ev, out / "tug_false_tracking.png"))
     return paths
