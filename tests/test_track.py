@@ -11,7 +11,7 @@ import pytest
 from gaitval.gait.phases import UNLIKELY_TRANSITIONS, gait_phase, gait_phases, is_unlikely
 from gaitval.track import (ASSOCIATORS, FILTERS, GATES, MOTION_MODELS, OCCLUSION_HANDLERS,
                            Tracker)
-from gaitval.track.associate import D_MAX_DEFAULT, ranked_associations
+from gaitval.track.associate import ranked_associations
 from gaitval.track.kalman import AxisKalmanFilter
 from gaitval.track.occlusion import catmull_rom
 from gaitval.track.tracker import step_durations
@@ -237,7 +237,7 @@ def test_tracker_gnn_follows_a_misdetection_gait_phase_does_not():
 
 
 # -- tracker ------------------------------------------------------------------------------
-def _walk_obs(n=120, direction=1.0, hide=None, curve=False):
+def _walk_obs(n=120, direction=1.0, hide=None):
     """Both legs walking along ±x (left leg on the walker's left); optional hidden run."""
     t = np.arange(n) * DT
     xy, pats, truth = [], [], []
@@ -245,8 +245,6 @@ def _walk_obs(n=120, direction=1.0, hide=None, curve=False):
         s = direction * 1.0 * t[k]
         pl = np.array([s, 0.1 * direction])
         pr = np.array([s + 0.15 * direction, -0.1 * direction])
-        if curve:
-            pr = pr + np.array([0.0, 0.4 * math.sin(2 * math.pi * t[k])])
         obs = [pl]
         if hide is None or not hide[0] <= k < hide[1]:
             obs.append(pr)
