@@ -106,20 +106,22 @@ class AxisKalmanFilter(LegFilter):
         return (float(x), float(y), float(vx), float(vy),
                 self.p0_pos_sd_m ** 2, 0.0, self.p0_vel_sd_mps ** 2)
 
+    def _consts(self, dt):
+        """(Δt²/2, q Δt⁴/4, q Δt³/2, q Δt²) for one Δt (cached: Δt rarely changes)."""
+        key = (dt, self.q_accel_sd_mps2)
+        if getattr(self, "_ckey", None) != key:
+            h = 0.5 * dt * dt
+            q = self.q_accel_sd_mps2 ** 2
+            self._ckey, self._cval = key, (h, q * h * h, q * h * dt, q * dt * dt)
+        return self._cval
+
     def predict(self, s, dt, ux, uy):
         x, y, vx, vy, a, b, c = s
-        h = 0.5 * dt * dt
-        q = self.q_accel_sd_mps2 ** 2
+        h, qaa, qab, qbb = self._consts(dt)
         # eq. (7): x = A x + B_u u
-        x = x + dt * vx + h * ux
-        y = y + dt * vy + h * uy
-        vx = vx + dt * ux
-        vy = vy + dt * uy
-        # eq. (8): P = A P Aᵀ + B Q Bᵀ (per axis)
-        a2 = a + 2.0 * dt * b + dt * dt * c + q * h * h
-        b2 = b + dt * c + q * h * dt
-        c2 = c + q * dt * dt
-        return (x, y, vx, vy, a2, b2, c2)
+        # eq. (8): P = A P Aᵀ + B Q Bᵀ (per axis: B Q Bᵀ = q [[Δt⁴/4, Δt³/2], [Δt³/2, Δt²]])
+        return (x + dt * vx + h * ux, y + dt * vy + h * uy, vx + dt * ux, vy + dt * uy,
+                a + dt * (2.0 * b + dt * c) + qaa, b + dt * c + qab, c + qbb)
 
     def correct(self, s, zx, zy):
         x, y, vx, vy, a, b, c = s
