@@ -8,8 +8,8 @@ STUDY_DIR defaults to ``data/default`` (the generated default study); when it ha
 trial sheet the tiny ultrasonic preset is generated into a temporary folder.  Both filters
 run the same model on the same ranges: constant velocity, TOA measurement, alpha = 1e-3,
 beta = 2, kappa = 0, W = diag(30, 25, 10)^2, V = the paper's diag(11, 9.3, 9, 9) mm^2,
-with the multipath gate off and samples with a missing echo treated as predict-only
-(filterpy's update cannot drop one anchor).  filterpy runs on the first ``--max-steps``
+with the multipath gate and the planar-array mirror guard off and samples with a missing
+echo treated as predict-only (filterpy's update cannot drop one anchor).  filterpy runs on the first ``--max-steps``
 samples of each trial (it is slow); gaitval's filter runs on the whole trials and on that
 same subset, and the figures printed are medians of repeated runs.  The last line is
 ``speedup vs filterpy: <x>`` (per-step time of filterpy / gaitval on the same samples).
@@ -67,7 +67,8 @@ def _prepare(log):
 
 
 def _ours(t, d, A):
-    return run_toa_ukf(t, d, A, W_sigma=W, V=V, init_guess=GUESS, gate_sigma=np.inf).x
+    return run_toa_ukf(t, d, A, W_sigma=W, V=V, init_guess=GUESS, gate_sigma=np.inf,
+                       mirror_guard=False).x
 
 
 def _filterpy(t, d, A, x0):

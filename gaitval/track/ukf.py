@@ -154,7 +154,7 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
                 kappa: float = 0.0, init_guess: np.ndarray | None = None,
                 init_sigma_pos: float = 0.05, init_sigma_vel: float = 1.0,
                 gate_sigma: float = 4.0, max_reject: int = 2, min_anchors: int = 3,
-                reinit_after: int = 10) -> ToaUkfResult:
+                reinit_after: int = 10, mirror_guard: bool = True) -> ToaUkfResult:
     """Track one transmitter from its ranges to fixed receivers with a UKF.
 
     Parameters
@@ -184,6 +184,8 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     min_anchors : int
         Fewer usable anchors than this for ``reinit_after`` steps triggers a re-initialisation.
     reinit_after : int
+    mirror_guard : bool
+        Keep the state on the ``init_guess`` side of a planar array (module notes).
 
     Returns
     -------
@@ -222,7 +224,8 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     centre = anchors.mean(axis=0)
     _, sv, vt = np.linalg.svd(anchors - centre)
     normal = None
-    if m >= 3 and sv[-1] < 1e-3 * max(sv[0], 1e-12) and init_guess is not None:
+    if mirror_guard and m >= 3 and sv[-1] < 1e-3 * max(sv[0], 1e-12) \
+            and init_guess is not None:
         normal = vt[-1] * np.sign(vt[-1] @ (guess - centre) or 1.0)
 
     # constant pieces of eq. (5): A = I + dt E,  G W G^T = dt^4/4 Q4 + dt^3/2 Q3 + dt^2 Q2
@@ -333,7 +336,8 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
                 x[3:] -= 2.0 * (normal @ x[3:]) * normal
                 reflected[k] = True
         starved = starved + 1 if (n_ok < min_anchors or mismatch) else 0
-        if not np.isfinite(P[0, 0]) or abs(x[0]) > 1e3:        # numerically lost
+        p00 = P[0, 0]
+        if p00 != p00 or abs(x[0]) > 1e3:                         # numerically lost
             starved = reinit_after
         out_x[k] = x
         out_p[k] = P.diagonal()
