@@ -95,6 +95,27 @@ def cmd_registration_summary(a) -> int:
     return 0
 
 
+def cmd_track(a) -> int:
+    from gaitval.steps import track_step
+    track_step(a.sensor, a.sheet, a.subjects, a.trial, a.method, a.config, a.out)
+    return 0
+
+
+def cmd_evaluate_tug(a) -> int:
+    from gaitval.steps import evaluate_tug_step
+    s = evaluate_tug_step(a.track, a.groundtruth, a.registration, a.trial, a.method,
+                          a.config, a.out)
+    print(s.to_string(index=False))
+    return 0
+
+
+def cmd_tug_tables(a) -> int:
+    from gaitval.steps import tug_tables_step
+    tug_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir, a.config_hash,
+                    methods=a.methods)
+    return 0
+
+
 def cmd_report(a) -> int:
     from gaitval.report.index import build_index
     md, html = build_index(a.reports_dir, study_names=a.studies)
@@ -167,6 +188,35 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--reports-dir", default="reports")
     s.add_argument("--config-hash", default="")
     s.set_defaults(func=cmd_registration_summary)
+
+    s = sub.add_parser("track", help="run one tracker method on one LRS trial")
+    s.add_argument("--sensor", required=True, help="ingested sensor.parquet")
+    s.add_argument("--sheet", required=True)
+    s.add_argument("--subjects", required=True)
+    s.add_argument("--trial", required=True)
+    s.add_argument("--method", required=True, help="e.g. tug_m1, tug_m2, tug_m3")
+    s.add_argument("--config", required=True, help="results/<study>/config.json")
+    s.add_argument("--out", required=True)
+    s.set_defaults(func=cmd_track)
+
+    s = sub.add_parser("evaluate-tug", help="evaluate one tracked TUG trial")
+    s.add_argument("--track", required=True)
+    s.add_argument("--groundtruth", required=True)
+    s.add_argument("--registration", required=True)
+    s.add_argument("--trial", required=True)
+    s.add_argument("--method", required=True)
+    s.add_argument("--config", required=True)
+    s.add_argument("--out", required=True)
+    s.set_defaults(func=cmd_evaluate_tug)
+
+    s = sub.add_parser("tug-tables", help="seed 000 Tables 2-5 and figures")
+    s.add_argument("inputs", nargs="+", help="per-(trial, method) evaluation folders")
+    s.add_argument("--methods", nargs="+", default=["tug_m1", "tug_m2", "tug_m3"])
+    s.add_argument("--tables-dir", required=True)
+    s.add_argument("--figures-dir", required=True)
+    s.add_argument("--reports-dir", default="reports")
+    s.add_argument("--config-hash", default="")
+    s.set_defaults(func=cmd_tug_tables)
 
     s = sub.add_parser("report", help="write reports/index.md and index.html")
     s.add_argument("--reports-dir", default="reports")

@@ -152,3 +152,88 @@ def registration_summary(inputs: list[str | Path], study: str, out_csv, out_stem
         "gaps longer than groundtruth.max_gap_s. Reviewers read this table first."))
     stamp(Path(out_stem).name, paths, reports_dir, config_hash_=config_hash)
     return df
+
+
+# -- tracking (LRS) ------------------------------------------------------------------------
+def method_definition(cfg: dict, method: str):
+    """A method's definition: ``tracking.methods.<name>`` from config, else the built-in."""
+    custom = (cfg.get("tracking") or {}).get("methods") or {}
+    return custom.get(method, method)
+
+
+def track_step(sensor_parquet, sheet, subjects, trial: str, method: str, config_json,
+               out_parquet) -> pd.DataFrame:
+    """Run one tracker method on one LRS trial; write the per-scan track (sensor frame)."""
+    from gaitval.io.scanlog import read_scanlog
+    from gaitval.methods import track_trial
+
+    cfg = load_json(config_json)
+    row, subj = trial_and_subject(sheet, subjects, trial)
+    scans = read_scanlog(sensor_parquet, trial=trial)
+    w = subj.get("leg_width_m")
+    if w is None or not np.isfinite(w):
+        w = float((cfg.get("registration") or {}).get("default_leg_width_m", 0.10))
+    overrides = ((cfg.get("tracking") or {}).get("overrides") or {}).get(method)
+    try:
+        track = track_trial(scans, method_definition(cfg, method), float(w),
+                            {"overrides": overrides})
+    except GaitvalError as exc:
+        raise exc.with_context(path=sensor_parquet, trial=trial) from None
+    track.insert(0, "method", method)
+    track.insert(0, "trial", trial)
+    write_parquet(track, out_parquet)
+    return track
+
+
+def evaluate_tug_step(track_parquet, gt_parquet, registration_json, trial: str, method: str,
+                      config_json, out_dir) -> pd.DataFrame:
+    """Evaluate one tracked TUG trial against its registered ground truth.
+
+    Writes ``frames.parquet``, ``events.parquet``, ``stance.parquet`` and
+    ``summary.parquet`` (see :func:`gaitval.evaluate.tug.evaluate_tug_trial`).  A trial whose
+    registration was refused gets an empty evaluation and ``category = not_registered``.
+    """
+    from gaitval.evaluate.tug import FRAME_COLUMNS, evaluate_tug_trial
+
+    cfg = load_json(config_json)
+    rec = load_json(registration_json)
+    out = Path(out_dir)
+    if rec.get("status") != "ok":
+        res = {"frames": pd.DataFrame(columns=list(FRAME_COLUMNS)),
+               "events": pd.DataFrame(columns=["trial", "method", "side", "kind"]),
+               "stance": pd.DataFrame(columns=["trial", "method", "side", "identified"]),
+               "summary": pd.DataFrame([{"trial": trial, "method": method, "success": False,
+                                         "category": "not_registered"}])}
+    else:
+        track = pd.read_parquet(track_parquet).drop(columns=["trial", "method"])
+        gt = pd.read_parquet(gt_parquet)
+        res = evaluate_tug_trial(track, gt, trial=trial, method=method,
+                                 cfg=(cfg.get("evaluation") or {}).get("tug"))
+    for name, df in res.items():
+        write_parquet(df.reset_index(drop=True), out / f"{name}.parquet")
+    return res["summary"]
+
+
+def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, reports_dir,
+                    config_hash: str = "", methods=("tug_m1", "tug_m2", "tug_m3")
+                    ) -> list[Path]:
+    """Gather per-trial TUG evaluations into seed 000 Tables 2-5 and the figures."""
+    from gaitval.report.provenance import stamp
+    from gaitval.report.tug_figures import write_tug_figures
+    from gaitval.tables.tug import write_tug_tables
+
+    parts: dict[str, list[pd.DataFrame]] = {"frames": [], "summary": [], "events": []}
+    for d in eval_dirs:
+        for name in parts:
+            df = pd.read_parquet(Path(d) / f"{name}.parquet")
+            if len(df):
+                parts[name].append(df)
+    frames, summaries, events = (pd.concat(parts[n], ignore_index=True) if parts[n]
+                                 else pd.DataFrame() for n in ("frames", "summary", "events"))
+    summaries = summaries[summaries.get("category", "") != "not_registered"] \
+        if len(summaries) else summaries
+    paths = write_tug_tables(frames, summaries, tables_dir, methods=tuple(methods))
+    stamp("tug_tables", paths, reports_dir, config_hash_=config_hash)
+    figs = write_tug_figures(frames, summaries, events, figures_dir)
+    stamp("tug_figures", figs, reports_dir, config_hash_=config_hash)
+    return paths + figs

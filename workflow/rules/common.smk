@@ -100,3 +100,8 @@ def report_items(wildcards):
 def parent_of(name, up=0):
     """Param function: the folder of output `name` (`up` levels higher)."""
     return lambda wildcards, output: str(Path(output[name]).parents[up])
+
+
+def tug_methods():
+    """The TUG tracker methods to run (config tug.methods)."""
+    return list(config.get("tug", {}).get("methods", ["tug_m1", "tug_m2", "tug_m3"]))

@@ -1,0 +1,90 @@
+# TUG leg tracking (seed 000): one job per (trial, method), evaluation against the
+# registered ground truth, then Tables 2-5 and the figures.
+
+
+rule track:
+    input:
+        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
+        config=f"{RESULTS}/{{study}}/config.json",
+        sheet=lambda w: sheet_path(w.study),
+    output:
+        f"{RESULTS}/{{study}}/track/{{method}}/{{trial}}.parquet",
+    params:
+        gv=GV,
+        subjects=lambda w: subjects_path(w.study),
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/track/{study}/{method}/{trial}.log",
+    shell:
+        "{params.gv} track --sensor {input.sensor} --sheet {input.sheet}"
+        " --subjects {params.subjects} --trial {wildcards.trial} --method {wildcards.method}"
+        " --config {input.config} --out {output} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+rule evaluate_tug:
+    input:
+        track=f"{RESULTS}/{{study}}/track/{{method}}/{{trial}}.parquet",
+        gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
+        reg=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
+        config=f"{RESULTS}/{{study}}/config.json",
+    output:
+        summary=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/summary.parquet",
+        frames=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/frames.parquet",
+    params:
+        gv=GV,
+        out=parent_of("summary"),
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/evaluate_tug/{study}/{method}/{trial}.log",
+    shell:
+        "{params.gv} evaluate-tug --track {input.track} --groundtruth {input.gt}"
+        " --registration {input.reg} --trial {wildcards.trial} --method {wildcards.method}"
+        " --config {input.config} --out {params.out} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+rule tug_tables:
+    input:
+        lambda w: [
+            f"{RESULTS}/{study}/evaluate/{method}/{trial}/summary.parquet"
+            for study in config["run"]
+            for method in tug_methods()
+            for trial in trial_ids(study, ["tug"])
+        ],
+    output:
+        t4=report(
+            f"{REPORTS}/tables/tug_table4.csv",
+            caption="../report/tug.rst",
+            category="TUG",
+        ),
+        t2=f"{REPORTS}/tables/tug_table2.csv",
+        t3=f"{REPORTS}/tables/tug_table3.csv",
+        t5=f"{REPORTS}/tables/tug_table5.csv",
+        fig=report(
+            f"{REPORTS}/figures/tug_trajectories.png",
+            caption="../report/tug.rst",
+            category="TUG",
+        ),
+    params:
+        gv=GV,
+        dirs=lambda w, input: " ".join(str(Path(p).parent) for p in input),
+        methods=" ".join(tug_methods()),
+        tables=parent_of("t4"),
+        figures=parent_of("fig"),
+        reports=parent_of("t4", up=1),
+        chash=CONFIG_HASH,
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/tug_tables.log",
+    shell:
+        "{params.gv} tug-tables {params.dirs} --methods {params.methods}"
+        " --tables-dir {params.tables} --figures-dir {params.figures}"
+        " --reports-dir {params.reports} --config-hash {params.chash}"
+        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+REPORT_ITEM_FUNCS.append(
+    lambda study: [f"{REPORTS}/tables/tug_table4.csv"] if trial_ids(study, ["tug"]) else []
+)
