@@ -32,8 +32,12 @@ position along the belt.  Within stride j (heel strike at ``u = 0``):
   velocity) to the next foot strike, arriving slightly retracting (vx = -0.2 v) and
   descending (vz = -0.2 m/s): forward arc with heel lift (peak ~0.2 m).
 
-The transmitter ``TX`` is rigidly attached to the heel (2 cm forward, 4 cm lateral, 1 cm up
-of the posterior heel point ``RHEE``); toe markers follow from the foot pitch.
+The transmitter is rigidly attached to the heel (acoustic centre 2 cm forward, 4 cm lateral,
+1 cm up of the posterior heel point ``RHEE``); its camera marker ``TX`` sits on the housing
+about 1 cm above the acoustic centre (+-3 mm per trial, turning with the foot), so the
+camera reference and the ultrasonic ranges do not see exactly the same point; toe markers
+follow from the foot pitch.  (Pendulum trials: the marker is aligned with the transducer
+head to within 2 mm, as the paper built that experiment to do.)
 
 *Ranging*: time of flight with the speed of sound of dry air ``331.3 sqrt(1 + T/273.15)``
 (the physics; the pipeline uses the paper's linear eq. (2), ``331.5 + 0.6 T``, whose
@@ -106,6 +110,7 @@ DEFAULTS: dict = {
     "dropout_prob": 0.002,
     "mocap_noise_m": 0.0004,
     "stride_cv": 0.02,
+    "pendulum_marker_offset_m": 0.002,
     "folder": "ultrasonic",
 }
 
@@ -203,9 +208,14 @@ def heel_path(t: np.ndarray, plan: dict) -> tuple[np.ndarray, np.ndarray, np.nda
     return x, z, th
 
 
-def foot_points(t: np.ndarray, plan: dict, y0: float, rng_phase: float, side: str
-                ) -> dict[str, np.ndarray]:
-    """Field positions (n, 3) of the heel, toe and (right foot) transmitter at ``t``."""
+def foot_points(t: np.ndarray, plan: dict, y0: float, rng_phase: float, side: str,
+                marker_offset: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Field positions (n, 3) of the heel, toe and (right foot) transmitter at ``t``.
+
+    ``TXA`` is the transmitter's acoustic centre (what the ranges measure), ``TX`` the
+    camera marker on it, ``marker_offset`` (forward, lateral-right, up; metres, foot frame)
+    away from the acoustic centre.
+    """
     x, z, th = heel_path(t, plan)
     period = float(np.median(np.diff(plan["t_hs"])))
     y = y0 + 0.008 * np.sin(2 * np.pi * t / period + rng_phase)
@@ -217,7 +227,11 @@ def foot_points(t: np.ndarray, plan: dict, y0: float, rng_phase: float, side: st
     if side == "R":
         # transmitter: 2 cm forward, 1 cm up (foot frame, pitch th), 4 cm to the right
         fx, fz = 0.02, 0.01
-        out["TX"] = np.column_stack([x + fx * c + fz * s, y - 0.04, z - fx * s + fz * c])
+        out["TXA"] = np.column_stack([x + fx * c + fz * s, y - 0.04, z - fx * s + fz * c])
+        mo = np.zeros(3) if marker_offset is None else np.asarray(marker_offset, float)
+        out["TX"] = out["TXA"] + np.column_stack([mo[0] * c + mo[2] * s,
+                                                  np.full_like(x, -mo[1]),
+                                                  -mo[0] * s + mo[2] * c])
     return out
 
 
@@ -349,7 +363,12 @@ def simulate_treadmill_trial(rng: np.random.Generator, cfg: dict, subject: dict,
     y_r = -0.075 + 0.01 * rng.standard_normal()
 
     t_m = np.arange(int(round(dur * rate))) / rate
-    pts = foot_points(t_m, plan_r, y_r, phase, "R")
+    # the camera marker sits on the transmitter housing, "approximately in alignment with
+    # the transmitter head" (seed 003 §4.3): 1 cm above its acoustic centre, placed by hand
+    # to +-3 mm; it turns with the foot, so its offset from the acoustic centre in the
+    # ultrasonic frame changes over the gait cycle
+    marker_offset = np.array([0.0, 0.0, 0.010]) + rng.uniform(-0.003, 0.003, 3)
+    pts = foot_points(t_m, plan_r, y_r, phase, "R", marker_offset)
     pts.update(foot_points(t_m, plan_l, y_r + 0.15, phase + np.pi, "L"))
     anchors_f = _to_field(PAPER_ANCHORS, R, o)
     labels = ["TX"] + ANCHOR_IDS + _FOOT_MARKERS
@@ -361,7 +380,7 @@ def simulate_treadmill_trial(rng: np.random.Generator, cfg: dict, subject: dict,
     xyz = _mocap_noise_and_gaps(rng, xyz, labels, rate, cfg["mocap_noise_m"])
 
     t_us, t_true, offset, drift = _clock(rng, dur, us_rate)
-    tx_us_t = foot_points(t_true, plan_r, y_r, phase, "R")["TX"]
+    tx_us_t = foot_points(t_true, plan_r, y_r, phase, "R")["TXA"]
     d_true = np.linalg.norm(tx_us_t[:, None, :] - anchors_f[None], axis=2)
     temp_true, temp_log = _temperature(rng, t_us)
     tof, counts = _ranges_to_tof(d_true, temp_true, rng, np.asarray(cfg["noise_V_m2"]),
@@ -375,13 +394,13 @@ def simulate_treadmill_trial(rng: np.random.Generator, cfg: dict, subject: dict,
         "t_hs_s": t_hs[:-1][keep], "duration_s": T[keep],
         # belt-relative stride length: belt travel plus the change of strike position
         "length_m": (speed_mps * T + np.diff(plan_r["x_hs"]))[keep]})
-    tx_f = pts["TX"]
+    tx_f = pts["TXA"]                                    # truth: the acoustic centre
     tx_u = _to_us_frame(tx_f, R, o)
     truth_tx = pd.DataFrame({"t_s": t_m, "x_m": tx_f[:, 0], "y_m": tx_f[:, 1],
                              "z_m": tx_f[:, 2], "xu_m": tx_u[:, 0], "yu_m": tx_u[:, 1],
                              "zu_m": tx_u[:, 2]})
     meta = {"clock_offset_s": offset, "clock_drift_ppm": drift, **counts,
-            "speed_mps": speed_mps, "stride_duration_mean_s": float(T_mean),
+            "speed_mps": speed_mps, "marker_offset_m": marker_offset.tolist(), "stride_duration_mean_s": float(T_mean),
             "board_R": R.tolist(), "board_origin_m": o.tolist(),
             "noise_V_m2": list(map(float, cfg["noise_V_m2"]))}
     return labels, xyz, _anchor_log(t_us, tof, temp_log, ""), truth_tx, meta, strides
@@ -425,12 +444,21 @@ def simulate_pendulum_trial(rng: np.random.Generator, cfg: dict, R: np.ndarray,
     t_us, t_true, offset, drift = _clock(rng, dur, us_rate)
     # one integration of the swing for both clocks' sample instants
     th_all = _pendulum_theta(np.concatenate([t_m, t_true]), L, theta0, 0.03, t_rel)
-    tx_u = tx_at(th_all[:len(t_m)])
+    th_m = th_all[:len(t_m)]
+    tx_u = tx_at(th_m)
+    # marker within 2 mm of the transducer head, fixed on the arm (radial, tangential, z)
+    mo = rng.uniform(-1.0, 1.0, 3) * float(cfg["pendulum_marker_offset_m"])
+    radial = np.column_stack([np.sin(th_m) * np.cos(tilt), -np.cos(th_m),
+                              np.sin(th_m) * np.sin(tilt)])
+    tangential = np.column_stack([np.cos(th_m) * np.cos(tilt), np.sin(th_m),
+                                  np.cos(th_m) * np.sin(tilt)])
+    marker_u = tx_u + mo[0] * radial + mo[1] * tangential + mo[2] * np.array([0, 0, 1.0])
     tx_f = _to_field(tx_u, R, o)
+    marker_f = _to_field(marker_u, R, o)
     anchors_f = _to_field(PAPER_ANCHORS, R, o)
     labels = ["TX"] + ANCHOR_IDS
     xyz = np.empty((len(t_m), 5, 3))
-    xyz[:, 0] = tx_f
+    xyz[:, 0] = marker_f
     xyz[:, 1:] = anchors_f[None]
     xyz = xyz + cfg["mocap_noise_m"] * rng.standard_normal(xyz.shape)
     p_true = tx_at(th_all[len(t_m):])
@@ -443,6 +471,7 @@ def simulate_pendulum_trial(rng: np.random.Generator, cfg: dict, R: np.ndarray,
                              "zu_m": tx_u[:, 2]})
     meta = {"clock_offset_s": offset, "clock_drift_ppm": drift, **counts,
             "pendulum_length_m": L, "theta0_rad": theta0, "release_s": t_rel,
+            "marker_offset_m": mo.tolist(),
             "board_R": R.tolist(), "board_origin_m": o.tolist(),
             "noise_V_m2": list(map(float, cfg["noise_V_m2"]))}
     return labels, xyz, _anchor_log(t_us, tof, temp_log, ""), truth_tx, meta
@@ -462,7 +491,8 @@ def generate_ultrasonic(out_dir: Path, cfg: dict | None = None, seed: int = 0
         ``n_pendulum_trials`` (5), ``pendulum_duration_s`` (20), ``mocap_rate_hz`` (200),
         ``us_rate_hz`` (50), ``noise_V_m2`` (the paper's V), ``multipath_prob`` (0.005),
         ``dropout_prob`` (0.002), ``mocap_noise_m`` (0.0004), ``stride_cv`` (0.02),
-        ``folder`` ("ultrasonic").
+        ``pendulum_marker_offset_m`` (0.002: largest per-axis offset of the pendulum's
+        camera marker from the transducer head), ``folder`` ("ultrasonic").
     seed : int
         Seed of ``np.random.default_rng``; each trial gets its own child stream, so the
         same seed gives byte-identical files.
