@@ -41,6 +41,9 @@ ANGLE = "angle_rad"
 NO_RETURN = float("nan")
 
 # -- physics -------------------------------------------------------------------------------
-#: Speed of sound in dry air at 0 degC (m/s); seed 003 eq. (2): c = 331.3 sqrt(1 + T/273.15)
+#: Speed of sound in dry air at 0 degC (m/s) in the physical law c = 331.3 sqrt(1 + T/273.15),
+#: which the simulator uses as the true physics.  The pipeline converts time of flight with
+#: seed 003's linear approximation, eq. (2): v_s = 331.5 + 0.6 T_c
+#: (:func:`gaitval.ultrasonic.speed_of_sound`); the two differ by ~0.1 % at room temperature.
 SPEED_OF_SOUND_0C = 331.3
 KELVIN_0C = 273.15

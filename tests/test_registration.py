@@ -399,7 +399,7 @@ def test_ultrasonic_anchor_frame_and_clock():
     tx_u = np.column_stack([np.interp(tu_m, t, tx[:, j]) for j in range(3)])
     dist = np.linalg.norm(tx_u[:, None] - anc_f[None], axis=2)
     temp = np.full(len(tu_m), 22.0)
-    c = 331.3 * np.sqrt(1 + 22.0 / 273.15)
+    c = 331.5 + 0.6 * 22.0          # seed 003 eq. (2), what the pipeline converts with
     log = UltrasonicLog(t=off + tu_m, temperature_c=temp, tof_s=dist / c,
                         anchors=pd.DataFrame({"anchor": ["R1", "R2", "R3", "R4"],
                                               "x_m": anchors_us[:, 0], "y_m": anchors_us[:, 1],

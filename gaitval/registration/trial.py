@@ -25,7 +25,6 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import pandas as pd
 
-from gaitval.consts import KELVIN_0C, SPEED_OF_SOUND_0C
 from gaitval.errors import RegistrationError
 from gaitval.groundtruth.build import (as_float, filled_markers, gt_cfg, leg_points, section,
                                        sensor_height)
@@ -272,15 +271,10 @@ def register_anchors(mocap: MocapTrial, log: UltrasonicLog, cfg: dict | None = N
 
 
 def anchor_distances(log: UltrasonicLog) -> np.ndarray:
-    """Transmitter-anchor distances (n, n_anchors), metres.
-
-    From ``distance_m``, or ``tof_s * c(T)`` with ``c = 331.3 sqrt(1 + T / 273.15)`` m/s
-    (seed 003 eq. (1)-(2)).
-    """
-    if log.distance_m is not None:
-        return np.asarray(log.distance_m, dtype=float)
-    c = SPEED_OF_SOUND_0C * np.sqrt(1.0 + np.asarray(log.temperature_c, float) / KELVIN_0C)  # eq. (2)
-    return np.asarray(log.tof_s, dtype=float) * c[:, None]                                   # eq. (1)
+    """Transmitter-anchor distances (n, n_anchors), metres, from ``distance_m`` or from
+    ``tof_s`` with seed 003 eq. (1)-(2) (:func:`gaitval.ultrasonic.log_distances`)."""
+    from gaitval.ultrasonic import log_distances
+    return log_distances(log)
 
 
 def _register_ultrasonic(mocap, log, trial, cfg, tid):
