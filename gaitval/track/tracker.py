@@ -39,8 +39,8 @@ import pandas as pd
 from gaitval.errors import GaitvalError
 from gaitval.gait.phases import SWINGING, gait_phase_xy
 from gaitval.track.associate import ASSOCIATORS
-from gaitval.track.gate import GATES
-from gaitval.track.kalman import FILTERS
+from gaitval.track.gate import GATES, ChiSquareGate
+from gaitval.track.kalman import FILTERS, AxisKalmanFilter
 from gaitval.track.motion import MOTION_MODELS
 from gaitval.track.occlusion import OCCLUSION_HANDLERS
 
@@ -224,7 +224,25 @@ class Tracker:
         v_st, v_sw = self.v_st_th, self.v_sw_th
         gate, assoc, occ, motion = self.gate, self.associator, self.occlusion, self.motion
 
+        # Speed: everything the per-scan loop calls is bound to a local name once, the
+        # swing table is a tuple indexed by phase, and the ``kf`` filter's Mahalanobis
+        # distance (one S per leg and scan, eq. 12) and the χ² gate test (eq. 13) are
+        # evaluated inline.  Same arithmetic in the same order as the part methods, so
+        # the results are identical (tests/test_track.py regression snapshot).
         posvel = F.posvel
+        vel = F.vel
+        predict = F.predict
+        correct = F.correct
+        mahal2 = F.mahalanobis2
+        inputs = motion.inputs
+        admits = gate.admits
+        select = assoc.select
+        sw_tab = tuple(SWINGING[i] for i in range(6))
+        axis_kf = type(F) is AxisKalmanFilter
+        r2 = F.r_sd_m ** 2 if axis_kf else 0.0
+        chi2_g = gate.g if type(gate) is ChiSquareGate else None
+        post_l, post_r = post
+        acc_l, acc_r = acc
 
         def phase_from(sl, sr):
             return gait_phase_xy(*posvel(sl), *posvel(sr), v_st, v_sw)
@@ -232,12 +250,12 @@ class Tracker:
         def book_accel(k, dt):
             """a_k = ‖v_k − v_{k−1}‖/Δt of both legs and the running swing-phase average g
             over the previous N_ac steps (§5.5)."""
-            sw_now = SWINGING[phase[k]]
+            sw_now = sw_tab[phase[k]]
             old = k - n_ac
-            sw_old = SWINGING[phase[old]] if (n_ac and old > k0) else (False, False)
+            sw_old = sw_tab[phase[old]] if (n_ac and old > k0) else (False, False)
             for f in (0, 1):
-                v1 = F.vel(post[f][k])
-                v0 = F.vel(post[f][k - 1])
+                v1 = vel(post[f][k])
+                v0 = vel(post[f][k - 1])
                 a = math.hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
                 acc[f][k] = a
                 if n_ac:
@@ -254,7 +272,7 @@ class Tracker:
         def resync_gain(k):
             for f in (0, 1):
                 lo = max(k0 + 1, k - n_ac + 1)
-                sel = [acc[f][i] for i in range(lo, k + 1) if SWINGING[phase[i]][f]]
+                sel = [acc[f][i] for i in range(lo, k + 1) if sw_tab[phase[i]][f]]
                 gsum[f], gcnt[f] = float(sum(sel)), len(sel)
 
         def refilter(f, ka, m, k_now):
@@ -275,71 +293,97 @@ class Tracker:
                 if real[f][i]:
                     p3 = z[f][i]
                     break
-            virt = occ.virtual_observations(p0, p1, p2, p3, n_uo)
+            virt = occ.virtual_observations(p0, p1, p2, p3, n_uo).tolist()
+            zf = z[f]
             for i in range(n_uo):
-                z[f][ka + 1 + i] = (float(virt[i, 0]), float(virt[i, 1]))
-                res.interpolated[f, ka + 1 + i] = True
+                zf[ka + 1 + i] = (virt[i][0], virt[i][1])
+            res.interpolated[f, ka + 1:ka + 1 + n_uo] = True
             # re-run both legs from ka with the stored associations (§5.4: "all state
             # parameters are updated")
             resync_gain(ka)
+            z_l, z_r = z
             for k in range(ka + 1, k_now + 1):
                 dt = dts[k]
-                ul, ur = motion.inputs(phase[k - 1], F.vel(post[0][k - 1]),
-                                       F.vel(post[1][k - 1]), gain(0), gain(1), dt)
-                for g, u in ((0, ul), (1, ur)):
-                    s = F.predict(post[g][k - 1], dt, u[0], u[1])
-                    if z[g][k] is not None:
-                        s = F.correct(s, z[g][k][0], z[g][k][1])
-                    post[g][k] = s
-                phase[k] = phase_from(post[0][k], post[1][k])
+                sl, sr = post_l[k - 1], post_r[k - 1]
+                ul, ur = inputs(phase[k - 1], vel(sl), vel(sr), gain(0), gain(1), dt)
+                sl = predict(sl, dt, ul[0], ul[1])
+                zk = z_l[k]
+                if zk is not None:
+                    sl = correct(sl, zk[0], zk[1])
+                sr = predict(sr, dt, ur[0], ur[1])
+                zk = z_r[k]
+                if zk is not None:
+                    sr = correct(sr, zk[0], zk[1])
+                post_l[k] = sl
+                post_r[k] = sr
+                phase[k] = phase_from(sl, sr)
                 book_accel(k, dt)
+
+        # per-scan association state, read by the two helpers below (closures see the
+        # current binding of ``prior``, ``obs``, ``cache`` and ``pcache``)
+        prior = obs = None
+        cache: tuple[dict, dict] = ({}, {})
+        pcache: dict = {}
+
+        def corrected(f, j):
+            s = cache[f].get(j)
+            if s is None:
+                s = correct(prior[f], obs[j - 1][0], obs[j - 1][1])   # eq. (14)–(16)
+                cache[f][j] = s
+            return s
+
+        def phase_of(a, b):
+            ph = pcache.get((a, b))
+            if ph is None:
+                ph = pcache[(a, b)] = phase_from(corrected(0, a), corrected(1, b))
+            return ph
 
         for k in range(k0 + 1, n):
             dt = dts[k]
-            sl_prev, sr_prev = post[0][k - 1], post[1][k - 1]
-            vl, vr = F.vel(sl_prev), F.vel(sr_prev)
+            sl_prev, sr_prev = post_l[k - 1], post_r[k - 1]
+            vl, vr = vel(sl_prev), vel(sr_prev)
             # predict, eq. (7)–(8) with u_{k-1} from eq. (18)–(20)
-            ul, ur = motion.inputs(phase[k - 1], vl, vr, gain(0), gain(1), dt)
-            prior = (F.predict(sl_prev, dt, ul[0], ul[1]), F.predict(sr_prev, dt, ur[0], ur[1]))
+            gl = gsum[0] / gcnt[0] if gcnt[0] > 0 else 0.0
+            gr = gsum[1] / gcnt[1] if gcnt[1] > 0 else 0.0
+            ul, ur = inputs(phase[k - 1], vl, vr, gl, gr, dt)
+            prior = (predict(sl_prev, dt, ul[0], ul[1]), predict(sr_prev, dt, ur[0], ur[1]))
             # gate, eq. (11)–(13)
             obs = xyl[k]
             cands = ([], [])
             if obs:
                 for f in (0, 1):
-                    px, py = F.pos(prior[f])
+                    pf = prior[f]
+                    px, py = pf[0], pf[1]
+                    cf = cands[f]
+                    if axis_kf and chi2_g is not None:
+                        sv = pf[4] + r2                       # eq. (12), per axis
+                        for j, (zx, zy) in enumerate(obs):
+                            ex = zx - px
+                            ey = zy - py
+                            lam2 = (ex * ex + ey * ey) / sv   # eq. (11)
+                            if lam2 < chi2_g:                 # eq. (13)
+                                cf.append((j + 1, math.sqrt(lam2)))
+                        continue
+                    px, py = F.pos(pf)
                     ctx = None
                     if needs_ctx:
                         v = vl if f == 0 else vr
                         ctx = {"leg_width_m": leg_width_m, "dt": dt, "speed": math.hypot(*v),
-                               "swing": SWINGING[phase[k - 1]][f], "n_unobserved": n_unobs[f]}
+                               "swing": sw_tab[phase[k - 1]][f], "n_unobserved": n_unobs[f]}
                     for j, (zx, zy) in enumerate(obs):
-                        lam2 = F.mahalanobis2(prior[f], zx, zy)
-                        if gate.admits(lam2, math.hypot(zx - px, zy - py), ctx):
-                            cands[f].append((j + 1, math.sqrt(lam2)))
+                        lam2 = mahal2(pf, zx, zy)
+                        if admits(lam2, math.hypot(zx - px, zy - py), ctx):
+                            cf.append((j + 1, math.sqrt(lam2)))
             # associate, eq. (9)–(10) and §5.2
-            cache: tuple[dict, dict] = ({0: prior[0]}, {0: prior[1]})
-
-            def corrected(f, j):
-                s = cache[f].get(j)
-                if s is None:
-                    s = F.correct(prior[f], obs[j - 1][0], obs[j - 1][1])   # eq. (14)–(16)
-                    cache[f][j] = s
-                return s
-
-            pcache: dict = {}
-
-            def phase_of(a, b):
-                ph = pcache.get((a, b))
-                if ph is None:
-                    ph = pcache[(a, b)] = phase_from(corrected(0, a), corrected(1, b))
-                return ph
-
-            a, b = assoc.select(cands[0], cands[1], phase[k - 1], phase_of)
+            cache = ({0: prior[0]}, {0: prior[1]})
+            pcache = {}
+            a, b = select(cands[0], cands[1], phase[k - 1], phase_of)
             # correct, eq. (14)–(16)
             for f, j in ((0, a), (1, b)):
                 post[f][k] = corrected(f, j)
                 if j:
-                    z[f][k] = (obs[j - 1][0], obs[j - 1][1])
+                    o = obs[j - 1]
+                    z[f][k] = (o[0], o[1])
                     real[f][k] = True
                     pats[f][k] = patterns[k][j - 1]
                     res.obs_index[f, k] = j - 1
@@ -348,15 +392,30 @@ class Tracker:
                     pats[f][k] = "UO"
                     n_unobs[f] += 1
             # gait phase, eq. (3)–(5)
-            phase[k] = phase_of(a, b)
-            book_accel(k, dt)
+            ph = phase[k] = phase_of(a, b)
+            # book_accel(k, dt), inline (same operations)
+            sw_now = sw_tab[ph]
+            old = k - n_ac
+            sw_old = sw_tab[phase[old]] if (n_ac and old > k0) else (False, False)
+            for f, pf, af in ((0, post_l, acc_l), (1, post_r, acc_r)):
+                v1 = vel(pf[k])
+                v0 = vel(pf[k - 1])
+                aa = math.hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
+                af[k] = aa
+                if n_ac:
+                    if sw_now[f]:
+                        gsum[f] += aa
+                        gcnt[f] += 1
+                    if sw_old[f]:
+                        gsum[f] -= af[old]
+                        gcnt[f] -= 1
             # occlusion handling (eq. 17 for Method 3)
             for f in (0, 1):
-                if real[f][k] and last_real[f] < k - 1:
-                    d = occ.delay(k - last_real[f] - 1)
-                    if d is not None:
-                        pending.append((k + d, f, last_real[f], k))
                 if real[f][k]:
+                    if last_real[f] < k - 1:
+                        d = occ.delay(k - last_real[f] - 1)
+                        if d is not None:
+                            pending.append((k + d, f, last_real[f], k))
                     last_real[f] = k
             if pending:
                 due = [p for p in pending if p[0] <= k]
