@@ -16,6 +16,7 @@ include: "workflow/rules/simulate.smk"
 include: "workflow/rules/ingest.smk"
 include: "workflow/rules/register.smk"
 include: "workflow/rules/tug.smk"
+include: "workflow/rules/ultrasonic.smk"
 include: "workflow/rules/peer.smk"
 include: "workflow/rules/report.smk"
 

@@ -116,6 +116,33 @@ def cmd_tug_tables(a) -> int:
     return 0
 
 
+def cmd_ultrasonic_noise(a) -> int:
+    from gaitval.steps import ultrasonic_noise_step
+    n = ultrasonic_noise_step(a.ingest, a.trials, a.config, a.out, a.table_stem,
+                              a.reports_dir, a.config_hash)
+    print(json.dumps(n, sort_keys=True))
+    return 0
+
+
+def cmd_ultrasonic_track(a) -> int:
+    from gaitval.steps import ultrasonic_track_step
+    ultrasonic_track_step(a.ingest, a.trial, a.config, a.noise, a.out)
+    return 0
+
+
+def cmd_gait_parameters(a) -> int:
+    from gaitval.steps import gait_parameters_step
+    gait_parameters_step(a.track, a.ingest, a.sheet, a.subjects, a.trial, a.config, a.out)
+    return 0
+
+
+def cmd_ultrasonic_tables(a) -> int:
+    from gaitval.steps import ultrasonic_tables_step
+    ultrasonic_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir,
+                           a.config_hash)
+    return 0
+
+
 def cmd_report(a) -> int:
     from gaitval.report.index import build_index
     md, html = build_index(a.reports_dir, study_names=a.studies)
@@ -217,6 +244,42 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--reports-dir", default="reports")
     s.add_argument("--config-hash", default="")
     s.set_defaults(func=cmd_tug_tables)
+
+    s = sub.add_parser("ultrasonic-noise", help="V and W from pendulum trials; Table 1")
+    s.add_argument("--ingest", nargs="+", required=True, help="pendulum ingest folders")
+    s.add_argument("--trials", nargs="+", required=True, help="their trial ids, same order")
+    s.add_argument("--config", required=True)
+    s.add_argument("--out", required=True, help="noise.json")
+    s.add_argument("--table-stem", required=True)
+    s.add_argument("--reports-dir", default="reports")
+    s.add_argument("--config-hash", default="")
+    s.set_defaults(func=cmd_ultrasonic_noise)
+
+    s = sub.add_parser("ultrasonic-track", help="UKF track of one ultrasonic trial")
+    s.add_argument("--ingest", required=True)
+    s.add_argument("--trial", required=True)
+    s.add_argument("--config", required=True)
+    s.add_argument("--noise", required=True, help="noise.json of ultrasonic-noise")
+    s.add_argument("--out", required=True)
+    s.set_defaults(func=cmd_ultrasonic_track)
+
+    s = sub.add_parser("gait-parameters", help="per-stride parameters, reference vs system")
+    s.add_argument("--track", required=True)
+    s.add_argument("--ingest", required=True)
+    s.add_argument("--sheet", required=True)
+    s.add_argument("--subjects", required=True)
+    s.add_argument("--trial", required=True)
+    s.add_argument("--config", required=True)
+    s.add_argument("--out", required=True)
+    s.set_defaults(func=cmd_gait_parameters)
+
+    s = sub.add_parser("ultrasonic-tables", help="seed 003 Tables 2-8, C1 and figures")
+    s.add_argument("inputs", nargs="+", help="per-trial gait parameter files")
+    s.add_argument("--tables-dir", required=True)
+    s.add_argument("--figures-dir", required=True)
+    s.add_argument("--reports-dir", default="reports")
+    s.add_argument("--config-hash", default="")
+    s.set_defaults(func=cmd_ultrasonic_tables)
 
     s = sub.add_parser("report", help="write reports/index.md and index.html")
     s.add_argument("--reports-dir", default="reports")

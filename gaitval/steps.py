@@ -237,3 +237,87 @@ def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, report
     figs = write_tug_figures(frames, summaries, events, figures_dir)
     stamp("tug_figures", figs, reports_dir, config_hash_=config_hash)
     return paths + figs
+
+
+# -- ultrasonic (seed 003) ------------------------------------------------------------------
+def ultrasonic_noise_step(ingest_dirs: list[str | Path], trials: list[str], config_json,
+                          out_json, table_stem, reports_dir, config_hash: str = "") -> dict:
+    """Identify V (per anchor) and W from the pendulum trials (seed 003 §4.3, eq. 23) and
+    render Table 1.  Writes ``noise.json`` (V, W, bias, RMSE) for the treadmill tracks."""
+    from gaitval.io.ingest import read_mocap_parquet
+    from gaitval.io.ultrasonic import read_ultrasonic
+    from gaitval.report.provenance import stamp
+    from gaitval.tables.ultrasonic_table1 import build_ultrasonic_table1
+
+    cfg = load_json(config_json).get("ultrasonic") or {}
+    pairs = []
+    for d, tid in zip(ingest_dirs, trials):
+        d = Path(d)
+        pairs.append((read_ultrasonic(d / "sensor.parquet", trial=tid),
+                      read_mocap_parquet(d / "mocap.parquet")))
+    if not pairs:
+        raise GaitvalError("no pendulum trials: the noise identification of seed 003 §4.3 "
+                           "needs at least one (protocol 'pendulum' in the trial sheet)")
+    paths, noise = build_ultrasonic_table1(pairs, table_stem, cfg, names=list(trials))
+    stamp(Path(table_stem).name, paths, reports_dir, config_hash_=config_hash)
+    write_text(out_json, json.dumps(noise, indent=1, sort_keys=True) + "\n")
+    return noise
+
+
+def ultrasonic_track_step(ingest_dir, trial: str, config_json, noise_json, out_parquet
+                          ) -> pd.DataFrame:
+    """UKF track of one treadmill trial (seed 003 eq. 3-13).
+
+    V comes from the pendulum identification (``noise.json``); W stays the configured
+    walking value (``ultrasonic.ukf.W_sigma_mps2``) unless ``ultrasonic.use_identified_W``
+    is true: the pendulum's slow arc gives a W far too small for a heel (see
+    :func:`gaitval.ultrasonic.identify_noise`).
+    """
+    from gaitval.io.ultrasonic import read_ultrasonic
+    from gaitval.ultrasonic import track_ultrasonic_trial
+
+    cfg = dict(load_json(config_json).get("ultrasonic") or {})
+    noise = load_json(noise_json)
+    ukf = dict(cfg.get("ukf") or {})
+    ukf["V_m2"] = noise["ukf"]["V_m2"]
+    if cfg.get("use_identified_W", False):
+        ukf["W_sigma_mps2"] = noise["ukf"]["W_sigma_mps2"]
+    cfg["ukf"] = ukf
+    log = read_ultrasonic(Path(ingest_dir) / "sensor.parquet", trial=trial)
+    track = track_ultrasonic_trial(log, cfg, trial=trial)
+    track.attrs = {}
+    write_parquet(track, out_parquet)
+    return track
+
+
+def gait_parameters_step(track_parquet, ingest_dir, sheet, subjects, trial: str,
+                         config_json, out_parquet) -> pd.DataFrame:
+    """Gait parameters per stride for reference and system (seed 003 eq. 16-22)."""
+    from gaitval.io.ingest import read_mocap_parquet
+    from gaitval.io.ultrasonic import read_ultrasonic
+    from gaitval.ultrasonic import gait_parameters
+
+    cfg = load_json(config_json).get("ultrasonic") or {}
+    row, subj = trial_and_subject(sheet, subjects, trial)
+    d = Path(ingest_dir)
+    log = read_ultrasonic(d / "sensor.parquet", trial=trial)
+    mocap = read_mocap_parquet(d / "mocap.parquet")
+    track = pd.read_parquet(track_parquet)
+    gp = gait_parameters(track, mocap, row, subj, cfg, anchors=log.anchors)
+    write_parquet(gp.reset_index(drop=True), out_parquet)
+    return gp
+
+
+def ultrasonic_tables_step(inputs: list[str | Path], tables_dir, figures_dir, reports_dir,
+                           config_hash: str = "") -> list[Path]:
+    """Seed 003 Tables 2-8, C1 and the figures from the per-trial gait parameters."""
+    from gaitval.report.provenance import stamp
+    from gaitval.report.stats_figures import write_ultrasonic_figures
+    from gaitval.tables.ultrasonic import write_ultrasonic_tables
+
+    gp = pd.concat([pd.read_parquet(p) for p in inputs], ignore_index=True)
+    paths = write_ultrasonic_tables(gp, tables_dir)
+    stamp("ultrasonic_tables", paths, reports_dir, config_hash_=config_hash)
+    figs = write_ultrasonic_figures(gp, figures_dir)
+    stamp("ultrasonic_figures", figs, reports_dir, config_hash_=config_hash)
+    return paths + figs

@@ -345,7 +345,12 @@ def tableC1(gait_params: pd.DataFrame, speed: str = "normal", column: str = "sys
         if max_strides_per_subject is not None:
             sub = (sub.sort_values(["subject", "trial", "stride"])
                    .groupby("subject", sort=True).head(max_strides_per_subject))
-        a = anova_oneway(sub, column, "subject").reset_index()
+        try:
+            a = anova_oneway(sub, column, "subject").reset_index()
+        except GaitvalError:
+            # fewer than two subjects with data: the ANOVA is undefined, say so by NaN
+            a = pd.DataFrame({"source": ["between", "within", "total"],
+                              **{c: np.nan for c in ("SS", "df", "MS", "F", "p")}})
         a.insert(0, "parameter", param)
         a.insert(1, "symbol", PARAM_INFO[param][0])
         published = pub.TABLE_C1[param] if speed == "normal" else None

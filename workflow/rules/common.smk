@@ -105,3 +105,11 @@ def parent_of(name, up=0):
 def tug_methods():
     """The TUG tracker methods to run (config tug.methods)."""
     return list(config.get("tug", {}).get("methods", ["tug_m1", "tug_m2", "tug_m3"]))
+
+
+def pendulum_trials():
+    return [(s, t) for s in config["run"] for t in trial_ids(s, ["pendulum"])]
+
+
+def treadmill_trials():
+    return [(s, t) for s in config["run"] for t in trial_ids(s, ["treadmill"])]

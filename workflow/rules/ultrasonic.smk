@@ -1,0 +1,122 @@
+# Ultrasonic foot tracking (seed 003): noise identification from the pendulum trials
+# (Table 1), UKF track per treadmill trial, gait parameters, Tables 2-8, C1 and figures.
+# Like every paper table, these pool the studies in `run`; the pendulum noise
+# identification is shared by them (run studies with different hardware separately).
+
+
+rule ultrasonic_noise:
+    input:
+        ingest=lambda w: [
+            f"{RESULTS}/{s}/ingest/{t}/sensor.parquet" for s, t in pendulum_trials()
+        ],
+        config=lambda w: f"{RESULTS}/{config['run'][0]}/config.json",
+    output:
+        noise=f"{RESULTS}/ultrasonic_noise.json",
+        table=report(
+            f"{REPORTS}/tables/ultrasonic_table1.csv",
+            caption="../report/ultrasonic.rst",
+            category="Ultrasonic",
+        ),
+    params:
+        gv=GV,
+        dirs=lambda w, input: " ".join(str(Path(p).parent) for p in input.ingest),
+        trials=lambda w: " ".join(t for _, t in pendulum_trials()),
+        stem=lambda w, output: output.table[: -len(".csv")],
+        reports=parent_of("table", up=1),
+        chash=CONFIG_HASH,
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/ultrasonic_noise.log",
+    shell:
+        "{params.gv} ultrasonic-noise --ingest {params.dirs} --trials {params.trials}"
+        " --config {input.config} --out {output.noise} --table-stem {params.stem}"
+        " --reports-dir {params.reports} --config-hash {params.chash}"
+        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+rule ultrasonic_track:
+    input:
+        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
+        config=f"{RESULTS}/{{study}}/config.json",
+        noise=f"{RESULTS}/ultrasonic_noise.json",
+    output:
+        f"{RESULTS}/{{study}}/ultrasonic/track/{{trial}}.parquet",
+    params:
+        gv=GV,
+        ingest=lambda w, input: str(Path(input.sensor).parent),
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/ultrasonic_track/{study}/{trial}.log",
+    shell:
+        "{params.gv} ultrasonic-track --ingest {params.ingest} --trial {wildcards.trial}"
+        " --config {input.config} --noise {input.noise} --out {output}"
+        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+rule gait_parameters:
+    input:
+        track=f"{RESULTS}/{{study}}/ultrasonic/track/{{trial}}.parquet",
+        mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
+        config=f"{RESULTS}/{{study}}/config.json",
+        sheet=lambda w: sheet_path(w.study),
+    output:
+        f"{RESULTS}/{{study}}/ultrasonic/gait/{{trial}}.parquet",
+    params:
+        gv=GV,
+        subjects=lambda w: subjects_path(w.study),
+        ingest=lambda w, input: str(Path(input.mocap).parent),
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/gait_parameters/{study}/{trial}.log",
+    shell:
+        "{params.gv} gait-parameters --track {input.track} --ingest {params.ingest}"
+        " --sheet {input.sheet} --subjects {params.subjects} --trial {wildcards.trial}"
+        " --config {input.config} --out {output} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+rule ultrasonic_tables:
+    input:
+        lambda w: [
+            f"{RESULTS}/{s}/ultrasonic/gait/{t}.parquet" for s, t in treadmill_trials()
+        ],
+    output:
+        t2=report(
+            f"{REPORTS}/tables/ultrasonic_table2.csv",
+            caption="../report/ultrasonic.rst",
+            category="Ultrasonic",
+        ),
+        tC1=f"{REPORTS}/tables/ultrasonic_tableC1.csv",
+        fig=report(
+            f"{REPORTS}/figures/ultrasonic_fig5.png",
+            caption="../report/ultrasonic.rst",
+            category="Ultrasonic",
+        ),
+    params:
+        gv=GV,
+        tables=parent_of("t2"),
+        figures=parent_of("fig"),
+        reports=parent_of("t2", up=1),
+        chash=CONFIG_HASH,
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/ultrasonic_tables.log",
+    shell:
+        "{params.gv} ultrasonic-tables {input} --tables-dir {params.tables}"
+        " --figures-dir {params.figures} --reports-dir {params.reports}"
+        " --config-hash {params.chash} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+REPORT_ITEM_FUNCS.append(
+    lambda study: [f"{REPORTS}/tables/ultrasonic_table1.csv"]
+    if trial_ids(study, ["pendulum"])
+    else []
+)
+REPORT_ITEM_FUNCS.append(
+    lambda study: [f"{REPORTS}/tables/ultrasonic_table2.csv"]
+    if trial_ids(study, ["treadmill"])
+    else []
+)
