@@ -56,10 +56,22 @@ def catmull_rom(p0, p1, p2, p3, n_uo: int) -> np.ndarray:
     n_uo : int
         Number of hidden steps.
     """
-    P = np.vstack([np.asarray(p, dtype=float) for p in (p0, p1, p2, p3)])
-    tau = np.arange(1, n_uo + 1) / (n_uo + 1.0)                      # τ = i/(N_uo+1)
-    T = np.column_stack([np.ones_like(tau), tau, tau ** 2, tau ** 3])
-    return 0.5 * T @ CATMULL_ROM_M @ P                                # eq. (17)
+    P = np.array([p0, p1, p2, p3], dtype=float)
+    return _weights(int(n_uo)) @ P                                    # eq. (17)
+
+
+_WEIGHTS: dict[int, np.ndarray] = {}
+
+
+def _weights(n_uo: int) -> np.ndarray:
+    """½ [1 τ τ² τ³] M of eq. (17) for τ = i/(N_uo+1), i = 1..N_uo (cached per N_uo)."""
+    w = _WEIGHTS.get(n_uo)
+    if w is None:
+        tau = np.arange(1, n_uo + 1) / (n_uo + 1.0)                  # τ = i/(N_uo+1)
+        T = np.column_stack([np.ones_like(tau), tau, tau ** 2, tau ** 3])
+        w = _WEIGHTS[n_uo] = 0.5 * T @ CATMULL_ROM_M                 # (½ T) M, as before
+        w.flags.writeable = False
+    return w
 
 
 class OcclusionHandler:

@@ -188,7 +188,12 @@ class Tracker:
                                                              np.array([self.dt_s or 0.025]))
         F = self.filter
         # plain Python floats in the loop (numpy scalars are several times slower)
-        xyl = [np.asarray(o, dtype=float).reshape(-1, 2).tolist() for o in xy]
+        arrs = [np.asarray(o, dtype=float).reshape(-1, 2) for o in xy]
+        flat = np.concatenate(arrs).tolist() if n else []      # one conversion, then slices
+        xyl, i = [], 0
+        for o in arrs:
+            xyl.append(flat[i:i + len(o)])
+            i += len(o)
         needs_ctx = getattr(self.gate, "needs_context", True)
         nan = np.full((2, n), np.nan)
         res = TrackResult(t=np.asarray(t, dtype=float), x=nan.copy(), y=nan.copy(),
@@ -203,6 +208,7 @@ class Tracker:
         k0, il, ir = init
         res.k_init = k0
         post: list[list] = [[None] * n, [None] * n]
+        oidx = [[-1] * n, [-1] * n]          # associated observation (0-based), -1
         z: list[list] = [[None] * n, [None] * n]         # observation used (real or virtual)
         real = [[False] * n, [False] * n]
         acc = [[0.0] * n, [0.0] * n]
@@ -214,13 +220,14 @@ class Tracker:
             z[f][k0] = (float(obs0[i][0]), float(obs0[i][1]))
             real[f][k0] = True
             pats[f][k0] = patterns[k0][i]
-            res.obs_index[f, k0] = i
+            oidx[f][k0] = i
         last_real = [k0, k0]
         n_unobs = [0, 0]
         n_ac = self.motion.n_ac
         gsum = [0.0, 0.0]
         gcnt = [0, 0]
         pending: list[tuple[int, int, int, int]] = []
+        next_due = n                     # earliest due step of the pending re-filters
         v_st, v_sw = self.v_st_th, self.v_sw_th
         gate, assoc, occ, motion = self.gate, self.associator, self.occlusion, self.motion
 
@@ -243,28 +250,62 @@ class Tracker:
         chi2_g = gate.g if type(gate) is ChiSquareGate else None
         post_l, post_r = post
         acc_l, acc_r = acc
+        if axis_kf:
+            # the ``kf`` filter's predict / correct as plain closures (no method lookup,
+            # constants per Δt cached here): the same expressions as
+            # AxisKalmanFilter.predict (eq. 7–8) and .correct (eq. 12, 14–16)
+            kcache: dict = {}
+            consts = F._consts
 
-        def phase_from(sl, sr):
-            return gait_phase_xy(*posvel(sl), *posvel(sr), v_st, v_sw)
+            def predict(s, dt, ux, uy):
+                cst = kcache.get(dt)
+                if cst is None:
+                    cst = kcache[dt] = consts(dt)
+                h, qaa, qab, qbb = cst
+                x, y, vx, vy, a, b, c = s
+                return (x + dt * vx + h * ux, y + dt * vy + h * uy, vx + dt * ux,
+                        vy + dt * uy, a + dt * (2.0 * b + dt * c) + qaa, b + dt * c + qab,
+                        c + qbb)
 
-        def book_accel(k, dt):
-            """a_k = ‖v_k − v_{k−1}‖/Δt of both legs and the running swing-phase average g
-            over the previous N_ac steps (§5.5)."""
-            sw_now = sw_tab[phase[k]]
-            old = k - n_ac
-            sw_old = sw_tab[phase[old]] if (n_ac and old > k0) else (False, False)
-            for f in (0, 1):
-                v1 = vel(post[f][k])
-                v0 = vel(post[f][k - 1])
-                a = math.hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
-                acc[f][k] = a
-                if n_ac:
-                    if sw_now[f]:
-                        gsum[f] += a
-                        gcnt[f] += 1
-                    if sw_old[f]:
-                        gsum[f] -= acc[f][old]
-                        gcnt[f] -= 1
+            def predict2(sl, sr, dt, ul, ur):
+                """Both legs' predictions with one constants look-up (= predict twice)."""
+                cst = kcache.get(dt)
+                if cst is None:
+                    cst = kcache[dt] = consts(dt)
+                h, qaa, qab, qbb = cst
+                x, y, vx, vy, a, b, c = sl
+                ux, uy = ul
+                pl = (x + dt * vx + h * ux, y + dt * vy + h * uy, vx + dt * ux,
+                      vy + dt * uy, a + dt * (2.0 * b + dt * c) + qaa, b + dt * c + qab,
+                      c + qbb)
+                x, y, vx, vy, a, b, c = sr
+                ux, uy = ur
+                return pl, (x + dt * vx + h * ux, y + dt * vy + h * uy, vx + dt * ux,
+                            vy + dt * uy, a + dt * (2.0 * b + dt * c) + qaa,
+                            b + dt * c + qab, c + qbb)
+
+            def correct(s, zx, zy):
+                x, y, vx, vy, a, b, c = s
+                sv = a + r2
+                k0_ = a / sv
+                k1 = b / sv
+                ex = zx - x
+                ey = zy - y
+                return (x + k0_ * ex, y + k0_ * ey, vx + k1 * ex, vy + k1 * ey,
+                        a - k0_ * a, b - k0_ * b, c - k1 * b)
+
+            def vel(s):
+                return s[2], s[3]
+
+            def phase_from(sl, sr):
+                return gait_phase_xy(sl[0], sl[1], sl[2], sl[3], sr[0], sr[1], sr[2], sr[3],
+                                     v_st, v_sw)
+        else:
+            def phase_from(sl, sr):
+                return gait_phase_xy(*posvel(sl), *posvel(sr), v_st, v_sw)
+
+            def predict2(sl, sr, dt, ul, ur):
+                return predict(sl, dt, ul[0], ul[1]), predict(sr, dt, ur[0], ur[1])
 
         def gain(f):
             return gsum[f] / gcnt[f] if gcnt[f] > 0 else 0.0
@@ -274,6 +315,51 @@ class Tracker:
                 lo = max(k0 + 1, k - n_ac + 1)
                 sel = [acc[f][i] for i in range(lo, k + 1) if sw_tab[phase[i]][f]]
                 gsum[f], gcnt[f] = float(sum(sel)), len(sel)
+
+        def rerun_kf(ka, k_now):
+            """The re-filtering loop of :func:`refilter` for the ``kf`` filter, unrolled
+            over the two legs (same operations in the same order as the generic loop)."""
+            z_l, z_r = z
+            gl = gsum[0] / gcnt[0] if gcnt[0] > 0 else 0.0
+            gr = gsum[1] / gcnt[1] if gcnt[1] > 0 else 0.0
+            sl = post_l[ka]
+            sr = post_r[ka]
+            for k in range(ka + 1, k_now + 1):
+                dt = dts[k]
+                ul, ur = inputs(phase[k - 1], (sl[2], sl[3]), (sr[2], sr[3]), gl, gr, dt)
+                ol, orr = sl, sr
+                sl, sr = predict2(sl, sr, dt, ul, ur)          # eq. (7)–(8)
+                zk = z_l[k]
+                if zk is not None:
+                    sl = correct(sl, zk[0], zk[1])              # eq. (14)–(16)
+                zk = z_r[k]
+                if zk is not None:
+                    sr = correct(sr, zk[0], zk[1])
+                post_l[k] = sl
+                post_r[k] = sr
+                ph = phase[k] = gait_phase_xy(sl[0], sl[1], sl[2], sl[3],    # eq. (3)–(5)
+                                              sr[0], sr[1], sr[2], sr[3], v_st, v_sw)
+                # book_accel(k, dt), inline (§5.5)
+                al = acc_l[k] = math.hypot(sl[2] - ol[2], sl[3] - ol[3]) / dt
+                ar = acc_r[k] = math.hypot(sr[2] - orr[2], sr[3] - orr[3]) / dt
+                if n_ac:
+                    sw_now = sw_tab[ph]
+                    old = k - n_ac
+                    sw_old = sw_tab[phase[old]] if old > k0 else (False, False)
+                    if sw_now[0]:
+                        gsum[0] += al
+                        gcnt[0] += 1
+                    if sw_old[0]:
+                        gsum[0] -= acc_l[old]
+                        gcnt[0] -= 1
+                    if sw_now[1]:
+                        gsum[1] += ar
+                        gcnt[1] += 1
+                    if sw_old[1]:
+                        gsum[1] -= acc_r[old]
+                        gcnt[1] -= 1
+                    gl = gsum[0] / gcnt[0] if gcnt[0] > 0 else 0.0
+                    gr = gsum[1] / gcnt[1] if gcnt[1] > 0 else 0.0
 
         def refilter(f, ka, m, k_now):
             """Catmull–Rom virtual observations for leg f, then re-filter (eq. 17, §5.4)."""
@@ -302,22 +388,46 @@ class Tracker:
             # parameters are updated")
             resync_gain(ka)
             z_l, z_r = z
+            if axis_kf:
+                rerun_kf(ka, k_now)
+                return
             for k in range(ka + 1, k_now + 1):
                 dt = dts[k]
                 sl, sr = post_l[k - 1], post_r[k - 1]
-                ul, ur = inputs(phase[k - 1], vel(sl), vel(sr), gain(0), gain(1), dt)
-                sl = predict(sl, dt, ul[0], ul[1])
+                ul, ur = inputs(phase[k - 1], (sl[2], sl[3]) if axis_kf else vel(sl),
+                                (sr[2], sr[3]) if axis_kf else vel(sr),
+                                gsum[0] / gcnt[0] if gcnt[0] > 0 else 0.0,
+                                gsum[1] / gcnt[1] if gcnt[1] > 0 else 0.0, dt)
+                sl, sr = predict2(sl, sr, dt, ul, ur)
                 zk = z_l[k]
                 if zk is not None:
                     sl = correct(sl, zk[0], zk[1])
-                sr = predict(sr, dt, ur[0], ur[1])
                 zk = z_r[k]
                 if zk is not None:
                     sr = correct(sr, zk[0], zk[1])
                 post_l[k] = sl
                 post_r[k] = sr
-                phase[k] = phase_from(sl, sr)
-                book_accel(k, dt)
+                ph = phase[k] = phase_from(sl, sr)
+                # book_accel(k, dt), inline (same operations)
+                sw_now = sw_tab[ph]
+                old = k - n_ac
+                sw_old = sw_tab[phase[old]] if (n_ac and old > k0) else (False, False)
+                for f_, s1, s0, af in ((0, sl, post_l[k - 1], acc_l),
+                                       (1, sr, post_r[k - 1], acc_r)):
+                    if axis_kf:
+                        aa = math.hypot(s1[2] - s0[2], s1[3] - s0[3]) / dt
+                    else:
+                        v1 = vel(s1)
+                        v0 = vel(s0)
+                        aa = math.hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
+                    af[k] = aa
+                    if n_ac:
+                        if sw_now[f_]:
+                            gsum[f_] += aa
+                            gcnt[f_] += 1
+                        if sw_old[f_]:
+                            gsum[f_] -= af[old]
+                            gcnt[f_] -= 1
 
         # per-scan association state, read by the two helpers below (closures see the
         # current binding of ``prior``, ``obs``, ``cache`` and ``pcache``)
@@ -341,12 +451,16 @@ class Tracker:
         for k in range(k0 + 1, n):
             dt = dts[k]
             sl_prev, sr_prev = post_l[k - 1], post_r[k - 1]
-            vl, vr = vel(sl_prev), vel(sr_prev)
+            if axis_kf:
+                vl = (sl_prev[2], sl_prev[3])
+                vr = (sr_prev[2], sr_prev[3])
+            else:
+                vl, vr = vel(sl_prev), vel(sr_prev)
             # predict, eq. (7)–(8) with u_{k-1} from eq. (18)–(20)
             gl = gsum[0] / gcnt[0] if gcnt[0] > 0 else 0.0
             gr = gsum[1] / gcnt[1] if gcnt[1] > 0 else 0.0
             ul, ur = inputs(phase[k - 1], vl, vr, gl, gr, dt)
-            prior = (predict(sl_prev, dt, ul[0], ul[1]), predict(sr_prev, dt, ur[0], ur[1]))
+            prior = predict2(sl_prev, sr_prev, dt, ul, ur)
             # gate, eq. (11)–(13)
             obs = xyl[k]
             cands = ([], [])
@@ -386,7 +500,7 @@ class Tracker:
                     z[f][k] = (o[0], o[1])
                     real[f][k] = True
                     pats[f][k] = patterns[k][j - 1]
-                    res.obs_index[f, k] = j - 1
+                    oidx[f][k] = j - 1
                     n_unobs[f] = 0
                 else:
                     pats[f][k] = "UO"
@@ -398,9 +512,14 @@ class Tracker:
             old = k - n_ac
             sw_old = sw_tab[phase[old]] if (n_ac and old > k0) else (False, False)
             for f, pf, af in ((0, post_l, acc_l), (1, post_r, acc_r)):
-                v1 = vel(pf[k])
-                v0 = vel(pf[k - 1])
-                aa = math.hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
+                s1 = pf[k]
+                s0 = pf[k - 1]
+                if axis_kf:
+                    aa = math.hypot(s1[2] - s0[2], s1[3] - s0[3]) / dt
+                else:
+                    v1 = vel(s1)
+                    v0 = vel(s0)
+                    aa = math.hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
                 af[k] = aa
                 if n_ac:
                     if sw_now[f]:
@@ -416,22 +535,26 @@ class Tracker:
                         d = occ.delay(k - last_real[f] - 1)
                         if d is not None:
                             pending.append((k + d, f, last_real[f], k))
+                            next_due = min(next_due, k + d)
                     last_real[f] = k
-            if pending:
+            if pending and k >= next_due:
                 due = [p for p in pending if p[0] <= k]
                 if due:
                     pending = [p for p in pending if p[0] > k]
                     for _, f, ka, m in sorted(due, key=lambda p: (p[2], p[1])):
                         refilter(f, ka, m, k)
                     resync_gain(k)
+                next_due = min((p[0] for p in pending), default=n)
         for _, f, ka, m in sorted(pending, key=lambda p: (p[2], p[1])):
             refilter(f, ka, m, n - 1)
 
         for f in (0, 1):
-            pv = np.array([F.pos(p) + F.vel(p) for p in post[f][k0:]], dtype=float)
+            pv = np.array([p[:4] for p in post[f][k0:]] if axis_kf else
+                          [F.pos(p) + F.vel(p) for p in post[f][k0:]], dtype=float)
             res.x[f, k0:], res.y[f, k0:] = pv[:, 0], pv[:, 1]
             res.vx[f, k0:], res.vy[f, k0:] = pv[:, 2], pv[:, 3]
             res.observed[f, k0:] = real[f][k0:]
+            res.obs_index[f, k0:] = oidx[f][k0:]
             res.pattern[f, k0:] = pats[f][k0:]
         res.phase[k0:] = np.asarray(phase[k0:], dtype=np.int8)
         if self.sides == "walking_direction" and _handedness(res) < 0:
