@@ -310,10 +310,15 @@ class Tracker:
         def gain(f):
             return gsum[f] / gcnt[f] if gcnt[f] > 0 else 0.0
 
+        swings_of = (tuple(sw[0] for sw in sw_tab), tuple(sw[1] for sw in sw_tab))
+
         def resync_gain(k):
+            """g from scratch over the window (after a re-filter rewrote its history)."""
+            lo = max(k0 + 1, k - n_ac + 1)
+            ph = phase[lo:k + 1]
             for f in (0, 1):
-                lo = max(k0 + 1, k - n_ac + 1)
-                sel = [acc[f][i] for i in range(lo, k + 1) if sw_tab[phase[i]][f]]
+                swf = swings_of[f]
+                sel = [a for a, p in zip(acc[f][lo:k + 1], ph) if swf[p]]
                 gsum[f], gcnt[f] = float(sum(sel)), len(sel)
 
         def rerun_kf(ka, k_now):
