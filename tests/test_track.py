@@ -308,6 +308,31 @@ def test_catmull_rom_refilter_improves_an_occlusion_during_a_turn():
     assert not res.observed[1, 40:52].any()
 
 
+@pytest.mark.parametrize("gate", ["chi2", {"name": "fixed_radius", "radius_leg_widths": 3.0}])
+def test_tracker_kf_fast_path_equals_the_generic_path(gate):
+    """The tracker evaluates the ``kf`` filter (and the χ² gate) inline for speed; the
+    generic path (any other filter, e.g. the 4×4 matrix form) must track identically."""
+    from gaitval.detect import split_observations
+    from gaitval.methods import build_tracker
+    from tug_synth import tug_scans
+
+    scans, _ = tug_scans(seed=11)
+    det, _ = build_tracker("tug_m3")
+    xy, pats = split_observations(det.detect(scans, 0.1), scans.n_scans)
+    runs = {}
+    for filt in ("kf", "kf_matrix"):
+        _, tr = build_tracker("tug_m3", {"filter__name": filt})
+        tr.gate = GATES.build(gate)
+        runs[filt] = tr.run(scans.t, xy, pats, 0.1)
+    a, b = runs["kf"], runs["kf_matrix"]
+    assert a.interpolated.any()                       # the re-filtering path ran
+    np.testing.assert_array_equal(a.phase, b.phase)
+    np.testing.assert_array_equal(a.obs_index, b.obs_index)
+    np.testing.assert_array_equal(a.interpolated, b.interpolated)
+    for name in ("x", "y", "vx", "vy"):
+        np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=0, atol=1e-9)
+
+
 def test_no_observations_gives_an_empty_track():
     t = np.arange(10) * DT
     res = Tracker().run(t, [np.zeros((0, 2))] * 10, [[]] * 10, 0.1)
