@@ -39,6 +39,7 @@ from gaitval.track.registry import Registry
 ASSOCIATORS = Registry("associator")
 
 D_MAX_DEFAULT = math.sqrt(13.82)
+_NO_PHASES: frozenset = frozenset()
 
 
 class Associator:
@@ -103,7 +104,7 @@ class GaitPhaseAssociator(Associator):
         self.d_max = d_max
 
     def select(self, cand_l, cand_r, prev_phase, phase_of):
-        unlikely = UNLIKELY_TRANSITIONS.get(prev_phase, frozenset())
+        unlikely = UNLIKELY_TRANSITIONS.get(prev_phase, _NO_PHASES)
         a, b = _GNN_FAST(self.d_max, cand_l, cand_r)
         if a >= 0 and phase_of(a, b) not in unlikely:
             return a, b                      # the cheapest association is likely: done
