@@ -305,6 +305,9 @@ def test_catmull_rom_refilter_improves_an_occlusion_during_a_turn():
     res = out["catmull_rom"][1]
     assert res.interpolated[1, 40:52].all() and not res.interpolated[1, :40].any()
     assert (res.pattern[1, 40:52] == "UO").all()        # virtual observations stay UO
+    # the re-filtering passes are recorded (leg, from, to) and cover the interpolated steps
+    spans = [(ka, kb) for f, ka, kb in res.refiltered if f == 1]
+    assert all(any(ka < k <= kb for ka, kb in spans) for k in range(40, 52))
     assert not res.observed[1, 40:52].any()
 
 

@@ -31,7 +31,7 @@ Spline-Based Interpolation during Turning Motion in Walk Tests. Sensors 2015, 15
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -71,6 +71,7 @@ class TrackResult:
     k_init: int
     swapped_sides: bool = False
     obs_index: np.ndarray | None = None     # (2, n): associated observation j (0-based), -1
+    refiltered: list = field(default_factory=list)   # Method 3: (leg, k_from, k_to) re-runs
 
     @property
     def swing(self) -> np.ndarray:
@@ -368,6 +369,7 @@ class Tracker:
 
         def refilter(f, ka, m, k_now):
             """Catmull–Rom virtual observations for leg f, then re-filter (eq. 17, §5.4)."""
+            res.refiltered.append((f, ka, k_now))
             n_uo = m - ka - 1
             nbo, nao = occ.n_before(n_uo), occ.n_after(n_uo)
             p1, p2 = z[f][ka], z[f][m]
@@ -584,4 +586,5 @@ def _swap_sides(res: TrackResult) -> None:
         setattr(res, name, arr[::-1].copy())
     ok = res.phase >= 0
     res.phase[ok] = _MIRROR_PHASE[res.phase[ok]]
+    res.refiltered = [(1 - f, a, b) for f, a, b in res.refiltered]
     res.swapped_sides = True
