@@ -239,6 +239,7 @@ class Tracker:
         # the results are identical (tests/test_track.py regression snapshot).
         posvel = F.posvel
         vel = F.vel
+        hypot, sqrt = math.hypot, math.sqrt
         predict = F.predict
         correct = F.correct
         mahal2 = F.mahalanobis2
@@ -483,7 +484,7 @@ class Tracker:
                             ey = zy - py
                             lam2 = (ex * ex + ey * ey) / sv   # eq. (11)
                             if lam2 < chi2_g:                 # eq. (13)
-                                cf.append((j + 1, math.sqrt(lam2)))
+                                cf.append((j + 1, sqrt(lam2)))
                         continue
                     px, py = F.pos(pf)
                     ctx = None
@@ -514,27 +515,32 @@ class Tracker:
                     n_unobs[f] += 1
             # gait phase, eq. (3)–(5)
             ph = phase[k] = phase_of(a, b)
-            # book_accel(k, dt), inline (same operations)
-            sw_now = sw_tab[ph]
-            old = k - n_ac
-            sw_old = sw_tab[phase[old]] if (n_ac and old > k0) else (False, False)
-            for f, pf, af in ((0, post_l, acc_l), (1, post_r, acc_r)):
-                s1 = pf[k]
-                s0 = pf[k - 1]
-                if axis_kf:
-                    aa = math.hypot(s1[2] - s0[2], s1[3] - s0[3]) / dt
-                else:
-                    v1 = vel(s1)
-                    v0 = vel(s0)
-                    aa = math.hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
-                af[k] = aa
-                if n_ac:
-                    if sw_now[f]:
-                        gsum[f] += aa
-                        gcnt[f] += 1
-                    if sw_old[f]:
-                        gsum[f] -= af[old]
-                        gcnt[f] -= 1
+            # book_accel(k, dt), inline (the same operations as in rerun_kf)
+            sl, sr = post_l[k], post_r[k]
+            if axis_kf:
+                al = acc_l[k] = hypot(sl[2] - sl_prev[2], sl[3] - sl_prev[3]) / dt
+                ar = acc_r[k] = hypot(sr[2] - sr_prev[2], sr[3] - sr_prev[3]) / dt
+            else:
+                v1, v0 = vel(sl), vel(sl_prev)
+                al = acc_l[k] = hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
+                v1, v0 = vel(sr), vel(sr_prev)
+                ar = acc_r[k] = hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
+            if n_ac:
+                sw_now = sw_tab[ph]
+                old = k - n_ac
+                sw_old = sw_tab[phase[old]] if old > k0 else (False, False)
+                if sw_now[0]:
+                    gsum[0] += al
+                    gcnt[0] += 1
+                if sw_old[0]:
+                    gsum[0] -= acc_l[old]
+                    gcnt[0] -= 1
+                if sw_now[1]:
+                    gsum[1] += ar
+                    gcnt[1] += 1
+                if sw_old[1]:
+                    gsum[1] -= acc_r[old]
+                    gcnt[1] -= 1
             # occlusion handling (eq. 17 for Method 3)
             for f in (0, 1):
                 if real[f][k]:
