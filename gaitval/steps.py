@@ -218,6 +218,7 @@ def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, report
                     config_hash: str = "", methods=("tug_m1", "tug_m2", "tug_m3")
                     ) -> list[Path]:
     """Gather per-trial TUG evaluations into seed 000 Tables 2-5 and the figures."""
+    from gaitval.evaluate.tug import FRAME_COLUMNS
     from gaitval.report.provenance import stamp
     from gaitval.report.tug_figures import write_tug_figures
     from gaitval.tables.tug import write_tug_tables
@@ -228,8 +229,12 @@ def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, report
             df = pd.read_parquet(Path(d) / f"{name}.parquet")
             if len(df):
                 parts[name].append(df)
+    empty = {"frames": pd.DataFrame(columns=list(FRAME_COLUMNS)),
+             "summary": pd.DataFrame(columns=["trial", "method", "success", "category"]),
+             "events": pd.DataFrame(columns=["trial", "method", "side", "kind", "t_start_s",
+                                             "t_end_s", "tug_phase"])}
     frames, summaries, events = (pd.concat(parts[n], ignore_index=True) if parts[n]
-                                 else pd.DataFrame() for n in ("frames", "summary", "events"))
+                                 else empty[n] for n in ("frames", "summary", "events"))
     summaries = summaries[summaries.get("category", "") != "not_registered"] \
         if len(summaries) else summaries
     paths = write_tug_tables(frames, summaries, tables_dir, methods=tuple(methods))

@@ -180,7 +180,10 @@ def replay_trial(out: Path, study: str, spec: dict, cfg: dict, seed: int, idx: i
     yaw = float(np.arctan2(d[1], d[0]))
     pose = (float(sx + 0.05 * rng.standard_normal()), float(sy + 0.05 * rng.standard_normal()),
             float(yaw + np.deg2rad(3.0) * rng.standard_normal()))
-    poles = np.array([p0 + 1.2 * d - 1.2 * left, p1 - 0.5 * d + 1.3 * left])
+    # Both poles on the same side of the walk: with one on each side the pole midpoint
+    # sits on the walking line and the 180-degree pole swap maps the walk onto itself,
+    # so no registration can tell the two transforms apart.
+    poles = np.array([p0 + 1.2 * d + 0.9 * left, p1 - 0.5 * d + 1.5 * left])
     lo = np.minimum(p0, p1) - 2.5
     hi = np.maximum(p0, p1) + 2.5
     h = float(cfg.get("sensor_height_m", 0.27))
