@@ -309,9 +309,6 @@ class Tracker:
             def predict2(sl, sr, dt, ul, ur):
                 return predict(sl, dt, ul[0], ul[1]), predict(sr, dt, ur[0], ur[1])
 
-        def gain(f):
-            return gsum[f] / gcnt[f] if gcnt[f] > 0 else 0.0
-
         swings_of = (tuple(sw[0] for sw in sw_tab), tuple(sw[1] for sw in sw_tab))
 
         def resync_gain(k):
