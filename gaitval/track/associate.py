@@ -11,8 +11,14 @@ The result (a, b) uses the same numbering; a = b only when both are 0.
 Notes
 -----
 Cost of an association, eq. (9)–(10): c_{a,b} = d_{L,a} + d_{R,b} with d_{f,j} = λ_{f,j}
-inside the gate and d_max outside it or for j = 0.  Only gated observations are offered,
-so "outside the gate" never needs to be enumerated.  d_max defaults to √G = √13.82 (the
+inside the gate and d_max outside it or for j = 0.  Only gated observations are offered:
+§5.2 builds the gate "to eliminate unlikely observation-to-track associations", so an
+observation outside a leg's gate is never associated with it (d_max only prices that
+case like a false alarm).  The literal alternative — enumerating out-of-gate
+observations at cost d_max when every gated association is an unlikely phase change
+(0.3 % of steps) — was tried on the default study: Method 2 went from 4 to 2 and
+Method 3 from 7 to 1 successful trials (far observations taken → swaps), so it is not
+used.  d_max defaults to √G = √13.82 (the
 gate's edge in λ units), so taking any gated observation costs less than leaving it.
 
 GNN (Method 1) picks the least-cost association.  The gait-phase association (Methods 2,
