@@ -447,11 +447,21 @@ class Tracker:
                 cache[f][j] = s
             return s
 
-        def phase_of(a, b):
-            ph = pcache.get((a, b))
-            if ph is None:
-                ph = pcache[(a, b)] = phase_from(corrected(0, a), corrected(1, b))
-            return ph
+        if axis_kf:
+            def phase_of(a, b):
+                ph = pcache.get((a, b))
+                if ph is None:
+                    sl = corrected(0, a)
+                    sr = corrected(1, b)
+                    ph = pcache[(a, b)] = gait_phase_xy(sl[0], sl[1], sl[2], sl[3], sr[0],
+                                                        sr[1], sr[2], sr[3], v_st, v_sw)
+                return ph
+        else:
+            def phase_of(a, b):
+                ph = pcache.get((a, b))
+                if ph is None:
+                    ph = pcache[(a, b)] = phase_from(corrected(0, a), corrected(1, b))
+                return ph
 
         for k in range(k0 + 1, n):
             dt = dts[k]
@@ -499,7 +509,8 @@ class Tracker:
             a, b = select(cands[0], cands[1], phase[k - 1], phase_of)
             # correct, eq. (14)–(16)
             for f, j in ((0, a), (1, b)):
-                post[f][k] = corrected(f, j)
+                s = cache[f].get(j)
+                post[f][k] = s if s is not None else corrected(f, j)
                 if j:
                     o = obs[j - 1]
                     z[f][k] = (o[0], o[1])
@@ -511,7 +522,10 @@ class Tracker:
                     pats[f][k] = "UO"
                     n_unobs[f] += 1
             # gait phase, eq. (3)–(5)
-            ph = phase[k] = phase_of(a, b)
+            ph = pcache.get((a, b))
+            if ph is None:
+                ph = phase_of(a, b)
+            phase[k] = ph
             # book_accel(k, dt), inline (the same operations as in rerun_kf)
             sl, sr = post_l[k], post_r[k]
             if axis_kf:
