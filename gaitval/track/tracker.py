@@ -56,7 +56,9 @@ class TrackResult:
 
     ``phase`` is -1 before initialisation; ``pattern`` is ``""`` there, else the pattern
     of the associated observation or ``"UO"``; ``obs_index`` is the 0-based index of the
-    associated observation in its scan (-1: none).
+    associated observation in its scan (-1: none); ``refiltered`` lists Method 3's
+    re-filtering passes as ``(leg, k_from, k_to)``: both legs were filtered again over
+    steps k_from+1..k_to after leg ``leg`` (0 = left) reappeared (eq. 17).
     """
 
     t: np.ndarray
