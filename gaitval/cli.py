@@ -64,6 +64,10 @@ def cmd_ingest_summary(a) -> int:
              "sensor_rate_hz", "beams", "anchors", "no_return_pct", "timestamp_issues",
              "annotations"]
     df = df[[c for c in first if c in df.columns]].sort_values("trial")
+    for c in ("mocap_frames", "markers", "events", "sensor_samples", "beams", "anchors",
+              "timestamp_issues", "annotations"):
+        if c in df:
+            df[c] = df[c].astype("Int64")
     stem = Path(a.out_stem)
     paths = write_table(df, stem, caption=(
         f"What gaitval read from each raw trial of study '{a.study}': mocap rate, frames and "

@@ -328,15 +328,15 @@ def test_agreement_by_group_and_missing_column():
 def test_peer_agreement_table(realdata, tmp_path):
     from gaitval.tables.peer import peer_agreement_table, write_peer_table
     path = realdata / "peer-results" / "gailo_results.parquet"
-    t = peer_agreement_table(path).set_index("statistic")
-    assert list(t.columns[1:]) == ["step_length_cm", "step_time_s", "stride_length_cm",
-                                   "stride_time_s", "velocity_cm_per_s",
-                                   "cadence_steps_per_min"]
-    assert (t.loc["n", t.columns[1:]] == 90).all()
+    t = peer_agreement_table(path).set_index("parameter")
+    assert list(t.index) == ["step_length", "step_time", "stride_length", "stride_time",
+                             "velocity", "cadence"]
+    assert t.loc["velocity", "unit"] == "cm/s" and t.loc["cadence", "unit"] == "steps/min"
+    assert (t["n"] == 90).all()
     df = pd.read_parquet(path)
     a = agreement(df, "gt_cadence", "us_cadence").iloc[0]
     for stat in ("bias", "loa_high", "icc_a1", "p"):
-        assert t.loc[stat, "cadence_steps_per_min"] == a[stat]
+        assert t.loc["cadence", stat] == a[stat]
     paths = write_peer_table(path, tmp_path / "peer_agreement")
     assert "Sensors 2024, 24(4), 1172" in paths[1].read_text()
 

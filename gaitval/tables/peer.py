@@ -27,8 +27,6 @@ STATISTICS = ("n", "ref_mean", "pro_mean", "bias", "bias_sd", "bias_ci_low",
               "loa_high_ci_low", "loa_high_ci_high", "rmse", "mad", "icc_a1",
               "icc_a1_ci_low", "icc_a1_ci_high", "icc_c1", "icc_c1_ci_low", "icc_c1_ci_high",
               "t", "df", "p")
-DIMENSIONLESS = {"n", "df", "t", "p", "icc_a1", "icc_a1_ci_low", "icc_a1_ci_high", "icc_c1",
-                 "icc_c1_ci_low", "icc_c1_ci_high"}
 
 
 def _read(parquet_path: str | Path) -> pd.DataFrame:
@@ -61,12 +59,11 @@ def peer_agreement_table(parquet_path: str | Path) -> pd.DataFrame:
     Returns
     -------
     DataFrame
-        Column ``statistic`` (one row per entry of :data:`STATISTICS`: n, means, bias and
-        its 95% CI, Bland–Altman limits and their 95% CIs, RMSE, MAD, ICC(A,1) and
-        ICC(C,1) with 95% CIs, paired t-test t/df/p of the bias), column ``unit_kind``
-        (``"unit"``: the value is in the unit of its column; ``"-"``: dimensionless), and
-        one column per pair named ``<name>_<unit>`` (e.g. ``step_length_cm``,
-        ``cadence_steps_per_min``).  Differences are system − reference.
+        One row per pair (tidy): ``parameter``, ``unit`` (cm, s, cm/s, steps/min), ``n``
+        (int), then the statistics of :data:`STATISTICS` (means, bias and its 95% CI,
+        Bland–Altman limits and their 95% CIs, RMSE, MAD in ``unit``; ICC(A,1) and
+        ICC(C,1) with 95% CIs, paired t-test t/df/p dimensionless).  Differences are
+        system − reference.
 
     Raises
     ------
@@ -80,15 +77,15 @@ def peer_agreement_table(parquet_path: str | Path) -> pd.DataFrame:
                               path=parquet_path,
                               hint="the system's columns start with 'us_', the "
                                    "reference's with 'gt_'")
-    out = pd.DataFrame({"statistic": list(STATISTICS),
-                        "unit_kind": ["-" if s in DIMENSIONLESS else "unit"
-                                      for s in STATISTICS]})
+    rows = []
     for name in names:
         a = agreement(df, REFERENCE_PREFIX + name, SYSTEM_PREFIX + name).iloc[0]
-        unit = PEER_UNITS.get(name)
-        col = f"{name}_{unit}" if unit else name
-        out[col] = [float(a[s]) for s in STATISTICS]
-    return out
+        row = {"parameter": name,
+               "unit": PEER_UNITS.get(name, "").replace("_per_", "/").replace("_", " ")}
+        for st in STATISTICS:
+            row[st] = int(a[st]) if st in ("n", "df") else float(a[st])
+        rows.append(row)
+    return pd.DataFrame(rows)
 
 
 def write_peer_table(parquet_path: str | Path, out_stem: str | Path) -> list[Path]:
@@ -101,6 +98,6 @@ def write_peer_table(parquet_path: str | Path, out_stem: str | Path) -> list[Pat
              "bias -/+ 1.96 sd with approximate 95% CIs from SE = sqrt(3 sd^2/n) (Bland & "
              "Altman 1999); ICC(A,1)/ICC(C,1): two-way model, McGraw & Wong (1996); "
              "t/df/p: paired t-test of the bias.",
-             "Units are in the column names (cm, s, cm/s, steps/min) and apply to rows "
-             "with unit_kind 'unit'."]
+             "Means, bias, limits, RMSE and MAD are in the row's unit; ICC, t, df and p "
+             "are dimensionless."]
     return write_table(table, out_stem, caption=caption, notes=notes, digits=4)
