@@ -215,14 +215,9 @@ def register_anchors(mocap: MocapTrial, anchors: pd.DataFrame, cfg: dict | None 
     if not np.all(np.isfinite(P)):
         raise MarkerError("a receiver marker has no valid sample", path=mocap.path,
                           trial=trial)
-    Q = _anchor_xyz(anchors)
-    mp, mq = P.mean(0), Q.mean(0)
-    H = (Q - mq).T @ (P - mp)
-    U, _, Vt = np.linalg.svd(H)
-    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(Vt.T @ U.T))])
-    R = Vt.T @ D @ U.T
-    o = mp - R @ mq
-    rms = float(np.sqrt(np.mean(np.sum((Q @ R.T + o - P) ** 2, axis=1))))
+    from gaitval.registration.rigid import fit_rigid_3d
+    R, o, res = fit_rigid_3d(_anchor_xyz(anchors), P)          # Kabsch, no scaling
+    rms = float(np.sqrt(np.mean(res ** 2)))
     if rms > 0.02:
         raise RegistrationError(f"receiver markers do not match the log's anchor geometry "
                                 f"(rigid-fit RMS {rms * 1000:.1f} mm)", path=mocap.path,
