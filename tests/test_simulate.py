@@ -89,7 +89,10 @@ def test_stance_fraction_in_the_study_truth(tiny, sheet):
 
 def test_shin_moves_fast_in_swing_and_barely_in_stance(tiny, sheet):
     """Seed 001 §2.5.1: the leg point at shin height is slowest in stance; in swing it moves
-    several times faster than the walker."""
+    several times faster than the walker.  Real walks (docs/simulator.md, shin-speed table:
+    FunctionalWalk, PiG_Motion-FlatFoot-Full, opensim_walking2) give a mean swing speed of
+    1.8–2.0 and a 95th percentile of 2.5–2.7 times the walking speed; the TUG trial speed
+    below also counts rising, turning and sitting, so only lower bounds are checked."""
     for _, r in _lrs(sheet, "tug").iterrows():
         legs = pd.read_parquet(tiny / "truth" / r["trial"] / "legs.parquet")
         for _, g in legs.groupby("side"):
@@ -98,8 +101,8 @@ def test_shin_moves_fast_in_swing_and_barely_in_stance(tiny, sheet):
             st = g["phase"].to_numpy() == "stance"
             walking = float(r["speed_mps"])
             assert np.median(v[st]) < 0.3 * walking
-            assert np.mean(v[~st]) > 1.8 * walking
-            assert np.percentile(v[~st], 95) > 3.0 * walking
+            assert np.mean(v[~st]) > 1.5 * walking
+            assert np.percentile(v[~st], 95) > 2.0 * walking
 
 
 def test_elderly_walk_slower_than_young(sheet):
@@ -209,8 +212,11 @@ def test_occlusion_in_the_study_comes_from_geometry(tiny, sheet):
             other = sc[(sc["scan"] == o["scan"]) & (sc["side"] != o["side"])].iloc[0]
             d_other = np.hypot(other["x_m"], other["y_m"])
             sep = abs(np.angle(np.exp(1j * (np.arctan2(other["y_m"], other["x_m"]) - bearing))))
-            # hidden behind the other leg (nearer, angular extents overlap) ...
-            behind_leg = d_other < dist and sep < 0.06 / d_other + 0.06 / dist
+            # hidden behind the other leg (nearer, angular extents overlap; a shank tilted
+            # 50° is cut as an ellipse 1.6 x longer than wide, so when the two shank
+            # points nearly coincide (a leg passing the other in a pivot step) its near
+            # surface can hide a leg whose centre is a few mm nearer) ...
+            behind_leg = d_other < dist + 0.03 and sep < 0.06 / d_other + 0.06 / dist
             # ... or behind something else: the centre beam stops well short of the leg
             behind_other = np.isnan(centre) or centre < dist - 0.10
             assert behind_leg or behind_other, (r["trial"], o["scan"])
@@ -240,8 +246,13 @@ def test_pose_and_clock_are_unknown_to_the_pipeline_but_recorded(tiny, sheet):
     nominal = cfg["tug"]["sensor_nominal_pose"]
     assert not np.allclose(tug[["x_m", "y_m", "yaw_rad"]].to_numpy()[0], nominal)
     assert (truth["clock_offset_s"].abs() > 0.1).all()
+    import pyarrow.parquet as pq
     for _, r in _lrs(sheet).iterrows():
-        text = (tiny / r["sensor_file"]).read_bytes()
+        # the log's schema (columns and key/value metadata) carries neither; the raw file
+        # bytes are compressed, so a byte search would match by chance
+        sch = pq.read_schema(tiny / r["sensor_file"])
+        text = " ".join(sch.names).encode() + b" ".join(
+            k + b" " + v for k, v in (sch.metadata or {}).items())
         assert b"clock_offset" not in text and b"yaw" not in text
     # the truth is self-consistent: sensor-frame leg centres map back onto the field legs
     for _, p in tug.iterrows():
@@ -373,3 +384,24 @@ def test_replay_of_a_real_walk(realdata, tmp_path):
     u = (0.27 - a[:, 2]) / (k[:, 2] - a[:, 2])
     exp = a[:, :2] + u[:, None] * (k[:, :2] - a[:, :2])
     np.testing.assert_allclose(lft[["x_m", "y_m"]].to_numpy(), exp, atol=1e-9)
+
+
+# ----------------------------------------------------------------- shin speed vs real walks
+def test_simulated_shin_speed_profile_matches_real_walks(realdata):
+    """The normalised speed of the leg point at 0.27 m (speed / walking speed), measured the
+    same way (knee-ankle axis, 10 Hz Butterworth) on three real C3D walks and on simulated
+    young (TUG) and elderly (MTST) straight walks: mean swing speed, mean per-stride swing
+    peak and the 95th percentile agree within 15 %, the mean stance speed within 30 %.
+    Real figures: docs/simulator.md, "Shin speed at sensor height"."""
+    from gaitval.simulate import shin
+    real = [shin.real_walk(realdata / "c3d" / f) for f in shin.REAL_WALKS]
+    ref = {k: np.mean([r[k] for r in real]) for k in shin.MEASURES}
+    # outside reference (Perry & Burnfield 2010): swing is ~40 % of the cycle, so the foot
+    # covers one stride in 0.4 cycle: ~2.5 x the body speed on average; less at shin height
+    assert 1.5 < ref["swing_norm"] < 2.3 and 2.2 < ref["swing_peak_norm"] < 3.0
+    sim = shin.sim_groups(seeds=(1, 2))
+    for group, m in sim.items():
+        for k in ("swing_norm", "swing_peak_norm", "p95_norm"):
+            assert m[k] == pytest.approx(ref[k], rel=0.15), (group, k, m[k], ref[k])
+        assert m["stance_norm"] == pytest.approx(ref["stance_norm"], rel=0.30), group
+        assert m["p99_norm"] < 1.2 * ref["p99_norm"], group

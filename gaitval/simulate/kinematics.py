@@ -33,16 +33,37 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-#: Shank tilt (knee ahead of ankle, degrees) over the gait cycle at a nominal step length of
-#: 0.70 m; contact at phase 0, toe off at phase 0.6.  Shank-to-vertical angles after Perry &
-#: Burnfield (2010): about 20° with the ankle ahead of the knee at initial contact, near
-#: vertical in mid-stance (the "leg perpendicular to the floor" of seed 001 §2.5.1),
-#: about 45° knee-ahead at toe off, back through vertical late in swing.
-_TILT_PHASE = np.array([0.00, 0.10, 0.22, 0.32, 0.45, 0.60, 0.72, 0.85, 0.93, 1.00])
-_TILT_DEG = np.array([-18.0, -9.0, -1.5, 2.0, 12.0, 42.0, 36.0, 2.0, -17.0, -18.0])
+#: Shank tilt (knee ahead of ankle, degrees) over the gait cycle (contact at phase 0, toe off
+#: at phase 0.6), measured on the real walks ``FunctionalWalk.c3d``,
+#: ``PiG_Motion-FlatFoot-Full.c3d`` and ``opensim_walking2.c3d`` (10 strides; knee-ankle
+#: joint-centre axis, 10 Hz low-pass; ``python -m gaitval.simulate.shin``): -12.5° (ankle
+#: ahead) at contact, vertical at 11 % (seed 001 §2.5.1: "the leg is perpendicular to the
+#: floor"), a steady forward roll through stance, 51° knee-ahead just after toe off, back
+#: through vertical at 87 %.  Those walks have a step length of 1.6 shank lengths
+#: (:data:`TILT_REF_STEP_PER_SHANK`).
+_TILT_PHASE = np.array([0.00, 0.05, 0.10, 0.15, 0.25, 0.35, 0.45, 0.55, 0.65, 0.725, 0.80,
+                        0.85, 0.90, 0.95, 1.00])
+_TILT_DEG = np.array([-12.5, -7.1, -1.0, 3.0, 9.0, 14.8, 23.4, 38.8, 51.3, 44.1, 24.4, 6.6,
+                      -9.8, -16.2, -12.5])
 _TILT = CubicSpline(_TILT_PHASE, _TILT_DEG, bc_type="periodic")
+TILT_REF_STEP_PER_SHANK = 1.6
 TOE_OFF_PHASE = 0.60
-MID_STANCE_PHASE = 0.27
+MID_STANCE_PHASE = 0.115
+
+
+#: Terminal-swing deceleration of the ankle in units of chord / swing time² (the hamstrings
+#: brake the swinging leg): puts the ankle's speed peak at 60 % of swing, 1.37 × its mean,
+#: as in the real walks (peak ≈ 80–85 % of the cycle, ≈ 1.35 × the mean swing speed).
+SWING_END_ACCEL = -6.0
+
+
+def _hermite5(tau: np.ndarray, s0, s1, a1=SWING_END_ACCEL) -> np.ndarray:
+    """Quintic Hermite from 0 to 1: start slope ``s0``, end slope ``s1``, start acceleration
+    0, end acceleration ``a1`` (all per unit chord and unit swing time)."""
+    tau = np.clip(tau, 0.0, 1.0)
+    t3, t4, t5 = tau ** 3, tau ** 4, tau ** 5
+    return ((10 * t3 - 15 * t4 + 6 * t5) + s0 * (tau - 6 * t3 + 8 * t4 - 3 * t5)
+            + s1 * (-4 * t3 + 7 * t4 - 3 * t5) + a1 * 0.5 * t3 * (1 - tau) ** 2)
 
 
 @dataclass
@@ -65,6 +86,9 @@ class GaitParams:
     turn_step_factor: float = 0.6       # step length in a tight turn / straight step length
     turn_time_factor: float = 1.15      # step time in a tight turn / straight step time
     knee_half_sep_m: float = 0.08       # knee joint centre from the body midline (frontal plane)
+    roll_fwd_m: float = 0.14            # ankle advance over the forefoot from heel off to toe off
+    roll_up_m: float = 0.09             # ankle rise from heel off to toe off
+    rocker_m: float = 0.025             # ankle advance over the heel in loading response
 
 
 @dataclass
@@ -372,23 +396,45 @@ def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
     t_c = np.where(np.isfinite(tc[j]), tc[j], -1e9)
     st_dur = np.where(has_next, off_next - t_c, np.inf)
     stance_prog = np.clip((t - t_c) / np.where(np.isfinite(st_dur), st_dur, 1.0), 0, 1)
-    heel = np.where(~swing & has_next & np.isfinite(st_dur) & np.isfinite(tc[j]),
-                    _smoothstep((stance_prog - 0.7) / 0.3), 0.0)
-    # heel rise also before the first lift-off (gait initiation from standing)
-    first = ~swing & has_next & ~np.isfinite(tc[j])
-    heel = np.where(first, _smoothstep(1 - (off_next - t) / 0.25), heel)
+    # foot roll over the forefoot (heel off → toe off): the ankle advances roll_fwd_m·u³
+    # and rises roll_up_m·u² over the last 40 % of stance (u: 0 → 1), so it leaves the
+    # floor already moving forward at 3·roll_fwd_m / (0.4·stance) (real walks: ≈ 1.5 × the
+    # walking speed at toe off).  Gait initiation rolls over the last 0.3 s before lift-off.
+    initiating = ~np.isfinite(tc[j])
+    roll_T = np.where(initiating, 0.3, 0.4 * np.where(np.isfinite(st_dur), st_dur, 1.0))
+    roll_T = np.maximum(roll_T, 0.05)
+    u = np.where(has_next & ~swing, np.clip(1.0 - (off_next - t) / roll_T, 0.0, 1.0), 0.0)
+    heel = u ** 2
     hdg0 = fh[j]
     hdg1 = fh[jn]
     dh = (hdg1 - hdg0 + np.pi) % (2 * np.pi) - np.pi
-    g = _minjerk(tau)
-    heading = np.where(swing, hdg0 + dh * g, hdg0)
     fwd0 = np.column_stack([np.cos(hdg0), np.sin(hdg0)])
-    heel_off = fxy[j] + (0.03 * 1.0) * fwd0              # ankle position at toe off
-    ax = np.where(swing[:, None], heel_off + (fxy[jn] - heel_off) * g[:, None],
-                  fxy[j] + 0.03 * heel[:, None] * fwd0)
-    az = gp.ankle_height_m + 0.05 * heel
-    bump = 0.09 * np.sin(np.pi * tau) ** 1.5
-    az = np.where(swing, gp.ankle_height_m + 0.05 * (1 - _smoothstep(tau / 0.3)) + bump, az)
+    toe_off_xy = fxy[j] + gp.roll_fwd_m * fwd0             # ankle position at toe off
+    # heel rocker: the heel lands with the ankle rocker_m behind its flat-foot place and
+    # rolls forward over the first 25 % of stance, (1 - w)² → speed 2·rocker_m / T_load at
+    # contact (real walks: the ankle still moves at ≈ 0.3–0.5 × the walking speed)
+    t_load = 0.25 * np.where(np.isfinite(st_dur), st_dur, 1.0)
+    w = np.where(initiating, 1.0, np.clip((t - t_c) / np.maximum(t_load, 0.02), 0.0, 1.0))
+    fwd1 = np.column_stack([np.cos(hdg1), np.sin(hdg1)])
+    land_xy = fxy[jn] - gp.rocker_m * fwd1
+    v1 = 2.0 * gp.rocker_m / np.maximum(t_load, 0.02)
+    # swing: quintic from toe off (speed v0, the roll's end speed) to heel strike (speed
+    # v1), terminal-swing braking SWING_END_ACCEL
+    v0 = 3.0 * gp.roll_fwd_m / roll_T
+    chord = np.maximum(np.hypot(*(land_xy - toe_off_xy).T), 1e-3)
+    t_sw = np.maximum(tc[jn] - off_next, 1e-6)
+    s0 = np.clip(v0 * t_sw / chord, 0.0, 2.0)
+    s1 = np.clip(v1 * t_sw / chord, 0.0, 1.0)
+    g = _hermite5(tau, s0, s1)
+    heading = np.where(swing, hdg0 + dh * _minjerk(tau), hdg0)
+    ax = np.where(swing[:, None], toe_off_xy + (land_xy - toe_off_xy) * g[:, None],
+                  fxy[j] + (gp.roll_fwd_m * u ** 3 - gp.rocker_m * (1 - w) ** 2)[:, None] * fwd0)
+    az = gp.ankle_height_m + gp.roll_up_m * heel
+    # swing height: the toe-off rise decays over the first 70 % of swing, plus a clearance
+    # arc peaking early in swing (real walks: ankle highest at ≈ 15–25 % of swing)
+    lift = gp.roll_up_m * (1 - _smoothstep(tau / 0.7))
+    bump = 0.045 * np.sin(np.pi * np.clip(tau / 0.6, 0.0, 1.0))
+    az = np.where(swing, gp.ankle_height_m + lift + bump, az)
     # gait phase phi: stance 0..0.6, swing 0.6..1
     phi = np.where(swing, TOE_OFF_PHASE + (1 - TOE_OFF_PHASE) * tau,
                    TOE_OFF_PHASE * stance_prog)
@@ -401,7 +447,10 @@ def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
     phi = np.where(post, np.minimum(MID_STANCE_PHASE,
                                     TOE_OFF_PHASE * (t - t_c) / (gp.step_time_s * 2 * gp.stance_frac)),
                    phi)
-    amp = np.clip(gp.step_length_m / 0.70, 0.4, 1.2)
+    # shank excursion grows with the step relative to the shank, sub-linearly (real walks:
+    # 1.35 × the step gave 1.15 × the range, opensim_walking2 vs the two slower walks)
+    amp = float(np.clip(np.sqrt(gp.step_length_m / gp.shank_length_m / TILT_REF_STEP_PER_SHANK),
+                        0.5, 1.3))
     tilt_deg = _TILT(phi) * amp
     # blend the last step's approach to standing (no tilt) so the body ends upright
     tilt = np.deg2rad(tilt_deg - np.where(post | pre, _TILT(MID_STANCE_PHASE) * amp, 0.0))

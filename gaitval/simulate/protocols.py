@@ -114,7 +114,11 @@ def sample_subject(rng: np.random.Generator, group: str, sid: str, sensor_height
     gp = GaitParams(step_length_m=float(sl), step_width_m=W, step_time_s=float(st),
                     stance_frac=sf, step_cv=cv, place_sd_m=sd,
                     shank_length_m=0.246 * H - 0.0, ankle_height_m=0.039 * H,
-                    hip_height_m=0.53 * H - 0.04)
+                    hip_height_m=0.53 * H - 0.04,
+                    # the foot rolls over the forefoot before toe off: ankle joint centre
+                    # ≈ 0.085 H behind the metatarsal heads; real walks (docs/simulator.md)
+                    # show it ≈ 0.14 m further forward and ≈ 0.10 m higher at toe off
+                    roll_fwd_m=0.085 * H, roll_up_m=0.06 * H)
     return subj, gp
 
 
