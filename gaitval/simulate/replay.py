@@ -182,8 +182,12 @@ def replay_trial(out: Path, study: str, spec: dict, cfg: dict, seed: int, idx: i
             float(yaw + np.deg2rad(3.0) * rng.standard_normal()))
     # Both poles on the same side of the walk: with one on each side the pole midpoint
     # sits on the walking line and the 180-degree pole swap maps the walk onto itself,
-    # so no registration can tell the two transforms apart.
-    poles = np.array([p0 + 1.2 * d + 0.9 * left, p1 - 0.5 * d + 1.5 * left])
+    # so no registration can tell the two transforms apart.  Both stand beside the start,
+    # where the walker never passes between them and the sensor, at bearings far apart
+    # (≈ 33° and ≈ 70° left of the walking line for the default sensor offset): a pole
+    # beyond the end of the walk lines up behind the nearer one when the walk is short
+    # (opensim_walking2: 1° apart) and its sight line crosses the walker's start position.
+    poles = np.array([p0 + 1.0 * d + 1.0 * left, p0 - 0.5 * d + 1.5 * left])
     lo = np.minimum(p0, p1) - 2.5
     hi = np.maximum(p0, p1) + 2.5
     h = float(cfg.get("sensor_height_m", 0.27))
