@@ -348,7 +348,10 @@ class LegState:
 
     ``ankle``, ``knee`` (n, 3) joint centres; ``heading`` (n,) foot heading; ``stance``
     (n,) bool; ``tilt`` (n,) shank tilt (rad, knee ahead positive); ``heel_rise`` (n,)
-    in [0, 1]; ``swing_tau`` (n,) progress through swing (NaN in stance).
+    in [0, 1] (foot pitched heel-up: 1 at toe off, fading over early swing); ``roll_dx``
+    (n,) how far the ankle is ahead of its flat-foot place over the forefoot (metres; the
+    forefoot stays put on the floor while the ankle rolls over it) and ``roll_dz`` (n,)
+    how far that roll lifts it.
     """
 
     ankle: np.ndarray
@@ -357,6 +360,8 @@ class LegState:
     stance: np.ndarray
     tilt: np.ndarray
     heel_rise: np.ndarray
+    roll_dx: np.ndarray | None = None
+    roll_dz: np.ndarray | None = None
 
     def point_at_height(self, h: float) -> np.ndarray:
         """(n, 2) horizontal position of the shank axis at height ``h`` (the "leg centre")."""
@@ -435,6 +440,10 @@ def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
     lift = gp.roll_up_m * (1 - _smoothstep(tau / 0.7))
     bump = 0.045 * np.sin(np.pi * np.clip(tau / 0.6, 0.0, 1.0))
     az = np.where(swing, gp.ankle_height_m + lift + bump, az)
+    fade = 1 - _smoothstep(tau / 0.7)
+    heel = np.where(swing, fade, heel)
+    roll_dx = gp.roll_fwd_m * np.where(swing, fade, u ** 3)
+    roll_dz = gp.roll_up_m * heel
     # gait phase phi: stance 0..0.6, swing 0.6..1
     phi = np.where(swing, TOE_OFF_PHASE + (1 - TOE_OFF_PHASE) * tau,
                    TOE_OFF_PHASE * stance_prog)
@@ -466,4 +475,4 @@ def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
     knee[:, :2] += max(0.0, gp.knee_half_sep_m - gp.step_width_m / 2) * outward
     knee[:, 2] += gp.shank_length_m * np.cos(tilt)
     return LegState(ankle=ankle, knee=knee, heading=heading, stance=~swing, tilt=tilt,
-                    heel_rise=heel)
+                    heel_rise=heel, roll_dx=roll_dx, roll_dz=roll_dz)

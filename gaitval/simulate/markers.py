@@ -71,8 +71,11 @@ def pig_markers(legs, pelvis: np.ndarray, pelvis_heading: np.ndarray, subj: dict
         # which stays on the floor while the heel rises
         rise = lg.heel_rise[:, None]
         out[pre + "HEE"] = ankle - 0.065 * ffw + np.array([0, 0, -0.045]) + 0.03 * rise * up
-        toe = ankle + 0.15 * ffw
-        toe[:, 2] = np.maximum(0.025, ankle[:, 2] - 0.055 - 0.05 * lg.heel_rise)
+        # (the ankle rolls roll_dx forward and roll_dz up over the planted forefoot)
+        roll = lg.roll_dx if lg.roll_dx is not None else np.zeros(len(ankle))
+        rise_m = lg.roll_dz if lg.roll_dz is not None else 0.05 * lg.heel_rise
+        toe = ankle + (0.15 - roll)[:, None] * ffw
+        toe[:, 2] = np.maximum(0.025, ankle[:, 2] - 0.055 - rise_m)
         out[pre + "TOE"] = toe
         if medial:
             out[pre + "KNEin"] = knee - (subj["knee_width_m"] / 2 + MARKER_RADIUS_M) * lat
