@@ -136,7 +136,9 @@ def real_walk(path, h: float = SCAN_HEIGHT_M) -> dict:
     t = m.t
     pel = [lb for lb in ("SACR", "LPSI", "RPSI", "LASI", "RASI")
            if m.has(lb) and np.isfinite(m.marker(lb)).all(axis=1).any()]
-    P = np.nanmean(np.stack([m.marker(lb) for lb in pel]), axis=0)
+    stack = np.stack([m.marker(lb) for lb in pel])
+    cnt = np.isfinite(stack).sum(axis=0)
+    P = np.where(cnt > 0, np.nansum(stack, axis=0) / np.maximum(cnt, 1), np.nan)
     knees = {s: joint_centre(m, s, "knee")[0] for s in "LR"}
     ankles = {s: joint_centre(m, s, "ankle")[0] for s in "LR"}
     both = np.all(np.isfinite(np.concatenate([knees["L"], knees["R"], P], axis=1)), axis=1)
