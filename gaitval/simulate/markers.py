@@ -89,13 +89,16 @@ def pig_markers(legs, pelvis: np.ndarray, pelvis_heading: np.ndarray, subj: dict
         if cluster:
             axis = knee - ankle
             axis /= np.linalg.norm(axis, axis=1, keepdims=True)
+            # the shank's own frame (the cluster is rigid on the bone): lateral axis
+            # perpendicular to the shank axis, forward = lateral x axis direction
+            e_lat = lat - np.sum(lat * axis, axis=1, keepdims=True) * axis
+            e_lat /= np.linalg.norm(e_lat, axis=1, keepdims=True)
+            e_fwd = np.cross(e_lat, axis) * (1.0 if sgn > 0 else -1.0)
             # directions around the shank, perpendicular to its axis
             for i, (frac, ang) in enumerate(((0.35, 90.0), (0.45, 45.0), (0.55, 135.0),
                                              (0.65, 70.0)), start=1):
                 a = np.deg2rad(ang)
-                d = np.cos(a) * ffw + np.sin(a) * lat
-                d = d - np.sum(d * axis, axis=1, keepdims=True) * axis
-                d /= np.linalg.norm(d, axis=1, keepdims=True)
+                d = np.cos(a) * e_fwd + np.sin(a) * e_lat
                 r = subj["leg_width_m"] / 2 + SKIN_OFFSET_M
                 out[f"{pre}TB{i}"] = ankle + frac * (knee - ankle) + r * d
     return out
