@@ -8,12 +8,14 @@ The model is deliberately small and physical:
 2. **Timing**: contact times advance by the step time (with subject variability);
    each foot lifts off ``(1 - stance_frac) * stride`` before its next contact, so the
    stance phase is ``stance_frac`` (≈ 0.6) of the gait cycle.
-3. **Feet and shanks** (:func:`leg_kinematics`): the ankle joint centre rests at its
-   foothold during stance (rising and moving forward with the heel in terminal stance),
-   and follows a minimum-jerk path to the next foothold during swing with a clearance
-   bump.  The shank (ankle → knee joint centre) tilts in the sagittal plane of the foot
-   following a periodic curve of the gait phase, so the shank point at sensor height is
-   nearly still in mid-stance and moves several times faster than the body in swing.
+3. **Feet and shanks** (:func:`leg_kinematics`): the ankle joint centre lands just behind
+   its foothold and rolls onto it over the heel, rests there in mid stance, then rolls
+   forward and up over the forefoot before toe off; in swing it follows a quintic from
+   the toe-off point to the next heel strike with non-zero end speeds and terminal-swing
+   braking, plus a clearance arc.  The shank (ankle → knee joint centre) tilts in the
+   sagittal plane of the foot along a periodic curve of the gait phase measured on real
+   walks, so the shank point at sensor height is slowest early in stance and moves
+   ≈ 2.5 times faster than the body at its swing peak (``gaitval.simulate.shin``).
 
 References
 ----------
@@ -376,13 +378,19 @@ def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
 
     Notes
     -----
-    Stance: ankle at the foothold; heel rise after 70 % of stance lifts the ankle by up to
-    0.05 m and moves it 0.03 m forward (rotation about the forefoot).  Swing: minimum-jerk
-    horizontal path ``x(τ) = x0 + (x1 - x0)(10τ³ - 15τ⁴ + 6τ⁵)`` and a clearance bump
-    ``0.09 sin(πτ)^1.5`` m.  Shank tilt ``θ(φ)`` from the periodic spline of the gait phase
-    ``φ`` (0 contact, 0.6 toe off), scaled by step length / 0.70 m (shank excursion grows
-    with step length); before gait initiation and after the last contact the phase is
-    clamped to mid-stance (standing), plus an optional posture tilt (sit-to-stand).
+    Stance: heel rocker ``x = x_f - rocker_m (1 - w)²`` over the first 25 % of stance
+    (``w``: 0 → 1), then the ankle rests on the foothold ``x_f``; forefoot roll from 60 %
+    of stance, ``x = x_f + roll_fwd_m u³``, ``z = h_a + roll_up_m u²`` (``u``: 0 → 1 at toe
+    off).  Swing (``τ``: 0 → 1, chord ``c`` from the toe-off point to the landing point
+    ``x_f' - rocker_m``): ``x = x0 + c·g(τ)`` with the quintic Hermite
+    ``g = (10τ³ - 15τ⁴ + 6τ⁵) + s0 (τ - 6τ³ + 8τ⁴ - 3τ⁵) + s1 (-4τ³ + 7τ⁴ - 3τ⁵)
+    + a1 τ³(1 - τ)²/2``, ``s0, s1`` the toe-off and heel-strike speeds times
+    ``T_swing / c``, ``a1`` = :data:`SWING_END_ACCEL`; height ``h_a + roll_up_m (1 -
+    smoothstep(τ/0.7)) + 0.045 sin(π min(1, τ/0.6))``.  Shank tilt ``θ(φ)`` from the
+    periodic spline of the gait phase ``φ`` (0 contact, 0.6 toe off) measured on real
+    walks, scaled by ``sqrt(step / shank / 1.6)``; before gait initiation and after the
+    last contact the phase is clamped to mid-stance (standing), plus an optional posture
+    tilt (sit-to-stand).  Constants and the real-data comparison: ``docs/simulator.md``.
     """
     f = plan.foot(side)
     tc, toff, fxy, fh = f["t_contact"], f["t_off"], f["xy"], f["heading"]
