@@ -279,6 +279,26 @@ def test_sides_from_walking_direction():
     assert np.nanmean(res2.y[0]) == pytest.approx(0.1, abs=0.01)
 
 
+def test_sides_decided_by_the_first_steps_not_by_a_later_swap():
+    """Legs walk +x (walker's left = +y).  Halfway the tracks are exchanged (a false
+    association): the labels must stay right for the first half and the error must show
+    where it happened, not be moved to the start by a whole-trial vote."""
+    from gaitval.track.tracker import TrackResult, _handedness
+    n = 200
+    t = np.arange(n) * DT
+    xm = 0.8 * t                                     # midpoint walking +x at 0.8 m/s
+    yl = np.where(np.arange(n) < 60, 0.1, -0.1)      # track 0: left leg, then (swap) right
+    res = TrackResult(t=t, x=np.vstack([xm, xm]), y=np.vstack([yl, -yl]),
+                      vx=np.full((2, n), 0.8), vy=np.zeros((2, n)),
+                      observed=np.ones((2, n), bool), interpolated=np.zeros((2, n), bool),
+                      pattern=np.full((2, n), "SL", dtype=object),
+                      phase=np.zeros(n, np.int8), k_init=0)
+    # whole-trial vote: 60 steps say "track 0 is left", 140 say "right" -> would swap
+    assert _handedness(res, window_s=1e9) < 0
+    # first second of motion: track 0 is on the left of the motion -> no swap
+    assert _handedness(res) > 0
+
+
 def _turn_obs(n=100, hide=(40, 52), omega=math.pi):
     """Left leg standing at (1, 0); right leg on a 0.5 m circle around it (a turn)."""
     t = np.arange(n) * DT

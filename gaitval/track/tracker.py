@@ -11,11 +11,14 @@ the first scan with two observations between 0.7 w_l (two shanks cannot be close
 observations nearer than that are one leg seen twice) and ``init_max_pair_m`` apart (the
 closest such pair), both legs at rest (v = 0, Phase 0).  Scans before that have no track
 (NaN).  Which of the two is the *left* leg is decided after the run from the walking
-direction (``sides="walking_direction"``): the left leg is on the left of the mean motion
-of the legs' midpoint, Σ_k (v_mid × (p_L − p_R)) > 0 over the steps where the midpoint moves
-faster than 0.3 m/s; this holds on the way out and on the way back.  If the sum is
-negative the two tracks' labels are exchanged (and Phases 1↔3, 2↔4) — exact, because the
-tracker treats both legs symmetrically.  ``sides="as_initialised"`` keeps the initial
+direction (``sides="walking_direction"``): the left leg is on the left of the motion of the
+legs' midpoint, Σ_k (v_mid × (p_L − p_R)) > 0 over the **first** ``handedness_window_s``
+(1.0 s) of steps in which the midpoint moves faster than 0.3 m/s — the first steps away
+from the chair, before any occlusion could have exchanged the tracks.  (Summing over the
+whole trial would let a later swap decide the labels of the start, and every error would
+then appear at the first step.)  If the sum is negative the two tracks' labels are
+exchanged (and Phases 1↔3, 2↔4) — exact, because the tracker treats both legs
+symmetrically.  ``sides="as_initialised"`` keeps the initial
 guess (the observation with the larger bearing angle is the left leg).
 
 Time step.  Δt is the sensor's scan period: ``dt_s`` if configured, else the median
@@ -588,15 +591,20 @@ class Tracker:
         return res
 
 
-def _handedness(res: TrackResult, min_speed: float = 0.3) -> float:
-    """Σ v_mid × (p_L − p_R) over the steps where the legs' midpoint moves (module notes)."""
+def _handedness(res: TrackResult, min_speed: float = 0.3, window_s: float = 1.0) -> float:
+    """Σ v_mid × (p_L − p_R) over the first ``window_s`` of steps in which the legs'
+    midpoint moves faster than ``min_speed`` (module notes)."""
     vmx = 0.5 * (res.vx[0] + res.vx[1])
     vmy = 0.5 * (res.vy[0] + res.vy[1])
     dx = res.x[0] - res.x[1]
     dy = res.y[0] - res.y[1]
     with np.errstate(invalid="ignore"):
-        ok = np.hypot(vmx, vmy) > min_speed
-    return float(np.nansum((vmx * dy - vmy * dx)[ok]))
+        moving = np.flatnonzero(np.hypot(vmx, vmy) > min_speed)
+    if moving.size == 0:
+        return 0.0
+    t = np.asarray(res.t, dtype=float)
+    moving = moving[t[moving] <= t[moving[0]] + window_s]
+    return float(np.nansum((vmx * dy - vmy * dx)[moving]))
 
 
 def _swap_sides(res: TrackResult) -> None:
