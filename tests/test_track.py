@@ -287,15 +287,15 @@ def test_sides_decided_by_the_first_steps_not_by_a_later_swap():
     n = 200
     t = np.arange(n) * DT
     xm = 0.8 * t                                     # midpoint walking +x at 0.8 m/s
-    yl = np.where(np.arange(n) < 60, 0.1, -0.1)      # track 0: left leg, then (swap) right
+    yl = np.where(np.arange(n) < 30, 0.1, -0.1)      # track 0: left leg, then (swap) right
     res = TrackResult(t=t, x=np.vstack([xm, xm]), y=np.vstack([yl, -yl]),
                       vx=np.full((2, n), 0.8), vy=np.zeros((2, n)),
                       observed=np.ones((2, n), bool), interpolated=np.zeros((2, n), bool),
                       pattern=np.full((2, n), "SL", dtype=object),
                       phase=np.zeros(n, np.int8), k_init=0)
-    # whole-trial vote: 60 steps say "track 0 is left", 140 say "right" -> would swap
+    # whole-trial vote: 30 steps say "track 0 is left", 170 say "right" -> would swap
     assert _handedness(res, window_s=1e9) < 0
-    # first second of motion: track 0 is on the left of the motion -> no swap
+    # first swing (0.5 s = 20 steps) of motion: track 0 is on the left -> no swap
     assert _handedness(res) > 0
 
 

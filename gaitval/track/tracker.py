@@ -12,9 +12,9 @@ observations nearer than that are one leg seen twice) and ``init_max_pair_m`` ap
 closest such pair), both legs at rest (v = 0, Phase 0).  Scans before that have no track
 (NaN).  Which of the two is the *left* leg is decided after the run from the walking
 direction (``sides="walking_direction"``): the left leg is on the left of the motion of the
-legs' midpoint, Σ_k (v_mid × (p_L − p_R)) > 0 over the **first** ``handedness_window_s``
-(1.0 s) of steps in which the midpoint moves faster than 0.3 m/s — the first steps away
-from the chair, before any occlusion could have exchanged the tracks.  (Summing over the
+legs' midpoint, Σ_k (v_mid × (p_L − p_R)) > 0 over the first 0.5 s of steps in which the
+midpoint moves faster than 0.3 m/s — the first swing away from the chair (a swing lasts
+0.35–0.5 s), before a false association could have exchanged the tracks.  (Summing over the
 whole trial would let a later swap decide the labels of the start, and every error would
 then appear at the first step.)  If the sum is negative the two tracks' labels are
 exchanged (and Phases 1↔3, 2↔4) — exact, because the tracker treats both legs
@@ -591,7 +591,7 @@ class Tracker:
         return res
 
 
-def _handedness(res: TrackResult, min_speed: float = 0.3, window_s: float = 1.0) -> float:
+def _handedness(res: TrackResult, min_speed: float = 0.3, window_s: float = 0.5) -> float:
     """Σ v_mid × (p_L − p_R) over the first ``window_s`` of steps in which the legs'
     midpoint moves faster than ``min_speed`` (module notes)."""
     vmx = 0.5 * (res.vx[0] + res.vx[1])
