@@ -288,6 +288,24 @@ def _resample(t: np.ndarray, y: np.ndarray, grid: np.ndarray) -> np.ndarray:
     return np.column_stack([np.interp(grid, t, y[:, k]) for k in range(y.shape[1])])
 
 
+def _lag_grid(ref, sys, min_overlap: float):
+    """Both signals as (n, channels) arrays and, for every lag of a full correlation,
+    the overlap length ``n`` and whether it covers ``min_overlap`` of the shorter one."""
+    ref = np.asarray(ref, float)
+    sys = np.asarray(sys, float)
+    if ref.ndim == 1:
+        ref = ref[:, None]
+    if sys.ndim == 1:
+        sys = sys[:, None]
+    N, M = len(ref), len(sys)
+    lags = correlation_lags(N, M, mode="full")
+    lo = np.maximum(0, lags)
+    hi = np.minimum(N, M + lags)
+    n = np.maximum(hi - lo, 1)
+    valid = (hi - lo) >= max(min_overlap * min(N, M), 3)
+    return ref, sys, N, M, lags, lo, hi, n, valid
+
+
 def align_xcorr(ref: np.ndarray, sys: np.ndarray, fs: float, *, min_overlap: float = 0.8,
                 max_lag: int | None = None, subsample: bool = True) -> float:
     """Lag (in samples) that best aligns ``sys`` to ``ref`` by maximum cross-correlation.
@@ -301,18 +319,7 @@ def align_xcorr(ref: np.ndarray, sys: np.ndarray, fs: float, *, min_overlap: flo
     stride off where the overlapping part happens to have a larger amplitude.  With
     ``subsample`` the peak is refined by a parabola through its neighbours.
     """
-    ref = np.asarray(ref, float)
-    sys = np.asarray(sys, float)
-    if ref.ndim == 1:
-        ref = ref[:, None]
-    if sys.ndim == 1:
-        sys = sys[:, None]
-    N, M = len(ref), len(sys)
-    lags = correlation_lags(N, M, mode="full")
-    lo = np.maximum(0, lags)
-    hi = np.minimum(N, M + lags)
-    n = np.maximum(hi - lo, 1)
-    valid = (hi - lo) >= max(min_overlap * min(N, M), 3)
+    ref, sys, N, M, lags, lo, hi, n, valid = _lag_grid(ref, sys, min_overlap)
     if max_lag is not None:
         valid &= np.abs(lags) <= max_lag
     if not valid.any():
@@ -351,18 +358,7 @@ def align_ssd(ref: np.ndarray, sys: np.ndarray, *, min_overlap: float = 0.8) -> 
     what separates the true lag from one a period away in a decaying swing (a pendulum's
     envelope is exponential, so a correlation coefficient cannot tell them apart).
     """
-    ref = np.asarray(ref, float)
-    sys = np.asarray(sys, float)
-    if ref.ndim == 1:
-        ref = ref[:, None]
-    if sys.ndim == 1:
-        sys = sys[:, None]
-    N, M = len(ref), len(sys)
-    lags = correlation_lags(N, M, mode="full")
-    lo = np.maximum(0, lags)
-    hi = np.minimum(N, M + lags)
-    n = np.maximum(hi - lo, 1)
-    valid = (hi - lo) >= max(min_overlap * min(N, M), 3)
+    ref, sys, N, M, lags, lo, hi, n, valid = _lag_grid(ref, sys, min_overlap)
     if not valid.any():
         raise RegistrationError("the ultrasonic and mocap recordings do not overlap enough "
                                 "to align them")
