@@ -32,11 +32,12 @@ import copy
 
 import numpy as np
 import pandas as pd
-from scipy.signal import butter, correlate, correlation_lags, sosfiltfilt
+from scipy.signal import correlate, correlation_lags
 
 from gaitval.errors import (ConfigError, GaitvalError, MarkerError, RegistrationError,
                             TimestampError)
 from gaitval.gait.strides import autocorr_symmetry, stride_table
+from gaitval.groundtruth.filters import lowpass  # zero-phase Butterworth, seed 003 §4.1
 from gaitval.track.ukf import run_toa_ukf
 from gaitval.types import MocapTrial, UltrasonicLog
 
@@ -273,12 +274,6 @@ def reference_trajectory(mocap: MocapTrial, anchors: pd.DataFrame, cfg: dict | N
                        "z_m": filled[:, 2], "gap": bad})
     df.attrs["registration_rms_m"] = rms
     return df
-
-
-def lowpass(x: np.ndarray, fs: float, cutoff_hz: float = 10.0, order: int = 2) -> np.ndarray:
-    """Zero-phase Butterworth low-pass (seed 003 §4.1: 2nd order, 10 Hz), along axis 0."""
-    sos = butter(order, cutoff_hz, btype="low", fs=fs, output="sos")
-    return sosfiltfilt(sos, x, axis=0)
 
 
 def _resample(t: np.ndarray, y: np.ndarray, grid: np.ndarray) -> np.ndarray:
