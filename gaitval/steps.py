@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from gaitval.config import deep_merge
 from gaitval.errors import GaitvalError
 from gaitval.io.atomic import write_csv, write_parquet, write_text
 from gaitval.io.trialsheet import load_subjects, load_trial_sheet
@@ -26,13 +27,6 @@ from gaitval.io.trialsheet import load_subjects, load_trial_sheet
 #: Config sections that parameterise the analysis (copied into the per-study config).
 ANALYSIS_SECTIONS = ("registration", "groundtruth", "rollator", "tracking", "tug",
                      "ultrasonic", "evaluation")
-
-
-def _deep_merge(base: dict, over: dict) -> dict:
-    out = dict(base)
-    for k, v in (over or {}).items():
-        out[k] = _deep_merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
-    return out
 
 
 def study_config(config: dict, sheet: str | Path, out: str | Path) -> dict:
@@ -46,7 +40,7 @@ def study_config(config: dict, sheet: str | Path, out: str | Path) -> dict:
     if cal.is_file():
         with open(cal, encoding="utf-8") as fh:
             study = yaml.safe_load(fh) or {}
-        cfg = _deep_merge(cfg, {k: v for k, v in study.items() if k in ANALYSIS_SECTIONS})
+        cfg = deep_merge(cfg, {k: v for k, v in study.items() if k in ANALYSIS_SECTIONS})
         cfg["calibration_file"] = str(cal)
     write_text(out, json.dumps(cfg, indent=1, sort_keys=True) + "\n")
     return cfg

@@ -28,12 +28,12 @@ Parameters Using a Low-Cost Ultrasonic Motion Analysis System. *Sensors* 2014, 1
 """
 from __future__ import annotations
 
-import copy
 
 import numpy as np
 import pandas as pd
 from scipy.signal import correlate, correlation_lags
 
+from gaitval.config import deep_merge
 from gaitval.errors import (ConfigError, GaitvalError, MarkerError, RegistrationError,
                             TimestampError)
 from gaitval.gait.strides import autocorr_symmetry, stride_table
@@ -75,22 +75,12 @@ TRACK_COLUMNS = ["t_s", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps",
                  "used_anchors", "rejected_anchors"]
 
 
-def _merge(base: dict, over: dict) -> dict:
-    out = copy.deepcopy(base)
-    for k, v in (over or {}).items():
-        if isinstance(v, dict) and isinstance(out.get(k), dict):
-            out[k] = _merge(out[k], v)
-        else:
-            out[k] = v
-    return out
-
-
 def resolve_cfg(cfg: dict | None) -> dict:
     """The ultrasonic configuration with every default filled in."""
     cfg = dict(cfg or {})
     if isinstance(cfg.get("ultrasonic"), dict):
         cfg = cfg["ultrasonic"]
-    return _merge(DEFAULT_CFG, cfg)
+    return deep_merge(DEFAULT_CFG, cfg)
 
 
 # --------------------------------------------------------------------------- ranging

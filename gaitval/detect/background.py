@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gaitval.track.registry import Registry
+from gaitval.registry import Registry
 
 BACKGROUNDS = Registry("background")
 

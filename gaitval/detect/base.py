@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from gaitval.track.registry import Registry
+from gaitval.registry import Registry
 from gaitval.types import ScanSeries
 
 DETECTORS = Registry("detector")

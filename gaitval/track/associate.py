@@ -40,7 +40,7 @@ import math
 from typing import Callable
 
 from gaitval.gait.phases import UNLIKELY_TRANSITIONS
-from gaitval.track.registry import Registry
+from gaitval.registry import Registry
 
 ASSOCIATORS = Registry("associator")
 

@@ -12,7 +12,7 @@ Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (seed 001), eq. (5) and §3 (f
 """
 from __future__ import annotations
 
-from gaitval.track.registry import Registry
+from gaitval.registry import Registry
 
 GATES = Registry("gate")
 

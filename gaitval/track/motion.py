@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import math
 
-from gaitval.track.registry import Registry
+from gaitval.registry import Registry
 
 MOTION_MODELS = Registry("motion model")
 

@@ -35,7 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from gaitval.errors import ConfigError
-from gaitval.track.registry import Registry
+from gaitval.registry import Registry
 
 OCCLUSION_HANDLERS = Registry("occlusion handler")
 

@@ -7,7 +7,7 @@ and its parameters; :meth:`Registry.build` turns such a spec into an object.
 
 Examples
 --------
->>> from gaitval.track.registry import Registry
+>>> from gaitval.registry import Registry
 >>> SHAPES = Registry("shape")
 >>> @SHAPES.register("square")
 ... class Square:
