@@ -4,6 +4,13 @@ A method is a dict naming one part per role (each a registry spec: a name or
 ``{"name": ..., **params}``) plus tracker parameters.  Adding a method is adding an entry
 here or in the workflow config; adding a part is one class plus one registry line.
 
+The roles (:data:`ROLES`): ``detector`` (scan → leg observations), ``filter`` (one leg's
+state), ``motion`` (the input u), ``phase`` (gait-phase identification), ``gate``,
+``associator``, ``occlusion`` and ``init``; ``tracker`` holds the loop's own parameters
+(``dt_s``, ``sides``).  An optional ``kind`` chooses how the parts are run
+(:mod:`gaitval.track.kinds`): the default ``detect_then_track``, or a tracker that reads
+raw scans (e.g. a particle filter), which then needs no per-scan roles.
+
 Seed 000 (TUG), Table 3 definitions, Table 2 parameters as defaults:
 
 =========  =======================  ====================  ===========================
@@ -36,12 +43,14 @@ from typing import Any
 
 import pandas as pd
 
-from gaitval.detect import DETECTORS, split_observations
+from gaitval.detect import DETECTORS
 from gaitval.errors import ConfigError
+from gaitval.track.kinds import TRACKER_KINDS, DetectThenTrack, TrackerKind
 from gaitval.track.tracker import Tracker
 from gaitval.types import ScanSeries
 
-ROLES = ("detector", "filter", "motion", "gate", "associator", "occlusion")
+ROLES = ("detector", "filter", "motion", "phase", "gate", "associator", "occlusion", "init")
+DEFAULT_KIND = "detect_then_track"
 
 _TUG_COMMON: dict[str, Any] = {
     "paper": "seed 000 (Yorozu et al., Sensors 2015, 15, 22451)",
@@ -50,9 +59,10 @@ _TUG_COMMON: dict[str, Any] = {
     "filter": {"name": "kf", "q_accel_sd_mps2": 15.0, "r_sd_m": 0.04,
                "p0_pos_sd_m": 0.04, "p0_vel_sd_mps": 0.5},
     "motion": {"name": "gait_phase_accel", "n_ac": 40, "limit_braking": True},
+    "phase": {"name": "speed_thresholds", "v_st_th": 0.47, "v_sw_th": 0.93},
     "gate": {"name": "chi2", "g": 13.82},
-    "tracker": {"v_st_th": 0.47, "v_sw_th": 0.93, "dt_s": None, "init_max_pair_m": 0.8,
-                "sides": "walking_direction"},
+    "init": {"name": "closest_pair", "max_pair_m": 0.8, "min_leg_widths": 0.7},
+    "tracker": {"dt_s": None, "sides": "walking_direction"},
 }
 
 
@@ -96,6 +106,11 @@ def set_params(method: dict[str, Any], overrides: dict[str, Any] | None) -> dict
     return m
 
 
+def _kind_name(method: dict[str, Any]) -> str:
+    kind = method.get("kind", DEFAULT_KIND)
+    return kind if isinstance(kind, str) else kind.get("name", DEFAULT_KIND)
+
+
 def get_method(method: str | dict[str, Any]) -> dict[str, Any]:
     """The method definition for a name in :data:`METHODS` or a full dict."""
     if isinstance(method, str):
@@ -104,6 +119,8 @@ def get_method(method: str | dict[str, Any]) -> dict[str, Any]:
         except KeyError:
             raise ConfigError(f"unknown tracking method {method!r}",
                               hint=f"choose one of: {', '.join(sorted(METHODS))}") from None
+    if _kind_name(method) != DEFAULT_KIND:
+        return copy.deepcopy(method)          # a raw-scan tracker: its parameters are its own
     missing = [r for r in ROLES if r not in method]
     if missing:
         raise ConfigError(f"tracking method is missing the role(s) {', '.join(missing)}",
@@ -113,7 +130,7 @@ def get_method(method: str | dict[str, Any]) -> dict[str, Any]:
 
 def build_tracker(method: str | dict[str, Any], overrides: dict[str, Any] | None = None
                   ) -> tuple[Any, Tracker]:
-    """Build ``(detector, tracker)`` from a method name or definition.
+    """Build ``(detector, tracker)`` of a detect-then-track method.
 
     Parameters
     ----------
@@ -124,11 +141,27 @@ def build_tracker(method: str | dict[str, Any], overrides: dict[str, Any] | None
         ``{"role__param": value}`` applied on top.
     """
     m = set_params(get_method(method), overrides)
+    if _kind_name(m) != DEFAULT_KIND:
+        raise ConfigError(f"method {method if isinstance(method, str) else ''!r} is a "
+                          f"{_kind_name(m)!r} tracker, not detect-then-track",
+                          hint="use build_method() for it")
     detector = DETECTORS.build(m["detector"])
-    tracker = Tracker(filter=m["filter"], motion=m["motion"], gate=m["gate"],
-                      associator=m["associator"], occlusion=m["occlusion"],
-                      **m.get("tracker", {}))
+    tracker = Tracker(**{r: m[r] for r in ROLES if r != "detector"}, **m.get("tracker", {}))
     return detector, tracker
+
+
+def build_method(method: str | dict[str, Any], overrides: dict[str, Any] | None = None
+                 ) -> TrackerKind:
+    """The runnable tracker of a method: its ``kind`` built from its parts.
+
+    A detect-then-track method gives :class:`~gaitval.track.kinds.DetectThenTrack` of its
+    detector and :class:`Tracker`; any other kind is built from the ``kind`` spec
+    (``{"name": ..., **params}``) through :data:`~gaitval.track.kinds.TRACKER_KINDS`.
+    """
+    m = set_params(get_method(method), overrides)
+    if _kind_name(m) == DEFAULT_KIND:
+        return DetectThenTrack(*build_tracker(m))
+    return TRACKER_KINDS.build(m["kind"])
 
 
 def track_trial(scans: ScanSeries, method: str | dict[str, Any], leg_width_m: float,
@@ -156,7 +189,4 @@ def track_trial(scans: ScanSeries, method: str | dict[str, Any], leg_width_m: fl
         NaN before the track is initialised.
     """
     cfg = cfg or {}
-    detector, tracker = build_tracker(method, cfg.get("overrides"))
-    obs = detector.detect(scans, leg_width_m)
-    xy, pats = split_observations(obs, scans.n_scans)
-    return tracker.run(scans.t, xy, pats, leg_width_m).to_frame()
+    return build_method(method, cfg.get("overrides")).track(scans, leg_width_m).to_frame()

@@ -7,12 +7,11 @@ import pytest
 from gaitval.detect import DETECTORS
 from gaitval.errors import ConfigError
 from gaitval.methods import METHODS, ROLES, build_tracker, get_method, set_params, track_trial
-from gaitval.track import ASSOCIATORS, FILTERS, GATES, MOTION_MODELS, OCCLUSION_HANDLERS
+from gaitval.track import ROLE_REGISTRIES
 from gaitval.track.tracker import TRACK_COLUMNS
 from tug_synth import tug_scans
 
-REGISTRIES = {"detector": DETECTORS, "filter": FILTERS, "motion": MOTION_MODELS,
-              "gate": GATES, "associator": ASSOCIATORS, "occlusion": OCCLUSION_HANDLERS}
+REGISTRIES = {"detector": DETECTORS, **ROLE_REGISTRIES}
 
 
 @pytest.fixture(scope="module")
@@ -27,7 +26,7 @@ def test_table3_definitions_and_table2_defaults():
     assert m3["associator"]["name"] == "gait_phase" and m3["occlusion"]["name"] == "catmull_rom"
     for m in (m1, m2, m3):                                  # seed 000 Table 2
         assert m["filter"]["q_accel_sd_mps2"] == 15.0 and m["filter"]["r_sd_m"] == 0.04
-        assert m["tracker"]["v_st_th"] == 0.47 and m["tracker"]["v_sw_th"] == 0.93
+        assert m["phase"]["v_st_th"] == 0.47 and m["phase"]["v_sw_th"] == 0.93
         assert m["gate"]["g"] == 13.82 and m["motion"]["n_ac"] == 40
 
 
@@ -39,17 +38,16 @@ def test_every_method_part_is_registered(role):
         assert name in REGISTRIES[role]
 
 
-@pytest.mark.parametrize("role, name", [(r, n) for r, reg in REGISTRIES.items()
-                                        for n in reg.names()])
-def test_every_registered_part_builds_with_defaults(role, name):
-    part = REGISTRIES[role].build(name)
-    assert part.registry_name == name
+def test_registries_cover_every_role():
+    """A method names exactly the roles the tracker is built from."""
+    assert set(REGISTRIES) == set(ROLES)
 
 
 def test_nested_overrides_by_path():
     det, tr = build_tracker("tug_m3", {"occlusion__n_bo": 4, "gate__g": 9.21,
-                                       "tracker__v_st_th": 0.3})
-    assert tr.occlusion.n_bo == 4 and tr.gate.g == 9.21 and tr.v_st_th == 0.3
+                                       "phase__v_st_th": 0.3, "tracker__dt_s": 0.05})
+    assert tr.occlusion.n_bo == 4 and tr.gate.g == 9.21 and tr.phase.v_st_th == 0.3
+    assert tr.dt_s == 0.05
     assert METHODS["tug_m3"]["occlusion"]["n_bo"] == "match"       # defaults untouched
     with pytest.raises(ConfigError, match="role"):
         set_params(METHODS["tug_m1"], {"nonsense": 1})

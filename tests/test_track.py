@@ -42,9 +42,10 @@ def test_prediction_by_hand():
 
 @pytest.mark.parametrize("name", FILTERS.names())
 def test_filter_contract_matches_the_matrix_form(name):
-    """Every filter gives the 4×4 textbook numbers on the same random sequence."""
+    """Every filter gives the 4×4 textbook numbers (seed000 eq. (7)–(8), (11)–(16)) with its
+    own noise matrices on the same random sequence."""
     F = FILTERS.build(name)
-    ref = FILTERS.build("kf_matrix")
+    ref = FILTERS.build({"name": "kf_matrix", "noise": F.noise()})
     rng = np.random.default_rng(1)
     s, r = F.init(0.3, -0.2, 0.1, 0.0), ref.init(0.3, -0.2, 0.1, 0.0)
     for _ in range(30):
@@ -228,7 +229,8 @@ def test_tracker_gnn_follows_a_misdetection_gait_phase_does_not():
         pats.append(["SL"] * len(obs))
     res = {}
     for assoc in ("gnn", "gait_phase"):
-        tr = Tracker(associator=assoc, sides="as_initialised", dt_s=DT, init_max_pair_m=1.2)
+        tr = Tracker(associator=assoc, sides="as_initialised", dt_s=DT,
+                     init={"name": "closest_pair", "max_pair_m": 1.2})
         res[assoc] = tr.run(t, xy, pats, 0.1)
     k = 39
     err = {a: math.hypot(r.x[0, k] - 2.0, r.y[0, k] - 0.1) for a, r in res.items()}
@@ -283,7 +285,7 @@ def test_sides_decided_by_the_first_steps_not_by_a_later_swap():
     """Legs walk +x (walker's left = +y).  Halfway the tracks are exchanged (a false
     association): the labels must stay right for the first half and the error must show
     where it happened, not be moved to the start by a whole-trial vote."""
-    from gaitval.track.tracker import TrackResult, _handedness
+    from gaitval.track.leg import TrackResult, handedness
     n = 200
     t = np.arange(n) * DT
     xm = 0.8 * t                                     # midpoint walking +x at 0.8 m/s
@@ -294,9 +296,9 @@ def test_sides_decided_by_the_first_steps_not_by_a_later_swap():
                       pattern=np.full((2, n), "SL", dtype=object),
                       phase=np.zeros(n, np.int8), k_init=0)
     # whole-trial vote: 30 steps say "track 0 is left", 170 say "right" -> would swap
-    assert _handedness(res, window_s=1e9) < 0
+    assert handedness(res, window_s=1e9) < 0
     # first swing (0.5 s = 20 steps) of motion: track 0 is on the left -> no swap
-    assert _handedness(res) > 0
+    assert handedness(res) > 0
 
 
 def _turn_obs(n=100, hide=(40, 52), omega=math.pi):
@@ -332,9 +334,9 @@ def test_catmull_rom_refilter_improves_an_occlusion_during_a_turn():
 
 
 @pytest.mark.parametrize("gate", ["chi2", {"name": "fixed_radius", "radius_leg_widths": 3.0}])
-def test_tracker_kf_fast_path_equals_the_generic_path(gate):
-    """The tracker evaluates the ``kf`` filter (and the χ² gate) inline for speed; the
-    generic path (any other filter, e.g. the 4×4 matrix form) must track identically."""
+def test_any_filter_obeying_the_contract_tracks_identically(gate):
+    """The tracker only calls the filter's role methods: the per-axis ``kf`` and the 4×4
+    textbook form must give the same track through the whole loop, re-filtering included."""
     from gaitval.detect import split_observations
     from gaitval.methods import build_tracker
     from tug_synth import tug_scans
@@ -389,10 +391,18 @@ def test_acceleration_input_eq19_20_and_braking_limit():
 
 @pytest.mark.parametrize("name", GATES.names())
 def test_gate_contract(name):
+    from gaitval.track.gate import GateContext
     g = GATES.build(name)
-    ctx = {"leg_width_m": 0.1, "dt": DT, "speed": 0.0, "swing": False, "n_unobserved": 0}
+    ctx = GateContext(leg_width_m=0.1, dt=DT, speed=0.0, swing=False, n_unobserved=0)
     assert g.admits(0.0, 0.0, ctx)
     assert not g.admits(1e6, 10.0, ctx)
+    # candidates(): the same decision for every observation of a scan, 1-based, with λ²
+    F = FILTERS.build("kf")
+    prior = F.predict(F.init(0.0, 0.0), DT, 0.0, 0.0)
+    obs = [(0.0, 0.0), (10.0, 0.0), (0.001, 0.0)]
+    got = g.candidates(F, prior, obs, ctx)
+    assert [j for j, _ in got] == [1, 3]
+    assert got[1][1] == pytest.approx(F.mahalanobis2(prior, 0.001, 0.0))
 
 
 # -- regression snapshot ---------------------------------------------------------------------

@@ -41,8 +41,42 @@ def empty_observations() -> pd.DataFrame:
 class Detector:
     """Role base: ``detect(scans, leg_width_m) -> observation table`` (module docstring)."""
 
+    windowed = False
+
     def detect(self, scans: ScanSeries, leg_width_m: float) -> pd.DataFrame:
         raise NotImplementedError
+
+
+class WindowedDetector(Detector):
+    """Role base of a detector that looks only where the tracker predicts the legs.
+
+    Seed 002 §II places a rectangular observation window from the predicted legs (its
+    size predefined at the start, then from their uncertainty) before grouping the points.
+    The tracker calls ``observe`` scan by scan instead of ``detect`` once per trial.
+
+    ``observe(scans, k, predicted, leg_width_m) -> (xy, patterns)``: ``predicted`` is None
+    (no track yet: look everywhere) or one ``((x, y), S)`` per leg, the predicted position
+    and its 2×2 innovation covariance (sensor frame); ``xy`` is a ``(J, 2)`` array of
+    observed leg centres and ``patterns`` a list of J labels.
+    """
+
+    windowed = True
+
+    def observe(self, scans: ScanSeries, k: int, predicted, leg_width_m: float):
+        raise NotImplementedError
+
+    def detect(self, scans: ScanSeries, leg_width_m: float) -> pd.DataFrame:
+        """All scans without a prediction (the observation table of the module notes)."""
+        rows = []
+        for k in range(scans.n_scans):
+            xy, pats = self.observe(scans, k, None, leg_width_m)
+            for j, ((x, y), p) in enumerate(zip(np.asarray(xy).reshape(-1, 2), pats)):
+                rows.append((k, float(scans.t[k]), j, float(x), float(y), p))
+        if not rows:
+            return empty_observations()
+        df = pd.DataFrame(rows, columns=["k", "t_sensor_s", "j", "x_m", "y_m", "pattern"])
+        df["width_m"], df["i_first"], df["i_last"] = np.nan, -1, -1
+        return df[list(OBS_COLUMNS)]
 
 
 def split_observations(obs: pd.DataFrame, n_scans: int

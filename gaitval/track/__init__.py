@@ -1,11 +1,21 @@
-"""Leg tracking: one subpackage module per role, and the :class:`Tracker` that wires them.
+"""Leg tracking: one module per role, and the :class:`Tracker` that wires them.
 
 Roles and their registries: ``FILTERS`` (kalman), ``MOTION_MODELS`` (motion),
-``GATES`` (gate), ``ASSOCIATORS`` (associate), ``OCCLUSION_HANDLERS`` (occlusion).
+``PHASE_MODELS`` (phase), ``GATES`` (gate), ``ASSOCIATORS`` (associate),
+``OCCLUSION_HANDLERS`` (occlusion), ``INITIALISERS`` (init), and ``TRACKER_KINDS`` (kinds:
+detect-then-track, or a tracker that reads raw scans such as a particle filter).
 """
 from gaitval.track.associate import ASSOCIATORS  # noqa: F401
 from gaitval.track.gate import GATES  # noqa: F401
+from gaitval.track.init import INITIALISERS  # noqa: F401
 from gaitval.track.kalman import FILTERS  # noqa: F401
+from gaitval.track.kinds import TRACKER_KINDS  # noqa: F401
 from gaitval.track.motion import MOTION_MODELS  # noqa: F401
 from gaitval.track.occlusion import OCCLUSION_HANDLERS  # noqa: F401
+from gaitval.track.phase import PHASE_MODELS  # noqa: F401
 from gaitval.track.tracker import TRACK_COLUMNS, Tracker, TrackResult  # noqa: F401
+
+#: every role registry, by the role's key in a method entry
+ROLE_REGISTRIES = {"filter": FILTERS, "motion": MOTION_MODELS, "phase": PHASE_MODELS,
+                   "gate": GATES, "associator": ASSOCIATORS, "occlusion": OCCLUSION_HANDLERS,
+                   "init": INITIALISERS}

@@ -2,8 +2,11 @@
 
 Role ``associator``: ``select(cand_l, cand_r, prev_phase, phase_of) -> (a, b)``.
 
-``cand_l`` / ``cand_r`` list the gated observations of each leg as ``(j, λ)`` with
-j = 1..J (1-based, as in the paper) and λ the Mahalanobis distance of eq. (11);
+``cand_l`` / ``cand_r`` list the gated observations of each leg as ``(j, λ²)`` with
+j = 1..J (1-based, as in the paper) and λ² the squared Mahalanobis distance of seed000
+eq. (11), as the gate role returns them; the associator's ``cost`` turns λ² into its
+distance d: ``"mahalanobis"`` d = λ (seed000 eq. (9)–(10)) or ``"mahalanobis2"`` d = λ²
+(seed001 eq. (6)–(8), "squared, no root");
 ``phase_of(a, b)`` returns the gait phase the legs would be in after correcting the left
 leg with observation a and the right with b (0 = no observation, a false alarm).
 The result (a, b) uses the same numbering; a = b only when both are 0.
@@ -39,6 +42,7 @@ from __future__ import annotations
 import math
 from typing import Callable
 
+from gaitval.errors import ConfigError
 from gaitval.gait.phases import UNLIKELY_TRANSITIONS
 from gaitval.registry import Registry
 
@@ -48,8 +52,32 @@ D_MAX_DEFAULT = math.sqrt(13.82)
 _NO_PHASES: frozenset = frozenset()
 
 
+_COSTS = ("mahalanobis", "mahalanobis2")
+
+
 class Associator:
-    """Role base."""
+    """Role base.
+
+    Parameters
+    ----------
+    d_max : float
+        Cost of leaving a leg without an observation (eq. (9)–(10)).
+    cost : {"mahalanobis", "mahalanobis2"}
+        d = λ (seed 000) or d = λ² (seed 001).
+    """
+
+    def __init__(self, d_max: float = D_MAX_DEFAULT, cost: str = "mahalanobis"):
+        if cost not in _COSTS:
+            raise ConfigError(f"unknown association cost {cost!r}",
+                              hint=f"choose one of: {', '.join(_COSTS)}")
+        self.d_max = d_max
+        self.cost = cost
+
+    def distances(self, cand: list[tuple[int, float]]) -> list[tuple[int, float]]:
+        """``(j, d)`` from the gate's ``(j, λ²)``."""
+        if self.cost == "mahalanobis":
+            return [(j, math.sqrt(lam2)) for j, lam2 in cand]
+        return cand
 
     def select(self, cand_l: list[tuple[int, float]], cand_r: list[tuple[int, float]],
                prev_phase: int, phase_of: Callable[[int, int], int]) -> tuple[int, int]:
@@ -65,7 +93,7 @@ def ranked_associations(cand_l, cand_r, d_max: float) -> list[tuple[float, int, 
         for b, db in opts_r:
             if a != 0 and a == b:
                 continue
-            out.append((da + db, a, b))                 # eq. (9)
+            out.append((da + db, a, b))                 # seed000 eq. (9)
     out.sort(key=lambda c: c[0])                        # stable: ties keep (a, b) order
     return out
 
@@ -89,12 +117,10 @@ def _GNN_FAST(d_max, cand_l, cand_r) -> tuple[int, int]:
 
 @ASSOCIATORS.register("gnn")
 class GNNAssociator(Associator):
-    """Global nearest neighbour: least total cost (seed 000 Method 1)."""
-
-    def __init__(self, d_max: float = D_MAX_DEFAULT):
-        self.d_max = d_max
+    """Global nearest neighbour: least total cost (seed 000 Method 1, seed 001)."""
 
     def select(self, cand_l, cand_r, prev_phase, phase_of):
+        cand_l, cand_r = self.distances(cand_l), self.distances(cand_r)
         a, b = _GNN_FAST(self.d_max, cand_l, cand_r)
         if a >= 0:
             return a, b
@@ -106,10 +132,8 @@ class GNNAssociator(Associator):
 class GaitPhaseAssociator(Associator):
     """Least-cost association with a likely gait-phase change (seed 000 §5.2)."""
 
-    def __init__(self, d_max: float = D_MAX_DEFAULT):
-        self.d_max = d_max
-
     def select(self, cand_l, cand_r, prev_phase, phase_of):
+        cand_l, cand_r = self.distances(cand_l), self.distances(cand_r)
         unlikely = UNLIKELY_TRANSITIONS.get(prev_phase, _NO_PHASES)
         a, b = _GNN_FAST(self.d_max, cand_l, cand_r)
         if a >= 0 and phase_of(a, b) not in unlikely:

@@ -1,20 +1,40 @@
 """Gates (validation regions): which observations may be associated with a leg.
 
-Role ``gate``: ``admits(lam2, dist, ctx) -> bool`` for one observation and one leg, where
-``lam2`` is the squared Mahalanobis distance λ² of seed 000 eq. (11), ``dist`` the Euclidean
-distance to the predicted position, and ``ctx`` a dict with at least ``leg_width_m`` and
-``dt`` (and, for richer gates, ``speed``, ``swing``, ``n_unobserved``).
+Role ``gate``: ``candidates(filter, prior, obs, ctx) -> [(j, λ²), …]`` lists the
+observations of one scan inside one leg's gate, j = 1..J (1-based, as in the papers), with
+λ² the squared Mahalanobis distance of seed000 eq. (11) (the associator turns it into its
+cost).  The base class implements it from ``admits(lam2, dist, ctx)``, the test for one
+observation, where ``dist`` is the Euclidean distance to the predicted position.
+
+``ctx`` (:class:`GateContext`) is only built for gates with ``needs_context = True``: the
+leg width w_l, Δt, the leg's speed ‖v_{k−1}‖, whether it was swinging at k−1 and H, the
+number of consecutive scans it has been unobserved (UO) up to k−1.
 
 References
 ----------
 Yorozu, A.; Moriguchi, T.; Takahashi, M. Sensors 2015, 15, 22451–22472 (seed 000), eq. (13).
-Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (seed 001), eq. (5) and §3 (fixed radii).
+Yorozu, A.; Moriguchi, T.; Takahashi, M. Gait Measurement System for the Multi-Target
+Stepping Task Using a Laser Range Sensor. Sensors 2015, 15, 11151–11168 (seed 001), eq. (5),
+Table 1 and §3 (fixed radii).
 """
 from __future__ import annotations
+
+import math
+from typing import NamedTuple
 
 from gaitval.registry import Registry
 
 GATES = Registry("gate")
+
+
+class GateContext(NamedTuple):
+    """What a context-dependent gate knows about one leg at scan k (see module notes)."""
+
+    leg_width_m: float
+    dt: float
+    speed: float          # ‖v_{k−1}‖ of the leg (a posteriori at k−1), m/s
+    swing: bool           # the leg's gait phase at k−1 is swing
+    n_unobserved: int     # H: consecutive UO scans up to k−1
 
 
 class Gate:
@@ -22,13 +42,22 @@ class Gate:
 
     needs_context = True
 
-    def admits(self, lam2: float, dist: float, ctx: dict) -> bool:
+    def admits(self, lam2: float, dist: float, ctx: GateContext | None) -> bool:
         raise NotImplementedError
+
+    def candidates(self, filter, prior, obs, ctx: GateContext | None
+                   ) -> list[tuple[int, float]]:
+        """``(j, λ²)`` of the gated observations (j = 1..J) of one leg."""
+        px, py = filter.pos(prior)
+        admits = self.admits
+        return [(j, lam2) for j, (lam2, (zx, zy)) in
+                enumerate(zip(filter.lam2_all(prior, obs), obs), 1)
+                if admits(lam2, math.hypot(zx - px, zy - py), ctx)]
 
 
 @GATES.register("chi2")
 class ChiSquareGate(Gate):
-    """Mahalanobis gate λ² < G, eq. (13).
+    """Mahalanobis gate λ² < G, seed000 eq. (13).
 
     Parameters
     ----------
@@ -42,18 +71,76 @@ class ChiSquareGate(Gate):
         self.g = g
 
     def admits(self, lam2, dist, ctx):
-        return lam2 < self.g                        # eq. (13)
+        return lam2 < self.g                        # seed000 eq. (13)
+
+    def candidates(self, filter, prior, obs, ctx):
+        g = self.g
+        return [(j, lam2) for j, lam2 in enumerate(filter.lam2_all(prior, obs), 1)
+                if lam2 < g]                        # seed000 eq. (13)
 
 
 @GATES.register("fixed_radius")
 class FixedRadiusGate(Gate):
-    """Circular gate ‖y − ŷ‖ < r_val with r_val = ``radius_leg_widths`` · w_l (seed 001 eq. 5).
+    """Circular gate ‖y − ŷ‖ < r_val, r_val = ``radius_leg_widths`` · w_l (seed001 eq. (5)).
 
-    Seed 001 uses 1.5 w_l (large) and 1.0 w_l (small) for its comparison methods.
+    Seed 001 uses 1.5 w_l (Methods 1 and 2) and 1.0 w_l (Method 3) for its comparisons.
     """
 
     def __init__(self, radius_leg_widths: float = 1.5):
         self.radius_leg_widths = radius_leg_widths
 
+    def radius(self, ctx: GateContext) -> float:
+        return self.radius_leg_widths * ctx.leg_width_m
+
     def admits(self, lam2, dist, ctx):
-        return dist < self.radius_leg_widths * ctx["leg_width_m"]
+        return dist < self.radius(ctx)              # seed001 eq. (5)
+
+
+@GATES.register("variable_region")
+class VariableValidationRegion(Gate):
+    """Seed 001's variable validation region, r_val by gait phase and observability.
+
+    Seed001 Table 1, with the leg's phase at k−1, H consecutive unobserved scans up to
+    k−1, and Δt the scan period:
+
+    ==========  ====================  ====================================
+    phase       observable (H = 0)    unobservable (H ≥ 1)
+    ==========  ====================  ====================================
+    stance      ¾ w_l + Δt ‖v_{k−1}‖   ¾ w_l + Δt H v_st
+    swing       w_l + Δt ‖v_{k−1}‖     w_l + Δt ‖v_{k−1}‖ + Δt H v_sw
+    ==========  ====================  ====================================
+
+    The gate admits ‖y − ŷ‖ < r_val (seed001 eq. (5)).
+
+    Parameters
+    ----------
+    v_sw, v_st : float
+        1.1 and 0.55 m/s: "the assumed speed of the leg in the swing and stance phases
+        while it is hidden" (seed 001, the paragraph introducing Table 1).
+    stance_leg_widths, swing_leg_widths : float
+        The constant terms, ¾ and 1 leg widths.
+    """
+
+    def __init__(self, v_sw: float = 1.1, v_st: float = 0.55,
+                 stance_leg_widths: float = 0.75, swing_leg_widths: float = 1.0):
+        self.v_sw = v_sw
+        self.v_st = v_st
+        self.stance_leg_widths = stance_leg_widths
+        self.swing_leg_widths = swing_leg_widths
+
+    def cell(self, ctx: GateContext) -> str:
+        """The Table 1 cell in use: ``stance|swing`` + ``_observable|_unobservable``."""
+        return (("swing" if ctx.swing else "stance")
+                + ("_unobservable" if ctx.n_unobserved > 0 else "_observable"))
+
+    def radius(self, ctx: GateContext) -> float:
+        w, dt, h = ctx.leg_width_m, ctx.dt, ctx.n_unobserved
+        if ctx.swing:
+            r = self.swing_leg_widths * w + dt * ctx.speed         # seed001 Table 1, swing
+            return r + dt * h * self.v_sw if h > 0 else r
+        if h > 0:
+            return self.stance_leg_widths * w + dt * h * self.v_st  # seed001 Table 1, stance
+        return self.stance_leg_widths * w + dt * ctx.speed
+
+    def admits(self, lam2, dist, ctx):
+        return dist < self.radius(ctx)              # seed001 eq. (5)

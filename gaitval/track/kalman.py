@@ -1,6 +1,6 @@
 """Kalman filters for one leg: state [x y ẋ ẏ] with an acceleration input (seed 000 §3.1, §5).
 
-Two interchangeable implementations of the role ``filter``:
+Three interchangeable implementations of the role ``filter``:
 
 ``kf`` (:class:`AxisKalmanFilter`)
     The filter of seed 000 written per axis.  With Q = diag(q, q), R = diag(r, r) and an
@@ -8,9 +8,14 @@ Two interchangeable implementations of the role ``filter``:
     covariance is block diagonal with two *identical* 2×2 blocks (position, velocity of one
     axis), so the whole filter is exact with three covariance numbers and scalar gains.
     This is the one the methods use: it is what makes a pure-Python tracker loop fast.
+``kf_aniso`` (:class:`AnisotropicKalmanFilter`)
+    The constant-velocity filter of seed 002 §II: a separate acceleration noise per axis
+    (σ_ax = 1.63, σ_ay = 5.24 m/s²) and a separate measurement noise per axis (0.059 m in
+    x, 0.02 m in y).  The axes stay uncoupled, so it is two 2×2 blocks, no longer equal.
 ``kf_matrix`` (:class:`MatrixKalmanFilter`)
-    The textbook 4×4 matrix form of the same equations, kept as the readable reference;
-    the contract tests check that both give the same numbers.
+    The textbook 4×4 matrix form of the same equations (either noise model), kept as the
+    readable reference; the contract tests check every filter against it with the same
+    noise matrices (:meth:`LegFilter.noise`).
 
 A state is an opaque value owned by the filter (a tuple for ``kf``, ``(x, P)`` arrays for
 ``kf_matrix``); the tracker only calls the methods below.
@@ -74,6 +79,18 @@ class LegFilter:
     def mahalanobis2(self, s, zx: float, zy: float) -> float:
         """λ² of eq. (11) for a predicted state ``s``."""
         raise NotImplementedError
+
+    def lam2_all(self, s, obs) -> list[float]:
+        """λ² of eq. (11) of every observation ``(zx, zy)`` in ``obs`` (one call per leg
+        and scan; filters override it with a loop that hoists S out)."""
+        m2 = self.mahalanobis2
+        return [m2(s, zx, zy) for zx, zy in obs]
+
+    def noise(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(Q_a, R, P0)``: acceleration-noise covariance (2×2, the Q of B Q Bᵀ), the
+        measurement covariance (2×2) and the initial covariance (4×4) this filter uses."""
+        return (np.eye(2) * self.q_accel_sd_mps2 ** 2, np.eye(2) * self.r_sd_m ** 2,
+                np.diag([self.p0_pos_sd_m ** 2] * 2 + [self.p0_vel_sd_mps ** 2] * 2))
 
     def innovation_cov(self, s) -> np.ndarray:
         """S of eq. (12) as a 2×2 array."""
@@ -141,7 +158,17 @@ class AxisKalmanFilter(LegFilter):
     def mahalanobis2(self, s, zx, zy):
         ex = zx - s[0]
         ey = zy - s[1]
-        return (ex * ex + ey * ey) / (s[4] + self.r_sd_m ** 2)   # eq. (11)
+        return (ex * ex + ey * ey) / (s[4] + self.r_sd_m ** 2)   # seed000 eq. (11)
+
+    def lam2_all(self, s, obs):
+        px, py = s[0], s[1]
+        sv = s[4] + self.r_sd_m ** 2                 # seed000 eq. (12), per axis
+        out = []
+        for zx, zy in obs:
+            ex = zx - px
+            ey = zy - py
+            out.append((ex * ex + ey * ey) / sv)     # seed000 eq. (11)
+        return out
 
     def innovation_cov(self, s):
         v = s[4] + self.r_sd_m ** 2
@@ -160,11 +187,111 @@ class AxisKalmanFilter(LegFilter):
         return (float(x), float(y), float(vx), float(vy), s[4], s[5], s[6])
 
 
+@FILTERS.register("kf_aniso")
+class AnisotropicKalmanFilter(LegFilter):
+    """Constant-velocity Kalman filter with per-axis noise (seed 002 §II).
+
+    Parameters
+    ----------
+    q_accel_sd_mps2 : (float, float)
+        σ_ax, σ_ay of the acceleration disturbance; seed 002: (1.63, 5.24) m/s².
+    r_sd_m : (float, float)
+        Measurement noise standard deviations in x and y; seed 002 gives 0.059 m (x) and
+        0.02 m (y), read as standard deviations (the paper does not say; gaitval's reading).
+    p0_pos_sd_m, p0_vel_sd_mps : float
+        Initial uncertainty (not given in the paper).
+
+    Notes
+    -----
+    State tuple ``(x, y, vx, vy, ax, bx, cx, ay, by, cy)``: ``[[a, b], [b, c]]`` is the
+    (position, velocity) covariance of each axis.  With Q = B diag(σ_ax², σ_ay²) Bᵀ and
+    R = diag(r_x², r_y²) the two axes never couple, so the filter is exact per axis.
+    """
+
+    def __init__(self, q_accel_sd_mps2=(1.63, 5.24), r_sd_m=(0.059, 0.02),
+                 p0_pos_sd_m: float = 0.05, p0_vel_sd_mps: float = 0.5):
+        qx, qy = (float(v) for v in q_accel_sd_mps2)
+        rx, ry = (float(v) for v in r_sd_m)
+        super().__init__(q_accel_sd_mps2=(qx, qy), r_sd_m=(rx, ry),
+                         p0_pos_sd_m=p0_pos_sd_m, p0_vel_sd_mps=p0_vel_sd_mps)
+        self._qx2, self._qy2 = qx * qx, qy * qy
+        self._rx2, self._ry2 = rx * rx, ry * ry
+
+    def init(self, x, y, vx=0.0, vy=0.0):
+        a, c = self.p0_pos_sd_m ** 2, self.p0_vel_sd_mps ** 2
+        return (float(x), float(y), float(vx), float(vy), a, 0.0, c, a, 0.0, c)
+
+    def predict(self, s, dt, ux, uy):
+        x, y, vx, vy, ax, bx, cx, ay, by, cy = s
+        h = 0.5 * dt * dt
+        qx, qy = self._qx2, self._qy2
+        # seed000 eq. (7): x = A x + B u;  eq. (8) per axis with that axis' σ_a² (seed 002 §II)
+        return (x + dt * vx + h * ux, y + dt * vy + h * uy, vx + dt * ux, vy + dt * uy,
+                ax + dt * (2.0 * bx + dt * cx) + qx * h * h, bx + dt * cx + qx * h * dt,
+                cx + qx * dt * dt,
+                ay + dt * (2.0 * by + dt * cy) + qy * h * h, by + dt * cy + qy * h * dt,
+                cy + qy * dt * dt)
+
+    def correct(self, s, zx, zy):
+        x, y, vx, vy, ax, bx, cx, ay, by, cy = s
+        sx = ax + self._rx2                  # S = C P Cᵀ + R, per axis
+        sy = ay + self._ry2
+        kx0, kx1 = ax / sx, bx / sx          # K = P Cᵀ S⁻¹
+        ky0, ky1 = ay / sy, by / sy
+        ex = zx - x
+        ey = zy - y
+        return (x + kx0 * ex, y + ky0 * ey, vx + kx1 * ex, vy + ky1 * ey,
+                ax - kx0 * ax, bx - kx0 * bx, cx - kx1 * bx,          # P = (I − K C) P
+                ay - ky0 * ay, by - ky0 * by, cy - ky1 * by)
+
+    def mahalanobis2(self, s, zx, zy):
+        ex = zx - s[0]
+        ey = zy - s[1]
+        return ex * ex / (s[4] + self._rx2) + ey * ey / (s[7] + self._ry2)
+
+    def lam2_all(self, s, obs):
+        px, py = s[0], s[1]
+        sx, sy = s[4] + self._rx2, s[7] + self._ry2
+        return [(zx - px) ** 2 / sx + (zy - py) ** 2 / sy for zx, zy in obs]
+
+    def innovation_cov(self, s):
+        return np.array([[s[4] + self._rx2, 0.0], [0.0, s[7] + self._ry2]])
+
+    def noise(self):
+        return (np.diag([self._qx2, self._qy2]), np.diag([self._rx2, self._ry2]),
+                np.diag([self.p0_pos_sd_m ** 2] * 2 + [self.p0_vel_sd_mps ** 2] * 2))
+
+    def pos(self, s):
+        return s[0], s[1]
+
+    def vel(self, s):
+        return s[2], s[3]
+
+    def posvel(self, s):
+        return s[:4]
+
+    def with_state(self, s, x, y, vx, vy):
+        return (float(x), float(y), float(vx), float(vy)) + tuple(s[4:])
+
+
 @FILTERS.register("kf_matrix")
 class MatrixKalmanFilter(LegFilter):
-    """The same filter in full 4×4 matrix form (reference implementation)."""
+    """The textbook 4×4 matrix form (reference implementation).
+
+    ``noise=(Q_a, R, P0)`` (as returned by :meth:`LegFilter.noise`) replaces the isotropic
+    noise built from the scalar parameters, so any filter can be checked against it.
+    """
 
     C = np.array([[1.0, 0, 0, 0], [0, 1.0, 0, 0]])
+
+    def __init__(self, q_accel_sd_mps2: float = 15.0, r_sd_m: float = 0.04,
+                 p0_pos_sd_m: float = 0.04, p0_vel_sd_mps: float = 0.5, noise=None):
+        super().__init__(q_accel_sd_mps2, r_sd_m, p0_pos_sd_m, p0_vel_sd_mps)
+        self._noise = (tuple(np.asarray(m, dtype=float) for m in noise) if noise is not None
+                       else LegFilter.noise(self))
+
+    def noise(self):
+        return self._noise
 
     @staticmethod
     def _ab(dt):
@@ -173,20 +300,18 @@ class MatrixKalmanFilter(LegFilter):
         return A, B
 
     def init(self, x, y, vx=0.0, vy=0.0):
-        P = np.diag([self.p0_pos_sd_m ** 2] * 2 + [self.p0_vel_sd_mps ** 2] * 2)
-        return (np.array([x, y, vx, vy], dtype=float), P)
+        return (np.array([x, y, vx, vy], dtype=float), self._noise[2].copy())
 
     def predict(self, s, dt, ux, uy):
         x, P = s
         A, B = self._ab(dt)
-        Q = np.eye(2) * self.q_accel_sd_mps2 ** 2
-        x = A @ x + B @ np.array([ux, uy])            # eq. (7)
-        P = A @ P @ A.T + B @ Q @ B.T                  # eq. (8)
+        Q = self._noise[0]
+        x = A @ x + B @ np.array([ux, uy])            # seed000 eq. (7)
+        P = A @ P @ A.T + B @ Q @ B.T                  # seed000 eq. (8)
         return (x, P)
 
     def innovation_cov(self, s):
-        R = np.eye(2) * self.r_sd_m ** 2
-        return self.C @ s[1] @ self.C.T + R            # eq. (12)
+        return self.C @ s[1] @ self.C.T + self._noise[1]   # seed000 eq. (12)
 
     def correct(self, s, zx, zy):
         x, P = s

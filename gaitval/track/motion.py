@@ -34,6 +34,7 @@ Spline-Based Interpolation during Turning Motion in Walk Tests. Sensors 2015, 15
 from __future__ import annotations
 
 import math
+from collections import deque
 
 from gaitval.registry import Registry
 
@@ -52,6 +53,44 @@ def _along(v: tuple[float, float], g: float, brake_dt: float = 0.0) -> tuple[flo
     return (g * v[0] / n, g * v[1] / n)
 
 
+class SwingAccelerationWindow:
+    """g_k^f of seed000 eq. (19)–(20): the mean ‖a‖ of one leg over the steps among the
+    last N_ac in which it was swinging (0 when there were none).
+
+    Kept as a running sum: :meth:`push` adds step k and drops step k − N_ac; after a
+    re-filter rewrote the history, :meth:`reset` starts again from the rewritten window.
+    """
+
+    __slots__ = ("n_ac", "buf", "total", "count")
+
+    def __init__(self, n_ac: int):
+        self.n_ac = n_ac
+        self.buf: deque = deque()
+        self.total = 0.0
+        self.count = 0
+
+    def push(self, a: float, swinging: bool) -> None:
+        buf = self.buf
+        buf.append((a, swinging))
+        if swinging:
+            self.total += a
+            self.count += 1
+        if len(buf) > self.n_ac:
+            a0, sw0 = buf.popleft()
+            if sw0:
+                self.total -= a0
+                self.count -= 1
+
+    def reset(self, entries: list[tuple[float, bool]]) -> None:
+        """Start from ``entries`` = (‖a‖, swinging) of the window's steps, oldest first."""
+        self.buf = deque(entries)
+        sel = [a for a, sw in entries if sw]
+        self.total, self.count = float(sum(sel)), len(sel)
+
+    def value(self) -> float:
+        return self.total / self.count if self.count > 0 else 0.0
+
+
 class MotionModel:
     """Role base.  ``n_ac`` = 0 means the model needs no acceleration gain."""
 
@@ -59,6 +98,10 @@ class MotionModel:
 
     def inputs(self, phase: int, vl, vr, gl: float, gr: float, dt: float):
         raise NotImplementedError
+
+    def new_window(self) -> SwingAccelerationWindow | None:
+        """A per-leg acceleration window for one run (None: the model needs none)."""
+        return SwingAccelerationWindow(self.n_ac) if self.n_ac else None
 
 
 @MOTION_MODELS.register("gait_phase_accel")
@@ -78,19 +121,19 @@ class GaitPhaseAcceleration(MotionModel):
     def inputs(self, phase, vl, vr, gl, gr, dt):
         bdt = dt if self.limit_braking else 0.0
         if phase == 1:
-            return _along(vl, gl), _ZERO          # eq. (19)
+            return _along(vl, gl), _ZERO          # seed000 eq. (19)
         if phase == 2:
-            return _along(vl, -gl, bdt), _ZERO    # eq. (20)
+            return _along(vl, -gl, bdt), _ZERO    # seed000 eq. (20)
         if phase == 3:
             return _ZERO, _along(vr, gr)
         if phase == 4:
             return _ZERO, _along(vr, -gr, bdt)
-        return _ZERO, _ZERO                       # eq. (18); Phase 5: none
+        return _ZERO, _ZERO                       # seed000 eq. (18); Phase 5: none
 
 
 @MOTION_MODELS.register("constant_velocity")
 class ConstantVelocity(MotionModel):
-    """u = 0: the constant-velocity model of seed 001 eq. (2)."""
+    """u = 0: the constant-velocity model of seed001 eq. (2) and seed 002 §II."""
 
     def inputs(self, phase, vl, vr, gl, gr, dt):
         return _ZERO, _ZERO

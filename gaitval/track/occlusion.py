@@ -1,9 +1,15 @@
 """Occlusion handlers: what a tracker does about a leg that was hidden (UO) for a while.
 
-Role ``occlusion``: ``delay(n_uo)`` says how many steps after the leg reappears the
-handler wants to act (``None``: never), and ``virtual_observations(p0, p1, p2, p3, n_uo)``
-returns the observations to re-filter the hidden steps with.  ``n_before(n_uo)`` /
-``n_after(n_uo)`` give N_bo / N_ao, where the outer control points are taken.
+Role ``occlusion``: the tracker calls ``begin(run)`` once (per-run state, or None),
+``after_scan(state, run, k)`` after every scan and ``finish(state, run)`` at the end.  A
+handler acts on the run through its small interface: the legs' histories
+(``run.legs[f].z``, ``.real``, ``.post``, ``.interpolated``), ``run.replay(ka, k)`` (filter
+both legs again over ka+1..k with the stored observations) and ``run.resync(k)``.
+
+Helpers the Catmull–Rom handler is built from: ``delay(n_uo)`` says how many steps after the
+leg reappears the handler acts (``None``: never), ``virtual_observations(p0, p1, p2, p3,
+n_uo)`` returns the observations to re-filter the hidden steps with, and ``n_before(n_uo)``
+/ ``n_after(n_uo)`` give N_bo / N_ao, where the outer control points are taken.
 
 Notes
 -----
@@ -32,6 +38,8 @@ Design; Barnhill, R.E., Riesenfeld, R.F., Eds.; Academic Press: New York, 1974; 
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from gaitval.errors import ConfigError
@@ -57,7 +65,7 @@ def catmull_rom(p0, p1, p2, p3, n_uo: int) -> np.ndarray:
         Number of hidden steps.
     """
     P = np.array([p0, p1, p2, p3], dtype=float)
-    return _weights(int(n_uo)) @ P                                    # eq. (17)
+    return _weights(int(n_uo)) @ P                                    # seed000 eq. (17)
 
 
 _WEIGHTS: dict[int, np.ndarray] = {}
@@ -76,6 +84,16 @@ def _weights(n_uo: int) -> np.ndarray:
 
 class OcclusionHandler:
     """Role base: the predict-only behaviour (never acts)."""
+
+    def begin(self, run):
+        """Per-run state (None when the handler keeps none)."""
+        return None
+
+    def after_scan(self, state, run, k: int) -> None:
+        """Called after scan k has been associated and corrected."""
+
+    def finish(self, state, run) -> None:
+        """Called after the last scan."""
 
     def delay(self, n_uo: int) -> int | None:
         return None
@@ -141,3 +159,59 @@ class CatmullRomInterpolation(OcclusionHandler):
 
     def virtual_observations(self, p0, p1, p2, p3, n_uo):
         return catmull_rom(p0, p1, p2, p3, n_uo)
+
+    # -- the handler's work in a run (seed 000 §5.4) --------------------------------------
+    def begin(self, run):
+        return _Pending(last_real=[run.k0, run.k0], due=[], next_due=run.n)
+
+    def after_scan(self, st, run, k):
+        for f in (0, 1):
+            if run.legs[f].real[k]:
+                last = st.last_real[f]
+                if last < k - 1:                   # leg f reappears after k−1−last UO scans
+                    d = self.delay(k - last - 1)
+                    if d is not None:
+                        st.due.append((k + d, f, last, k))
+                        st.next_due = min(st.next_due, k + d)
+                st.last_real[f] = k
+        if st.due and k >= st.next_due:
+            now = [p for p in st.due if p[0] <= k]
+            st.due = [p for p in st.due if p[0] > k]
+            for _, f, ka, m in sorted(now, key=lambda p: (p[2], p[1])):
+                self.refilter(run, f, ka, m, k)
+            run.resync(k)
+            st.next_due = min((p[0] for p in st.due), default=run.n)
+
+    def finish(self, st, run):
+        for _, f, ka, m in sorted(st.due, key=lambda p: (p[2], p[1])):
+            self.refilter(run, f, ka, m, run.n - 1)
+
+    def refilter(self, run, f: int, ka: int, m: int, k_now: int) -> None:
+        """Virtual observations for leg f over ka+1..m−1, then both legs filtered again
+        from ka to k_now ("all state parameters are updated", seed 000 §5.4)."""
+        run.refiltered.append((f, ka, k_now))
+        leg, k0 = run.legs[f], run.k0
+        n_uo = m - ka - 1
+        i0 = ka - self.n_before(n_uo)
+        p1, p2 = leg.z[ka], leg.z[m]
+        p0 = next((leg.z[i] for i in range(max(i0, k0), k0 - 1, -1) if leg.real[i]), None)
+        if p0 is None:                             # nothing observed that early: the estimate
+            p0 = run.filter.pos(leg.post[max(i0, k0)])
+        p3 = next((leg.z[i] for i in range(min(m + self.n_after(n_uo), k_now), m - 1, -1)
+                   if leg.real[i]), p2)
+        virt = self.virtual_observations(p0, p1, p2, p3, n_uo).tolist()   # seed000 eq. (17)
+        for i in range(n_uo):
+            leg.z[ka + 1 + i] = (virt[i][0], virt[i][1])
+            leg.interpolated[ka + 1 + i] = True
+        run.resync(ka)
+        run.replay(ka, k_now)
+
+
+@dataclass
+class _Pending:
+    """Catmull–Rom per-run state: the last observed scan of each leg and the re-filters
+    waiting for their N_ao outer observations, as ``(due_k, leg, k_last_seen, k_back)``."""
+
+    last_real: list
+    due: list
+    next_due: int
