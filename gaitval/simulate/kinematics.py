@@ -17,6 +17,9 @@ The model is deliberately small and physical:
    walks, so the shank point at sensor height is slowest early in stance and moves
    ≈ 2.5 times faster than the body at its swing peak (``gaitval.simulate.shin``).
 
+Steps 1 and 2 (paths, footholds, timing) live in :mod:`gaitval.simulate.footsteps`, whose
+public names are re-exported here; this module turns a plan into legs (step 3).
+
 References
 ----------
 Yorozu A, Moriguchi T, Takahashi M. Improved leg tracking considering gait phase and
@@ -30,10 +33,17 @@ Perry J, Burnfield JM. Gait Analysis: Normal and Pathological Function, 2nd ed. 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.interpolate import CubicSpline
+
+from gaitval.simulate.footsteps import (GaitParams, Path2D, StepPlan, make_path,
+                                        plan_from_footholds, plan_steps)
+
+__all__ = ["GaitParams", "LegState", "MID_STANCE_PHASE", "Path2D", "SWING_END_ACCEL",
+           "StepPlan", "TILT_REF_STEP_PER_SHANK", "TOE_OFF_PHASE", "leg_kinematics",
+           "make_path", "plan_from_footholds", "plan_steps"]
 
 #: Shank tilt (knee ahead of ankle, degrees) over the gait cycle (contact at phase 0, toe off
 #: at phase 0.6), measured on the real walks ``FunctionalWalk.c3d``,
@@ -66,272 +76,6 @@ def _hermite5(tau: np.ndarray, s0, s1, a1=SWING_END_ACCEL) -> np.ndarray:
     t3, t4, t5 = tau ** 3, tau ** 4, tau ** 5
     return ((10 * t3 - 15 * t4 + 6 * t5) + s0 * (tau - 6 * t3 + 8 * t4 - 3 * t5)
             + s1 * (-4 * t3 + 7 * t4 - 3 * t5) + a1 * 0.5 * t3 * (1 - tau) ** 2)
-
-
-@dataclass
-class GaitParams:
-    """One walker's gait (SI units).
-
-    ``step_cv`` is the coefficient of variation of step time and length; ``place_sd_m``
-    the standard deviation of foot placement around the plan (elderly > young).
-    """
-
-    step_length_m: float = 0.70
-    step_width_m: float = 0.10
-    step_time_s: float = 0.50
-    stance_frac: float = 0.60
-    step_cv: float = 0.03
-    place_sd_m: float = 0.015
-    shank_length_m: float = 0.42
-    ankle_height_m: float = 0.08
-    hip_height_m: float = 0.90
-    turn_step_factor: float = 0.6       # step length in a tight turn / straight step length
-    turn_time_factor: float = 1.15      # step time in a tight turn / straight step time
-    knee_half_sep_m: float = 0.08       # knee joint centre from the body midline (frontal plane)
-    roll_fwd_m: float = 0.14            # ankle advance over the forefoot from heel off to toe off
-    roll_up_m: float = 0.09             # ankle rise from heel off to toe off
-    rocker_m: float = 0.025             # ankle advance over the heel in loading response
-
-
-@dataclass
-class Path2D:
-    """A densely sampled walking path: arc length ``s``, points ``xy``, heading, curvature."""
-
-    s: np.ndarray
-    xy: np.ndarray
-    heading: np.ndarray
-    curvature: np.ndarray
-    labels: np.ndarray = field(default_factory=lambda: np.array([], dtype=object))
-
-    @property
-    def length(self) -> float:
-        return float(self.s[-1])
-
-    def at(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        s = np.clip(np.asarray(s, dtype=float), 0.0, self.length)
-        x = np.interp(s, self.s, self.xy[:, 0])
-        y = np.interp(s, self.s, self.xy[:, 1])
-        h = np.interp(s, self.s, np.unwrap(self.heading))
-        k = np.interp(s, self.s, self.curvature)
-        return np.column_stack([x, y]), h, k
-
-
-def make_path(start_xy, start_heading: float, segments: list[tuple], ds: float = 0.005
-              ) -> Path2D:
-    """Build a path from ``("line", length, label)`` and ``("arc", radius, dtheta, label)``.
-
-    ``dtheta`` > 0 turns left (counter-clockwise).  Each sample keeps the segment label
-    (e.g. ``forward``, ``turning``) so phases can be read off the path.
-    """
-    xy = [np.asarray(start_xy, dtype=float)]
-    hd = [float(start_heading)]
-    kk = [0.0]
-    lab = [segments[0][-1]]
-    for seg in segments:
-        if seg[0] == "line":
-            n = max(1, int(np.ceil(seg[1] / ds)))
-            step = seg[1] / n
-            for _ in range(n):
-                p = xy[-1] + step * np.array([np.cos(hd[-1]), np.sin(hd[-1])])
-                xy.append(p)
-                hd.append(hd[-1])
-                kk.append(0.0)
-                lab.append(seg[-1])
-        elif seg[0] == "arc":
-            r, dth = float(seg[1]), float(seg[2])
-            n = max(1, int(np.ceil(abs(dth) * r / ds)))
-            for _ in range(n):
-                h0 = hd[-1]
-                h1 = h0 + dth / n
-                chord = 2 * r * np.sin(abs(dth / n) / 2)
-                hm = 0.5 * (h0 + h1)
-                xy.append(xy[-1] + chord * np.array([np.cos(hm), np.sin(hm)]))
-                hd.append(h1)
-                kk.append(np.sign(dth) / r)
-                lab.append(seg[-1])
-        else:
-            raise ValueError(f"unknown path segment {seg[0]!r}")
-    xy = np.array(xy)
-    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(xy, axis=0).T))])
-    return Path2D(s=s, xy=xy, heading=np.array(hd), curvature=np.array(kk),
-                  labels=np.array(lab, dtype=object))
-
-
-@dataclass
-class StepPlan:
-    """Footholds in time order.
-
-    Arrays of length ``n`` (one entry per foot contact, the first two are the initial
-    stance of L and R at ``t_contact = -inf``-like start times): ``side`` (0 = L, 1 = R),
-    ``t_contact``, ``t_off`` (lift-off time of this foot *before* this contact; NaN for
-    the initial stance), ``xy`` (n, 2), ``heading`` (n,), ``label`` (path label),
-    ``cross`` (True when the foot landed across the line of the other, stance foot).
-    """
-
-    side: np.ndarray
-    t_contact: np.ndarray
-    t_off: np.ndarray
-    xy: np.ndarray
-    heading: np.ndarray
-    label: np.ndarray
-    cross: np.ndarray
-    t_start: float
-    t_end: float
-
-    def foot(self, side: int) -> dict:
-        m = self.side == side
-        return {k: getattr(self, k)[m] for k in ("t_contact", "t_off", "xy", "heading",
-                                                   "label", "cross")}
-
-
-def plan_steps(path: Path2D, gp: GaitParams, rng: np.random.Generator, *, t0: float = 0.0,
-               first_side: int = 1, end_pose: tuple | None = None,
-               targets: np.ndarray | None = None, start_half_width: float | None = None
-               ) -> StepPlan:
-    """Footholds and contact times along ``path``.
-
-    Parameters
-    ----------
-    path : Path2D
-    gp : GaitParams
-    rng : Generator
-    t0 : float
-        Time of the first foot lift-off (gait initiation).
-    first_side : int
-        Foot that steps first (0 = L, 1 = R).
-    end_pose : (x, y, heading, n_steps), optional
-        After the path, pivot in ``n_steps`` small steps to this pose (turn to sit, TUG).
-    targets : ndarray (m, 2), optional
-        Foot placements to aim at instead of the nominal ones (MTST); one per step in order.
-    start_half_width : float, optional
-        Half distance between the feet before the first step (default: half step width;
-        seated people keep their feet about hip width apart).
-
-    Notes
-    -----
-    Step length is shortened and step time lengthened with the largest path curvature
-    ``k`` under the coming step: ``L = L0 (1 - (1 - turn_step_factor) min(1, 0.35 |k|))``.  A tight turn (radius ≤ 0.35 m) uses the
-    full factor.  Cross steps are not scripted: a step is flagged ``cross`` when the
-    landing foot ends up on the far side of the stance foot in the stance foot's heading
-    frame (the definition of seed 001 §2.5.3 applied to the truth).
-    """
-    sides, tc, xy, hd, lab = [], [], [], [], []
-    # initial stance: both feet beside the path start
-    p0, h0, _ = path.at(np.array([0.0]))
-    nrm0 = np.array([-np.sin(h0[0]), np.cos(h0[0])])
-    for side in (0, 1):
-        sgn = 1.0 if side == 0 else -1.0
-        sides.append(side)
-        tc.append(-np.inf)
-        hw = gp.step_width_m / 2 if start_half_width is None else start_half_width
-        xy.append(p0[0] + sgn * nrm0 * hw)
-        hd.append(h0[0])
-        lab.append(path.labels[0])
-    s = 0.0
-    t = t0
-    side = first_side
-    k_step = 0
-    step_times = []
-    while True:
-        # the curvature under the coming step sets its length and duration
-        _, _, kap = path.at(s + np.linspace(0.0, gp.step_length_m, 9))
-        turn = min(1.0, float(np.abs(kap).max()) * 0.35)
-        L = gp.step_length_m * (1 - (1 - gp.turn_step_factor) * turn)
-        L *= 1 + gp.step_cv * rng.standard_normal()
-        if k_step == 0:
-            L *= 0.5                                # first step starts from standing
-        T = gp.step_time_s * (1 + (gp.turn_time_factor - 1) * turn)
-        T *= 1 + gp.step_cv * rng.standard_normal()
-        s_new = s + L
-        last = s_new >= path.length - 0.5 * gp.step_length_m * 0.5
-        if last:
-            s_new = path.length
-        p, h, _ = path.at(np.array([s_new]))
-        nrm = np.array([-np.sin(h[0]), np.cos(h[0])])
-        sgn = 1.0 if side == 0 else -1.0
-        foot = p[0] + sgn * nrm * gp.step_width_m / 2
-        if targets is not None and k_step < len(targets) and np.all(np.isfinite(targets[k_step])):
-            foot = np.asarray(targets[k_step], dtype=float).copy()
-        foot = foot + gp.place_sd_m * rng.standard_normal(2)
-        t = t + T if k_step > 0 else t + T * 0.9
-        sides.append(side)
-        tc.append(t)
-        xy.append(foot)
-        hd.append(h[0] + 0.03 * rng.standard_normal())
-        lab.append(path.labels[int(np.searchsorted(path.s, s_new).clip(0, len(path.s) - 1))])
-        step_times.append(T)
-        side = 1 - side
-        s = s_new
-        k_step += 1
-        if last:
-            break
-    if end_pose is not None:
-        ex, ey, eh, n_piv = end_pose
-        start_c = 0.5 * (np.array(xy[-1]) + np.array(xy[-2]))
-        h_start = hd[-1]
-        for j in range(1, int(n_piv) + 1):
-            f = j / n_piv
-            c = (1 - f) * start_c + f * np.array([ex, ey])
-            h = (1 - f) * h_start + f * eh
-            nrm = np.array([-np.sin(h), np.cos(h)])
-            sgn = 1.0 if side == 0 else -1.0
-            T = gp.step_time_s * gp.turn_time_factor * 1.2 * (1 + gp.step_cv * rng.standard_normal())
-            t = t + T
-            sides.append(side)
-            tc.append(t)
-            xy.append(c + sgn * nrm * gp.step_width_m / 2 + gp.place_sd_m * rng.standard_normal(2))
-            hd.append(h)
-            lab.append(path.labels[-1])
-            step_times.append(T)
-            side = 1 - side
-    # closing step: the trailing foot joins the other one
-    h = hd[-1]
-    nrm = np.array([-np.sin(h), np.cos(h)])
-    sgn = 1.0 if side == 0 else -1.0
-    other = np.array(xy[-1])
-    T = gp.step_time_s * (1 + gp.step_cv * rng.standard_normal())
-    t = t + T
-    sides.append(side)
-    tc.append(t)
-    xy.append(other + (2 * sgn * nrm * gp.step_width_m / 2))
-    hd.append(h)
-    lab.append(lab[-1])
-    step_times.append(T)
-
-    return plan_from_footholds(np.array(sides), np.array(tc, dtype=float), np.array(xy),
-                               np.array(hd), np.array(lab, dtype=object),
-                               np.array(step_times), gp, t0)
-
-
-def plan_from_footholds(sides, tc, xy, hd, lab, step_times, gp: GaitParams, t0: float
-                        ) -> StepPlan:
-    """Complete a foothold list (first two = initial stance) with lift-off times and cross flags.
-
-    Lift-off of the foot landing at contact ``i``: ``t_off = t_c - (1 - stance_frac) * stride``
-    with ``stride = T_i + T_{i-1}`` (two step times), so stance is ``stance_frac`` of the cycle.
-    """
-    t_off = np.full(len(tc), np.nan)
-    st = np.concatenate([[np.nan, np.nan], np.asarray(step_times, dtype=float)])
-    for i in range(2, len(tc)):
-        prev_T = st[i - 1] if np.isfinite(st[i - 1]) else st[i]
-        swing = (1 - gp.stance_frac) * (st[i] + prev_T)
-        t_off[i] = t0 if i == 2 else max(tc[i] - swing, tc[i - 2] + 0.05)
-    # cross-step truth (seed 001 §2.5.3): landing foot on the far side of the stance foot
-    cross = np.zeros(len(tc), dtype=bool)
-    for i in range(2, len(tc)):
-        j = i - 1
-        while j >= 0 and sides[j] == sides[i]:
-            j -= 1
-        if j < 0:
-            continue
-        # walking direction: bisector of the stance and the landing foot's headings
-        h = float(np.angle(np.exp(1j * hd[j]) + np.exp(1j * hd[i])))
-        nrm = np.array([-np.sin(h), np.cos(h)])
-        lateral = float((xy[i] - xy[j]) @ nrm)      # + = left of the stance foot
-        want = 1.0 if sides[i] == 0 else -1.0
-        cross[i] = lateral * want < 0.0
-    return StepPlan(side=sides, t_contact=tc, t_off=t_off, xy=xy, heading=hd,
-                    label=lab, cross=cross, t_start=t0, t_end=float(tc[-1]))
 
 
 def _minjerk(tau: np.ndarray) -> np.ndarray:
@@ -372,29 +116,34 @@ class LegState:
         return self.ankle[:, :2] + u[:, None] * (self.knee[:, :2] - self.ankle[:, :2])
 
 
-def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
-                   posture_tilt: np.ndarray | None = None) -> LegState:
-    """Ankle and knee joint centres of one leg at times ``t`` (vectorised over frames).
+@dataclass
+class _Timeline:
+    """Where each requested time falls in one foot's contact / lift-off timeline.
 
-    Notes
-    -----
-    Stance: heel rocker ``x = x_f - rocker_m (1 - w)²`` over the first 25 % of stance
-    (``w``: 0 → 1), then the ankle rests on the foothold ``x_f``; forefoot roll from 60 %
-    of stance, ``x = x_f + roll_fwd_m u³``, ``z = h_a + roll_up_m u²`` (``u``: 0 → 1 at toe
-    off).  Swing (``τ``: 0 → 1, chord ``c`` from the toe-off point to the landing point
-    ``x_f' - rocker_m``): ``x = x0 + c·g(τ)`` with the quintic Hermite
-    ``g = (10τ³ - 15τ⁴ + 6τ⁵) + s0 (τ - 6τ³ + 8τ⁴ - 3τ⁵) + s1 (-4τ³ + 7τ⁴ - 3τ⁵)
-    + a1 τ³(1 - τ)²/2``, ``s0, s1`` the toe-off and heel-strike speeds times
-    ``T_swing / c``, ``a1`` = :data:`SWING_END_ACCEL`; height ``h_a + roll_up_m (1 -
-    smoothstep(τ/0.7)) + 0.045 sin(π min(1, τ/0.6))``.  Shank tilt ``θ(φ)`` from the
-    periodic spline of the gait phase ``φ`` (0 contact, 0.6 toe off) measured on real
-    walks, scaled by ``sqrt(step / shank / 1.6)``; before gait initiation and after the
-    last contact the phase is clamped to mid-stance (standing), plus an optional posture
-    tilt (sit-to-stand).  Constants and the real-data comparison: ``docs/simulator.md``.
+    ``j`` last contact at or before t (0 = initial stance, ``tc = -inf``), ``jn`` the next
+    one; ``off_next`` the lift-off before it (inf after the last contact); ``tau`` swing
+    progress 0 → 1; ``t_c`` the last contact time (-1e9 for the initial stance),
+    ``st_dur`` the stance duration and ``stance_prog`` the stance progress 0 → 1.
     """
+
+    tc: np.ndarray
+    fxy: np.ndarray
+    fh: np.ndarray
+    j: np.ndarray
+    jn: np.ndarray
+    has_next: np.ndarray
+    off_next: np.ndarray
+    swing: np.ndarray
+    tau: np.ndarray
+    t_c: np.ndarray
+    st_dur: np.ndarray
+    stance_prog: np.ndarray
+
+
+def _timeline(plan: StepPlan, side: int, t: np.ndarray) -> _Timeline:
+    """Locate times ``t`` among the contacts and lift-offs of foot ``side``."""
     f = plan.foot(side)
     tc, toff, fxy, fh = f["t_contact"], f["t_off"], f["xy"], f["heading"]
-    n = len(t)
     m = len(tc)
     # event timeline: contact j at tc[j] (j=0 initial, tc=-inf), lift-off j at toff[j]
     j = np.searchsorted(tc, t, side="right") - 1            # last contact <= t
@@ -409,6 +158,19 @@ def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
     t_c = np.where(np.isfinite(tc[j]), tc[j], -1e9)
     st_dur = np.where(has_next, off_next - t_c, np.inf)
     stance_prog = np.clip((t - t_c) / np.where(np.isfinite(st_dur), st_dur, 1.0), 0, 1)
+    return _Timeline(tc=tc, fxy=fxy, fh=fh, j=j, jn=jn, has_next=has_next, off_next=off_next,
+                     swing=swing, tau=tau, t_c=t_c, st_dur=st_dur, stance_prog=stance_prog)
+
+
+def _ankle_path(tl: _Timeline, t: np.ndarray, gp: GaitParams) -> tuple[np.ndarray, ...]:
+    """Ankle joint centre (xy, z), foot heading, heel rise and forefoot roll at ``t``.
+
+    Returns ``(ax (n, 2), az, heading, heel, roll_dx, roll_dz)``; the model is in the notes
+    of :func:`leg_kinematics`.
+    """
+    tc, fxy, fh, j, jn = tl.tc, tl.fxy, tl.fh, tl.j, tl.jn
+    has_next, off_next, swing, tau = tl.has_next, tl.off_next, tl.swing, tl.tau
+    t_c, st_dur = tl.t_c, tl.st_dur
     # foot roll over the forefoot (heel off → toe off): the ankle advances roll_fwd_m·u³
     # and rises roll_up_m·u² over the last 40 % of stance (u: 0 → 1), so it leaves the
     # floor already moving forward at 3·roll_fwd_m / (0.4·stance) (real walks: ≈ 1.5 × the
@@ -452,9 +214,17 @@ def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
     heel = np.where(swing, fade, heel)
     roll_dx = gp.roll_fwd_m * np.where(swing, fade, u ** 3)
     roll_dz = gp.roll_up_m * heel
+    return ax, az, heading, heel, roll_dx, roll_dz
+
+
+def _shank_tilt(tl: _Timeline, t: np.ndarray, gp: GaitParams,
+                posture_tilt: np.ndarray | None) -> np.ndarray:
+    """Shank tilt (rad, knee ahead positive) from the gait phase (notes of :func:`leg_kinematics`)."""
+    tc, j, has_next, off_next = tl.tc, tl.j, tl.has_next, tl.off_next
+    swing, tau, t_c = tl.swing, tl.tau, tl.t_c
     # gait phase phi: stance 0..0.6, swing 0.6..1
     phi = np.where(swing, TOE_OFF_PHASE + (1 - TOE_OFF_PHASE) * tau,
-                   TOE_OFF_PHASE * stance_prog)
+                   TOE_OFF_PHASE * tl.stance_prog)
     # standing before initiation: hold mid-stance, ramp into terminal stance in 0.35 s
     pre = ~swing & ~np.isfinite(tc[j])
     ramp = _smoothstep(1 - (off_next - t) / 0.35)
@@ -473,6 +243,32 @@ def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
     tilt = np.deg2rad(tilt_deg - np.where(post | pre, _TILT(MID_STANCE_PHASE) * amp, 0.0))
     if posture_tilt is not None:
         tilt = tilt + posture_tilt
+    return tilt
+
+
+def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
+                   posture_tilt: np.ndarray | None = None) -> LegState:
+    """Ankle and knee joint centres of one leg at times ``t`` (vectorised over frames).
+
+    Notes
+    -----
+    Stance: heel rocker ``x = x_f - rocker_m (1 - w)²`` over the first 25 % of stance
+    (``w``: 0 → 1), then the ankle rests on the foothold ``x_f``; forefoot roll from 60 %
+    of stance, ``x = x_f + roll_fwd_m u³``, ``z = h_a + roll_up_m u²`` (``u``: 0 → 1 at toe
+    off).  Swing (``τ``: 0 → 1, chord ``c`` from the toe-off point to the landing point
+    ``x_f' - rocker_m``): ``x = x0 + c·g(τ)`` with the quintic Hermite
+    ``g = (10τ³ - 15τ⁴ + 6τ⁵) + s0 (τ - 6τ³ + 8τ⁴ - 3τ⁵) + s1 (-4τ³ + 7τ⁴ - 3τ⁵)
+    + a1 τ³(1 - τ)²/2``, ``s0, s1`` the toe-off and heel-strike speeds times
+    ``T_swing / c``, ``a1`` = :data:`SWING_END_ACCEL`; height ``h_a + roll_up_m (1 -
+    smoothstep(τ/0.7)) + 0.045 sin(π min(1, τ/0.6))``.  Shank tilt ``θ(φ)`` from the
+    periodic spline of the gait phase ``φ`` (0 contact, 0.6 toe off) measured on real
+    walks, scaled by ``sqrt(step / shank / 1.6)``; before gait initiation and after the
+    last contact the phase is clamped to mid-stance (standing), plus an optional posture
+    tilt (sit-to-stand).  Constants and the real-data comparison: ``docs/simulator.md``.
+    """
+    tl = _timeline(plan, side, t)
+    ax, az, heading, heel, roll_dx, roll_dz = _ankle_path(tl, t, gp)
+    tilt = _shank_tilt(tl, t, gp, posture_tilt)
     fwd = np.column_stack([np.cos(heading), np.sin(heading)])
     outward = (1.0 if side == 0 else -1.0) * np.column_stack([-np.sin(heading), np.cos(heading)])
     ankle = np.column_stack([ax, az])
@@ -482,5 +278,5 @@ def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
     # midline) while the feet land at ± step_width/2, so each shank leans outward upward
     knee[:, :2] += max(0.0, gp.knee_half_sep_m - gp.step_width_m / 2) * outward
     knee[:, 2] += gp.shank_length_m * np.cos(tilt)
-    return LegState(ankle=ankle, knee=knee, heading=heading, stance=~swing, tilt=tilt,
+    return LegState(ankle=ankle, knee=knee, heading=heading, stance=~tl.swing, tilt=tilt,
                     heel_rise=heel, roll_dx=roll_dx, roll_dz=roll_dz)
