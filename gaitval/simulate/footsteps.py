@@ -224,8 +224,8 @@ def _pivot_steps(fh: _Footholds, path: Path2D, gp: GaitParams, rng: np.random.Ge
         sgn = 1.0 if side == 0 else -1.0
         T = gp.step_time_s * gp.turn_time_factor * 1.2 * (1 + gp.step_cv * rng.standard_normal())
         t = t + T
-        fh.add(side, t, c + sgn * nrm * gp.step_width_m / 2 + gp.place_sd_m * rng.standard_normal(2),
-               h, path.labels[-1], T)
+        foot = c + sgn * nrm * gp.step_width_m / 2 + gp.place_sd_m * rng.standard_normal(2)
+        fh.add(side, t, foot, h, path.labels[-1], T)
         side = 1 - side
     return t, side
 

@@ -12,9 +12,9 @@ import pandas as pd
 from gaitval.simulate import laser as L
 from gaitval.simulate.markers import (BONES, JOINT_CENTRES, add_noise_and_gaps,
                                       pig_markers)
-from gaitval.simulate.protocols import (POLE_TOP_M, RLT_CORNERS, RLT_TOP_M, TrialSim,
-                                        rollator_tubes)
+from gaitval.simulate.rollator import RLT_CORNERS, RLT_TOP_M, rollator_tubes
 from gaitval.simulate.scene import ID_ATTENDANT, ID_LEFT, ID_RIGHT, ID_STICK, ID_WALL, to_sensor
+from gaitval.simulate.trialsim import POLE_TOP_M, TrialSim
 from gaitval.types import ScanSeries
 
 BLOCK = 256

@@ -1,0 +1,162 @@
+"""The multi-target stepping task scene (seed 001): mat, coloured targets, attendant.
+
+Every number here is a physical or anthropometric assumption documented in
+``docs/simulator.md``; none is tuned towards a tracker's outcome.
+
+References
+----------
+Yorozu A, Nishiguchi S, Yamada M, Aoyama T, Moriguchi T, Takahashi M. Gait measurement
+system for the multi-target stepping task using a laser range sensor. Sensors
+2015;15:11151–11168 (MTST: 5.85 × 1.15 m mat, 0.160 × 0.165 m targets, attendant,
+Δt = 0.05 s, 16 elderly of whom 2 use a stick).
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from gaitval.simulate.kinematics import (GaitParams, StepPlan, make_path, plan_from_footholds,
+                                         plan_steps)
+from gaitval.simulate.scene import ID_POLE, Walker
+from gaitval.simulate.trialsim import POLE_RADIUS_M, TrialSim, _walls
+
+MAT_LENGTH, MAT_WIDTH = 5.85, 1.15
+TARGET_W, TARGET_L = 0.160, 0.165
+COLORS = ("red", "blue", "white")
+
+
+def mtst_targets(rng) -> pd.DataFrame:
+    """Targets on the mat: rows every ≈ 0.45–0.6 m, three colours per row in random lanes.
+
+    Lane centres at y = −0.35, 0, +0.35 m (the 1.15 m mat holds three 0.16 m targets with
+    ≈ 0.19 m between them); a row's colours are a random permutation (the paper's
+    "arranged randomly"), so the assigned colour jumps between lanes from row to row.
+    """
+    rows = []
+    x = 0.55
+    tid = 0
+    while x < MAT_LENGTH - 0.4:
+        perm = rng.permutation(3)
+        for lane, c in zip((-0.35, 0.0, 0.35), perm):
+            rows.append({"target": f"T{tid:02d}", "x_m": round(x, 3),
+                         "y_m": round(lane + rng.uniform(-0.05, 0.05), 3), "color": COLORS[c]})
+            tid += 1
+        x += rng.uniform(1.0, 1.4)
+    return pd.DataFrame(rows)
+
+
+def plan_mtst(rng, gp: GaitParams, targets: pd.DataFrame, color: str, t0: float
+              ) -> tuple[StepPlan, dict]:
+    """Footholds from start to goal stepping on every target of ``color``.
+
+    Walkers take nominal steps along y = 0 and, before each assigned target, choose the
+    number of steps (nominal count ± 2, step length within 0.6–1.35 of nominal) that
+    brings the foot on the target's side onto it; when no count fits (targets too close),
+    the foot that arrives takes the target even across the midline — a cross step
+    arises from the geometry.  Placement scatter is ``place_sd_m`` around the aim, plus
+    for target steps 2 cm and 10 % of the distance between the target and the foothold
+    the walker would have chosen without it (endpoint error grows with the correction).
+    """
+    tg = targets[targets["color"] == color].sort_values("x_m").reset_index(drop=True)
+    sides = [0, 1]
+    xy = [np.array([-0.35, gp.step_width_m / 2]), np.array([-0.35, -gp.step_width_m / 2])]
+    hd = [0.0, 0.0]
+    lab = ["walk", "walk"]
+    times = []
+    which: dict[int, str] = {}
+    side = int(rng.integers(0, 2))
+    x = -0.35
+    L0 = gp.step_length_m
+    goal = MAT_LENGTH + 0.35
+
+    def add(aim, label, first=False, extra_sd=0.0):
+        nonlocal side, x
+        p = np.asarray(aim, float) + np.hypot(gp.place_sd_m, extra_sd) * rng.standard_normal(2)
+        T = gp.step_time_s * (1 + gp.step_cv * rng.standard_normal())
+        sides.append(side)
+        xy.append(p)
+        hd.append(float(0.04 * rng.standard_normal()))
+        lab.append(label)
+        times.append(T * (0.9 if first else 1.0))
+        side = 1 - side
+        x = float(aim[0])
+
+    def own_side():
+        """A free step lands on its own side of the walkway centre and at least half a
+        step width to its own side of the stance foot (so a cross step is undone)."""
+        W = gp.step_width_m
+        y_st = xy[-1][1]
+        return max(W / 2, y_st + W / 2) if side == 0 else min(-W / 2, y_st - W / 2)
+
+    nstep = 0
+    for _, row in tg.iterrows():
+        d = row["x_m"] - x
+        want = 0 if row["y_m"] > 0.05 else (1 if row["y_m"] < -0.05 else None)
+        best = None
+        for n in sorted({max(1, int(round(d / L0)) + k) for k in (-2, -1, 0, 1, 2)}):
+            ratio = d / n / L0
+            if not 0.6 <= ratio <= 1.35:
+                continue
+            arriving = side if n % 2 == 1 else 1 - side
+            ok = want is None or arriving == want
+            cost = abs(ratio - 1) + (0 if ok else 10)
+            if best is None or cost < best[0]:
+                best = (cost, n)
+        n = best[1] if best else max(1, int(round(d / L0)))
+        for k in range(1, n):
+            add((x + d / n, own_side()), "walk", nstep == 0)
+            nstep += 1
+        which[len(sides)] = row["target"]
+        # endpoint scatter grows with the adjustment away from the natural foothold
+        # (Fitts-like: SD ≈ 10 % of the corrective movement's amplitude)
+        natural = np.array([x + d / n, own_side()])
+        amp = float(np.hypot(*(np.array([row["x_m"], row["y_m"]]) - natural)))
+        add((row["x_m"], row["y_m"]), "target", nstep == 0, extra_sd=0.10 * amp + 0.02)
+        nstep += 1
+    while goal - x > 0.3 * L0:
+        d = goal - x
+        n = max(1, int(np.ceil(d / L0)))
+        add((x + d / n, own_side()), "walk", nstep == 0)
+        nstep += 1
+    # closing step beside the last foot
+    add((x, own_side()), "walk")
+    plan = plan_from_footholds(np.array(sides), t0 + np.concatenate([[-np.inf, -np.inf],
+                               np.cumsum(times)]), np.array(xy), np.array(hd),
+                               np.array(lab, dtype=object), np.array(times), gp, t0)
+    return plan, which
+
+
+def build_mtst(rng, study, subj, gp, trial, rep, sensor_pose, cfg, color, stick,
+               attendant_gp) -> TrialSim:
+    """MTST trial: start → goal along the mat stepping on the assigned colour, attendant beside.
+
+    The LRS stands 1.0 m beyond the goal end of the mat facing the walker (x = 6.85 m,
+    yaw = π nominal).  The nursing attendant walks 0.75 m to the participant's right,
+    0.25 m behind, at the participant's speed.
+    """
+    targets = mtst_targets(rng)
+    t0 = float(rng.uniform(0.6, 1.0))
+    plan, which = plan_mtst(rng, gp, targets, color, t0)
+    walker = Walker(plan=plan, gp=gp, leg_width_m=subj["leg_width_m"],
+                    stick_side=(1 if stick else None))
+    # attendant: same path shifted, own gait, same speed
+    agp = attendant_gp
+    dur = plan.t_end - t0
+    n_att = max(2, int(round((MAT_LENGTH + 0.7) / agp.step_length_m)))
+    agp = GaitParams(**{**agp.__dict__, "step_time_s": dur / (n_att + 1)})
+    apath = make_path((-0.6, -0.75), 0.0, [("line", MAT_LENGTH + 0.7, "walk")])
+    aplan = plan_steps(apath, agp, rng, t0=t0 + 0.1, first_side=int(rng.integers(0, 2)))
+    attendant = Walker(plan=aplan, gp=agp, leg_width_m=0.11)
+    poles = np.array([[5.6, -1.3], [3.0, 1.35]])
+    circles = [(x, y, POLE_RADIUS_M, ID_POLE) for x, y in poles]
+    t_end = plan.t_end + float(rng.uniform(0.8, 1.2))
+    targets = targets.assign(assigned=targets["color"] == color)
+    return TrialSim(study=study, protocol="mtst", subject=subj["subject"], trial=trial,
+                    walker=walker, sensor="utm30lx", sensor_height_m=cfg["sensor_height_m"],
+                    mocap_rate_hz=cfg["mocap_rate_hz"], t_end_s=t_end,
+                    circles=np.array(circles, dtype=float), walls=_walls(-2.0, 8.5, -2.2, 2.2),
+                    poles=poles, fixed_pose=sensor_pose, attendant=attendant,
+                    phase_fn=lambda t: np.full(len(t), "walk", dtype=object),
+                    targets=targets, target_steps=which,
+                    log_every=int(round(cfg["log_period_s"] / 0.025)), repetition=rep,
+                    stick=stick, scenario=color, variant={})
