@@ -26,8 +26,10 @@ from gaitval.io.atomic import write_csv, write_parquet, write_text
 from gaitval.io.c3d import read_c3d, write_c3d
 from gaitval.io.scanlog import write_scanlog
 from gaitval.simulate import render as RD
-from gaitval.simulate.protocols import POLE_RADIUS_M, POLE_TOP_M, TrialSim, _walls
 from gaitval.simulate.scene import ID_POLE
+from gaitval.simulate.sheet import (SUBJECT_COLUMNS, TRIAL_COLUMNS, sensor_clock,
+                                    summarise_realism)
+from gaitval.simulate.trialsim import POLE_RADIUS_M, POLE_TOP_M, TrialSim, _walls
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 _NOT_A_MARKER = re.compile(r"(Angle|Force|Moment|Power|GRF|Gamage|Score|NM$|^#|CentreOfMass"
@@ -167,6 +169,42 @@ def replay_trial(out: Path, study: str, spec: dict, cfg: dict, seed: int, idx: i
     t = m.t
     walker = ReplayWalker(t, np.stack([kL, kR]), np.stack([aL, aR]), w)
     rng = np.random.default_rng([seed, 21, idx])
+    pose, poles, lo, hi = _place_sensor_and_poles(aL, aR, cfg, rng)
+    h = float(cfg.get("sensor_height_m", 0.27))
+    sim = TrialSim(study=study, protocol=str(cfg.get("protocol", "tug")), subject=str(spec["subject"]),
+                   trial=trial, walker=walker, sensor=str(cfg.get("sensor", "utm30lx")),
+                   sensor_height_m=h, mocap_rate_hz=m.rate_hz, t_end_s=float(t[-1]),
+                   circles=np.array([(x, y, POLE_RADIUS_M, ID_POLE) for x, y in poles]),
+                   walls=_walls(lo[0], hi[0], lo[1], hi[1]), poles=poles, fixed_pose=pose,
+                   phase_fn=None, scenario="replay")
+    clock = sensor_clock(rng, cfg.get("clock", {}))
+    # the log is cut to the capture: no legs are known outside it
+    series, scans, stats, _ = _render_window(sim, clock, rng, float(t[0]))
+    mocap_rel, lrs_rel, legs = _write_replay_files(out, trial, m, walker, h, poles, series,
+                                                   scans, rng)
+    row = {"study": study, "protocol": sim.protocol, "subject": sim.subject, "trial": trial,
+           "sensor_kind": "lrs", "mocap_file": mocap_rel, "sensor_file": lrs_rel,
+           "sensor_topic": "", "annotation_file": "", "sensor_height_m": h,
+           "clock_offset_s": np.nan, "speed": "", "speed_mps": np.nan, "stick": False,
+           "scenario": "replay", "repetition": 1}
+    subj = {"subject": sim.subject, "group": "adult", "age_y": np.nan, "sex": "",
+            "height_m": np.nan, "mass_kg": np.nan, "leg_width_m": w, "knee_width_m": kw,
+            "ankle_width_m": aw, "leg_length_m": np.nan, "shank_length_m": np.nan,
+            "stick": False}
+    pose_row = {"trial": trial, "x_m": pose[0], "y_m": pose[1], "yaw_rad": pose[2],
+                "clock_offset_s": clock["clock_offset_s"],
+                "clock_drift_ppm": clock["clock_drift_ppm"]}
+    return row, subj, pose_row, _replay_realism(trial, legs, scans, stats)
+
+
+def _place_sensor_and_poles(aL: np.ndarray, aR: np.ndarray, cfg: dict,
+                            rng: np.random.Generator):
+    """Sensor pose (x, y, yaw), pole positions (2, 2) and the room's corners (lo, hi).
+
+    The walking line runs along the mid-ankle path; the sensor stands
+    ``sensor_behind_m`` behind its start and ``sensor_side_m`` to its left, placed by hand
+    (5 cm, 3° scatter drawn from ``rng``).
+    """
     # walking line from the mid-ankle path: sensor behind the start, slightly to the side
     both = np.stack([aL, aR])[:, :, :2]
     cnt = np.isfinite(both[..., 0]).sum(axis=0)
@@ -190,20 +228,17 @@ def replay_trial(out: Path, study: str, spec: dict, cfg: dict, seed: int, idx: i
     poles = np.array([p0 + 1.0 * d + 1.0 * left, p0 - 0.5 * d + 1.5 * left])
     lo = np.minimum(p0, p1) - 2.5
     hi = np.maximum(p0, p1) + 2.5
-    h = float(cfg.get("sensor_height_m", 0.27))
-    sim = TrialSim(study=study, protocol=str(cfg.get("protocol", "tug")), subject=str(spec["subject"]),
-                   trial=trial, walker=walker, sensor=str(cfg.get("sensor", "utm30lx")),
-                   sensor_height_m=h, mocap_rate_hz=m.rate_hz, t_end_s=float(t[-1]),
-                   circles=np.array([(x, y, POLE_RADIUS_M, ID_POLE) for x, y in poles]),
-                   walls=_walls(lo[0], hi[0], lo[1], hi[1]), poles=poles, fixed_pose=pose,
-                   phase_fn=None, scenario="replay")
-    clock_cfg = cfg.get("clock", {})
-    lo_off, hi_off = clock_cfg.get("offset_s", [0.2, 2.0])
-    clock = {"clock_offset_s": round(float(rng.uniform(lo_off, hi_off)), 6),
-             "clock_drift_ppm": round(float(rng.normal(0, clock_cfg.get("drift_ppm_sd", 30.0))), 3),
-             "jitter_s": float(clock_cfg.get("jitter_s", 0.0005))}
-    # the log is cut to the capture: no legs are known outside it
-    series, scans, stats, _ = _render_window(sim, clock, rng, float(t[0]))
+    return pose, poles, lo, hi
+
+
+def _write_replay_files(out: Path, trial: str, m, walker: ReplayWalker, h: float,
+                        poles: np.ndarray, series, scans: pd.DataFrame,
+                        rng: np.random.Generator) -> tuple[str, str, pd.DataFrame]:
+    """Write the trial's C3D (real markers + two poles), scan log and truth.
+
+    Returns the C3D and scan-log paths relative to ``out`` and the true leg points at
+    sensor height (``t_s, side, x_m, y_m, phase``).
+    """
     # markers: the real ones plus the two poles
     keep = [i for i, lab in enumerate(m.labels) if not _NOT_A_MARKER.search(lab)]
     labels = [m.labels[i] for i in keep] + ["POLE1", "POLE2"]
@@ -215,6 +250,7 @@ def replay_trial(out: Path, study: str, spec: dict, cfg: dict, seed: int, idx: i
     write_c3d(out / mocap_rel, labels, xyz, m.rate_hz, events=m.events if len(m.events) else None,
               first_frame=m.first_frame)
     write_scanlog(out / lrs_rel, series, scan_time_s=0.025)
+    t = m.t
     rows = []
     for k, side in enumerate("LR"):
         c = walker.legs(t)[k].point_at_height(h)
@@ -227,30 +263,23 @@ def replay_trial(out: Path, study: str, spec: dict, cfg: dict, seed: int, idx: i
     write_parquet(scans, tdir / "scans_legs.parquet")
     ev = m.events.copy() if len(m.events) else pd.DataFrame(columns=["context", "label", "t_s"])
     write_csv(ev, tdir / "events.csv", float_format="%.5f")
-    row = {"study": study, "protocol": sim.protocol, "subject": sim.subject, "trial": trial,
-           "sensor_kind": "lrs", "mocap_file": mocap_rel, "sensor_file": lrs_rel,
-           "sensor_topic": "", "annotation_file": "", "sensor_height_m": h,
-           "clock_offset_s": np.nan, "speed": "", "speed_mps": np.nan, "stick": False,
-           "scenario": "replay", "repetition": 1}
-    subj = {"subject": sim.subject, "group": "adult", "age_y": np.nan, "sex": "",
-            "height_m": np.nan, "mass_kg": np.nan, "leg_width_m": w, "knee_width_m": kw,
-            "ankle_width_m": aw, "leg_length_m": np.nan, "shank_length_m": np.nan,
-            "stick": False}
-    pose_row = {"trial": trial, "x_m": pose[0], "y_m": pose[1], "yaw_rad": pose[2],
-                "clock_offset_s": clock["clock_offset_s"],
-                "clock_drift_ppm": clock["clock_drift_ppm"]}
+    return mocap_rel, lrs_rel, legs
+
+
+def _replay_realism(trial: str, legs: pd.DataFrame, scans: pd.DataFrame, stats: dict
+                    ) -> list[dict]:
+    """The trial's realism row (see :func:`gaitval.simulate.sheet.summarise_realism`)."""
     sp = RD.leg_speeds(legs.dropna())
     scans = scans[np.isfinite(scans["x_m"])]           # frames with a known leg only
-    realism = [{"protocol": "replay", "phase": "all", "trial": trial, "leg_scans": len(scans),
-                "occluded_leg_scans": int(scans["occluded"].sum()),
-                "occluded_L": int(scans.loc[scans.side == "L", "occluded"].sum()),
-                "occluded_R": int(scans.loc[scans.side == "R", "occluded"].sum()),
-                "beams": stats["n_beams_total"], "returns": stats["n_returns"],
-                "mixed": stats["n_mixed"], "dropouts": stats["n_dropout"],
-                "stance_speed_mps": sp["stance_speed_mps"], "swing_speed_mps": sp["swing_speed_mps"],
-                "swing_peak_mps": sp["swing_peak_mps"], "walking_speed_mps": np.nan,
-                "steps": np.nan, "cross_steps": np.nan}]
-    return row, subj, pose_row, realism
+    return [{"protocol": "replay", "phase": "all", "trial": trial, "leg_scans": len(scans),
+             "occluded_leg_scans": int(scans["occluded"].sum()),
+             "occluded_L": int(scans.loc[scans.side == "L", "occluded"].sum()),
+             "occluded_R": int(scans.loc[scans.side == "R", "occluded"].sum()),
+             "beams": stats["n_beams_total"], "returns": stats["n_returns"],
+             "mixed": stats["n_mixed"], "dropouts": stats["n_dropout"],
+             "stance_speed_mps": sp["stance_speed_mps"], "swing_speed_mps": sp["swing_speed_mps"],
+             "swing_peak_mps": sp["swing_peak_mps"], "walking_speed_mps": np.nan,
+             "steps": np.nan, "cross_steps": np.nan}]
 
 
 def _render_window(sim: TrialSim, clock: dict, rng, t0: float):
@@ -269,8 +298,6 @@ def _render_window(sim: TrialSim, clock: dict, rng, t0: float):
 
 def generate_replay_study(out_dir: Path, cfg: dict, seed: int | None = None) -> Path:
     """Write the replay study described by ``cfg["replay"]`` (see ``config/studies/replay.yaml``)."""
-    from gaitval.simulate.study import SUBJECT_COLUMNS, TRIAL_COLUMNS, summarise_realism
-
     rcfg = dict(cfg["replay"])
     trials_cfg = rcfg.get("trials") or []
     if not trials_cfg:

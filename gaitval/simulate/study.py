@@ -1,6 +1,9 @@
 """Assemble a simulated study: subjects, trials, raw files, truth and realism figures.
 
-Entry point :func:`generate_study`; presets live in ``config/studies/<name>.yaml``.
+Entry point :func:`generate_study`; presets live in ``config/studies/<name>.yaml``.  The
+trial-sheet and subject-table columns, the sensor clock draw and the realism summary are
+shared with the replay of real walks (:mod:`gaitval.simulate.replay`) from
+:mod:`gaitval.simulate.sheet` and re-exported here.
 """
 from __future__ import annotations
 
@@ -22,14 +25,14 @@ from gaitval.io.scanlog import write_scanlog
 from gaitval.simulate import protocols as P
 from gaitval.simulate import render as RD
 from gaitval.simulate.kinematics import GaitParams
+from gaitval.simulate.sheet import (SUBJECT_COLUMNS, TRIAL_COLUMNS, sensor_clock,
+                                    summarise_realism)
+
+__all__ = ["PRESET_DIR", "SUBJECT_COLUMNS", "TRIAL_COLUMNS", "generate_study", "load_preset",
+           "summarise_realism"]
 
 log = logging.getLogger(__name__)
 PRESET_DIR = Path(__file__).resolve().parents[2] / "config" / "studies"
-TRIAL_COLUMNS = ["study", "protocol", "subject", "trial", "sensor_kind", "mocap_file",
-                 "sensor_file", "sensor_topic", "annotation_file", "sensor_height_m",
-                 "clock_offset_s", "speed", "speed_mps", "stick", "scenario", "repetition"]
-SUBJECT_COLUMNS = ["subject", "group", "age_y", "sex", "height_m", "mass_kg", "leg_width_m",
-                   "knee_width_m", "ankle_width_m", "leg_length_m", "shank_length_m", "stick"]
 
 
 def load_preset(preset: str | dict) -> dict:
@@ -48,13 +51,6 @@ def load_preset(preset: str | dict) -> dict:
 def _rng(seed: int, *keys: int) -> np.random.Generator:
     """Independent stream per (seed, purpose, index...): results do not depend on order."""
     return np.random.default_rng([int(seed) & 0xFFFFFFFF, *[int(k) for k in keys]])
-
-
-def _clock(rng, cfg) -> dict:
-    lo, hi = cfg.get("offset_s", [0.2, 2.0])
-    return {"clock_offset_s": round(float(rng.uniform(lo, hi)), 6),
-            "clock_drift_ppm": round(float(rng.normal(0.0, cfg.get("drift_ppm_sd", 30.0))), 3),
-            "jitter_s": float(cfg.get("jitter_s", 0.0005))}
 
 
 def _trial_row(study, sim: P.TrialSim, mocap, sensor, annot="", speed_mps=np.nan) -> dict:
@@ -177,36 +173,6 @@ def _render_trial(out: Path, study: str, sim: P.TrialSim, subj: dict, clock: dic
         })
 
 
-def summarise_realism(rows: list[dict]) -> pd.DataFrame:
-    """Per protocol (and TUG phase): occlusion, mixed-pixel and dropout fractions, speeds,
-    steps per trial and cross steps per 100 steps (the published figures beside them)."""
-    df = pd.DataFrame(rows)
-    published = {("tug", "forward"): 0.035, ("tug", "turning"): 0.113,
-                 ("tug", "return"): 0.051, ("tug", "all"): 0.054}
-    out = []
-    for (proto, ph), g in df.groupby(["protocol", "phase"], sort=True):
-        r = {"protocol": proto, "phase": ph, "n_trials": g["trial"].nunique(),
-             "leg_scans": int(g["leg_scans"].sum()),
-             "occlusion_rate": g["occluded_leg_scans"].sum() / max(g["leg_scans"].sum(), 1),
-             "occlusion_rate_L": 2 * g["occluded_L"].sum() / max(g["leg_scans"].sum(), 1),
-             "occlusion_rate_R": 2 * g["occluded_R"].sum() / max(g["leg_scans"].sum(), 1),
-             "occlusion_rate_published": published.get((proto, ph), np.nan)}
-        if ph == "all":
-            r.update({
-                "mixed_pixel_frac": g["mixed"].sum() / max(g["returns"].sum(), 1),
-                "dropout_frac": g["dropouts"].sum() / max(g["beams"].sum(), 1),
-                "stance_speed_mps": g["stance_speed_mps"].mean(),
-                "swing_speed_mps": g["swing_speed_mps"].mean(),
-                "swing_peak_mps": g["swing_peak_mps"].mean(),
-                "walking_speed_mps": g["walking_speed_mps"].mean(),
-                "steps_per_trial": g["steps"].mean(),
-                "cross_steps_per_100": 100 * g["cross_steps"].sum() / max(g["steps"].sum(), 1),
-                "cross_steps_per_100_published": 100 * 19 / 414 if proto == "mtst" else np.nan,
-            })
-        out.append(r)
-    return pd.DataFrame(out)
-
-
 def _subject_rows(study_cfg: dict, seed: int):
     """Yield (protocol, subject dict, GaitParams) for every participant of the preset."""
     out = []
@@ -225,6 +191,91 @@ def _subject_rows(study_cfg: dict, seed: int):
             out.append((proto, subj, gp))
             k += 1
     return out
+
+
+class _Laps:
+    """Logs how long each protocol took to simulate (call with the next protocol, or None)."""
+
+    def __init__(self) -> None:
+        self.t = time.perf_counter()
+        self.proto = None
+
+    def __call__(self, proto) -> None:
+        now = time.perf_counter()
+        if self.proto is not None:
+            log.info("simulated %s in %.2f s", self.proto, now - self.t)
+        self.t, self.proto = now, proto
+
+
+def _subject_trials(proto: str, c: dict, study: str, subj: dict, gp: GaitParams, rng_s,
+                    attendant_gp: GaitParams) -> list:
+    """One participant's trials as ``build(rng_t) -> TrialSim``, in order.
+
+    TUG and MTST draw the fixed sensor's pose for this participant from ``rng_s`` here.
+    """
+    sid = subj["subject"]
+    if proto == "tug":
+        pose = P._pose_jitter(rng_s, c["sensor_nominal_pose"])
+        return [lambda rng, r=r: P.build_tug(rng, study, subj, gp, f"tug_{sid}_t{r}", r, pose, c)
+                for r in range(1, int(c["n_trials"]) + 1)]
+    if proto == "mtst":
+        pose = P._pose_jitter(rng_s, c["sensor_nominal_pose"])
+        return [lambda rng, r=r: P.build_mtst(rng, study, subj, gp, f"mtst_{sid}_t{r}", r, pose,
+                                              c, P.COLORS[(r - 1) % 3], bool(subj["stick"]),
+                                              attendant_gp)
+                for r in range(1, int(c["n_trials"]) + 1)]
+    if proto == "rollator":
+        return [lambda rng, r=r, scen=scen: P.build_rollator(
+                    rng, study, subj, gp, f"rollator_{sid}_{scen}_r{r}", r, scen, c)
+                for scen in c.get("scenarios", ["straight", "obstacle"])
+                for r in range(1, int(c.get("n_repetitions", 2)) + 1)]
+    return []
+
+
+def _lrs_trials(out: Path, cfg: dict, study: str, seed: int, laps: _Laps, sheet: list,
+                realism: list, poses: list, subjects: list) -> None:
+    """Simulate and write every LRS trial (TUG, MTST, rollator) of the preset.
+
+    Streams: participant ``si`` draws from ``_rng(seed, 2, si)`` (sensor pose, clock
+    drift), trial ``idx`` (1-based over the study) from ``_rng(seed, 3, idx)`` (scene,
+    mocap variant, clock offset).
+    """
+    clock_cfg = cfg.get("clock", {})
+    idx = 0
+    attendant_gp = GaitParams(step_length_m=0.55, step_width_m=0.12, step_time_s=0.6,
+                              stance_frac=0.62, step_cv=0.03, place_sd_m=0.02,
+                              shank_length_m=0.40, hip_height_m=0.85)
+    for si, (proto, subj, gp) in enumerate(_subject_rows(cfg, seed)):
+        if proto != laps.proto:
+            laps(proto)
+        subjects.append(subj)
+        rng_s = _rng(seed, 2, si)
+        builders = _subject_trials(proto, cfg[proto], study, subj, gp, rng_s, attendant_gp)
+        drift = sensor_clock(rng_s, clock_cfg)["clock_drift_ppm"]
+        for build in builders:
+            idx += 1
+            rng_t = _rng(seed, 3, idx)
+            sim = build(rng_t)
+            sim.variant.update(_variant(rng_t, cfg))
+            clock = {**sensor_clock(rng_t, clock_cfg), "clock_drift_ppm": drift}
+            _render_trial(out, study, sim, subj, clock, seed, idx, realism, sheet, poses)
+
+
+def _add_ultrasonic(out: Path, cfg: dict, study: str, seed: int, laps: _Laps,
+                    trials: pd.DataFrame, subj_df: pd.DataFrame
+                    ) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Write the ultrasonic protocols' trials and append their sheet and subject rows."""
+    try:
+        from gaitval.simulate.ultrasonic import generate_ultrasonic
+    except ImportError as exc:
+        warnings.warn(f"ultrasonic protocols skipped: {exc}", stacklevel=3)
+        return trials, subj_df
+    ucfg = {**cfg["ultrasonic"], "study": study}
+    ut, us = generate_ultrasonic(out, ucfg, seed)
+    laps(None)
+    trials = pd.concat([trials, ut.reindex(columns=TRIAL_COLUMNS)], ignore_index=True)
+    subj_df = pd.concat([subj_df, us.reindex(columns=SUBJECT_COLUMNS)], ignore_index=True)
+    return trials, subj_df
 
 
 def generate_study(out_dir: Path, preset: str | dict = "default", seed: int | None = None
@@ -259,75 +310,13 @@ def generate_study(out_dir: Path, preset: str | dict = "default", seed: int | No
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     sheet, realism, poses, subjects = [], [], [], []
-    clock_cfg = cfg.get("clock", {})
-    idx = 0
-    attendant_gp = GaitParams(step_length_m=0.55, step_width_m=0.12, step_time_s=0.6,
-                              stance_frac=0.62, step_cv=0.03, place_sd_m=0.02,
-                              shank_length_m=0.40, hip_height_m=0.85)
-    tick = {"t": time.perf_counter(), "proto": None}
-
-    def lap(proto):
-        now = time.perf_counter()
-        if tick["proto"] is not None:
-            log.info("simulated %s in %.2f s", tick["proto"], now - tick["t"])
-        tick.update(t=now, proto=proto)
-
-    for si, (proto, subj, gp) in enumerate(_subject_rows(cfg, seed)):
-        if proto != tick["proto"]:
-            lap(proto)
-        c = cfg[proto]
-        subjects.append(subj)
-        rng_s = _rng(seed, 2, si)
-        if proto == "tug":
-            pose = P._pose_jitter(rng_s, c["sensor_nominal_pose"])
-            drift = _clock(rng_s, clock_cfg)["clock_drift_ppm"]
-            for r in range(1, int(c["n_trials"]) + 1):
-                idx += 1
-                rng_t = _rng(seed, 3, idx)
-                sim = P.build_tug(rng_t, study, subj, gp, f"tug_{subj['subject']}_t{r}", r,
-                                  pose, c)
-                sim.variant.update(_variant(rng_t, cfg))
-                clock = {**_clock(rng_t, clock_cfg), "clock_drift_ppm": drift}
-                _render_trial(out, study, sim, subj, clock, seed, idx, realism, sheet, poses)
-        elif proto == "mtst":
-            pose = P._pose_jitter(rng_s, c["sensor_nominal_pose"])
-            drift = _clock(rng_s, clock_cfg)["clock_drift_ppm"]
-            for r in range(1, int(c["n_trials"]) + 1):
-                idx += 1
-                rng_t = _rng(seed, 3, idx)
-                color = P.COLORS[(r - 1) % 3]
-                sim = P.build_mtst(rng_t, study, subj, gp, f"mtst_{subj['subject']}_t{r}", r,
-                                   pose, c, color, bool(subj["stick"]), attendant_gp)
-                sim.variant.update(_variant(rng_t, cfg))
-                clock = {**_clock(rng_t, clock_cfg), "clock_drift_ppm": drift}
-                _render_trial(out, study, sim, subj, clock, seed, idx, realism, sheet, poses)
-        elif proto == "rollator":
-            drift = _clock(rng_s, clock_cfg)["clock_drift_ppm"]
-            for scen in c.get("scenarios", ["straight", "obstacle"]):
-                for r in range(1, int(c.get("n_repetitions", 2)) + 1):
-                    idx += 1
-                    rng_t = _rng(seed, 3, idx)
-                    sim = P.build_rollator(rng_t, study, subj, gp,
-                                           f"rollator_{subj['subject']}_{scen}_r{r}", r, scen, c)
-                    sim.variant.update(_variant(rng_t, cfg))
-                    clock = {**_clock(rng_t, clock_cfg), "clock_drift_ppm": drift}
-                    _render_trial(out, study, sim, subj, clock, seed, idx, realism, sheet,
-                                  poses)
-    lap("ultrasonic" if cfg.get("ultrasonic") else None)
+    laps = _Laps()
+    _lrs_trials(out, cfg, study, seed, laps, sheet, realism, poses, subjects)
+    laps("ultrasonic" if cfg.get("ultrasonic") else None)
     trials = pd.DataFrame(sheet, columns=TRIAL_COLUMNS)
     subj_df = pd.DataFrame(subjects, columns=SUBJECT_COLUMNS)
     if cfg.get("ultrasonic"):
-        try:
-            from gaitval.simulate.ultrasonic import generate_ultrasonic
-        except ImportError as exc:
-            warnings.warn(f"ultrasonic protocols skipped: {exc}", stacklevel=2)
-        else:
-            ucfg = {**cfg["ultrasonic"], "study": study}
-            ut, us = generate_ultrasonic(out, ucfg, seed)
-            lap(None)
-            trials = pd.concat([trials, ut.reindex(columns=TRIAL_COLUMNS)], ignore_index=True)
-            subj_df = pd.concat([subj_df, us.reindex(columns=SUBJECT_COLUMNS)],
-                                ignore_index=True)
+        trials, subj_df = _add_ultrasonic(out, cfg, study, seed, laps, trials, subj_df)
     write_csv(trials, out / "trials.csv")
     write_csv(subj_df, out / "subjects.csv")
     write_csv(pd.DataFrame(poses, columns=["trial", "x_m", "y_m", "yaw_rad", "clock_offset_s",
