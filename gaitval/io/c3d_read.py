@@ -1,0 +1,273 @@
+"""Reading C3D files: marker trajectories in metres and seconds, NaN gaps, events.
+
+Part of :mod:`gaitval.io.c3d`, which re-exports :func:`read_c3d` and
+:func:`clean_labels`; the conventions (units, gaps, labels, duplicates, first frame,
+events) are in that module's notes.  It uses ezc3d [1]_ after the structural checks of
+:mod:`gaitval.io.c3d_format`.
+
+References
+----------
+.. [1] Michaud, B., & Begon, M. (2021). ezc3d: An easy C3D file I/O cross-platform
+   solution for C++, Python and MATLAB. Journal of Open Source Software, 6(58), 2911.
+.. [2] Motion Lab Systems (2008). The C3D File Format User Guide. https://www.c3d.org
+"""
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from gaitval.errors import FileFormatError
+from gaitval.io.c3d_format import EVENT_COLUMNS, UNIT_SCALE, _open_ezc3d, _precheck
+from gaitval.types import MocapTrial
+
+# the reader's messages keep the name of the module users import it from
+log = logging.getLogger("gaitval.io.c3d")
+
+def _param(c, group: str, name: str, default=None):
+    try:
+        return c["parameters"][group][name]["value"]
+    except KeyError:
+        return default
+
+
+def _strings(value) -> list[str]:
+    if value is None:
+        return []
+    if isinstance(value, str):
+        return [value.strip("\x00 \t")]
+    return [str(v).strip("\x00 \t") for v in np.asarray(value, dtype=object).ravel()]
+
+
+def _first_number(value, default=None):
+    if value is None:
+        return default
+    arr = np.asarray(value).ravel()
+    return default if arr.size == 0 else arr[0].item()
+
+
+def _raw_labels(c, n_points: int) -> list[str]:
+    labels = _strings(_param(c, "POINT", "LABELS"))
+    k = 2
+    while _param(c, "POINT", f"LABELS{k}") is not None:
+        labels += _strings(_param(c, "POINT", f"LABELS{k}"))
+        k += 1
+    labels = labels[:n_points]
+    labels += [""] * (n_points - len(labels))
+    return labels
+
+
+def clean_labels(raw: list[str], *, duplicates: str = "suffix"
+                 ) -> tuple[list[str], dict[str, list[str]], list[str]]:
+    """Strip subject prefixes and disambiguate duplicates (see the module docstring).
+
+    Returns
+    -------
+    labels : list of str
+    dups : dict
+        Duplicated label -> the labels given to its occurrences (``["RKNE", "RKNE#2"]``).
+    prefixes : list of str
+        Distinct prefixes stripped (``"Matt:"``), in order of appearance.
+    """
+    stripped, prefixes = [], []
+    for k, lab in enumerate(raw):
+        lab = lab.strip()
+        if ":" in lab:
+            pre, lab = lab.rsplit(":", 1)
+            if pre + ":" not in prefixes:
+                prefixes.append(pre + ":")
+            lab = lab.strip()
+        stripped.append(lab or f"POINT{k + 1}")
+    counts: dict[str, int] = {}
+    for lab in stripped:
+        counts[lab] = counts.get(lab, 0) + 1
+    dups = {lab: [] for lab, n in counts.items() if n > 1}
+    if dups and duplicates == "error":
+        raise ValueError(", ".join(f"{lab} x{counts[lab]}" for lab in dups))
+    seen: dict[str, int] = {}
+    taken = set(stripped)
+    out = []
+    for lab in stripped:
+        seen[lab] = seen.get(lab, 0) + 1
+        new = lab
+        if seen[lab] > 1:
+            k = seen[lab]
+            while f"{lab}#{k}" in taken:                 # never collide with a real label
+                k += 1
+            new = f"{lab}#{k}"
+            taken.add(new)
+        out.append(new)
+        if lab in dups:
+            dups[lab].append(new)
+    return out, dups, prefixes
+
+
+def _events(c) -> tuple[pd.DataFrame, str]:
+    """Events from the EVENT group, else from the header event block."""
+    times = _param(c, "EVENT", "TIMES")
+    if times is not None and np.asarray(times).size:
+        arr = np.asarray(times, dtype=np.float64)
+        if arr.ndim == 1:
+            arr = arr.reshape(-1, 2).T      # stored column-major: (minutes, seconds) pairs
+        t = 60.0 * arr[0] + arr[1]          # C3D guide: TIMES(1,i) minutes, TIMES(2,i) seconds
+        n = len(t)
+        used = _first_number(_param(c, "EVENT", "USED"), n)
+        n = min(n, int(used))
+        ctx = (_strings(_param(c, "EVENT", "CONTEXTS")) + [""] * n)[:n]
+        lab = (_strings(_param(c, "EVENT", "LABELS")) + [""] * n)[:n]
+        df = pd.DataFrame({"context": ctx, "label": lab, "t_s": t[:n]})
+        source = "EVENT"
+    else:
+        ht = c["header"]["events"]["events_time"]
+        hl = c["header"]["events"]["events_label"]
+        rows = [("", str(lab).strip(), float(tt)) for tt, lab in zip(ht, hl)
+                if str(lab).strip()]
+        df = pd.DataFrame(rows, columns=EVENT_COLUMNS)
+        source = "header" if rows else "none"
+    df = df.astype({"context": object, "label": object, "t_s": np.float64})
+    df = df.sort_values("t_s", kind="stable").reset_index(drop=True)
+    return df, source
+
+
+def _first_frame(c) -> tuple[int, int]:
+    """(first_frame 1-based, header value 1-based) — see the module docstring."""
+    header_ff = int(c["header"]["points"]["first_frame"]) + 1
+    start = _param(c, "TRIAL", "ACTUAL_START_FIELD")
+    if start is not None and np.asarray(start).size >= 1:
+        w = [int(v) & 0xFFFF for v in np.asarray(start).ravel()[:2]] + [0]
+        ff = w[0] + 65536 * w[1]
+        if ff >= 1:
+            return ff, header_ff
+    return header_ff, header_ff
+
+
+def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "suffix"
+             ) -> MocapTrial:
+    """Read the marker trajectories of a C3D file (metres, seconds, NaN gaps).
+
+    Parameters
+    ----------
+    path : str or Path
+    trial : str, optional
+        Trial id, named in error messages.
+    duplicates : {"suffix", "error"}
+        Policy for labels that are equal after prefix stripping: ``suffix`` keeps every
+        marker and names later ones ``LABEL#2``, ``LABEL#3`` (listed in
+        ``meta["duplicates"]``); ``error`` raises :class:`FileFormatError`.
+
+    Returns
+    -------
+    MocapTrial
+        ``labels`` (prefix stripped), ``xyz`` (n_frames, n_markers, 3) in metres with NaN
+        gaps, ``rate_hz``, ``first_frame`` (1-based), ``events`` (``context, label, t_s``
+        on the ``MocapTrial.t`` time base), ``units`` (the file's unit), ``meta`` with
+        ``original_labels``, ``prefixes``, ``duplicates``, ``n_zero_gaps``, ``n_analogs``,
+        ``analog_rate_hz``, ``events_source``, ``manufacturer``, ``processor``.
+
+    Raises
+    ------
+    FileFormatError
+        Missing, unreadable, truncated or non-standard file; unknown units; duplicate
+        labels under ``duplicates="error"``.  The message names the file and the reason.
+
+    Notes
+    -----
+    The conventions (units, gaps, prefixes, duplicates, first frame, events) are in the
+    module docstring and ``docs/formats.md``.
+    """
+    path = Path(path)
+    if duplicates not in ("suffix", "error"):
+        raise ValueError("duplicates must be 'suffix' or 'error'")
+    pre = _precheck(path, trial)
+    c = _open_ezc3d(path, trial)
+    pts = _point_data(c, pre, path, trial)                    # (4, n_points, n_frames)
+    units, units_assumed = _units(c, path, trial)
+    raw_labels = _raw_labels(c, int(pts.shape[1]))
+    labels, dups, prefixes = _labels(raw_labels, duplicates, path, trial)
+
+    res = np.asarray(c["data"]["meta_points"]["residuals"], dtype=np.float64)
+    xyz = pts[:3].transpose(2, 1, 0) * UNIT_SCALE[units]        # (n_frames, n_points, 3)
+    neg = (res[0].T < 0) if res.size else np.zeros(xyz.shape[:2], dtype=bool)
+    zero = np.all(xyz == 0.0, axis=2) & ~neg                     # all-zero coordinates
+    gap = neg | zero | ~np.all(np.isfinite(xyz), axis=2)
+    xyz[gap] = np.nan
+
+    rate = _first_number(_param(c, "POINT", "RATE"), None)
+    rate = float(rate) if rate else float(c["header"]["points"]["frame_rate"])
+    if not rate > 0:
+        raise FileFormatError("C3D point rate is zero", path=path, trial=trial)
+    ff, header_ff = _first_frame(c)
+    events, ev_source = _events(c)
+    company = " ".join(_strings(_param(c, "MANUFACTURER", "COMPANY")))
+    software = " ".join(_strings(_param(c, "MANUFACTURER", "SOFTWARE")))
+    meta: dict[str, Any] = {
+        "original_labels": raw_labels,
+        "prefixes": prefixes,
+        "duplicates": dups,
+        "n_zero_gaps": int(zero.sum()),
+        "units_assumed": units_assumed,
+        "n_analogs": int(c["data"]["analogs"].shape[1]),
+        "analog_rate_hz": float(c["header"]["analogs"]["frame_rate"]),
+        "events_source": ev_source,
+        "manufacturer": " / ".join(s for s in (company, software) if s),
+        "processor": pre["processor"],
+        "first_frame_header": header_ff,
+        "subjects": _strings(_param(c, "SUBJECTS", "NAMES")),
+    }
+    return MocapTrial(path=str(path), rate_hz=rate, first_frame=int(ff), labels=labels,
+                      xyz=xyz, events=events, units=units, meta=meta)
+
+
+def _point_data(c, pre: dict, path: Path, trial: str | None) -> np.ndarray:
+    """The point array (4, n_points, n_frames); a file with fewer frames than its header
+    (or ``POINT:FRAMES``) announces is truncated."""
+    pts = np.asarray(c["data"]["points"], dtype=np.float64)   # (4, n_points, n_frames)
+    n_frames = int(pts.shape[2])
+    # ezc3d shrinks its header to what it could read, so compare with the raw header
+    # words (meaningful below 65535 frames) and POINT:FRAMES
+    expected = 0
+    if pre["processor"] == "Intel" and 0 < pre["last_frame_word"] < 65535:
+        expected = pre["last_frame_word"] - pre["first_frame_word"] + 1
+    p_frames = _first_number(_param(c, "POINT", "FRAMES"), 0)
+    if p_frames and 0 < int(p_frames) < 65535:
+        expected = max(expected, int(p_frames))
+    if n_frames == 0:
+        raise FileFormatError("C3D file holds no point frames (empty or truncated)",
+                              path=path, trial=trial)
+    if n_frames < expected:
+        raise FileFormatError(f"C3D file is truncated: the header announces {expected} "
+                              f"frames, the data section holds {n_frames}",
+                              path=path, trial=trial)
+    return pts
+
+
+def _units(c, path: Path, trial: str | None) -> tuple[str, bool]:
+    """``POINT:UNITS`` (mm when absent: (unit, assumed))."""
+    units_raw = _strings(_param(c, "POINT", "UNITS"))
+    units = units_raw[0].lower() if units_raw and units_raw[0] else ""
+    units_assumed = not units
+    if units_assumed:
+        units = "mm"
+    if units not in UNIT_SCALE:
+        raise FileFormatError(f"POINT:UNITS is {units_raw[0]!r}; gaitval reads mm, cm or m",
+                              path=path, trial=trial)
+    return units, units_assumed
+
+
+def _labels(raw_labels: list[str], duplicates: str, path: Path, trial: str | None
+            ) -> tuple[list[str], dict[str, list[str]], list[str]]:
+    """:func:`clean_labels` with its errors as FileFormatError and duplicates logged."""
+    try:
+        labels, dups, prefixes = clean_labels(raw_labels, duplicates=duplicates)
+    except ValueError as exc:
+        raise FileFormatError(f"duplicate marker labels after prefix stripping: {exc}",
+                              path=path, trial=trial,
+                              hint="rename them in the capture software, or read with "
+                                   "duplicates='suffix'") from None
+    if dups:
+        log.warning("%s: duplicate marker labels kept with suffixes: %s", path,
+                    "; ".join(f"{k} -> {', '.join(v)}" for k, v in dups.items()))
+    return labels, dups, prefixes

@@ -1,0 +1,149 @@
+"""Writing C3D files (the simulator's mocap, the replay study's re-exported walks).
+
+Part of :mod:`gaitval.io.c3d`, which re-exports :func:`write_c3d`; the conventions
+(units, gaps, labels, first frame, events) are in that module's notes.  It uses
+ezc3d [1]_.
+
+References
+----------
+.. [1] Michaud, B., & Begon, M. (2021). ezc3d: An easy C3D file I/O cross-platform
+   solution for C++, Python and MATLAB. Journal of Open Source Software, 6(58), 2911.
+.. [2] Motion Lab Systems (2008). The C3D File Format User Guide. https://www.c3d.org
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from gaitval.io.atomic import atomic_path
+from gaitval.io.c3d_format import EVENT_COLUMNS
+
+def _add_int_parameter(c, group: str, name: str, values: list[int]) -> None:
+    """Add an INT parameter (ezc3d's ``add_parameter`` would store integers as FLOAT)."""
+    from ezc3d import ezc3d as swig
+
+    p = swig.Parameter(name, "")
+    p.set(swig.VecInt([int(v) for v in values]), [len(values)])
+    c.parameters.add_parameter(group, p)
+
+
+def write_c3d(path: str | Path, labels: list[str], xyz_m: np.ndarray, rate_hz: float, *,
+              events: pd.DataFrame | None = None, first_frame: int = 1,
+              subject_prefix: str | None = None) -> Path:
+    """Write marker trajectories as a C3D file in millimetres (atomically).
+
+    Parameters
+    ----------
+    path : str or Path
+        Target file (``.c3d``).
+    labels : list of str
+        Marker labels, one per marker (without prefix).
+    xyz_m : ndarray, shape (n_frames, n_markers, 3)
+        Positions in metres; NaN (in any coordinate) marks a missing sample.
+    rate_hz : float
+        Point rate.
+    events : DataFrame, optional
+        Columns ``context``, ``label``, ``t_s`` (seconds on the ``MocapTrial.t`` time base,
+        i.e. from frame 1 of the capture).  Written to the ``EVENT`` group.
+    first_frame : int
+        1-based number of the first stored frame (also in ``TRIAL:ACTUAL_START_FIELD``).
+    subject_prefix : str, optional
+        Written as ``<prefix>:<label>`` with a Vicon ``SUBJECTS`` group, as Nexus does.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Notes
+    -----
+    Points are stored as floats (``POINT:SCALE = -1``) in ``mm``.  A missing sample is
+    written as Vicon writes it: coordinates 0 and residual -1, so every C3D reader sees
+    the gap.  Present samples get residual 0.
+    """
+    import ezc3d
+
+    xyz = np.asarray(xyz_m, dtype=np.float64)
+    if xyz.ndim != 3 or xyz.shape[2] != 3:
+        raise ValueError(f"xyz_m must have shape (n_frames, n_markers, 3), not {xyz.shape}")
+    n_frames, n_markers, _ = xyz.shape
+    labels = [str(s) for s in labels]
+    if len(labels) != n_markers:
+        raise ValueError(f"{len(labels)} labels for {n_markers} markers")
+    if first_frame < 1:
+        raise ValueError("first_frame is 1-based and must be >= 1")
+    if subject_prefix:
+        file_labels = [f"{subject_prefix}:{s}" for s in labels]
+    else:
+        file_labels = list(labels)
+
+    gap = ~np.all(np.isfinite(xyz), axis=2)                      # (n_frames, n_markers)
+    mm = np.where(gap[..., None], 0.0, xyz * 1000.0)
+    points = np.ones((4, n_markers, n_frames), dtype=np.float64)
+    points[:3] = mm.transpose(2, 1, 0)
+    residuals = np.where(gap.T, -1.0, 0.0)[None, :, :]
+
+    c = ezc3d.c3d()
+    c["parameters"]["POINT"]["RATE"]["value"] = np.array([float(rate_hz)])
+    c["parameters"]["POINT"]["LABELS"]["value"] = file_labels
+    c["parameters"]["POINT"]["DESCRIPTIONS"]["value"] = [""] * n_markers
+    c["parameters"]["POINT"]["UNITS"]["value"] = ["mm"]
+    c["header"]["points"]["first_frame"] = int(first_frame - 1)   # ezc3d is 0-based
+    c["data"]["points"] = points
+    c["data"]["meta_points"] = {
+        "residuals": residuals,
+        "camera_masks": np.zeros((7, n_markers, n_frames), dtype=bool),
+    }
+    _add_trial_parameters(c, first_frame, n_frames, subject_prefix)
+    if events is not None and len(events):
+        _add_events(c, events, subject_prefix)
+    _write_atomic(c, path)
+    return Path(path)
+
+
+def _add_trial_parameters(c, first_frame: int, n_frames: int,
+                          subject_prefix: str | None) -> None:
+    """TRIAL first/last frame (two 16-bit words), MANUFACTURER and a Vicon SUBJECTS group."""
+    last = first_frame + n_frames - 1
+    _add_int_parameter(c, "TRIAL", "ACTUAL_START_FIELD", [first_frame & 0xFFFF, first_frame >> 16])
+    _add_int_parameter(c, "TRIAL", "ACTUAL_END_FIELD", [last & 0xFFFF, last >> 16])
+    c.add_parameter("MANUFACTURER", "SOFTWARE", ["gaitval"])
+    if subject_prefix:
+        _add_int_parameter(c, "SUBJECTS", "USED", [1])
+        _add_int_parameter(c, "SUBJECTS", "USES_PREFIXES", [1])
+        c.add_parameter("SUBJECTS", "NAMES", [subject_prefix])
+        c.add_parameter("SUBJECTS", "LABEL_PREFIXES", [f"{subject_prefix}:"])
+
+
+def _add_events(c, events: pd.DataFrame, subject_prefix: str | None) -> None:
+    """The EVENT group as Nexus writes it (times as minutes 0, seconds)."""
+    ev = events.reset_index(drop=True)
+    for col in EVENT_COLUMNS:
+        if col not in ev:
+            raise ValueError(f"events need columns {EVENT_COLUMNS}; missing {col!r}")
+    t = ev["t_s"].to_numpy(dtype=np.float64)
+    times = np.vstack([np.zeros_like(t), t])                 # minutes 0, as Nexus writes
+    _add_int_parameter(c, "EVENT", "USED", [len(ev)])
+    c.add_parameter("EVENT", "CONTEXTS", [str(s) for s in ev["context"]])
+    c.add_parameter("EVENT", "LABELS", [str(s) for s in ev["label"]])
+    c.add_parameter("EVENT", "DESCRIPTIONS", [""] * len(ev))
+    c.add_parameter("EVENT", "SUBJECTS", [subject_prefix or ""] * len(ev))
+    _add_int_parameter(c, "EVENT", "ICON_IDS", [0] * len(ev))
+    _add_int_parameter(c, "EVENT", "GENERIC_FLAGS", [0] * len(ev))
+    c.add_parameter("EVENT", "TIMES", times)
+
+
+def _write_atomic(c, path: str | Path) -> None:
+    """Write the ezc3d object to ``path`` through a temporary file (ezc3d appends .c3d)."""
+    with atomic_path(path) as tmp:
+        ez_tmp = str(tmp) + ".c3d"                               # ezc3d appends .c3d
+        try:
+            c.write(ez_tmp)
+            os.replace(ez_tmp, tmp)
+        finally:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(ez_tmp)
