@@ -155,12 +155,8 @@ def cmd_report(a) -> int:
 
 
 # -- parser -------------------------------------------------------------------------------
-def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="gaitval", description=__doc__.splitlines()[0])
-    from gaitval import __version__
-    p.add_argument("--version", action="version", version=f"gaitval {__version__}")
-    sub = p.add_subparsers(dest="verb", required=True)
-
+def _add_input_verbs(sub) -> None:
+    """Getting data in: inspect a file, validate a sheet, simulate, ingest, a peer's results."""
     s = sub.add_parser("inspect", help="show what gaitval's loaders see in a file")
     s.add_argument("file")
     s.add_argument("--json", action="store_true", help="machine-readable output")
@@ -202,6 +198,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--config-hash", default="")
     s.set_defaults(func=cmd_peer)
 
+
+def _add_lrs_verbs(sub) -> None:
+    """Laser range sensor studies: registration and ground truth, tracking, TUG evaluation."""
     s = sub.add_parser("register", help="register one trial and build its ground truth")
     s.add_argument("--ingest", required=True, help="the trial's ingest folder")
     s.add_argument("--sheet", required=True)
@@ -249,6 +248,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--config-hash", default="")
     s.set_defaults(func=cmd_tug_tables)
 
+
+def _add_ultrasonic_verbs(sub) -> None:
+    """The ultrasonic study (seed 003): noise identification, UKF tracking, gait parameters."""
     s = sub.add_parser("ultrasonic-noise", help="V and W from pendulum trials; Table 1")
     s.add_argument("--ingest", nargs="+", required=True, help="pendulum ingest folders")
     s.add_argument("--trials", nargs="+", required=True, help="their trial ids, same order")
@@ -284,6 +286,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--reports-dir", default="reports")
     s.add_argument("--config-hash", default="")
     s.set_defaults(func=cmd_ultrasonic_tables)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``gaitval`` argument parser: one sub-command per verb, in pipeline order."""
+    p = argparse.ArgumentParser(prog="gaitval", description=__doc__.splitlines()[0])
+    from gaitval import __version__
+    p.add_argument("--version", action="version", version=f"gaitval {__version__}")
+    sub = p.add_subparsers(dest="verb", required=True)
+    _add_input_verbs(sub)
+    _add_lrs_verbs(sub)
+    _add_ultrasonic_verbs(sub)
 
     s = sub.add_parser("report", help="write reports/index.md and index.html")
     s.add_argument("--reports-dir", default="reports")
