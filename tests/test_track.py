@@ -428,14 +428,18 @@ def _snapshot_values():
 def test_regression_snapshot():
     """Seeded synthetic TUG through all three methods; a change shows up as a diff here.
 
-    Regenerate deliberately with ``GAITVAL_UPDATE_SNAPSHOTS=1``.
+    Regenerate deliberately with ``GAITVAL_UPDATE_SNAPSHOTS=1`` (then commit the file).  A
+    missing snapshot is a failure, never a silent first write.
     """
     import os
 
     got = _snapshot_values()
-    if os.environ.get("GAITVAL_UPDATE_SNAPSHOTS") == "1" or not SNAPSHOT.exists():
+    if os.environ.get("GAITVAL_UPDATE_SNAPSHOTS") == "1":
         SNAPSHOT.parent.mkdir(parents=True, exist_ok=True)
         SNAPSHOT.write_text(json.dumps(got, indent=1, sort_keys=True) + "\n")
-        pytest.skip("snapshot written")
+        pytest.skip("snapshot written (GAITVAL_UPDATE_SNAPSHOTS=1)")
+    if not SNAPSHOT.exists():
+        pytest.fail(f"regression snapshot {SNAPSHOT} is missing: generate it with "
+                    "GAITVAL_UPDATE_SNAPSHOTS=1 and commit it")
     want = json.loads(SNAPSHOT.read_text())
     assert got == want

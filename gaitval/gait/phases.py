@@ -95,10 +95,16 @@ def gait_phase(pl: tuple[float, float], vl: tuple[float, float],
 
 
 def gait_phase_xy(xl, yl, vxl, vyl, xr, yr, vxr, vyr, v_st_th, v_sw_th) -> int:
-    """:func:`gait_phase` on plain floats (the tracker's inner loop)."""
+    """:func:`gait_phase` on plain floats."""
+    return gait_phase_of_states((xl, yl, vxl, vyl), (xr, yr, vxr, vyr), v_st_th, v_sw_th)
+
+
+def gait_phase_of_states(l, r, v_st_th: float, v_sw_th: float) -> int:
+    """:func:`gait_phase` of two states read as ``(x, y, vx, vy, …)`` (the tracker's loop)."""
+    vxl, vyl, vxr, vyr = l[2], l[3], r[2], r[3]
     sl = math.hypot(vxl, vyl)
     sr = math.hypot(vxr, vyr)
-    # eq. (3)–(4) with the resolution of the module notes
+    # seed000 eq. (3)–(4) with the resolution of the module notes
     lsw = False if sl < v_st_th else (True if sl > v_sw_th else sl > sr)
     rsw = False if sr < v_st_th else (True if sr > v_sw_th else sr > sl)
     if lsw and rsw:
@@ -106,9 +112,9 @@ def gait_phase_xy(xl, yl, vxl, vyl, xr, yr, vxr, vyr, v_st_th, v_sw_th) -> int:
     if not lsw and not rsw:
         return 0
     if lsw:
-        # eq. (5): (p^R - p^L) · v^L
-        return 1 if (xr - xl) * vxl + (yr - yl) * vyl > 0.0 else 2
-    return 3 if (xl - xr) * vxr + (yl - yr) * vyr > 0.0 else 4
+        # seed000 eq. (5): (p^R - p^L) · v^L
+        return 1 if (r[0] - l[0]) * vxl + (r[1] - l[1]) * vyl > 0.0 else 2
+    return 3 if (l[0] - r[0]) * vxr + (l[1] - r[1]) * vyr > 0.0 else 4
 
 
 def gait_phases(pl: np.ndarray, vl: np.ndarray, pr: np.ndarray, vr: np.ndarray,

@@ -17,8 +17,10 @@ Three interchangeable implementations of the role ``filter``:
     readable reference; the contract tests check every filter against it with the same
     noise matrices (:meth:`LegFilter.noise`).
 
-A state is an opaque value owned by the filter (a tuple for ``kf``, ``(x, P)`` arrays for
-``kf_matrix``); the tracker only calls the methods below.
+A state is a tuple whose first four entries are the leg's ``x, y, vx, vy`` (sensor frame,
+m and m/s) as Python floats; what follows is the filter's own (covariance terms for ``kf``
+and ``kf_aniso``, the 4×4 array P for ``kf_matrix``).  The tracker and the other roles read
+the first four entries and otherwise only call the methods below.
 
 Notes
 -----
@@ -97,18 +99,15 @@ class LegFilter:
         raise NotImplementedError
 
     def pos(self, s) -> tuple[float, float]:
-        raise NotImplementedError
+        return s[0], s[1]
 
     def vel(self, s) -> tuple[float, float]:
-        raise NotImplementedError
+        return s[2], s[3]
 
     def posvel(self, s) -> tuple[float, float, float, float]:
         """(x, y, vx, vy) of a state."""
-        return self.pos(s) + self.vel(s)
+        return s[:4]
 
-    def with_state(self, s, x: float, y: float, vx: float, vy: float):
-        """``s`` with its mean replaced (covariance kept); used to rewrite a history."""
-        raise NotImplementedError
 
 
 @FILTERS.register("kf")
@@ -119,22 +118,26 @@ class AxisKalmanFilter(LegFilter):
     (position, velocity) of either axis.
     """
 
+    def __init__(self, q_accel_sd_mps2: float = 15.0, r_sd_m: float = 0.04,
+                 p0_pos_sd_m: float = 0.04, p0_vel_sd_mps: float = 0.5):
+        super().__init__(q_accel_sd_mps2, r_sd_m, p0_pos_sd_m, p0_vel_sd_mps)
+        self._cache: dict[float, tuple] = {}
+
     def init(self, x, y, vx=0.0, vy=0.0):
         return (float(x), float(y), float(vx), float(vy),
                 self.p0_pos_sd_m ** 2, 0.0, self.p0_vel_sd_mps ** 2)
 
     def _consts(self, dt):
         """(Δt²/2, q Δt⁴/4, q Δt³/2, q Δt²) for one Δt (cached: Δt rarely changes)."""
-        key = (dt, self.q_accel_sd_mps2)
-        if getattr(self, "_ckey", None) != key:
-            h = 0.5 * dt * dt
-            q = self.q_accel_sd_mps2 ** 2
-            self._ckey, self._cval = key, (h, q * h * h, q * h * dt, q * dt * dt)
-        return self._cval
+        h = 0.5 * dt * dt
+        q = self.q_accel_sd_mps2 ** 2
+        c = self._cache[dt] = (h, q * h * h, q * h * dt, q * dt * dt)
+        return c
 
     def predict(self, s, dt, ux, uy):
         x, y, vx, vy, a, b, c = s
-        h, qaa, qab, qbb = self._consts(dt)
+        cst = self._cache.get(dt)
+        h, qaa, qab, qbb = cst if cst is not None else self._consts(dt)
         # eq. (7): x = A x + B_u u
         # eq. (8): P = A P Aᵀ + B Q Bᵀ (per axis: B Q Bᵀ = q [[Δt⁴/4, Δt³/2], [Δt³/2, Δt²]])
         return (x + dt * vx + h * ux, y + dt * vy + h * uy, vx + dt * ux, vy + dt * uy,
@@ -174,17 +177,7 @@ class AxisKalmanFilter(LegFilter):
         v = s[4] + self.r_sd_m ** 2
         return np.array([[v, 0.0], [0.0, v]])
 
-    def pos(self, s):
-        return s[0], s[1]
 
-    def vel(self, s):
-        return s[2], s[3]
-
-    def posvel(self, s):
-        return s[:4]
-
-    def with_state(self, s, x, y, vx, vy):
-        return (float(x), float(y), float(vx), float(vy), s[4], s[5], s[6])
 
 
 @FILTERS.register("kf_aniso")
@@ -261,17 +254,7 @@ class AnisotropicKalmanFilter(LegFilter):
         return (np.diag([self._qx2, self._qy2]), np.diag([self._rx2, self._ry2]),
                 np.diag([self.p0_pos_sd_m ** 2] * 2 + [self.p0_vel_sd_mps ** 2] * 2))
 
-    def pos(self, s):
-        return s[0], s[1]
 
-    def vel(self, s):
-        return s[2], s[3]
-
-    def posvel(self, s):
-        return s[:4]
-
-    def with_state(self, s, x, y, vx, vy):
-        return (float(x), float(y), float(vx), float(vy)) + tuple(s[4:])
 
 
 @FILTERS.register("kf_matrix")
@@ -299,37 +282,33 @@ class MatrixKalmanFilter(LegFilter):
         B = np.array([[dt * dt / 2, 0], [0, dt * dt / 2], [dt, 0], [0, dt]])
         return A, B
 
+    @staticmethod
+    def _state(x: np.ndarray, P: np.ndarray) -> tuple:
+        return (*x.tolist(), P)
+
     def init(self, x, y, vx=0.0, vy=0.0):
-        return (np.array([x, y, vx, vy], dtype=float), self._noise[2].copy())
+        return self._state(np.array([x, y, vx, vy], dtype=float), self._noise[2].copy())
 
     def predict(self, s, dt, ux, uy):
-        x, P = s
+        x, P = np.array(s[:4]), s[4]
         A, B = self._ab(dt)
         Q = self._noise[0]
         x = A @ x + B @ np.array([ux, uy])            # seed000 eq. (7)
         P = A @ P @ A.T + B @ Q @ B.T                  # seed000 eq. (8)
-        return (x, P)
+        return self._state(x, P)
 
     def innovation_cov(self, s):
-        return self.C @ s[1] @ self.C.T + self._noise[1]   # seed000 eq. (12)
+        return self.C @ s[4] @ self.C.T + self._noise[1]   # seed000 eq. (12)
 
     def correct(self, s, zx, zy):
-        x, P = s
+        x, P = np.array(s[:4]), s[4]
         S = self.innovation_cov(s)
-        K = P @ self.C.T @ np.linalg.inv(S)            # eq. (15)
-        x = x + K @ (np.array([zx, zy]) - self.C @ x)  # eq. (14)
-        P = (np.eye(4) - K @ self.C) @ P               # eq. (16)
-        return (x, P)
+        K = P @ self.C.T @ np.linalg.inv(S)            # seed000 eq. (15)
+        x = x + K @ (np.array([zx, zy]) - self.C @ x)  # seed000 eq. (14)
+        P = (np.eye(4) - K @ self.C) @ P               # seed000 eq. (16)
+        return self._state(x, P)
 
     def mahalanobis2(self, s, zx, zy):
-        e = np.array([zx, zy]) - self.C @ s[0]
-        return float(e @ np.linalg.solve(self.innovation_cov(s), e))   # eq. (11)
+        e = np.array([zx - s[0], zy - s[1]])
+        return float(e @ np.linalg.solve(self.innovation_cov(s), e))   # seed000 eq. (11)
 
-    def pos(self, s):
-        return float(s[0][0]), float(s[0][1])
-
-    def vel(self, s):
-        return float(s[0][2]), float(s[0][3])
-
-    def with_state(self, s, x, y, vx, vy):
-        return (np.array([x, y, vx, vy], dtype=float), s[1].copy())

@@ -80,9 +80,9 @@ class LegTrack:
         """g_k of the motion model (0 without a window)."""
         return self.window.value() if self.window is not None else 0.0
 
-    def fill(self, res: "TrackResult", f: int, k0: int, posvel) -> None:
+    def fill(self, res: "TrackResult", f: int, k0: int) -> None:
         """Write scans k0.. of this leg into row f of ``res``."""
-        pv = np.array([posvel(p) for p in self.post[k0:]], dtype=float).reshape(-1, 4)
+        pv = np.array([p[:4] for p in self.post[k0:]], dtype=float).reshape(-1, 4)
         res.x[f, k0:], res.y[f, k0:] = pv[:, 0], pv[:, 1]
         res.vx[f, k0:], res.vy[f, k0:] = pv[:, 2], pv[:, 3]
         res.observed[f, k0:] = self.real[k0:]

@@ -1,7 +1,7 @@
 """Gait-phase identification: the role that names the phase of both legs at a scan.
 
-Role ``phase``: ``identify(l, r) -> int`` with ``l``, ``r`` the legs' ``(x, y, vx, vy)``
-(a posteriori, sensor frame) and the phase code of :mod:`gaitval.gait.phases` (0 both in
+Role ``phase``: ``identify(l, r) -> int`` with ``l``, ``r`` the legs' filter states, read
+as ``(x, y, vx, vy, …)`` (a posteriori, sensor frame) and the phase code of :mod:`gaitval.gait.phases` (0 both in
 stance, 1/2 left swings accelerating/decelerating, 3/4 the same for the right leg, 5 both
 swing).  The tracker feeds it to the motion model (seed000 eq. (18)–(20)), the gait-phase
 associator (seed 000 §5.2) and context-dependent gates (seed001 Table 1).
@@ -13,7 +13,7 @@ Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (seed 001), eq. (9)–(10).
 """
 from __future__ import annotations
 
-from gaitval.gait.phases import gait_phase_xy
+from gaitval.gait.phases import gait_phase_of_states
 from gaitval.registry import Registry
 
 PHASE_MODELS = Registry("gait phase model")
@@ -45,5 +45,4 @@ class SpeedThresholdPhases(PhaseModel):
         self.v_sw_th = v_sw_th
 
     def identify(self, l, r):
-        return gait_phase_xy(l[0], l[1], l[2], l[3], r[0], r[1], r[2], r[3],  # seed000 eq. (3)–(5)
-                             self.v_st_th, self.v_sw_th)
+        return gait_phase_of_states(l, r, self.v_st_th, self.v_sw_th)   # seed000 eq. (3)–(5)

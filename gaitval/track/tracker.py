@@ -146,11 +146,10 @@ class Hypotheses:
     ``phase_of(a, b)``: the phase after left ← a, right ← b (seed000 eq. (3)–(5)).
     """
 
-    __slots__ = ("correct", "identify", "posvel", "prior", "obs", "cache", "pcache")
+    __slots__ = ("correct", "identify", "prior", "obs", "cache", "pcache")
 
     def __init__(self, run: TrackingRun, prior, obs):
         self.correct = run.filter.correct
-        self.posvel = run.filter.posvel
         self.identify = run.phase_model.identify
         self.prior, self.obs = prior, obs
         self.cache = ({0: prior[0]}, {0: prior[1]})
@@ -167,8 +166,8 @@ class Hypotheses:
     def phase_of(self, a: int, b: int) -> int:
         ph = self.pcache.get((a, b))
         if ph is None:
-            ph = self.pcache[(a, b)] = self.identify(self.posvel(self.corrected(0, a)),
-                                                     self.posvel(self.corrected(1, b)))
+            ph = self.pcache[(a, b)] = self.identify(self.corrected(0, a),
+                                                     self.corrected(1, b))
         return ph
 
 
@@ -176,7 +175,9 @@ class TrackingRun:
     """The state of one run: both legs' histories and the gait phase per scan.
 
     Roles act on it through ``predict``, ``commit``, ``replay`` and ``resync``; the
-    occlusion handler reads ``legs``, ``k0``, ``n`` and ``filter``.
+    occlusion handler reads ``legs``, ``k0``, ``n`` and ``filter``.  Filter states are
+    tuples beginning ``(x, y, vx, vy)`` (:mod:`gaitval.track.kalman`), so the loop reads
+    velocities by index.
     """
 
     def __init__(self, tracker: Tracker, t: np.ndarray, source, leg_width_m: float,
@@ -196,17 +197,18 @@ class TrackingRun:
 
     def predict(self, k: int):
         """Both legs' a priori states at k (seed000 eq. (7)–(8), u from eq. (18)–(20))."""
-        F, dt = self.filter, self.dts[k]
+        predict, dt = self.filter.predict, self.dts[k]
         L, R = self.legs
         sl, sr = L.post[k - 1], R.post[k - 1]
-        ul, ur = self.motion.inputs(self.phase[k - 1], F.vel(sl), F.vel(sr), L.gain(),
-                                    R.gain(), dt)
-        return F.predict(sl, dt, ul[0], ul[1]), F.predict(sr, dt, ur[0], ur[1])
+        ul, ur = self.motion.inputs(self.phase[k - 1], (sl[2], sl[3]), (sr[2], sr[3]),
+                                    L.window.value() if L.window is not None else 0.0,
+                                    R.window.value() if R.window is not None else 0.0, dt)
+        return predict(sl, dt, ul[0], ul[1]), predict(sr, dt, ur[0], ur[1])
 
     def gate_context(self, f: int, k: int) -> GateContext:
         leg = self.legs[f]
-        v = self.filter.vel(leg.post[k - 1])
-        return GateContext(self.leg_width_m, self.dts[k], math.hypot(*v),
+        s = leg.post[k - 1]
+        return GateContext(self.leg_width_m, self.dts[k], math.hypot(s[2], s[3]),
                            _SWING[self.phase[k - 1]][f], leg.n_unobserved)
 
     def commit(self, k: int, a: int, b: int, hyp: Hypotheses, obs, pats) -> None:
@@ -222,10 +224,12 @@ class TrackingRun:
 
     def book(self, k: int) -> None:
         """‖a_k‖ per leg into its acceleration window (seed 000 §5.5)."""
-        vel, dt, sw = self.filter.vel, self.dts[k], _SWING[self.phase[k]]
-        for f, leg in enumerate(self.legs):
-            v1, v0 = vel(leg.post[k]), vel(leg.post[k - 1])
-            a = leg.acc[k] = math.hypot(v1[0] - v0[0], v1[1] - v0[1]) / dt
+        dt, sw = self.dts[k], _SWING[self.phase[k]]
+        hypot = math.hypot
+        for f in (0, 1):
+            leg = self.legs[f]
+            s1, s0 = leg.post[k], leg.post[k - 1]
+            a = leg.acc[k] = hypot(s1[2] - s0[2], s1[3] - s0[3]) / dt
             if leg.window is not None:
                 leg.window.push(a, sw[f])
 
@@ -238,7 +242,7 @@ class TrackingRun:
             for leg, s in zip(self.legs, self.predict(k)):
                 z = leg.z[k]
                 leg.post[k] = F.correct(s, z[0], z[1]) if z is not None else s
-            self.phase[k] = self.phase_model.identify(F.posvel(L.post[k]), F.posvel(R.post[k]))
+            self.phase[k] = self.phase_model.identify(L.post[k], R.post[k])  # seed000 eq. (3)–(5)
             self.book(k)
 
     def resync(self, k: int) -> None:
@@ -246,14 +250,14 @@ class TrackingRun:
         for f, leg in enumerate(self.legs):
             if leg.window is not None:
                 lo = max(self.k0 + 1, k - leg.window.n_ac + 1)
-                leg.window.reset([(leg.acc[i], _SWING[self.phase[i]][f])
-                                  for i in range(lo, k + 1)])
+                swings = [_SWING[p][f] for p in self.phase[lo:k + 1]]
+                leg.window.reset(list(zip(leg.acc[lo:k + 1], swings)))
 
     def result(self) -> TrackResult:
         res = empty_result(self.t)
         res.k_init, k0 = self.k0, self.k0
         for f, leg in enumerate(self.legs):
-            leg.fill(res, f, k0, self.filter.posvel)
+            leg.fill(res, f, k0)
         res.phase[k0:] = np.asarray(self.phase[k0:], dtype=np.int8)
         res.refiltered = self.refiltered
         return res
