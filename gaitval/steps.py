@@ -33,13 +33,18 @@ def study_config(config: dict, sheet: str | Path, out: str | Path) -> dict:
     """Write the effective analysis config of one study (JSON) and return it.
 
     The workflow config's :data:`ANALYSIS_SECTIONS` are the base; ``study.yaml`` beside the
-    trial sheet, when present, overrides them (the study's calibration).
+    trial sheet, when present, overrides them (the study's calibration); it is checked
+    against the config schema first, so a typo in it stops with the file and key named
+    (:func:`gaitval.configcheck.check_study_file`).
     """
+    from gaitval.configcheck import check_study_file
+
     cfg = {k: config[k] for k in ANALYSIS_SECTIONS if k in config}
     cal = Path(sheet).parent / "study.yaml"
     if cal.is_file():
         with open(cal, encoding="utf-8") as fh:
             study = yaml.safe_load(fh) or {}
+        check_study_file(study, cal)
         cfg = deep_merge(cfg, {k: v for k, v in study.items() if k in ANALYSIS_SECTIONS})
         cfg["calibration_file"] = str(cal)
     write_text(out, json.dumps(cfg, indent=1, sort_keys=True) + "\n")

@@ -2,14 +2,33 @@
 import sys
 from pathlib import Path
 
-from snakemake.utils import validate
+from snakemake.common.configfile import load_configfile
 
+from gaitval.configcheck import check_config, display_path, load_schema
+from gaitval.errors import ConfigError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash
 from gaitval.steps import ANALYSIS_SECTIONS
 
 
-validate(config, "../schemas/config.schema.yaml")
+def _config_layers():
+    """(name, dict) of every config source, lowest precedence first: the Snakefile's
+    configfile, each --configfile, then --config (so a problem names where its key is)."""
+    settings = getattr(workflow, "config_settings", None)
+    cli = [Path(f).resolve() for f in getattr(settings, "configfiles", ())]
+    files = [Path(f).resolve() for f in getattr(workflow, "configfiles", ())]
+    files = [f for f in files if f not in cli] + cli
+    layers = [(display_path(f), load_configfile(str(f))) for f in files if f.is_file()]
+    return layers + [("--config", dict(getattr(settings, "config", None) or {}))]
+
+
+# Every key against workflow/schemas/config.schema.yaml: a typo stops the run here with
+# the key's path and the nearest valid key (gaitval.configcheck), as one message.
+try:
+    check_config(config, _config_layers(), schema=load_schema(
+        Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"))
+except ConfigError as exc:
+    sys.exit(f"ConfigError: {exc}")
 
 DATA = config.get("data_dir", "data")
 RESULTS = config.get("results_dir", "results")

@@ -1,0 +1,224 @@
+"""Check a workflow config or a study's ``study.yaml`` against the config schema.
+
+The schema (``workflow/schemas/config.schema.yaml``) describes every section and key and
+refuses unknown ones.  A problem is raised as one :class:`~gaitval.errors.ConfigError`
+that names the file the key came from, the key's full path and, for a typo, the nearest
+valid key::
+
+    [file config/config.yaml] unknown key groundtruth.lowpas_hz — did you mean
+    groundtruth.lowpass_hz?
+
+Only jsonschema and PyYAML are imported: the Snakefile calls this at parse time.
+"""
+from __future__ import annotations
+
+import difflib
+import functools
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import jsonschema
+import yaml
+
+from gaitval.errors import ConfigError
+
+#: The config schema, found beside the package in the repository (the workflow's copy).
+SCHEMA_PATH = (Path(__file__).resolve().parents[1] / "workflow" / "schemas"
+               / "config.schema.yaml")
+
+_TYPE_NAMES = {"number": "a number", "integer": "an integer", "string": "a string",
+               "boolean": "true or false", "array": "a list", "object": "a mapping",
+               "null": "null"}
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One schema violation: where (key path) and what, in words."""
+
+    path: tuple
+    message: str
+    source: str = ""
+
+
+@functools.lru_cache(maxsize=4)
+def _load_schema(path: str) -> dict:
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError("the config schema is missing", path=p,
+                          hint="gaitval checks configs against the repository's "
+                               "workflow/schemas/config.schema.yaml")
+    with open(p, encoding="utf-8") as fh:
+        return yaml.safe_load(fh)
+
+
+def load_schema(path: str | Path | None = None) -> dict:
+    """The config schema (cached; do not modify it)."""
+    return _load_schema(str(path or SCHEMA_PATH))
+
+
+def dotted(path: Sequence) -> str:
+    """``("groundtruth", "lowpass_hz")`` -> ``groundtruth.lowpass_hz``; ``run[0]``."""
+    out = ""
+    for k in path:
+        out += f"[{k}]" if isinstance(k, int) else (f".{k}" if out else str(k))
+    return out or "(top level)"
+
+
+def _key_paths(schema: dict, root: dict, prefix=(), depth=0) -> list[tuple]:
+    """Every fixed key path the schema describes (following local ``$ref``)."""
+    if depth > 8 or not isinstance(schema, dict):
+        return []
+    if "$ref" in schema:
+        name = schema["$ref"].rsplit("/", 1)[-1]
+        schema = {**root.get("$defs", {}).get(name, {}), **schema}
+    out = []
+    for k, sub in (schema.get("properties") or {}).items():
+        out.append(prefix + (k,))
+        out += _key_paths(sub, root, prefix + (k,), depth + 1)
+    return out
+
+
+def _suggest(key: str, parent: tuple, here: list[str], root: dict) -> str:
+    close = difflib.get_close_matches(key, here, n=1, cutoff=0.6)
+    if close:
+        return f" — did you mean {dotted(parent + (close[0],))}?"
+    elsewhere = [p for p in _key_paths(root, root) if p[-1] == key]
+    if elsewhere:
+        return f" — did you mean {dotted(elsewhere[0])}?"
+    return f" (valid keys here: {', '.join(sorted(here))})" if here else ""
+
+
+def _at(instance: Any, path: Sequence) -> Any:
+    for k in path:
+        instance = instance[k]
+    return instance
+
+
+def _describe(value: Any) -> str:
+    return f"{value!r} ({type(value).__name__})"
+
+
+def _problems_of(error: jsonschema.ValidationError, instance: Any, root: dict
+                 ) -> list[Problem]:
+    """One error of jsonschema -> the problems to report, in words."""
+    path = tuple(error.absolute_path)
+    where, v, s = dotted(path), error.validator, error.schema
+    if v == "additionalProperties":
+        here = list(s.get("properties") or {})
+        extra = [k for k in error.instance if k not in here]
+        return [Problem(path + (k,), f"unknown key {dotted(path + (k,))}"
+                        f"{_suggest(str(k), path, here, root)}") for k in extra]
+    if v == "type":
+        want = error.validator_value
+        want = [want] if isinstance(want, str) else list(want)
+        return [Problem(path, f"{where} must be {' or '.join(_TYPE_NAMES[t] for t in want)}"
+                              f", got {_describe(error.instance)}")]
+    if v == "enum":
+        choices = [str(c) for c in error.validator_value]
+        close = difflib.get_close_matches(str(error.instance), choices, n=1)
+        tip = f" — did you mean {close[0]}?" if close else ""
+        return [Problem(path, f"{where} must be one of {', '.join(choices)}, got "
+                              f"{error.instance!r}{tip}")]
+    if v == "required":
+        missing = [k for k in error.validator_value if k not in error.instance]
+        return [Problem(path, f"{where} is missing the key(s) {', '.join(missing)}")]
+    if v == "pattern":
+        parent = _at(instance, path)
+        if isinstance(parent, dict) and error.instance in parent:    # via propertyNames
+            key = path + (error.instance,)
+            return [Problem(key, f"bad key {dotted(key)}: {s.get('description', '')}")]
+    if v in ("anyOf", "oneOf") and s.get("description"):
+        return [Problem(path, f"{where}: {s['description']}")]
+    return [Problem(path, f"{where}: {error.message}")]
+
+
+def find_problems(instance: Any, schema: dict, root: dict | None = None) -> list[Problem]:
+    """Every problem of ``instance`` against ``schema``, sorted by key path.
+
+    ``root`` is the document holding ``$defs`` when ``schema`` is one of them.
+    """
+    root = root or schema
+    full = schema if schema is root else {**schema, "$defs": root.get("$defs", {})}
+    validator = jsonschema.Draft202012Validator(full)
+    out = []
+    for err in validator.iter_errors(instance):
+        out += _problems_of(err, instance, root)
+    # unknown / malformed keys first: a typo is usually the cause of the other problems
+    typo = ("unknown key", "bad key")
+    return sorted(set(out), key=lambda p: (not p.message.startswith(typo),
+                                           [str(k) for k in p.path], p.message))
+
+
+def _has_path(layer: Any, path: Sequence) -> bool:
+    for k in path:
+        if isinstance(layer, Mapping) and k in layer:
+            layer = layer[k]
+        elif isinstance(layer, list) and isinstance(k, int) and k < len(layer):
+            layer = layer[k]
+        else:
+            return False
+    return True
+
+
+def _source(path: tuple, layers: Sequence[tuple[str, Any]]) -> str:
+    """The highest-precedence layer that sets ``path`` (else the lowest layer)."""
+    for name, layer in reversed(layers):
+        if _has_path(layer, path):
+            return name
+    return layers[0][0] if layers else ""
+
+
+def raise_problems(problems: list[Problem]) -> None:
+    """Raise the first problem as a :class:`ConfigError`; the rest in its hint."""
+    if not problems:
+        return
+    first, rest = problems[0], problems[1:]
+    hint = None
+    if rest:
+        more = "; ".join(f"{p.source}: {p.message}" if p.source else p.message
+                         for p in rest[:5])
+        hint = f"{len(rest)} more: {more}" + ("; ..." if len(rest) > 5 else "")
+    if first.source.startswith("--"):          # a command-line option, not a file
+        raise ConfigError(f"{first.source}: {first.message}", hint=hint)
+    raise ConfigError(first.message, path=first.source or None, hint=hint)
+
+
+def display_path(path: str | Path) -> str:
+    """``path`` relative to the working directory when it is below it."""
+    rel = os.path.relpath(Path(path).resolve(), Path.cwd().resolve())
+    return str(path) if rel.startswith("..") else rel
+
+
+def check_config(config: Mapping, layers: Sequence[tuple[str, Any]] | None = None, *,
+                 schema: dict | None = None) -> None:
+    """Check a whole workflow config; raise :class:`ConfigError` on the first problem.
+
+    Parameters
+    ----------
+    config : mapping
+        The merged config (Snakemake's ``config``).
+    layers : sequence of (name, dict), optional
+        The sources merged into ``config``, lowest precedence first (the Snakefile's
+        ``configfile``, each ``--configfile``, ``--config``): a problem names the last
+        one that sets the key.  Default: ``config/config.yaml`` alone.
+    schema : dict, optional
+        Default :func:`load_schema`.
+    """
+    schema = schema or load_schema()
+    layers = list(layers) if layers else [("config/config.yaml", config)]
+    probs = find_problems(dict(config), schema)
+    raise_problems([Problem(p.path, p.message, _source(p.path, layers)) for p in probs])
+
+
+def check_study_file(study: Any, path: str | Path, *, schema: dict | None = None) -> None:
+    """Check a study's ``study.yaml`` (already loaded) against ``$defs/study_file``."""
+    schema = schema or load_schema()
+    src = display_path(path)
+    if not isinstance(study, Mapping):
+        raise ConfigError(f"study.yaml must be a mapping of sections, got {_describe(study)}",
+                          path=src)
+    probs = find_problems(dict(study), schema["$defs"]["study_file"], root=schema)
+    raise_problems([Problem(p.path, p.message, src) for p in probs])
