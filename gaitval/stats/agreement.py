@@ -101,39 +101,60 @@ def icc(ratings, alpha: float = 0.05) -> pd.DataFrame:
     df1, df2 = n - 1, (n - 1) * (k - 1)
     q = 1 - alpha / 2
     with np.errstate(divide="ignore", invalid="ignore"):
-        c1 = (msr - mse) / (msr + (k - 1) * mse)                      # ICC(C,1), S&F ICC(3,1)
-        a1 = (msr - mse) / (msr + (k - 1) * mse + k * (msc - mse) / n)  # ICC(A,1), ICC(2,1)
-        ck = (msr - mse) / msr                                        # ICC(C,k), ICC(3,k)
-        ak = (msr - mse) / (msr + (msc - mse) / n)                    # ICC(A,k), ICC(2,k)
         f0 = msr / mse
         p_f0 = float(sps.f.sf(f0, df1, df2))
-        fl = f0 / sps.f.ppf(q, df1, df2)
-        fu = f0 * sps.f.ppf(q, df2, df1)
-        rows["ICC(C,1)"].update(icc=c1, ci_low=(fl - 1) / (fl + k - 1),
-                                ci_high=(fu - 1) / (fu + k - 1), F=f0, df1=df1, df2=df2,
-                                p=p_f0)
-        rows["ICC(C,k)"].update(icc=ck, ci_low=1 - 1 / fl, ci_high=1 - 1 / fu, F=f0,
-                                df1=df1, df2=df2, p=p_f0)
-        # absolute agreement: McGraw & Wong 1996 Table 7, case 3A (Satterthwaite df)
-        a = k * a1 / (n * (1 - a1))
-        b = 1 + k * a1 * (n - 1) / (n * (1 - a1))
-        v = (a * msc + b * mse) ** 2 / ((a * msc) ** 2 / (k - 1) + (b * mse) ** 2 / df2)
-        f_star = sps.f.ppf(q, df1, v)
-        f_low = sps.f.ppf(q, v, df1)
-        lo = n * (msr - f_star * mse) / (f_star * (k * msc + (k * n - k - n) * mse)
-                                         + n * msr)
-        hi = n * (f_low * msr - mse) / (k * msc + (k * n - k - n) * mse + n * f_low * msr)
         # F test of ICC(A,.) = 0: McGraw & Wong 1996 Table 8 case 3A with rho0 = 0
-        # (a = 0, b = 1) reduces to F = MSR / MSE on (n-1, (n-1)(k-1)) df
-        fa = f0
-        rows["ICC(A,1)"].update(icc=a1, ci_low=lo, ci_high=hi, F=fa, df1=df1, df2=df2,
-                                p=p_f0)
-        rows["ICC(A,k)"].update(icc=ak, ci_low=lo * k / (1 + (k - 1) * lo),
-                                ci_high=hi * k / (1 + (k - 1) * hi), F=fa, df1=df1,
-                                df2=df2, p=p_f0)
+        # (a = 0, b = 1) reduces to F = MSR / MSE on (n-1, (n-1)(k-1)) df, as for ICC(C,.)
+        test = {"F": f0, "df1": df1, "df2": df2, "p": p_f0}
+        c_1, c_k = _icc_consistency(msr, mse, n, k, q)
+        a_1, a_k = _icc_absolute(msr, msc, mse, n, k, q)
+        rows["ICC(C,1)"].update(**c_1, **test)
+        rows["ICC(C,k)"].update(**c_k, **test)
+        rows["ICC(A,1)"].update(**a_1, **test)
+        rows["ICC(A,k)"].update(**a_k, **test)
     out = pd.DataFrame.from_dict(rows, orient="index")[list(ICC_COLUMNS)]
     out.index.name = "type"
     return out.astype(float)
+
+
+def _icc_consistency(msr: float, mse: float, n: int, k: int, q: float
+                     ) -> tuple[dict, dict]:
+    """ICC(C,1) and ICC(C,k) with their F-based CIs (formulas in :func:`icc`'s notes).
+
+    ``q = 1 − α/2``.  Call inside ``np.errstate(divide="ignore", invalid="ignore")``.
+    """
+    df1, df2 = n - 1, (n - 1) * (k - 1)
+    c1 = (msr - mse) / (msr + (k - 1) * mse)                      # ICC(C,1), S&F ICC(3,1)
+    ck = (msr - mse) / msr                                        # ICC(C,k), ICC(3,k)
+    f0 = msr / mse
+    fl = f0 / sps.f.ppf(q, df1, df2)
+    fu = f0 * sps.f.ppf(q, df2, df1)
+    return ({"icc": c1, "ci_low": (fl - 1) / (fl + k - 1), "ci_high": (fu - 1) / (fu + k - 1)},
+            {"icc": ck, "ci_low": 1 - 1 / fl, "ci_high": 1 - 1 / fu})
+
+
+def _icc_absolute(msr: float, msc: float, mse: float, n: int, k: int, q: float
+                  ) -> tuple[dict, dict]:
+    """ICC(A,1) and ICC(A,k) with Satterthwaite CIs (formulas in :func:`icc`'s notes).
+
+    ``q = 1 − α/2``.  Call inside ``np.errstate(divide="ignore", invalid="ignore")``.
+    """
+    df1, df2 = n - 1, (n - 1) * (k - 1)
+    a1 = (msr - mse) / (msr + (k - 1) * mse + k * (msc - mse) / n)  # ICC(A,1), ICC(2,1)
+    ak = (msr - mse) / (msr + (msc - mse) / n)                    # ICC(A,k), ICC(2,k)
+    # absolute agreement: McGraw & Wong 1996 Table 7, case 3A (Satterthwaite df)
+    a = k * a1 / (n * (1 - a1))
+    b = 1 + k * a1 * (n - 1) / (n * (1 - a1))
+    v = (a * msc + b * mse) ** 2 / ((a * msc) ** 2 / (k - 1) + (b * mse) ** 2 / df2)
+    f_star = sps.f.ppf(q, df1, v)
+    f_low = sps.f.ppf(q, v, df1)
+    lo = n * (msr - f_star * mse) / (f_star * (k * msc + (k * n - k - n) * mse)
+                                     + n * msr)
+    hi = n * (f_low * msr - mse) / (k * msc + (k * n - k - n) * mse + n * f_low * msr)
+    # ICC(A,k) bounds: the ICC(A,1) bounds stepped up by Spearman–Brown
+    return ({"icc": a1, "ci_low": lo, "ci_high": hi},
+            {"icc": ak, "ci_low": lo * k / (1 + (k - 1) * lo),
+             "ci_high": hi * k / (1 + (k - 1) * hi)})
 
 
 def bland_altman(ref: np.ndarray, pro: np.ndarray, alpha: float = 0.05) -> dict[str, float]:
