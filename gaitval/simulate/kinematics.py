@@ -219,7 +219,11 @@ def _ankle_path(tl: _Timeline, t: np.ndarray, gp: GaitParams) -> tuple[np.ndarra
 
 def _shank_tilt(tl: _Timeline, t: np.ndarray, gp: GaitParams,
                 posture_tilt: np.ndarray | None) -> np.ndarray:
-    """Shank tilt (rad, knee ahead positive) from the gait phase (notes of :func:`leg_kinematics`)."""
+    """Shank tilt (rad, knee ahead positive) from the gait phase.
+
+    The periodic tilt curve, its scaling and the standing clamps are in the notes of
+    :func:`leg_kinematics`.
+    """
     tc, j, has_next, off_next = tl.tc, tl.j, tl.has_next, tl.off_next
     swing, tau, t_c = tl.swing, tl.tau, tl.t_c
     # gait phase phi: stance 0..0.6, swing 0.6..1
