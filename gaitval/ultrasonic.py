@@ -687,7 +687,7 @@ def identify_noise(trials: list[tuple[UltrasonicLog, MocapTrial]], cfg: dict | N
     def rmse(w):
         key = tuple(round(x, 9) for x in w)
         if key not in cache:
-            cc = _merge(c, {"ukf": {"W_sigma_mps2": list(key), "V_m2": V}})
+            cc = deep_merge(c, {"ukf": {"W_sigma_mps2": list(key), "V_m2": V}})
             cache[key] = _rmse3(_track_errors(aligned, logs, cc, skip))
         return cache[key]
 

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from gaitval.config import deep_merge
 from gaitval.tables.render import write_table
 
 #: Seed 003 Table 1 (mm), transcribed: mean, std, RMSE, Net RMSE per axis.  The paper's
@@ -103,7 +104,7 @@ def build_ultrasonic_table1(trials, stem: str | Path, cfg: dict | None = None, *
     from gaitval import ultrasonic as U
 
     res = U.identify_noise(trials, cfg, names=names)
-    ucfg = U._merge(U.resolve_cfg(cfg), {"ukf": {"W_sigma_mps2": res["W_sigma_mps2"],
+    ucfg = deep_merge(U.resolve_cfg(cfg), {"ukf": {"W_sigma_mps2": res["W_sigma_mps2"],
                                                  "V_m2": res["V_m2"]}})
     err = U.pendulum_errors(trials, ucfg, names=names, aligned=res["_aligned"])
     return write_ultrasonic_table1(err, stem, res), U.noise_to_config(res)
