@@ -212,3 +212,23 @@ def test_a_raw_scan_tracker_kind_is_chosen_by_the_method_entry(monkeypatch):
     assert df.loc[df["side"] == "L", "x_m"].tolist() == [2.0] * 4
     with pytest.raises(ConfigError, match="not detect-then-track"):
         build_tracker(method)
+
+
+def test_an_occlusion_handler_can_restart_both_legs(monkeypatch):
+    """The run interface a re-initialising handler (seed 002 §II) uses: ``run.restart``."""
+    from gaitval.track import OCCLUSION_HANDLERS
+    from gaitval.track.occlusion import OcclusionHandler
+
+    class RestartAt(OcclusionHandler):
+        def after_scan(self, state, run, k):
+            if k == 50:
+                obs, pats = run.source.at(k, None)
+                run.restart(k, obs, pats, 0, 1)
+
+    monkeypatch.setitem(OCCLUSION_HANDLERS._items, "test_restart", RestartAt)
+    t, xy, pats, truth = _walk()
+    res = Tracker(occlusion="test_restart", dt_s=DT, sides="as_initialised").run(t, xy, pats, 0.1)
+    assert res.restarts == [50]
+    assert (res.vx[:, 50] == 0).all() and (res.x[:, 50] == truth[:, 50, 0]).all()
+    err = np.hypot(res.x - truth[:, :, 0], res.y - truth[:, :, 1])
+    assert np.nanmax(err) < 0.05

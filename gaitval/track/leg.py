@@ -115,6 +115,7 @@ class TrackResult:
     swapped_sides: bool = False
     obs_index: np.ndarray | None = None     # (2, n): associated observation j (0-based), -1
     refiltered: list = field(default_factory=list)   # Method 3: (leg, k_from, k_to) re-runs
+    restarts: list = field(default_factory=list)     # scans where both legs were re-initialised
 
     @property
     def swing(self) -> np.ndarray:

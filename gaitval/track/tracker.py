@@ -174,8 +174,9 @@ class Hypotheses:
 class TrackingRun:
     """The state of one run: both legs' histories and the gait phase per scan.
 
-    Roles act on it through ``predict``, ``commit``, ``replay`` and ``resync``; the
-    occlusion handler reads ``legs``, ``k0``, ``n`` and ``filter``.  Filter states are
+    Roles act on it through ``predict``, ``commit``, ``replay``, ``resync`` and
+    ``restart``; the occlusion handler reads ``legs``, ``k0``, ``n``, ``filter`` and
+    ``source`` (the observations, e.g. to re-initialise from them).  Filter states are
     tuples beginning ``(x, y, vx, vy)`` (:mod:`gaitval.track.kalman`), so the loop reads
     velocities by index.
     """
@@ -189,8 +190,10 @@ class TrackingRun:
                     np.array([tracker.dt_s or 0.025]))
         self.dts = self.dts.tolist()
         self.k0, il, ir = start
+        self.source = source
         self.phase = [0] * self.n
         self.refiltered: list[tuple[int, int, int]] = []
+        self.restarts: list[int] = []
         obs, pats = source.at(self.k0, None)
         self.legs = tuple(LegTrack.start(self.n, self.k0, self.filter, obs[i], pats[i], i,
                                          self.motion.new_window()) for i in (il, ir))
@@ -253,6 +256,17 @@ class TrackingRun:
                 swings = [_SWING[p][f] for p in self.phase[lo:k + 1]]
                 leg.window.reset(list(zip(leg.acc[lo:k + 1], swings)))
 
+    def restart(self, k: int, obs, pats, il: int, ir: int) -> None:
+        """Re-initialise both legs at scan k on observations ``il`` (left) and ``ir``
+        (right), at rest, as at the start (e.g. seed 002's KF after N lost frames); the
+        scan is recorded in ``TrackResult.restarts``."""
+        F = self.filter
+        self.restarts.append(k)
+        for leg, i in ((self.legs[0], il), (self.legs[1], ir)):
+            leg.post[k] = F.init(float(obs[i][0]), float(obs[i][1]))
+            leg.observed(k, obs[i], pats[i], i)
+        self.phase[k] = 0
+
     def result(self) -> TrackResult:
         res = empty_result(self.t)
         res.k_init, k0 = self.k0, self.k0
@@ -260,4 +274,5 @@ class TrackingRun:
             leg.fill(res, f, k0)
         res.phase[k0:] = np.asarray(self.phase[k0:], dtype=np.int8)
         res.refiltered = self.refiltered
+        res.restarts = self.restarts
         return res
