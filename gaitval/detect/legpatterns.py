@@ -2,7 +2,7 @@
 
 Notes
 -----
-Edges, seed 000 eq. (6) (= seed 001 eq. 1): between beams i and i+1 when
+Edges, seed000 eq. (6) (= seed001 eq. (1)): between beams i and i+1 when
 |l_i − l_{i+1}| > w_l/2, with l_i the i-th range counted from the sensor's right (beam 0 at
 ``angle_min``, the ROS order).  When l_i > l_{i+1}: e_m^B = i, e_{m+1}^F = i+1; when
 l_i < l_{i+1}: e_m^F = i, e_{m+1}^B = i+1.  "No return" and background count as +∞; the
@@ -78,14 +78,14 @@ _SQRT3_2 = math.sqrt(3.0) / 2.0
 
 
 def edges(l: np.ndarray, leg_width_m: float) -> list[tuple[int, str]]:
-    """Edges of one scan as ``(beam index, 'B' | 'F')`` in scan order (eq. 6).
+    """Edges of one scan as ``(beam index, 'B' | 'F')`` in scan order (seed000 eq. (6)).
 
     ``l`` is one scan's ranges (NaN or inf = no return).  No padding is added here.
     """
     r = np.where(np.isfinite(l), l, np.inf)
     out: list[tuple[int, str]] = []
     with np.errstate(invalid="ignore"):
-        jump = np.abs(r[:-1] - r[1:]) > leg_width_m / 2.0       # eq. (6)
+        jump = np.abs(r[:-1] - r[1:]) > leg_width_m / 2.0       # seed000 eq. (6)
     for i in np.flatnonzero(jump):
         if r[i] > r[i + 1]:
             out += [(int(i), "B"), (int(i) + 1, "F")]
@@ -201,7 +201,7 @@ def detect_scan(r: np.ndarray, angles: np.ndarray, leg_width_m: float,
     rp[0] = rp[-1] = np.inf
     rp[1:-1] = np.where(np.isfinite(r), r, np.inf)
     with np.errstate(invalid="ignore"):
-        jump = np.flatnonzero(np.abs(rp[:-1] - rp[1:]) > leg_width_m / 2.0)   # eq. (6)
+        jump = np.flatnonzero(np.abs(rp[:-1] - rp[1:]) > leg_width_m / 2.0)   # seed000 eq. (6)
     rho = 0.5 * leg_width_m
     out = []
     for s in range(len(jump) - 1):

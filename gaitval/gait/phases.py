@@ -13,8 +13,8 @@ Six phases (seed 000 §3, Figure 6):
 
 Notes
 -----
-Stance condition of the right leg, eq. (3): ‖v^R‖ < ‖v^L‖ ∨ ‖v^R‖ < v_st_th.
-Swing condition, eq. (4): ‖v^R‖ > ‖v^L‖ ∨ ‖v^R‖ > v_sw_th.  (The left leg likewise.)
+Stance condition of the right leg, seed000 eq. (3): ‖v^R‖ < ‖v^L‖ ∨ ‖v^R‖ < v_st_th.
+Swing condition, seed000 eq. (4): ‖v^R‖ > ‖v^L‖ ∨ ‖v^R‖ > v_sw_th.  (The left leg likewise.)
 
 The two conditions overlap (a leg slower than the other but above v_sw_th satisfies
 both) and can both fail (equal speeds between the thresholds).  gaitval resolves them as
@@ -25,7 +25,8 @@ follows, which keeps every case of the paper's text:
 * between the thresholds the relative test decides: the strictly faster leg swings, the
   other is in stance (equal speeds: stance).
 
-Acceleration vs deceleration, eq. (5): with the left leg swinging and the right in stance,
+Acceleration vs deceleration, seed000 eq. (5): with the left leg swinging and the right in
+stance,
 (p^R − p^L)·v^L > 0 (the swing leg is still behind the stance leg: accelerating) is
 Phase 1, otherwise Phase 2 (it has passed the stance leg: decelerating); mirrored for the right leg (Phases 3/4).
 
@@ -65,7 +66,8 @@ def is_unlikely(prev_phase: int, phase: int) -> bool:
 
 
 def leg_swings(speed: float, other_speed: float, v_st_th: float, v_sw_th: float) -> bool:
-    """Swing (True) or stance (False) of one leg, eq. (3)–(4) (resolution in module notes)."""
+    """Swing (True) or stance (False) of one leg, seed000 eq. (3)–(4) (resolution in module
+    notes)."""
     if speed < v_st_th:
         return False
     if speed > v_sw_th:

@@ -4,7 +4,7 @@ Role ``associator``: ``select(cand_l, cand_r, prev_phase, phase_of) -> (a, b)``.
 
 ``cand_l`` / ``cand_r`` list the gated observations of each leg as ``(j, λ²)`` with
 j = 1..J (1-based, as in the paper) and λ² the squared Mahalanobis distance of seed000
-eq. (11), as the gate role returns them; the associator's ``cost`` turns λ² into its
+seed000 eq. (11), as the gate role returns them; the associator's ``cost`` turns λ² into its
 distance d: ``"mahalanobis"`` d = λ (seed000 eq. (9)–(10)) or ``"mahalanobis2"`` d = λ²
 (seed001 eq. (6)–(8), "squared, no root");
 ``phase_of(a, b)`` returns the gait phase the legs would be in after correcting the left
@@ -13,7 +13,8 @@ The result (a, b) uses the same numbering; a = b only when both are 0.
 
 Notes
 -----
-Cost of an association, eq. (9)–(10): c_{a,b} = d_{L,a} + d_{R,b} with d_{f,j} = λ_{f,j}
+Cost of an association, seed000 eq. (9)–(10): c_{a,b} = d_{L,a} + d_{R,b} with
+d_{f,j} = λ_{f,j}
 inside the gate and d_max outside it or for j = 0.  Only gated observations are offered:
 §5.2 builds the gate "to eliminate unlikely observation-to-track associations", so an
 observation outside a leg's gate is never associated with it (d_max only prices that
@@ -61,7 +62,7 @@ class Associator:
     Parameters
     ----------
     d_max : float
-        Cost of leaving a leg without an observation (eq. (9)–(10)).
+        Cost of leaving a leg without an observation (seed000 eq. (9)–(10)).
     cost : {"mahalanobis", "mahalanobis2"}
         d = λ (seed 000) or d = λ² (seed 001).
     """
@@ -85,7 +86,8 @@ class Associator:
 
 
 def ranked_associations(cand_l, cand_r, d_max: float) -> list[tuple[float, int, int]]:
-    """All joint associations as ``(c_{a,b}, a, b)``, cheapest first (eq. 9–10)."""
+    """All joint associations as ``(c_{a,b}, a, b)``, cheapest first (seed000 eq. (9)–(10)).
+    """
     opts_l = [(0, d_max)] + list(cand_l)
     opts_r = [(0, d_max)] + list(cand_r)
     out = []

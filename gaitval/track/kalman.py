@@ -24,12 +24,13 @@ the first four entries and otherwise only call the methods below.
 
 Notes
 -----
-Seed 000 eq. (1): x_k = A x_{k-1} + B_u u_{k-1} + B Δx_{k-1}, with
+seed000 eq. (1): x_k = A x_{k-1} + B_u u_{k-1} + B Δx_{k-1}, with
 A = [[1,0,Δt,0],[0,1,0,Δt],[0,0,1,0],[0,0,0,1]], B_u = B = [[Δt²/2,0],[0,Δt²/2],[Δt,0],[0,Δt]].
-Eq. (2): y_k = C x_k + w_k, C = [[1,0,0,0],[0,1,0,0]].
-Eq. (7)–(8): prediction; the printed eq. (8) reads ``A P Aᵀ + Q B Qᵀ``, an evident typo for
-the process noise of eq. (1), ``B Q Bᵀ``, which is what is implemented.
-Eq. (14)–(16): correction.  Eq. (11)–(12): Mahalanobis distance and innovation covariance.
+seed000 eq. (2): y_k = C x_k + w_k, C = [[1,0,0,0],[0,1,0,0]].
+seed000 eq. (7)–(8): prediction; the printed eq. (8) reads ``A P Aᵀ + Q B Qᵀ``, an evident
+typo for the process noise of eq. (1), ``B Q Bᵀ``, which is what is implemented.
+seed000 eq. (14)–(16): correction.  seed000 eq. (11)–(12): Mahalanobis distance and
+innovation covariance.
 
 References
 ----------
@@ -71,19 +72,19 @@ class LegFilter:
         raise NotImplementedError
 
     def predict(self, s, dt: float, ux: float, uy: float):
-        """A priori state at k from the a posteriori state at k-1 (eq. 7–8)."""
+        """A priori state at k from the a posteriori state at k-1 (seed000 eq. (7)–(8))."""
         raise NotImplementedError
 
     def correct(self, s, zx: float, zy: float):
-        """A posteriori state given the observation (zx, zy) (eq. 14–16)."""
+        """A posteriori state given the observation (zx, zy) (seed000 eq. (14)–(16))."""
         raise NotImplementedError
 
     def mahalanobis2(self, s, zx: float, zy: float) -> float:
-        """λ² of eq. (11) for a predicted state ``s``."""
+        """λ² of seed000 eq. (11) for a predicted state ``s``."""
         raise NotImplementedError
 
     def lam2_all(self, s, obs) -> list[float]:
-        """λ² of eq. (11) of every observation ``(zx, zy)`` in ``obs`` (one call per leg
+        """λ² of seed000 eq. (11) of every observation ``(zx, zy)`` in ``obs`` (one call per leg
         and scan; filters override it with a loop that hoists S out)."""
         m2 = self.mahalanobis2
         return [m2(s, zx, zy) for zx, zy in obs]
@@ -95,7 +96,7 @@ class LegFilter:
                 np.diag([self.p0_pos_sd_m ** 2] * 2 + [self.p0_vel_sd_mps ** 2] * 2))
 
     def innovation_cov(self, s) -> np.ndarray:
-        """S of eq. (12) as a 2×2 array."""
+        """S of seed000 eq. (12) as a 2×2 array."""
         raise NotImplementedError
 
     def pos(self, s) -> tuple[float, float]:
@@ -138,24 +139,25 @@ class AxisKalmanFilter(LegFilter):
         x, y, vx, vy, a, b, c = s
         cst = self._cache.get(dt)
         h, qaa, qab, qbb = cst if cst is not None else self._consts(dt)
-        # eq. (7): x = A x + B_u u
-        # eq. (8): P = A P Aᵀ + B Q Bᵀ (per axis: B Q Bᵀ = q [[Δt⁴/4, Δt³/2], [Δt³/2, Δt²]])
+        # seed000 eq. (7): x = A x + B_u u
+        # seed000 eq. (8): P = A P Aᵀ + B Q Bᵀ
+        #   (per axis: B Q Bᵀ = q [[Δt⁴/4, Δt³/2], [Δt³/2, Δt²]])
         return (x + dt * vx + h * ux, y + dt * vy + h * uy, vx + dt * ux, vy + dt * uy,
                 a + dt * (2.0 * b + dt * c) + qaa, b + dt * c + qab, c + qbb)
 
     def correct(self, s, zx, zy):
         x, y, vx, vy, a, b, c = s
-        sv = a + self.r_sd_m ** 2            # eq. (12): S = C P Cᵀ + R (per axis)
-        k0 = a / sv                          # eq. (15): K = P Cᵀ S⁻¹
+        sv = a + self.r_sd_m ** 2            # seed000 eq. (12): S = C P Cᵀ + R (per axis)
+        k0 = a / sv                          # seed000 eq. (15): K = P Cᵀ S⁻¹
         k1 = b / sv
         ex = zx - x
         ey = zy - y
-        # eq. (14): x = x + K (y - C x)
+        # seed000 eq. (14): x = x + K (y - C x)
         x = x + k0 * ex
         y = y + k0 * ey
         vx = vx + k1 * ex
         vy = vy + k1 * ey
-        # eq. (16): P = (I - K C) P
+        # seed000 eq. (16): P = (I - K C) P
         return (x, y, vx, vy, a - k0 * a, b - k0 * b, c - k1 * b)
 
     def mahalanobis2(self, s, zx, zy):
@@ -218,7 +220,8 @@ class AnisotropicKalmanFilter(LegFilter):
         x, y, vx, vy, ax, bx, cx, ay, by, cy = s
         h = 0.5 * dt * dt
         qx, qy = self._qx2, self._qy2
-        # seed000 eq. (7): x = A x + B u;  eq. (8) per axis with that axis' σ_a² (seed 002 §II)
+        # seed000 eq. (7): x = A x + B u;  seed000 eq. (8) per axis with that axis' σ_a²
+        # (seed 002 §II)
         return (x + dt * vx + h * ux, y + dt * vy + h * uy, vx + dt * ux, vy + dt * uy,
                 ax + dt * (2.0 * bx + dt * cx) + qx * h * h, bx + dt * cx + qx * h * dt,
                 cx + qx * dt * dt,

@@ -99,7 +99,7 @@ class TrackResult:
     of the associated observation or ``"UO"``; ``obs_index`` is the 0-based index of the
     associated observation in its scan (-1: none); ``refiltered`` lists Method 3's
     re-filtering passes as ``(leg, k_from, k_to)``: both legs were filtered again over
-    steps k_from+1..k_to after leg ``leg`` (0 = left) reappeared (eq. 17).
+    steps k_from+1..k_to after leg ``leg`` (0 = left) reappeared (seed000 eq. (17)).
     """
 
     t: np.ndarray

@@ -1,13 +1,13 @@
-"""Motion models: the acceleration input u of eq. (1) (seed 000 §3, §5.5).
+"""Motion models: the acceleration input u of seed000 eq. (1) (seed 000 §3, §5.5).
 
 Role ``motion``: ``inputs(phase, vl, vr, gl, gr, dt) -> ((ulx, uly), (urx, ury))`` and the
 acceleration-gain window ``n_ac``.
 
 Notes
 -----
-Eq. (18): Phase 0 → u^L = u^R = 0.
-Eq. (19): Phase 1 → u^L = g^L v^L/‖v^L‖, u^R = 0.
-Eq. (20): Phase 2 → u^L = −g^L v^L/‖v^L‖, u^R = 0.
+seed000 eq. (18): Phase 0 → u^L = u^R = 0.
+seed000 eq. (19): Phase 1 → u^L = g^L v^L/‖v^L‖, u^R = 0.
+seed000 eq. (20): Phase 2 → u^L = −g^L v^L/‖v^L‖, u^R = 0.
 Phases 3 and 4 mirror 1 and 2 for the right leg.  Phase 5 (both legs swinging) has no
 input in the paper; gaitval uses u = 0 there.
 
@@ -15,7 +15,7 @@ Braking limit (gaitval's addition, ``limit_braking=True``): in the decelerating 
 input may stop the leg within one step but not reverse it, ‖u‖ ≤ ‖v‖/Δt.  Without it,
 g·Δt (≈ 1 m/s per 25 ms step for a swing acceleration of 40 m/s²) overshoots the stance
 band ‖v‖ < v_st_th at the end of every swing; the reversed velocity then points back
-towards the stance leg, eq. (5) calls that "accelerating" (Phase 1/3), and eq. (19)
+towards the stance leg, seed000 eq. (5) calls that "accelerating" (Phase 1/3), and eq. (19)
 accelerates the leg backwards while it stands still — a runaway seen on simulated TUGs.
 ``limit_braking=False`` gives the paper's equations unchanged.
 
@@ -106,7 +106,7 @@ class MotionModel:
 
 @MOTION_MODELS.register("gait_phase_accel")
 class GaitPhaseAcceleration(MotionModel):
-    """Acceleration input per gait phase, eq. (18)–(20).
+    """Acceleration input per gait phase, seed000 eq. (18)–(20).
 
     Parameters
     ----------

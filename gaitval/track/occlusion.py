@@ -13,7 +13,7 @@ n_uo)`` returns the observations to re-filter the hidden steps with, and ``n_bef
 
 Notes
 -----
-Seed 000 eq. (17), Catmull–Rom: with the leg observed at k and at k+N_uo+1 and hidden in
+seed000 eq. (17), Catmull–Rom: with the leg observed at k and at k+N_uo+1 and hidden in
 between, the virtual observations are
 
     y'_{k+i} = ½ [1 τ τ² τ³] M [y_{k−N_bo}; y_k; y_{k+N_uo+1}; y_{k+N_uo+N_ao+1}],
@@ -22,7 +22,7 @@ between, the virtual observations are
 
 and the Kalman filter is run again from step k with them (§5.4).
 
-N_bo and N_ao are not given in the paper.  Eq. (17) is the *uniform* Catmull–Rom spline:
+N_bo and N_ao are not given in the paper.  seed000 eq. (17) is the *uniform* Catmull–Rom spline:
 its end tangents, (y_{k+N_uo+1} − y_{k−N_bo})/2 per unit τ, equal the leg's velocity only
 when the control points are spaced like the interpolated interval, i.e. N_bo = N_ao =
 N_uo + 1 steps.  gaitval's default is therefore ``"match"`` (N_bo = N_ao = N_uo + 1),
@@ -47,7 +47,7 @@ from gaitval.registry import Registry
 
 OCCLUSION_HANDLERS = Registry("occlusion handler")
 
-#: eq. (17) basis matrix (the ½ applied separately)
+#: seed000 eq. (17) basis matrix (the ½ applied separately)
 CATMULL_ROM_M = np.array([[0.0, 2.0, 0.0, 0.0],
                           [-1.0, 0.0, 1.0, 0.0],
                           [2.0, -5.0, 4.0, -1.0],
@@ -55,7 +55,7 @@ CATMULL_ROM_M = np.array([[0.0, 2.0, 0.0, 0.0],
 
 
 def catmull_rom(p0, p1, p2, p3, n_uo: int) -> np.ndarray:
-    """Virtual observations y'_{k+1..k+N_uo} of eq. (17), shape (n_uo, dim).
+    """Virtual observations y'_{k+1..k+N_uo} of seed000 eq. (17), shape (n_uo, dim).
 
     Parameters
     ----------
@@ -72,7 +72,8 @@ _WEIGHTS: dict[int, np.ndarray] = {}
 
 
 def _weights(n_uo: int) -> np.ndarray:
-    """½ [1 τ τ² τ³] M of eq. (17) for τ = i/(N_uo+1), i = 1..N_uo (cached per N_uo)."""
+    """½ [1 τ τ² τ³] M of seed000 eq. (17) for τ = i/(N_uo+1), i = 1..N_uo (cached per
+    N_uo)."""
     w = _WEIGHTS.get(n_uo)
     if w is None:
         tau = np.arange(1, n_uo + 1) / (n_uo + 1.0)                  # τ = i/(N_uo+1)
@@ -132,7 +133,7 @@ class CatmullRomInterpolation(OcclusionHandler):
     Parameters
     ----------
     n_bo, n_ao : int or "match"
-        N_bo, N_ao of eq. (17) (see the module notes for the default).
+        N_bo, N_ao of seed000 eq. (17) (see the module notes for the default).
     max_n : int
         Cap of N_bo, N_ao under ``"match"``.
     min_n_uo : int

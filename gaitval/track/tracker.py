@@ -1,12 +1,13 @@
 """The leg tracker: one part per role, wired in seed 000's per-scan order.
 
-Per scan k (seed 000 §5): **predict** both legs (seed000 eq. (7)–(8), input u from the gait
-phase at k−1, eq. (18)–(20)); take the scan's **observations** (precomputed detections, or a
-detector that places its window from the prediction); **gate** them per leg (eq. (11)–(13)
-or seed001 Table 1); **associate** (eq. (9)–(10), GNN or the gait-phase rule of §5.2);
-**correct** (eq. (14)–(16); a leg without an observation keeps its prediction and gets the
-UO pattern) and identify the **gait phase** (eq. (3)–(5)); **handle occlusion** (nothing,
-or Catmull–Rom virtual observations and re-filtering, eq. (17)).  The loop in
+Per scan k (seed 000 §5): **predict** both legs (seed000 eq. (7)–(8), input u from the
+gait phase at k−1, eq. (18)–(20)); take the scan's **observations** (precomputed
+detections, or a detector that places its window from the prediction); **gate** them per
+leg (seed000 eq. (11)–(13) or seed001 Table 1); **associate** (seed000 eq. (9)–(10), GNN or
+the gait-phase rule of §5.2); **correct** (seed000 eq. (14)–(16); a leg without an
+observation keeps its prediction and gets the UO pattern) and identify the **gait phase**
+(seed000 eq. (3)–(5)); **handle occlusion** (nothing, or Catmull–Rom virtual observations
+and re-filtering, seed000 eq. (17)).  The loop in
 :meth:`Tracker.run` holds no role's arithmetic; :class:`TrackingRun` keeps the per-leg
 histories (:class:`~gaitval.track.leg.LegTrack`) the roles read and write.
 
@@ -128,8 +129,8 @@ class Tracker:
             cr = gate.candidates(run.filter, prior[1], obs,
                                  run.gate_context(1, k) if context else None)
             hyp = Hypotheses(run, prior, obs)
-            a, b = assoc.select(cl, cr, run.phase[k - 1], hyp.phase_of)   # eq. (9)–(10)
-            run.commit(k, a, b, hyp, obs, pats)                   # eq. (14)–(16), (3)–(5)
+            a, b = assoc.select(cl, cr, run.phase[k - 1], hyp.phase_of)   # seed000 eq. (9)–(10)
+            run.commit(k, a, b, hyp, obs, pats)          # seed000 eq. (14)–(16), (3)–(5)
             occ.after_scan(state, run, k)                         # seed000 eq. (17)
         occ.finish(state, run)
         res = run.result()
