@@ -214,10 +214,18 @@ def evaluate_tug_step(track_parquet, gt_parquet, registration_json, trial: str, 
 
 
 def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, reports_dir,
-                    config_hash: str = "", methods=("tug_m1", "tug_m2", "tug_m3")
-                    ) -> list[Path]:
-    """Gather per-trial TUG evaluations into seed 000 Tables 2-5 and the figures."""
+                    config_hash: str = "", methods=("tug_m1", "tug_m2", "tug_m3"),
+                    configs: list[str | Path] | None = None) -> list[Path]:
+    """Gather per-trial TUG evaluations into seed 000 Tables 2-5 and the figures.
+
+    Table 2 shows the method definitions actually run: ``tracking.methods`` and
+    ``tracking.overrides`` of each study's ``config.json`` (``configs``; default
+    ``results/<study>/config.json`` above the ``evaluate/<method>/<trial>`` folders).  A
+    method run with different parameters in different studies gets one set of rows per
+    study, labelled ``<method> (<study>)``.
+    """
     from gaitval.evaluate.tug import FRAME_COLUMNS
+    from gaitval.methods import get_method, set_params
     from gaitval.report.provenance import stamp
     from gaitval.report.tug_figures import write_tug_figures
     from gaitval.tables.tug import write_tug_tables
@@ -236,7 +244,23 @@ def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, report
                                  else empty[n] for n in ("frames", "summary", "events"))
     summaries = summaries[summaries.get("category", "") != "not_registered"] \
         if len(summaries) else summaries
-    paths = write_tug_tables(frames, summaries, tables_dir, methods=tuple(methods))
+    # Table 2: the definitions each study ran (config-defined methods, overrides applied)
+    if configs is None:
+        configs = [Path(d).parents[2] / "config.json" for d in eval_dirs
+                   if len(Path(d).parents) > 2]
+    found = sorted({Path(c) for c in configs if Path(c).is_file()})
+    cfgs = {c.parent.name: load_json(c) for c in found} or {"": {}}
+    used: dict[str, dict] = {}
+    for m in methods:
+        runs = {study: set_params(get_method(method_definition(cfg, m)),
+                                  ((cfg.get("tracking") or {}).get("overrides") or {}).get(m))
+                for study, cfg in cfgs.items()}
+        distinct = {json.dumps(d, sort_keys=True, default=str) for d in runs.values()}
+        if len(distinct) == 1:
+            used[m] = next(iter(runs.values()))
+        else:
+            used.update({f"{m} ({study})": d for study, d in runs.items()})
+    paths = write_tug_tables(frames, summaries, tables_dir, methods=used)
     stamp("tug_tables", paths, reports_dir, config_hash_=config_hash)
     figs = write_tug_figures(frames, summaries, events, figures_dir)
     stamp("tug_figures", figs, reports_dir, config_hash_=config_hash)

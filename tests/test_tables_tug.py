@@ -79,6 +79,20 @@ def test_table2_parameters():
     assert nbo["tug_m1"] == "" and nbo["tug_m3"] == "match"
 
 
+def test_table2_from_definitions_blank_where_a_method_has_no_such_part():
+    """Definitions instead of names: what was run is shown, absent parts left blank (a
+    raw-scan tracker kind has no per-scan roles)."""
+    from gaitval.methods import METHODS, set_params
+
+    m3 = set_params(METHODS["tug_m3"], {"phase__v_st_th": 0.4, "tracker__dt_s": 0.05})
+    pf = {"label": "PF", "kind": {"name": "my_particle_filter", "n": 500}}
+    t = tug_table2({"tug_m3": m3, "pf": pf}, dt_measured_s=0.025).set_index(
+        ["method", "symbol"])["value"]
+    assert t["tug_m3", "v_st_th"] == "0.4" and t["tug_m3", "Δt"] == "0.05"
+    assert t["pf", "Δt"] == "0.025" and t["pf", "G"] == "" and t["pf", "v_st_th"] == ""
+    assert t["pf", "N_bo"] == "" and t["pf", "√Q"] == ""
+
+
 def test_write_tug_tables(tmp_path, data):
     f, s = data
     paths = write_tug_tables(f, s, tmp_path)

@@ -13,6 +13,7 @@ per leg observation state, :data:`PUBLISHED_T5`).  Method 1 has no published Tab
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -93,37 +94,55 @@ def _rmse(e: pd.Series) -> float:
     return float(np.sqrt(np.mean(e ** 2))) if len(e) else float("nan")
 
 
+def _spec(part) -> dict:
+    """A role's registry spec as a dict: a bare name -> ``{"name": name}``; absent -> {}."""
+    if part is None:
+        return {}
+    return dict(part) if isinstance(part, dict) else {"name": part}
+
+
 def tug_table2(methods=("tug_m1", "tug_m2", "tug_m3"), dt_measured_s: float | None = None
                ) -> pd.DataFrame:
     """Table 2: the parameters used, one row per parameter and method.
+
+    Parameters
+    ----------
+    methods : sequence of str, or mapping of str to dict
+        Names of built-in methods (:data:`gaitval.methods.METHODS`), or name -> the
+        definition actually run: a method of the config's ``tracking.methods`` or a
+        built-in, with its ``tracking.overrides`` applied
+        (``set_params(get_method(...), overrides)``).  A parameter the method does not
+        have is left blank.
+    dt_measured_s : float, optional
+        The sampling time shown when a method does not fix ``tracker.dt_s``.
 
     Returns
     -------
     DataFrame
         ``parameter, symbol, unit, method, value, value_published``.
     """
+    if not isinstance(methods, Mapping):
+        methods = {name: get_method(name) for name in methods}
     rows = []
-    for name in methods:
-        m = get_method(name)
-        tr = m.get("tracker", {})
-        occ = m["occlusion"] if isinstance(m["occlusion"], dict) else {"name": m["occlusion"]}
-        det = m["detector"] if isinstance(m["detector"], dict) else {"name": m["detector"]}
-        bg = det.get("background", "percentile")
-        bg = bg if isinstance(bg, dict) else {"name": bg}
-        dt = tr.get("dt_s") or dt_measured_s
+    for name, m in methods.items():
+        filt, motion, phase, gate = (_spec(m.get(r)) for r in ("filter", "motion", "phase",
+                                                                 "gate"))
+        occ, det = _spec(m.get("occlusion")), _spec(m.get("detector"))
+        bg = _spec(det.get("background", "percentile"))
+        dt = (m.get("tracker") or {}).get("dt_s") or dt_measured_s
         cr = occ.get("name") == "catmull_rom"
         items = [
             ("sampling time", "Δt", "s", dt, PUBLISHED_T2["dt_s"]),
             ("motion covariance Q (sd per axis)", "√Q", "m/s²",
-             m["filter"].get("q_accel_sd_mps2"), PUBLISHED_T2["q_accel_sd_mps2"]),
-            ("observation covariance R (sd per axis)", "√R", "m", m["filter"].get("r_sd_m"),
+             filt.get("q_accel_sd_mps2"), PUBLISHED_T2["q_accel_sd_mps2"]),
+            ("observation covariance R (sd per axis)", "√R", "m", filt.get("r_sd_m"),
              PUBLISHED_T2["r_sd_m"]),
-            ("speed threshold, stance", "v_st_th", "m/s", (m.get("phase") or {}).get("v_st_th"),
+            ("speed threshold, stance", "v_st_th", "m/s", phase.get("v_st_th"),
              PUBLISHED_T2["v_st_th_mps"]),
-            ("speed threshold, swing", "v_sw_th", "m/s", (m.get("phase") or {}).get("v_sw_th"),
+            ("speed threshold, swing", "v_sw_th", "m/s", phase.get("v_sw_th"),
              PUBLISHED_T2["v_sw_th_mps"]),
-            ("gate (P_G = 0.999)", "G", "", m["gate"].get("g"), PUBLISHED_T2["gate_g"]),
-            ("steps for the acceleration function", "N_ac", "steps", m["motion"].get("n_ac"),
+            ("gate (P_G = 0.999)", "G", "", gate.get("g"), PUBLISHED_T2["gate_g"]),
+            ("steps for the acceleration function", "N_ac", "steps", motion.get("n_ac"),
              PUBLISHED_T2["n_ac"]),
             ("Catmull–Rom points before occlusion", "N_bo", "steps",
              occ.get("n_bo") if cr else None, None),
@@ -287,6 +306,9 @@ def write_tug_tables(frames, summaries, out_dir: str | Path, *,
         Per-trial ``frames`` and ``summary`` of :func:`evaluate_tug_trial`.
     out_dir : path
         Usually ``reports/tables``.
+    methods : sequence of str, or mapping of str to dict
+        The methods of Table 2: names, or name -> the definition actually run (see
+        :func:`tug_table2`).
     """
     out = Path(out_dir)
     f, s = _concat(frames), _concat(summaries)

@@ -1,0 +1,339 @@
+"""The config schema catches typos (gaitval.configcheck), and Table 2 shows the methods run.
+
+Every problem must name the file, the key's full path and, for a typo, the nearest valid
+key; the shipped config and every key the code reads with a default must validate.
+"""
+from __future__ import annotations
+
+import copy
+import inspect
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+from gaitval.configcheck import check_config, check_study_file, load_schema
+from gaitval.errors import ConfigError
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = ROOT / "config" / "config.yaml"
+
+
+@pytest.fixture
+def cfg() -> dict:
+    with open(CONFIG, encoding="utf-8") as fh:
+        return yaml.safe_load(fh)
+
+
+def error_of(config: dict, layers=None) -> str:
+    with pytest.raises(ConfigError) as exc:
+        check_config(config, layers)
+    return str(exc.value)
+
+
+# -- the shipped files ------------------------------------------------------------------
+def test_shipped_config_validates(cfg):
+    check_config(cfg)
+
+
+@pytest.mark.slow
+def test_simulated_study_yaml_validates(tmp_path):
+    """The study.yaml the simulator writes beside a generated trial sheet."""
+    simulate = pytest.importorskip("gaitval.simulate")
+    simulate.generate_study(tmp_path, "tiny")
+    with open(tmp_path / "study.yaml", encoding="utf-8") as fh:
+        study = yaml.safe_load(fh)
+    assert "rollator" in study and "registration" in study
+    check_study_file(study, tmp_path / "study.yaml")
+
+
+def test_every_analysis_section_is_in_both_schemas():
+    from gaitval.steps import ANALYSIS_SECTIONS
+
+    schema = load_schema()
+    for section in ANALYSIS_SECTIONS:
+        assert section in schema["properties"], section
+        assert section in schema["$defs"]["study_file"]["properties"], section
+
+
+# -- typos ------------------------------------------------------------------------------
+def test_top_level_typo(cfg):
+    cfg["groundtruh"] = cfg.pop("groundtruth")
+    msg = error_of(cfg)
+    assert "config/config.yaml" in msg
+    assert "unknown key groundtruh — did you mean groundtruth?" in msg
+
+
+def test_nested_typo(cfg):
+    cfg["groundtruth"]["lowpas_hz"] = 6
+    msg = error_of(cfg)
+    assert msg == ("[file config/config.yaml] unknown key groundtruth.lowpas_hz — did you "
+                   "mean groundtruth.lowpass_hz?")
+
+
+def test_deep_typo(cfg):
+    cfg["ultrasonic"]["ukf"]["alpah"] = cfg["ultrasonic"]["ukf"].pop("alpha")
+    assert "unknown key ultrasonic.ukf.alpah — did you mean ultrasonic.ukf.alpha?" in \
+        error_of(cfg)
+
+
+def test_key_in_the_wrong_section_points_to_its_section(cfg):
+    cfg["lowpass_hz"] = 6
+    assert "unknown key lowpass_hz — did you mean groundtruth.lowpass_hz?" in error_of(cfg)
+
+
+def test_unlike_any_key_lists_the_valid_ones(cfg):
+    cfg["evaluation"]["tug"] = {"zzz": 1}
+    msg = error_of(cfg)
+    assert "unknown key evaluation.tug.zzz (valid keys here: drift_max_m," in msg
+
+
+def test_typo_in_a_config_defined_method_and_an_override(cfg):
+    from gaitval.methods import METHODS
+
+    m = copy.deepcopy(METHODS["tug_m3"])
+    m["occlusoin"] = m.pop("occlusion")
+    cfg["tracking"]["methods"]["my_m3"] = m
+    assert "unknown key tracking.methods.my_m3.occlusoin — did you mean " \
+           "tracking.methods.my_m3.occlusion?" in error_of(cfg)
+    cfg["tracking"]["methods"] = {}
+    cfg["tracking"]["overrides"] = {"tug_m3": {"occlusion_max_n": 10}}
+    assert "bad key tracking.overrides.tug_m3.occlusion_max_n: an override is " \
+           "<role>__<param>" in error_of(cfg)
+
+
+def test_several_problems_in_one_message(cfg):
+    cfg["groundtruth"]["lowpas_hz"] = 6
+    cfg["registration"]["pole_diamter_m"] = 0.05
+    msg = error_of(cfg)
+    assert msg.startswith("[file config/config.yaml] unknown key groundtruth.lowpas_hz")
+    assert "1 more: config/config.yaml: unknown key registration.pole_diamter_m — did you " \
+           "mean registration.pole_diameter_m?" in msg
+
+
+# -- types and values ---------------------------------------------------------------------
+def test_wrong_type_names_path_and_type(cfg):
+    cfg["groundtruth"]["lowpass_hz"] = "ten"
+    assert "groundtruth.lowpass_hz must be a number, got 'ten' (str)" in error_of(cfg)
+    cfg["groundtruth"]["lowpass_hz"] = 10.0
+    cfg["ultrasonic"]["ukf"]["max_reject"] = 1.5
+    assert "ultrasonic.ukf.max_reject must be an integer, got 1.5 (float)" in error_of(cfg)
+    cfg["ultrasonic"]["ukf"]["max_reject"] = 2
+    cfg["run"] = "tiny"
+    assert "run must be a list, got 'tiny' (str)" in error_of(cfg)
+
+
+def test_wrong_choice_suggests_one(cfg):
+    cfg["groundtruth"]["leg_point"] = "cylnder"
+    assert "groundtruth.leg_point must be one of auto, axis, cylinder, got 'cylnder' — " \
+           "did you mean cylinder?" in error_of(cfg)
+
+
+def test_study_entry_needs_sheet_or_simulate(cfg):
+    cfg["studies"]["lab"] = {"trial_sheet": "t.csv"}
+    assert "studies.lab: a real study needs trial_sheet and subjects" in error_of(cfg)
+
+
+# -- which file --------------------------------------------------------------------------
+def test_problem_names_the_layer_that_set_the_key(cfg):
+    typo = {"groundtruth": {"lowpas_hz": 6}}
+    merged = copy.deepcopy(cfg)
+    merged["groundtruth"].update(typo["groundtruth"])
+    base = ("config/config.yaml", cfg)
+    assert error_of(merged, [base, ("--config", typo)]).startswith(
+        "--config: unknown key groundtruth.lowpas_hz")
+    assert error_of(merged, [base, ("/tmp/mine.yaml", typo), ("--config", {})]).startswith(
+        "[file /tmp/mine.yaml] unknown key groundtruth.lowpas_hz")
+
+
+def test_study_yaml_typo_names_the_study_yaml(cfg, tmp_path):
+    from gaitval.steps import study_config
+
+    (tmp_path / "study.yaml").write_text("registration:\n  pole_diamter_m: 0.06\n")
+    with pytest.raises(ConfigError) as exc:
+        study_config(cfg, tmp_path / "trials.csv", tmp_path / "config.json")
+    msg = str(exc.value)
+    assert str(tmp_path / "study.yaml") in msg
+    assert "unknown key registration.pole_diamter_m — did you mean " \
+           "registration.pole_diameter_m?" in msg
+    assert not (tmp_path / "config.json").exists()
+    (tmp_path / "study.yaml").write_text("registraton:\n  pole_diameter_m: 0.06\n")
+    with pytest.raises(ConfigError, match="unknown key registraton — did you mean "
+                                          "registration?"):
+        study_config(cfg, tmp_path / "trials.csv", tmp_path / "config.json")
+    (tmp_path / "study.yaml").write_text("study: lab\nregistration: {pole_diameter_m: 0.06}\n")
+    out = study_config(cfg, tmp_path / "trials.csv", tmp_path / "config.json")
+    assert out["registration"]["pole_diameter_m"] == 0.06
+
+
+@pytest.mark.slow
+def test_snakemake_stops_with_the_message_only():
+    snakemake = Path(sys.executable).parent / "snakemake"
+    cmd = [str(snakemake), "--snakefile", str(ROOT / "Snakefile"), "-n",
+           "--config", 'run=["tiny"]', 'groundtruth={"lowpas_hz": 6}']
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert res.returncode != 0
+    assert "--config: unknown key groundtruth.lowpas_hz — did you mean " \
+           "groundtruth.lowpass_hz?" in res.stderr
+    assert "Traceback" not in res.stderr and "File \"" not in res.stderr
+
+
+# -- every key the code reads validates, with the code's defaults ------------------------
+def schema_defaults(node: dict, schema: dict) -> dict:
+    if "$ref" in node:
+        node = {**schema["$defs"][node["$ref"].rsplit("/", 1)[-1]], **node}
+    out = {}
+    for k, sub in (node.get("properties") or {}).items():
+        if "properties" in sub or "$ref" in sub and "default" not in sub:
+            out[k] = schema_defaults(sub, schema)
+        elif "default" in sub:
+            out[k] = sub["default"]
+    return out
+
+
+def test_code_defaults_validate_and_match_the_schema(cfg):
+    from gaitval.evaluate.tug_truth import DEFAULTS as TUG
+    from gaitval.groundtruth.build import DEFAULTS as GT
+    from gaitval.registration import clock, poles, trial
+
+    reg = {**trial.DEFAULTS, **poles.DEFAULTS, **clock.DEFAULTS}
+    schema = load_schema()
+    defaults = schema_defaults(schema, schema)
+    assert {k: defaults["registration"][k] for k in reg} == reg
+    assert {k: defaults["groundtruth"][k] for k in GT} == GT
+    assert defaults["evaluation"]["tug"] == TUG
+    cfg["registration"].update(reg)
+    cfg["groundtruth"].update(GT)
+    cfg["evaluation"]["tug"] = dict(TUG)
+    check_config(cfg)
+
+
+def test_ultrasonic_defaults_validate_and_match_the_schema(cfg):
+    mod = pytest.importorskip("gaitval.ultrasonic")
+    us = getattr(mod, "DEFAULT_CFG", None)
+    if us is None:
+        pytest.skip("gaitval.ultrasonic.DEFAULT_CFG has moved")
+    schema = load_schema()
+    want = schema_defaults(schema, schema)["ultrasonic"]
+    assert {k: want[k] for k in us} == us
+    cfg["ultrasonic"] = copy.deepcopy(us)
+    check_config(cfg)
+
+
+def test_builtin_methods_validate_and_roles_match():
+    from gaitval.methods import METHODS, ROLES
+    from gaitval.track.tracker import Tracker
+
+    schema = load_schema()
+    method = schema["$defs"]["method"]["properties"]
+    assert set(ROLES) <= set(method)
+    params = set(inspect.signature(Tracker.__init__).parameters) - set(ROLES) - {"self"}
+    assert set(method["tracker"]["properties"]) == params
+    cfg = {"studies": {}, "run": ["x"], "tracking": {"methods": copy.deepcopy(METHODS)}}
+    check_config(cfg)
+
+
+# -- Table 2 shows the methods actually run ----------------------------------------------
+def my_m3() -> dict:
+    from gaitval.methods import METHODS
+
+    m = copy.deepcopy(METHODS["tug_m3"])
+    m["label"] = "my Method 3"
+    m["gate"] = {"name": "chi2", "g": 9.21}
+    return m
+
+
+def g_of(t2: pd.DataFrame, method: str) -> str:
+    return t2[(t2.symbol == "G") & (t2.method == method)].iloc[0]["value"]
+
+
+def study_results(root: Path, study: str, cfg: dict, methods) -> list[Path]:
+    """A results/<study>/ tree as the workflow leaves it: config.json and one evaluation
+    folder per method."""
+    from gaitval.evaluate.tug import FRAME_COLUMNS
+
+    (root / study).mkdir(parents=True)
+    (root / study / "config.json").write_text(json.dumps(cfg))
+    dirs = []
+    for m in methods:
+        d = root / study / "evaluate" / m / "t1"
+        d.mkdir(parents=True)
+        pd.DataFrame(columns=list(FRAME_COLUMNS)).to_parquet(d / "frames.parquet")
+        pd.DataFrame([{"trial": "t1", "method": m, "success": True,
+                       "category": "success"}]).to_parquet(d / "summary.parquet")
+        pd.DataFrame(columns=["trial", "method", "side", "kind", "t_start_s", "t_end_s",
+                              "tug_phase"]).to_parquet(d / "events.parquet")
+        dirs.append(d)
+    return dirs
+
+
+@pytest.fixture
+def table2_of(monkeypatch, tmp_path):
+    """Run tug_tables_step; return Table 2 built from the definitions it passed on."""
+    import gaitval.report.tug_figures as figures
+    import gaitval.tables.tug as tables
+    from gaitval.steps import tug_tables_step
+
+    seen = {}
+
+    def spy(frames, summaries, out_dir, *, methods, dt_measured_s=None):
+        seen["methods"] = methods
+        return []
+
+    monkeypatch.setattr(tables, "write_tug_tables", spy)
+    monkeypatch.setattr(figures, "write_tug_figures", lambda *a, **k: [])
+
+    def run(dirs, methods):
+        tug_tables_step(dirs, tmp_path / "t", tmp_path / "f", tmp_path / "r",
+                        methods=methods)
+        return tables.tug_table2(seen["methods"])
+    return run
+
+
+def test_table2_config_only_method(tmp_path, table2_of):
+    from gaitval.tables.tug import tug_table2
+
+    with pytest.raises(ConfigError):         # what the table did before: built-ins only
+        tug_table2(["my_m3"])
+    cfg = {"tracking": {"methods": {"my_m3": my_m3()}, "overrides": {}}}
+    t2 = table2_of(study_results(tmp_path / "res", "s", cfg, ["tug_m1", "my_m3"]),
+                   ["tug_m1", "my_m3"])
+    assert g_of(t2, "my_m3") == "9.21" and g_of(t2, "tug_m1") == "13.82"
+    nbo = t2[t2.symbol == "N_bo"].set_index("method")["value"]
+    assert nbo["my_m3"] == "match"
+
+
+def test_table2_shows_overrides(tmp_path, table2_of):
+    cfg = {"tracking": {"methods": {"my_m3": my_m3()},
+                        "overrides": {"my_m3": {"gate__g": 5.99},
+                                      "tug_m3": {"occlusion__n_bo": 5,
+                                                 "filter__r_sd_m": 0.03}}}}
+    t2 = table2_of(study_results(tmp_path / "res", "s", cfg, ["tug_m3", "my_m3"]),
+                   ["tug_m3", "my_m3"])
+    v = t2.set_index(["method", "symbol"])["value"]
+    assert v["my_m3", "G"] == "5.99" and v["tug_m3", "G"] == "13.82"
+    assert v["tug_m3", "N_bo"] == "5" and v["tug_m3", "N_ao"] == "match"
+    assert v["tug_m3", "√R"] == "0.03" and v["my_m3", "√R"] == "0.04"
+
+
+def test_table2_without_config_changes_is_the_builtin_table(tmp_path, table2_of):
+    from gaitval.tables.tug import tug_table2
+
+    names = ["tug_m1", "tug_m2", "tug_m3"]
+    cfg = {"tracking": {"methods": {}, "overrides": {}}}
+    t2 = table2_of(study_results(tmp_path / "res", "s", cfg, names), names)
+    assert t2.equals(tug_table2(names))
+
+
+def test_table2_studies_that_ran_a_method_differently(tmp_path, table2_of):
+    a = {"tracking": {"overrides": {"tug_m3": {"gate__g": 9.21}}}}
+    b = {"tracking": {"overrides": {}}}
+    dirs = (study_results(tmp_path / "res", "a", a, ["tug_m1", "tug_m3"])
+            + study_results(tmp_path / "res", "b", b, ["tug_m1", "tug_m3"]))
+    t2 = table2_of(dirs, ["tug_m1", "tug_m3"])
+    assert list(dict.fromkeys(t2.method)) == ["tug_m1", "tug_m3 (a)", "tug_m3 (b)"]
+    assert g_of(t2, "tug_m3 (a)") == "9.21" and g_of(t2, "tug_m3 (b)") == "13.82"
