@@ -170,16 +170,28 @@ def test_study_yaml_typo_names_the_study_yaml(cfg, tmp_path):
     assert out["registration"]["pole_diameter_m"] == 0.06
 
 
-@pytest.mark.slow
-def test_snakemake_stops_with_the_message_only():
+def dry_run(*args: str) -> subprocess.CompletedProcess:
     snakemake = Path(sys.executable).parent / "snakemake"
-    cmd = [str(snakemake), "--snakefile", str(ROOT / "Snakefile"), "-n",
-           "--config", 'run=["tiny"]', 'groundtruth={"lowpas_hz": 6}']
-    res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, cwd=ROOT)
+    cmd = [str(snakemake), "--snakefile", str(ROOT / "Snakefile"), "-n", *args]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=300, cwd=ROOT)
+
+
+@pytest.mark.slow
+def test_snakemake_stops_with_the_message_only(tmp_path):
+    res = dry_run("--config", 'run=["tiny"]', 'groundtruth={"lowpas_hz": 6}')
     assert res.returncode != 0
     assert "--config: unknown key groundtruth.lowpas_hz — did you mean " \
            "groundtruth.lowpass_hz?" in res.stderr
     assert "Traceback" not in res.stderr and "File \"" not in res.stderr
+    # a real study's study.yaml is checked before any job runs
+    (tmp_path / "study.yaml").write_text("registration: {pole_diamter_m: 0.06}\n")
+    lab = {"studies": {"lab": {"trial_sheet": str(tmp_path / "trials.csv"),
+                               "subjects": str(tmp_path / "subjects.csv")}}, "run": ["lab"]}
+    (tmp_path / "lab.yaml").write_text(yaml.safe_dump(lab))
+    res = dry_run("--configfile", str(tmp_path / "lab.yaml"))
+    assert res.returncode != 0
+    assert f"[file {tmp_path / 'study.yaml'}] unknown key registration.pole_diamter_m" \
+        in res.stderr
 
 
 # -- every key the code reads validates, with the code's defaults ------------------------

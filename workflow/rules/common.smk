@@ -4,7 +4,8 @@ from pathlib import Path
 
 from snakemake.common.configfile import load_configfile
 
-from gaitval.configcheck import check_config, display_path, load_schema
+from gaitval.configcheck import (check_config, check_study_file, display_path,
+                                 load_schema)
 from gaitval.errors import ConfigError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash
@@ -22,15 +23,28 @@ def _config_layers():
     return layers + [("--config", dict(getattr(settings, "config", None) or {}))]
 
 
-# Every key against workflow/schemas/config.schema.yaml: a typo stops the run here with
-# the key's path and the nearest valid key (gaitval.configcheck), as one message.
+def _check_study_files(schema):
+    """study.yaml of each study in `run` whose trial sheet is already there (a simulated
+    study's is checked again when its config is built, rule study_config)."""
+    for study in config["run"]:
+        entry = config["studies"].get(study) or {}
+        sheet = Path(entry.get("trial_sheet") or Path(DATA) / study / "trials.csv")
+        cal = sheet.parent / "study.yaml"
+        if cal.is_file():
+            check_study_file(load_configfile(str(cal)), cal, schema=schema)
+
+
+DATA = config.get("data_dir", "data")
+# Every key against workflow/schemas/config.schema.yaml, then the studies' study.yaml: a
+# typo stops the run here with the file, the key's path and the nearest valid key
+# (gaitval.configcheck), as one message.
 try:
-    check_config(config, _config_layers(), schema=load_schema(
-        Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"))
+    _SCHEMA = load_schema(Path(workflow.basedir) / "workflow/schemas/config.schema.yaml")
+    check_config(config, _config_layers(), schema=_SCHEMA)
+    _check_study_files(_SCHEMA)
 except ConfigError as exc:
     sys.exit(f"ConfigError: {exc}")
 
-DATA = config.get("data_dir", "data")
 RESULTS = config.get("results_dir", "results")
 PRESETS = Path(workflow.basedir) / "config" / "studies"
 REPORTS = config.get("reports_dir", "reports")
