@@ -232,3 +232,16 @@ def test_an_occlusion_handler_can_restart_both_legs(monkeypatch):
     assert (res.vx[:, 50] == 0).all() and (res.x[:, 50] == truth[:, 50, 0]).all()
     err = np.hypot(res.x - truth[:, :, 0], res.y - truth[:, :, 1])
     assert np.nanmax(err) < 0.05
+
+
+def test_measurement_noise_in_leg_widths_is_set_per_subject():
+    """seed001 eq. (2)–(3): R = diag((w_l/2)², (w_l/2)²) for each participant's w_l."""
+    F = FILTERS.build({"name": "kf", "r_sd_m": 0.04, "r_sd_leg_widths": 0.5})
+    assert F.for_leg_width(0.12).r_sd_m == pytest.approx(0.06)
+    assert F.r_sd_m == 0.04                                    # the method's part unchanged
+    plain = FILTERS.build("kf")
+    assert plain.for_leg_width(0.12) is plain
+    t, xy, pats, _ = _walk()
+    a = Tracker(filter={"name": "kf", "r_sd_leg_widths": 0.4}, dt_s=DT).run(t, xy, pats, 0.1)
+    b = Tracker(filter={"name": "kf", "r_sd_m": 0.04}, dt_s=DT).run(t, xy, pats, 0.1)
+    np.testing.assert_allclose(a.x, b.x, rtol=1e-12)          # 0.4 w_l = 0.04 m here

@@ -40,6 +40,8 @@ Spline-Based Interpolation during Turning Motion in Walk Tests. Sensors 2015, 15
 """
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 
 from gaitval.registry import Registry
@@ -59,6 +61,9 @@ class LegFilter:
         Observation noise standard deviation (R = diag(r², r²)); seed 000 Table 2: 0.04.
     p0_pos_sd_m, p0_vel_sd_mps : float
         Initial state uncertainty (not given in the paper).
+    r_sd_leg_widths : float or None
+        (``kf``) measurement noise in leg widths, set per subject (:meth:`for_leg_width`);
+        None keeps ``r_sd_m``.
     """
 
     def __init__(self, q_accel_sd_mps2: float = 15.0, r_sd_m: float = 0.04,
@@ -67,6 +72,18 @@ class LegFilter:
         self.r_sd_m = r_sd_m
         self.p0_pos_sd_m = p0_pos_sd_m
         self.p0_vel_sd_mps = p0_vel_sd_mps
+
+    def for_leg_width(self, leg_width_m: float) -> "LegFilter":
+        """The filter for one subject: itself, or a copy whose measurement noise is set from
+        the subject's leg width when ``r_sd_leg_widths`` is given (seed 001: R =
+        diag((w_l/2)², (w_l/2)²), i.e. ``r_sd_leg_widths: 0.5``)."""
+        k = getattr(self, "r_sd_leg_widths", None)
+        if k is None:
+            return self
+        out = copy.copy(self)
+        out.r_sd_m = k * leg_width_m
+        out._cache = {}
+        return out
 
     def init(self, x: float, y: float, vx: float = 0.0, vy: float = 0.0):
         raise NotImplementedError
@@ -120,8 +137,10 @@ class AxisKalmanFilter(LegFilter):
     """
 
     def __init__(self, q_accel_sd_mps2: float = 15.0, r_sd_m: float = 0.04,
-                 p0_pos_sd_m: float = 0.04, p0_vel_sd_mps: float = 0.5):
+                 p0_pos_sd_m: float = 0.04, p0_vel_sd_mps: float = 0.5,
+                 r_sd_leg_widths: float | None = None):
         super().__init__(q_accel_sd_mps2, r_sd_m, p0_pos_sd_m, p0_vel_sd_mps)
+        self.r_sd_leg_widths = r_sd_leg_widths
         self._cache: dict[float, tuple] = {}
 
     def init(self, x, y, vx=0.0, vy=0.0):

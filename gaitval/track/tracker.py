@@ -184,7 +184,8 @@ class TrackingRun:
 
     def __init__(self, tracker: Tracker, t: np.ndarray, source, leg_width_m: float,
                  start: tuple[int, int, int]):
-        self.filter, self.motion = tracker.filter, tracker.motion
+        self.filter = tracker.filter.for_leg_width(leg_width_m)
+        self.motion = tracker.motion
         self.phase_model = tracker.phase
         self.t, self.n, self.leg_width_m = t, len(t), leg_width_m
         self.dts = (step_durations(t, tracker.dt_s)[1] if self.n > 1 else
