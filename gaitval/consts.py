@@ -44,6 +44,7 @@ NO_RETURN = float("nan")
 #: Speed of sound in dry air at 0 degC (m/s) in the physical law c = 331.3 sqrt(1 + T/273.15),
 #: which the simulator uses as the true physics.  The pipeline converts time of flight with
 #: seed 003's linear approximation, eq. (2): v_s = 331.5 + 0.6 T_c
-#: (:func:`gaitval.ultrasonic.speed_of_sound`); the two differ by ~0.1 % at room temperature.
+#: (:func:`gaitval.io.ultrasonic.speed_of_sound`); the two differ by ~0.1 % at room
+#: temperature.  Both laws go through the one eq. (1) conversion of :mod:`gaitval.io.ultrasonic`.
 SPEED_OF_SOUND_0C = 331.3
 KELVIN_0C = 273.15

@@ -18,6 +18,17 @@ Schema metadata key ``gaitval:ultrasonic`` holds a JSON object::
 
 The anchor geometry (receiver positions, metres, in the ultrasonic system's frame) lives in
 the metadata so one file is a complete record.
+
+Ranging (seed 003 eq. (1)–(2)) is the one unit conversion of these logs and lives here
+too: :func:`tof_to_distance` (and its inverse :func:`distance_to_tof`, which the simulator
+uses with its own speed-of-sound law), :func:`log_distances` (the ranges of a log in metres,
+whichever quantity it stores) and :func:`anchor_positions`.
+
+References
+----------
+Qi, Y.; Soh, C.B.; Gunawan, E.; Low, K.-S.; Thomas, R. Estimation of Spatial-Temporal Gait
+Parameters Using a Low-Cost Ultrasonic Motion Analysis System. *Sensors* 2014, 14,
+15434–15457. doi:10.3390/s140815434
 """
 from __future__ import annotations
 
@@ -27,7 +38,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from gaitval.errors import FileFormatError
+from gaitval.errors import FileFormatError, TimestampError
 from gaitval.io.atomic import atomic_path
 from gaitval.io.scanlog import check_timestamps
 from gaitval.types import UltrasonicLog
@@ -36,6 +47,69 @@ META_KEY = b"gaitval:ultrasonic"
 FORMAT = "gaitval-ultrasonic"
 VERSION = 1
 SUFFIX = ".us.parquet"
+#: Columns of an anchor table (``UltrasonicLog.anchors``): id, then position (m).
+ANCHOR_COLUMNS = ["anchor", "x_m", "y_m", "z_m"]
+
+
+# ------------------------------------------------------------------------------ ranging
+def speed_of_sound(temp_c):
+    """Speed of ultrasound in air, ``v_s = 331.5 + 0.6 T_c`` (m/s), seed003 eq. (2)."""
+    return 331.5 + 0.6 * np.asarray(temp_c, dtype=float)
+
+
+def _per_sample(v, x: np.ndarray):
+    """Speeds per sample ``(n,)`` as a column when ``x`` holds ``(n, m)`` anchors."""
+    return v[:, None] if x.ndim == 2 and np.ndim(v) == 1 else v
+
+
+def tof_to_distance(tof_s, temp_c, *, speed=speed_of_sound):
+    """Range from time of flight, ``d = t v_s(T_c)`` (seed003 eq. (1)–(2)).
+
+    Parameters
+    ----------
+    tof_s : array_like, shape (n,) or (n, m)
+        Times of flight (s); NaN stays NaN.
+    temp_c : array_like, shape (n,) or scalar
+        Air temperature (degrees Celsius) at each sample.
+    speed : callable, optional
+        Speed of sound (m/s) from the temperature; default :func:`speed_of_sound`
+        (seed003 eq. (2)).
+
+    Returns
+    -------
+    ndarray
+        Distances in metres, shape of ``tof_s``.
+    """
+    tof = np.asarray(tof_s, dtype=float)
+    return tof * _per_sample(speed(temp_c), tof)                          # seed003 eq. (1)
+
+
+def distance_to_tof(d_m, temp_c, *, speed=speed_of_sound):
+    """Time of flight of a range, ``t = d / v_s(T_c)``: seed003 eq. (1) solved for ``t``.
+
+    Same shapes and ``speed`` as :func:`tof_to_distance`, of which it is the inverse; the
+    simulator passes its own physical law (:func:`gaitval.simulate.us_sensor.speed_of_sound_true`).
+    """
+    d = np.asarray(d_m, dtype=float)
+    return d / _per_sample(speed(temp_c), d)                              # seed003 eq. (1)
+
+
+def log_distances(log: UltrasonicLog) -> np.ndarray:
+    """(n, m) ranges in metres of a log that stores either TOF or distances."""
+    if log.distance_m is not None:
+        return np.asarray(log.distance_m, dtype=float)
+    if log.tof_s is None:
+        raise TimestampError("ultrasonic log holds neither times of flight nor distances",
+                             path=log.source or None)
+    return tof_to_distance(log.tof_s, log.temperature_c)
+
+
+def anchor_positions(anchors: pd.DataFrame) -> np.ndarray:
+    """Receiver positions ``(m, 3)`` (metres, ultrasonic frame) of an anchor table."""
+    return anchors[ANCHOR_COLUMNS[1:]].to_numpy(dtype=float)
+
+
+# ------------------------------------------------------------------------------ files
 
 
 def write_ultrasonic(path: str | Path, log: UltrasonicLog, *, transmitter: str = "heel",

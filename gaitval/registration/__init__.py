@@ -1,5 +1,5 @@
 """Registration of a sensor to the mocap field: calibration poles, 2-D rigid fit, moving
-(rollator) sensor poses, and clock synchronisation.
+(rollator) sensor poses, the ultrasonic anchor frame, and clock synchronisation.
 
 Entry points for the pipeline: :func:`register_trial` (one trial -> one
 :class:`RegistrationRecord`, a row of ``registration.csv``) and
@@ -7,13 +7,14 @@ Entry points for the pipeline: :func:`register_trial` (one trial -> one
 common brief, repeated in :mod:`gaitval.registration.rigid` and
 :mod:`gaitval.registration.clock`.
 """
+from gaitval.registration.anchors import AnchorFit, fit_anchor_frame
 from gaitval.registration.clock import ClockEstimate, estimate_clock, estimate_clock_offset
 from gaitval.registration.poles import PoleFit, find_pole_candidates, register_poles
 from gaitval.registration.rigid import field_to_sensor, fit_rigid_2d, sensor_to_field
 from gaitval.registration.trial import (RECORD_FIELDS, RegistrationRecord, register_anchors,
                                         register_trial, registration_table)
 
-__all__ = ["ClockEstimate", "estimate_clock", "estimate_clock_offset", "PoleFit",
-           "find_pole_candidates", "register_poles", "field_to_sensor", "fit_rigid_2d",
-           "sensor_to_field", "RECORD_FIELDS", "RegistrationRecord", "register_anchors",
-           "register_trial", "registration_table"]
+__all__ = ["AnchorFit", "fit_anchor_frame", "ClockEstimate", "estimate_clock",
+           "estimate_clock_offset", "PoleFit", "find_pole_candidates", "register_poles",
+           "field_to_sensor", "fit_rigid_2d", "sensor_to_field", "RECORD_FIELDS",
+           "RegistrationRecord", "register_anchors", "register_trial", "registration_table"]

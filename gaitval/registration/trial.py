@@ -29,11 +29,13 @@ from gaitval.errors import RegistrationError
 from gaitval.groundtruth.build import (as_float, filled_markers, gt_cfg, leg_points, section,
                                        sensor_height)
 from gaitval.groundtruth.gaps import fill_short_gaps
+from gaitval.io.ultrasonic import log_distances
 from gaitval.registration import clock as CK
 from gaitval.registration import poles as PO
 from gaitval.registration.moving import (ROLLATOR_MARKERS, parse_mount, rollator_pose,
                                          sensor_pose_from_rollator)
-from gaitval.registration.rigid import field_to_sensor, fit_rigid_3d, wrap_angle
+from gaitval.registration.anchors import fit_anchor_frame
+from gaitval.registration.rigid import field_to_sensor, wrap_angle
 from gaitval.types import MocapTrial, ScanSeries, UltrasonicLog
 
 #: Columns of ``registration.csv`` (issue 4), in order.
@@ -229,10 +231,11 @@ def _check_peak(ce, c, path, tid):
 
 def register_anchors(mocap: MocapTrial, log: UltrasonicLog, cfg: dict | None = None, *,
                      trial=None):
-    """3-D rigid fit of the log's anchor coordinates to the ANC markers.
+    """The ultrasonic frame of one trial, with the ``registration`` configuration.
 
-    Anchors are matched to markers by name when the log's anchor ids equal marker labels,
-    else in order (log anchor k <-> ``anchor_markers[k]``).
+    :func:`~gaitval.registration.anchors.fit_anchor_frame` (the one anchor registration)
+    with ``registration.anchor_markers``, ``registration.max_anchor_residual_m`` and each
+    marker's median position.
 
     Returns
     -------
@@ -244,36 +247,14 @@ def register_anchors(mocap: MocapTrial, log: UltrasonicLog, cfg: dict | None = N
         Fewer than three anchor markers, or a residual above ``max_anchor_residual_m``.
     """
     c = reg_cfg(cfg)
-    ids = log.anchor_ids
-    labels = ids if all(mocap.has(a) for a in ids) else list(c["anchor_markers"])[:len(ids)]
-    src, dst, used = [], [], []
-    A = log.anchors[["x_m", "y_m", "z_m"]].to_numpy(dtype=float)
-    for k, lb in enumerate(labels):
-        if k < len(A) and mocap.has(lb):
-            p = mocap.marker(lb)
-            ok = np.isfinite(p).all(axis=1)
-            if ok.any():
-                src.append(A[k])
-                dst.append(np.median(p[ok], axis=0))
-                used.append(lb)
-    if len(src) < 3:
-        raise RegistrationError(
-            f"the C3D has {len(src)} usable anchor marker(s) (looked for {labels}); three "
-            "are needed to register the ultrasonic frame", path=mocap.path, trial=trial,
-            hint="label the receiver markers ANC1..ANC4")
-    R, t, res = fit_rigid_3d(np.array(src), np.array(dst))
-    if res.max() > float(c["max_anchor_residual_m"]):
-        raise RegistrationError(
-            f"anchor residual {res.max() * 1000:.1f} mm at {used[int(np.argmax(res))]} "
-            f"exceeds {c['max_anchor_residual_m'] * 1000:.0f} mm", path=mocap.path,
-            trial=trial, hint="check the anchor coordinates in the log metadata")
-    return R, t, res
+    fit = fit_anchor_frame(mocap, log.anchors, c["anchor_markers"], centre="median",
+                           max_residual_m=float(c["max_anchor_residual_m"]), trial=trial)
+    return fit.R, fit.t, fit.residuals_m
 
 
 def anchor_distances(log: UltrasonicLog) -> np.ndarray:
     """Transmitter-anchor distances (n, n_anchors), metres, from ``distance_m`` or from
-    ``tof_s`` with seed 003 eq. (1)-(2) (:func:`gaitval.ultrasonic.log_distances`)."""
-    from gaitval.ultrasonic import log_distances
+    ``tof_s`` with seed003 eq. (1)-(2) (:func:`gaitval.io.ultrasonic.log_distances`)."""
     return log_distances(log)
 
 

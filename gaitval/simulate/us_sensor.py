@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from gaitval import consts as C
+from gaitval.io.ultrasonic import distance_to_tof
 from gaitval.types import UltrasonicLog
 
 #: The paper's receiver positions p1..p4 (m) in the ultrasonic frame (seed 003 §4.1).
@@ -51,11 +52,11 @@ def _ranges_to_tof(d_true: np.ndarray, temp_c: np.ndarray, rng: np.random.Genera
                    ) -> tuple[np.ndarray, dict]:
     """True ranges -> logged times of flight (noise, multipath, dropouts, 1 us tick)."""
     n, m = d_true.shape
-    c = speed_of_sound_true(temp_c)[:, None]
     d = d_true + rng.standard_normal((n, m)) * np.sqrt(V_m2)[None, :]
     mp = rng.random((n, m)) < multipath_prob
     d = d + mp * rng.uniform(0.05, 0.5, size=(n, m))
-    tof = np.round(d / c * 1e6) * 1e-6                       # 16-bit counter, 1 us tick
+    tof = distance_to_tof(d, temp_c, speed=speed_of_sound_true)      # seed003 eq. (1)
+    tof = np.round(tof * 1e6) * 1e-6                         # 16-bit counter, 1 us tick
     drop = rng.random((n, m)) < dropout_prob
     tof[drop] = np.nan
     return tof, {"n_multipath": int(mp.sum()), "n_dropout": int(drop.sum())}
