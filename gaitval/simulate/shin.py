@@ -33,7 +33,7 @@ REAL_WALKS = ("FunctionalWalk.c3d", "PiG_Motion-FlatFoot-Full.c3d", "opensim_wal
 SCAN_HEIGHT_M = 0.27
 MEASURES = ("v_walk_mps", "stride_s", "stance_norm", "swing_norm", "swing_peak_norm",
             "p95_norm", "p99_norm", "max_norm", "decel_mps2", "decel_norm",
-            "shank_range_deg", "shank_omega_dps", "shank_omega_norm")
+            "shank_range_deg", "shank_omega_dps", "shank_omega_norm", "swing_fwd_min_mps")
 
 
 def _phase_intervals(contacts: np.ndarray, offs: np.ndarray) -> list[tuple[float, float]]:
@@ -61,21 +61,47 @@ def profile(t: np.ndarray, knee: np.ndarray, ankle: np.ndarray, swings: list, v_
     Returns
     -------
     dict of arrays: ``v`` (speed per frame), ``swing`` mask, per-stride ``peak`` and
-    ``decel`` (largest speed drop rate in the 0.15 s around contact), shank angle ``theta``
-    (sagittal, knee ahead positive, degrees) and ``omega`` (deg/s).
+    ``decel`` (largest speed drop rate in the 0.15 s around contact), per-swing ``fwd_min``
+    (:func:`point_profile`), shank angle ``theta`` (sagittal, knee ahead positive,
+    degrees) and ``omega`` (deg/s).
     """
     knee = lowpass(knee, rate_hz)
     ankle = lowpass(ankle, rate_hz)
     p, ok = point_at_height(knee, ankle, h)
-    v2 = differentiate(p[:, :2], t)
-    v = np.hypot(v2[:, 0], v2[:, 1])
-    dv = differentiate(v, t)
+    out = _point_measures(t, p[:, :2], ok, swings, stride_s)
     d = knee - ankle
     theta = np.degrees(np.arctan2(d[:, :2] @ fwd, d[:, 2]))
     omega = differentiate(theta, t)
+    keep = out.pop("_keep")
+    out.update(theta=theta[keep], omega=omega[keep])
+    return out
+
+
+def point_profile(t: np.ndarray, xy: np.ndarray, swings: list, rate_hz: float,
+                  stride_s: float = 1.0) -> dict:
+    """Shin-height measures of one leg from its point at sensor height (a simulated
+    study's ``truth/<trial>/legs.parquet``), low-passed like :func:`profile`.
+
+    Returns the keys of :func:`profile` except the shank angles.  ``fwd_min`` holds, per
+    complete swing, the lowest speed of the point along the swing's own direction (the
+    chord from its position at foot off to its position at contact; m/s): negative when
+    the swinging shin moves backwards.  Swings whose point travels less than 5 cm have no
+    direction and are left out.
+    """
+    xy = lowpass(np.asarray(xy, dtype=float), rate_hz)
+    ok = np.isfinite(xy).all(axis=1)
+    out = _point_measures(t, xy, ok, swings, stride_s)
+    out.pop("_keep")
+    return out
+
+
+def _point_measures(t, p2, ok, swings, stride_s) -> dict:
+    """Speeds, swing mask, per-stride peak / contact deceleration / forward minimum."""
+    v2 = differentiate(p2, t)
+    v = np.hypot(v2[:, 0], v2[:, 1])
+    dv = differentiate(v, t)
     swing = np.zeros(len(t), dtype=bool)
-    known = np.zeros(len(t), dtype=bool)
-    peaks, decs, ranges = [], [], []
+    peaks, decs, fmins = [], [], []
     for a, b in swings:
         m = (t >= a) & (t < b)
         swing |= m
@@ -84,13 +110,19 @@ def profile(t: np.ndarray, knee: np.ndarray, ankle: np.ndarray, swings: list, v_
             peaks.append(np.nanmax(v[m]))
             w = (t >= b - 0.15) & (t <= b + 0.05)
             decs.append(-np.nanmin(dv[w]))
+            i = np.flatnonzero(m)
+            chord = p2[i[-1]] - p2[i[0]]
+            dist = float(np.hypot(*chord))
+            if dist >= 0.05:
+                fmins.append(float(np.nanmin(v2[i] @ (chord / dist))))
     # frames between the first and last event are classified; the rest is unknown
+    known = np.zeros(len(t), dtype=bool)
     if swings:
         known = (t >= min(a for a, _ in swings) - 0.6 * stride_s) & (t <= max(b for _, b in swings)
                                                                         + 0.6 * stride_s)
-    ok = ok & np.isfinite(v) & known
-    return {"v": v[ok], "swing": swing[ok], "peak": np.array(peaks), "decel": np.array(decs),
-            "theta": theta[ok], "omega": omega[ok]}
+    keep = ok & np.isfinite(v) & known
+    return {"v": v[keep], "swing": swing[keep], "peak": np.array(peaks), "decel": np.array(decs),
+            "fwd_min": np.array(fmins), "_keep": keep}
 
 
 def summarise(legs: list[dict], v_walk: float, stride_s: float) -> dict:
@@ -99,6 +131,7 @@ def summarise(legs: list[dict], v_walk: float, stride_s: float) -> dict:
     sw = np.concatenate([g["swing"] for g in legs])
     pk = np.concatenate([g["peak"] for g in legs])
     dc = np.concatenate([g["decel"] for g in legs])
+    fm = np.concatenate([g["fwd_min"] for g in legs])
     rng_deg = np.mean([np.ptp(g["theta"]) for g in legs if len(g["theta"])])
     om = max(np.nanmax(np.abs(g["omega"])) for g in legs if len(g["omega"]))
     a_ref = v_walk / stride_s
@@ -112,7 +145,8 @@ def summarise(legs: list[dict], v_walk: float, stride_s: float) -> dict:
             "decel_mps2": float(np.mean(dc)) if len(dc) else np.nan,
             "decel_norm": float(np.mean(dc)) / a_ref if len(dc) else np.nan,
             "shank_range_deg": float(rng_deg), "shank_omega_dps": float(om),
-            "shank_omega_norm": float(om) * stride_s / 360.0}
+            "shank_omega_norm": float(om) * stride_s / 360.0,
+            "swing_fwd_min_mps": float(np.min(fm)) if len(fm) else np.nan}
 
 
 def _marker_events(mocap, side: str, heel: str, toe: str) -> tuple[np.ndarray, np.ndarray]:
