@@ -35,6 +35,17 @@ METHOD = "method"
 RANGE = "range_m"
 ANGLE = "angle_rad"
 
+# -- ground truth and evaluation frames (one row per sensor sample and side) -------------
+T_SENSOR = "t_sensor_s"  # a sensor sample's time on the sensor clock
+T_MOCAP = "t_mocap_s"    # the same instant on the mocap clock
+SCAN = "scan"            # index of the scan in the sensor log
+XS, YS = "xs_m", "ys_m"  # position in the sensor frame (X, Y: in the field)
+VALID = "valid"          # bool: the row has a usable value
+
+# -- trial-sheet cells read by more than one stage ----------------------------------------
+SENSOR_HEIGHT = "sensor_height_m"
+CLOCK_OFFSET = "clock_offset_s"
+
 # -- "no return" in laser data ------------------------------------------------------------
 #: Every loader maps inf, NaN, zero, below-range-min and above-range-max returns to NaN in
 #: float metres.  NaN is the one documented "no return" value inside gaitval.
