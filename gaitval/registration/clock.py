@@ -9,6 +9,8 @@ values of cross-correlation between these two trajectories"), by maximising the 
 cross-correlation (NCC) of a motion signal seen by both systems, refined to sub-sample
 precision by a parabola through the peak and its two neighbours.
 
+* :func:`to_mocap_time` inverts the model for a registered trial (the ground truth maps
+  every sensor sample to the mocap clock with it).
 * :func:`estimate_clock_offset` is generic (any 1-D or multi-channel signals).
 * :func:`lrs_occupancy_signals` builds the LRS signal: for every beam (grouped into bins of
   about 0.5 deg), the observed "foreground" indicator of each scan (range nearer than the
@@ -70,6 +72,12 @@ class ClockEstimate:
     clock_drift_ppm: float
     sync_peak: float
     method: str = "ncc"
+
+
+def to_mocap_time(t_sensor, clock_offset_s: float, clock_drift_ppm: float) -> np.ndarray:
+    """Sensor-clock times on the mocap clock, the clock model inverted:
+    ``t_mocap = (t_sensor - clock_offset_s) / (1 + clock_drift_ppm * 1e-6)``."""
+    return (np.asarray(t_sensor, dtype=float) - clock_offset_s) / (1.0 + clock_drift_ppm * 1e-6)
 
 
 def _uniform(t, x, t0, dt, n):
@@ -157,47 +165,77 @@ def estimate_clock_offset(t_a, sig_a, t_b, sig_b, max_lag_s: float, *,
     if A.shape[1] != B.shape[1]:
         raise ValueError("the two signals must have the same number of channels")
     tb_ch = t_b if t_b.ndim == 2 else np.repeat(t_b[:, None], B.shape[1], axis=1)
-    tb_first = tb_ch[:, 0]
     if dt is None:
-        dt = float(min(np.median(np.diff(t_a)), np.median(np.diff(tb_first))))
+        dt = float(min(np.median(np.diff(t_a)), np.median(np.diff(tb_ch[:, 0]))))
     ta0, tb0 = float(np.nanmin(t_a)), float(np.nanmin(tb_ch))
-    na = int(np.floor((np.nanmax(t_a) - ta0) / dt)) + 1
-    nb = int(np.floor((np.nanmax(tb_ch) - tb0) / dt)) + 1
-    Ag = _uniform(t_a, A, ta0, dt, na)
-    Bg = np.full((nb, B.shape[1]), np.nan)
-    for j in range(B.shape[1]):
-        Bg[:, j] = _uniform(tb_ch[:, j], B[:, j:j + 1], tb0, dt, nb)[:, 0]
-    wa = np.isfinite(Ag).astype(float)
-    wb = np.isfinite(Bg).astype(float)
-    Ag = np.where(wa > 0, Ag - np.nanmean(np.where(wa > 0, Ag, np.nan), axis=0), 0.0)
-    Bg = np.where(wb > 0, Bg - np.nanmean(np.where(wb > 0, Bg, np.nan), axis=0), 0.0)
-    Ag = np.nan_to_num(Ag)
-    Bg = np.nan_to_num(Bg)
-    nfft = sfft.next_fast_len(na + nb)
-    num = _xcorr(Ag, Bg, nfft)
-    ea = _xcorr(Ag * Ag, wb, nfft)
-    eb = _xcorr(wa, Bg * Bg, nfft)
-    ov = _xcorr(wa, wb, nfft)
-    lags = np.arange(-(na - 1), nb)
-    tau = tb0 - ta0 + lags * dt
+    Ag, wa = _centred_grid(t_a, A, ta0, dt)
+    Bg, wb = _centred_grid(tb_ch, B, tb0, dt)
+    na, nb = len(Ag), len(Bg)
+    ncc, ea, eb, ov = _masked_ncc(Ag, Bg, wa, wb)
+    tau = tb0 - ta0 + np.arange(-(na - 1), nb) * dt
     if centre_s is None:
         overlap = (np.nanmax(t_a) >= tb0) and (np.nanmax(tb_ch) >= ta0)
         centre_s = 0.0 if overlap else tb0 - ta0
     nmin = min(wa.any(axis=1).sum(), wb.any(axis=1).sum()) * A.shape[1]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ncc = num / np.sqrt(np.maximum(ea, 0) * np.maximum(eb, 0))
     usable = (np.abs(tau - centre_s) <= max_lag_s) & (ov >= min_overlap * nmin * 0.999) \
         & np.isfinite(ncc) & (ea > 1e-12) & (eb > 1e-12)
     if not usable.any():
         return float("nan"), float("nan")
     k = int(np.flatnonzero(usable)[np.argmax(ncc[usable])])
-    delta = 0.0
-    if 0 < k < len(ncc) - 1 and usable[k - 1] and usable[k + 1]:
-        y0, y1, y2 = ncc[k - 1], ncc[k], ncc[k + 1]
+    return float(tau[k] + _parabolic_vertex(ncc, usable, k) * dt), float(ncc[k])
+
+
+def _centred_grid(t: np.ndarray, x: np.ndarray, t0: float, dt: float
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Channels ``x`` (n, ch) sampled at ``t`` ((n,) shared, or (n, ch) per channel) on the
+    grid ``t0 + k dt`` up to the last sample, each channel minus its mean on the grid.
+
+    Returns
+    -------
+    grid : ndarray (n_grid, ch)
+        Centred values, 0 where a channel has no sample (masked NCC: gaps do not count).
+    weight : ndarray (n_grid, ch)
+        1 where a channel has a sample, else 0.
+    """
+    n = int(np.floor((np.nanmax(t) - t0) / dt)) + 1
+    if t.ndim == 1:
+        g = _uniform(t, x, t0, dt, n)
+    else:
+        g = np.full((n, x.shape[1]), np.nan)
+        for j in range(x.shape[1]):
+            g[:, j] = _uniform(t[:, j], x[:, j:j + 1], t0, dt, n)[:, 0]
+    w = np.isfinite(g).astype(float)
+    g = np.where(w > 0, g - np.nanmean(np.where(w > 0, g, np.nan), axis=0), 0.0)
+    return np.nan_to_num(g), w
+
+
+def _masked_ncc(Ag, Bg, wa, wb):
+    """Masked normalised cross-correlation of two centred grids at every lag.
+
+    Returns ``ncc, ea, eb, ov`` at lags ``-(na - 1) .. nb - 1``: NCC(k) = sum a'_i b'_{i+k}
+    / sqrt(ea(k) eb(k)), with ``ea``, ``eb`` the energies of each signal where the other
+    has samples and ``ov`` the number of overlapping samples (Padfield 2012).
+    """
+    nfft = sfft.next_fast_len(len(Ag) + len(Bg))
+    num = _xcorr(Ag, Bg, nfft)
+    ea = _xcorr(Ag * Ag, wb, nfft)
+    eb = _xcorr(wa, Bg * Bg, nfft)
+    ov = _xcorr(wa, wb, nfft)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ncc = num / np.sqrt(np.maximum(ea, 0) * np.maximum(eb, 0))
+    return ncc, ea, eb, ov
+
+
+def _parabolic_vertex(c: np.ndarray, usable: np.ndarray, k: int) -> float:
+    """Sub-sample shift of the peak ``k`` of ``c``: the vertex of the parabola through
+    ``c[k-1], c[k], c[k+1]`` (0 at an edge, beside an unusable lag, or when not a maximum),
+    ``delta = (c[k-1] - c[k+1]) / (2 (c[k-1] - 2 c[k] + c[k+1]))`` clipped to +-0.5."""
+    if 0 < k < len(c) - 1 and usable[k - 1] and usable[k + 1]:
+        y0, y1, y2 = c[k - 1], c[k], c[k + 1]
         den = y0 - 2 * y1 + y2
         if den < 0:
-            delta = float(np.clip(0.5 * (y0 - y2) / den, -0.5, 0.5))
-    return float(tau[k] + delta * dt), float(ncc[k])
+            return float(np.clip(0.5 * (y0 - y2) / den, -0.5, 0.5))
+    return 0.0
 
 
 def beam_times(sensor) -> np.ndarray:

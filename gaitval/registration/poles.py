@@ -5,6 +5,9 @@ poles").
 
 Method (all in the sensor frame, metres / radians)
 --------------------------------------------------
+Steps 1-3 find the poles in the scans (:mod:`gaitval.registration.poledetect`); steps 4-5,
+here, match them to the markers and fit the pose.
+
 1. **Static background.**  The per-beam median range over the calibration window (by
    default every scan of the trial, evenly subsampled to at most ``pole_max_scans``) and the
    per-beam *static fraction* (share of scans whose range lies within ``pole_static_tol_m``
@@ -49,38 +52,26 @@ Yorozu, A., et al. (2015). Gait measurement system for the multi-target stepping
 using a laser range sensor. Sensors 15(5), 11151-11168.
 """
 from __future__ import annotations
+from __future__ import annotations
 
-import itertools
 import re
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
+from gaitval import consts as C
 from gaitval.errors import RegistrationError
+from gaitval.registration.poledetect import (DEFAULTS, find_pole_candidates, foreground_points,
+                                             pole_cfg, static_background)
 from gaitval.registration.rigid import field_to_sensor, fit_rigid_2d, wrap_angle
 from gaitval.types import MocapTrial, ScanSeries
 
-#: Defaults of the ``registration:`` config keys used here.
-DEFAULTS = {
-    "pole_labels": None,            # None: every C3D label matching POLE<n>
-    "pole_diameter_m": 0.05,
-    "max_pole_residual_m": 0.02,
-    "pole_match_tol_m": 0.10,
-    "pole_min_static_fraction": 0.5,
-    "pole_static_tol_m": 0.03,
-    "pole_segment_jump_m": 0.05,
-    "pole_edge_step_m": 0.10,
-    "pole_window_s": None,          # None: whole trial; else the first N seconds
-    "pole_max_scans": 800,
-    "pole_ambiguity": "motion",     # or "bearing"
-}
+__all__ = ["DEFAULTS", "PoleFit", "find_pole_candidates", "foreground_points",
+           "mocap_pole_positions", "motion_score", "register_poles", "static_background"]
 
-
-def _cfg(cfg: dict | None) -> dict:
-    out = dict(DEFAULTS)
-    out.update({k: v for k, v in (cfg or {}).items() if k in DEFAULTS})
-    return out
+#: At most this many candidate -> marker assignments are fitted.
+MAX_ASSIGNMENTS = 5000
 
 
 @dataclass
@@ -154,135 +145,7 @@ def mocap_pole_positions(mocap: MocapTrial, labels=None, *, trial=None) -> pd.Da
             path=mocap.path, trial=trial,
             hint="label the pole markers POLE1, POLE2 (or set registration.pole_labels), "
                  "or register this trial by hand")
-    return pd.DataFrame(rows, columns=["pole", "x_m", "y_m"])
-
-
-def static_background(sensor: ScanSeries, cfg: dict | None = None
-                      ) -> tuple[np.ndarray, np.ndarray]:
-    """Per-beam median range and static fraction over the calibration window.
-
-    Returns
-    -------
-    median_m : ndarray (n_beams,)
-        NaN where a beam returns nothing in more than half of the window.
-    static_fraction : ndarray (n_beams,)
-        Fraction of scans within ``pole_static_tol_m`` of the median.
-    """
-    c = _cfg(cfg)
-    r = sensor.ranges
-    idx = np.arange(sensor.n_scans)
-    if c["pole_window_s"] is not None:
-        idx = idx[sensor.t - sensor.t[0] <= float(c["pole_window_s"])]
-    if len(idx) > c["pole_max_scans"]:
-        idx = idx[np.linspace(0, len(idx) - 1, int(c["pole_max_scans"])).astype(int)]
-    sub = r[idx]
-    valid_frac = np.mean(np.isfinite(sub), axis=0)
-    with np.errstate(all="ignore"):
-        import warnings
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            med = np.nanmedian(sub, axis=0)
-        static = np.mean(np.abs(sub - med) <= c["pole_static_tol_m"], axis=0)
-    med[valid_frac < 0.5] = np.nan
-    return med, static
-
-
-def _fit_fixed_radius(p: np.ndarray, R: float) -> np.ndarray:
-    """Circle centre with known radius R through points p (k, 2) seen from the origin."""
-    m = p.mean(axis=0)
-    c = m + R * m / np.linalg.norm(m)
-    if len(p) < 2:
-        return c
-    for _ in range(20):
-        d = p - c
-        n = np.linalg.norm(d, axis=1)
-        res = n - R
-        J = -d / n[:, None]
-        step, *_ = np.linalg.lstsq(J, -res, rcond=None)
-        c = c + step
-        if np.linalg.norm(step) < 1e-7:
-            break
-    return c
-
-
-def find_pole_candidates(sensor: ScanSeries, cfg: dict | None = None) -> pd.DataFrame:
-    """Thin static objects of the pole diameter in the scans (sensor frame).
-
-    Returns
-    -------
-    DataFrame ``xs_m, ys_m, range_m, bearing_rad, n_beams, width_m`` (centres, metres),
-    one row per candidate, ordered by bearing.  See the module docstring for the method.
-    """
-    c = _cfg(cfg)
-    d = float(c["pole_diameter_m"])
-    R = d / 2.0
-    med, static = static_background(sensor, c)
-    r = med.copy()
-    r[static < c["pole_min_static_fraction"]] = np.nan
-    a = sensor.angles
-    dth = abs(sensor.angle_increment)
-    nb = len(r)
-    ok = np.isfinite(r)
-    # segments: split at missing beams and range jumps
-    brk = np.ones(nb + 1, dtype=bool)
-    with np.errstate(invalid="ignore"):
-        brk[1:nb] = ~(ok[1:] & ok[:-1] & (np.abs(np.diff(r)) <= c["pole_segment_jump_m"]))
-    starts = np.flatnonzero(brk[:-1] & ok)
-    rows = []
-    for s in starts:
-        e = s
-        while e + 1 < nb and not brk[e + 1]:
-            e += 1
-        n = e - s + 1
-        rmin = np.nanmin(r[s:e + 1])
-        if n * dth * rmin > 3 * d:          # far too wide to be a pole
-            continue
-        pts = np.column_stack([r[s:e + 1] * np.cos(a[s:e + 1]), r[s:e + 1] * np.sin(a[s:e + 1])])
-        width = np.linalg.norm(pts[-1] - pts[0]) + rmin * dth
-        if abs(width - d) > max(0.5 * d, 1.5 * rmin * dth):
-            continue
-
-        def step_ok(i0, direction):
-            # depth step beside the segment, allowing one mixed pixel in between
-            for k in (1, 2):
-                j = i0 + direction * k
-                if j < 0 or j >= nb:
-                    return True  # edge of the field of view counts as open space
-                if not np.isfinite(med[j]):
-                    return True
-                if med[j] >= rmin + c["pole_edge_step_m"]:
-                    return True
-                if med[j] < rmin + 0.5 * R:   # a nearer or equal surface: not a free pole
-                    return False
-            return False
-
-        if not (step_ok(s, -1) and step_ok(e, +1)):
-            continue
-        keep = r[s:e + 1] <= rmin + 1.2 * R     # drop mixed pixels at the edges
-        cen = _fit_fixed_radius(pts[keep], R)
-        rows.append((cen[0], cen[1], float(np.hypot(*cen)), float(np.arctan2(cen[1], cen[0])),
-                     int(n), float(width)))
-    return pd.DataFrame(rows, columns=["xs_m", "ys_m", "range_m", "bearing_rad", "n_beams",
-                                       "width_m"])
-
-
-def foreground_points(sensor: ScanSeries, background: np.ndarray, *, margin_m: float = 0.10,
-                      max_scans: int = 300, max_range_m: float | None = None) -> np.ndarray:
-    """Sensor-frame points of returns nearer than the static background (pooled scans).
-
-    Returns an (m, 2) array of points (metres) from at most ``max_scans`` evenly spaced
-    scans; used as time-agnostic motion evidence.
-    """
-    idx = np.linspace(0, sensor.n_scans - 1, min(max_scans, sensor.n_scans)).astype(int)
-    r = sensor.ranges[idx]
-    bg = np.where(np.isfinite(background), background, np.inf)
-    with np.errstate(invalid="ignore"):
-        fg = np.isfinite(r) & (r < bg - margin_m)
-        if max_range_m is not None:
-            fg &= r <= max_range_m
-    k, i = np.nonzero(fg)
-    a = sensor.angles[i]
-    return np.column_stack([r[k, i] * np.cos(a), r[k, i] * np.sin(a)])
+    return pd.DataFrame(rows, columns=["pole", C.X, C.Y])
 
 
 def motion_score(pose, leg_xy_field: np.ndarray, fg_points: np.ndarray,
@@ -327,26 +190,56 @@ def register_poles(sensor: ScanSeries, mocap: MocapTrial, cfg: dict | None = Non
         No/one pole marker, a pole not found in the scans, an ambiguous correspondence, or
         a residual above ``max_pole_residual_m``.
     """
-    c = _cfg(cfg)
+    c = pole_cfg(cfg)
     markers = mocap_pole_positions(mocap, c["pole_labels"], trial=trial)
     cand = find_pole_candidates(sensor, c)
     labels = list(markers["pole"])
-    M = markers[["x_m", "y_m"]].to_numpy()
-    n_p = len(M)
+    M = markers[[C.X, C.Y]].to_numpy()
     where = dict(path=sensor.source or None, trial=trial)
-    if len(cand) < n_p:
+    if len(cand) < len(M):
         raise RegistrationError(
-            f"found {len(cand)} thin static object(s) in the scans but the C3D has {n_p} "
+            f"found {len(cand)} thin static object(s) in the scans but the C3D has {len(M)} "
             f"calibration poles ({', '.join(labels)}); a pole is not visible to the sensor "
             "or hidden for more than half of the calibration window",
             hint="check that every pole stands in the scan plane, or set "
                  "registration.pole_window_s to a participant-free part of the trial", **where)
-    S = cand[["xs_m", "ys_m"]].to_numpy()
+    S = cand[[C.XS, C.YS]].to_numpy()
+    assignments = _consistent_assignments(S, M, float(c["pole_match_tol_m"]), labels, where)
+    hyps = _pose_hypotheses(S, M, assignments)
+    best, scores = hyps[0], {}
+    if len(hyps) > 1:
+        if c["pole_ambiguity"] == "bearing":
+            best = _by_bearing(hyps, cand["bearing_rad"].to_numpy(), where)
+        else:
+            best, scores = _by_motion(hyps, sensor, c, leg_xy_field, where)
+    worst, x, y, yaw, res, asg = best
+    per_pole = {lb: float(v) for lb, v in zip(labels, res)}
+    if worst > float(c["max_pole_residual_m"]):
+        lb = labels[int(np.argmax(res))]
+        raise RegistrationError(
+            f"pole residual {worst * 1000:.1f} mm at {lb} exceeds "
+            f"registration.max_pole_residual_m = {c['max_pole_residual_m'] * 1000:.0f} mm "
+            f"(per pole: " + ", ".join(f"{k} {v * 1000:.1f} mm" for k, v in per_pole.items())
+            + ")", hint="a pole may have moved between calibration and recording, or the "
+                        "pole diameter in the config is wrong", **where)
+    poles = pd.DataFrame({"pole": labels, C.XS: S[list(asg), 0], C.YS: S[list(asg), 1],
+                          C.X: M[:, 0], C.Y: M[:, 1], "residual_m": res})
+    return PoleFit(x, y, float(wrap_angle(yaw)), per_pole, poles, scores)
+
+
+def _consistent_assignments(S: np.ndarray, M: np.ndarray, tol: float, labels, where
+                            ) -> list[tuple[int, ...]]:
+    """Injective assignments marker j -> candidate k whose pairwise distances agree with the
+    markers' within ``tol`` (backtracking; at most :data:`MAX_ASSIGNMENTS`).
+
+    Raises
+    ------
+    RegistrationError
+        When no assignment fits the markers' distance pattern (a pole is not found).
+    """
+    n_p = len(M)
     DM = np.linalg.norm(M[:, None] - M[None], axis=2)
     DS = np.linalg.norm(S[:, None] - S[None], axis=2)
-    tol = float(c["pole_match_tol_m"])
-
-    # backtracking over injective assignments consistent with the distance pattern
     assignments = []
 
     def extend(partial):
@@ -362,8 +255,6 @@ def register_poles(sensor: ScanSeries, mocap: MocapTrial, cfg: dict | None = Non
         return
 
     extend([])
-    if len(assignments) > 5000:
-        assignments = assignments[:5000]
     if not assignments:
         raise RegistrationError(
             f"no set of {n_p} pole candidates in the scans matches the distances between "
@@ -371,62 +262,66 @@ def register_poles(sensor: ScanSeries, mocap: MocapTrial, cfg: dict | None = Non
             f"{DM[0, 1]:.3f} m) within {tol} m; a pole is not found",
             hint="check the pole diameter (registration.pole_diameter_m) and that both "
                  "poles are visible", **where)
+    return assignments[:MAX_ASSIGNMENTS]
+
+
+def _pose_hypotheses(S: np.ndarray, M: np.ndarray, assignments) -> list[tuple]:
+    """Rigid fit of every assignment (:func:`~gaitval.registration.rigid.fit_rigid_2d`),
+    best worst-residual first, grouped into distinct poses (within 0.05 m and 2 deg).
+
+    Returns a list of ``(worst_residual_m, x_m, y_m, yaw_rad, residuals, assignment)``.
+    """
     fits = []
     for asg in assignments:
         x, y, yaw, res = fit_rigid_2d(S[list(asg)], M)
         fits.append((float(res.max()), x, y, yaw, res, asg))
     fits.sort(key=lambda f: f[0])
-    # group into distinct pose hypotheses
     hyps = []
     for f in fits:
         if any(np.hypot(f[1] - h[1], f[2] - h[2]) < 0.05
                and abs(wrap_angle(f[3] - h[3])) < np.deg2rad(2) for h in hyps):
             continue
         hyps.append(f)
-    best = hyps[0]
-    scores = {}
-    if len(hyps) > 1:
-        if c["pole_ambiguity"] == "bearing":
-            ordered = [h for h in hyps
-                       if np.all(np.diff(cand["bearing_rad"].to_numpy()[list(h[5])]) > 0)]
-            if not ordered:
-                raise RegistrationError(
-                    "no pole assignment has the pole labels at increasing bearing "
-                    "(pole_ambiguity: bearing)", **where)
-            best = ordered[0]
-        else:
-            fg = None
-            if leg_xy_field is not None and len(leg_xy_field):
-                med, _ = static_background(sensor, c)
-                fg = foreground_points(sensor, med)
-            if fg is None or len(fg) == 0:
-                raise RegistrationError(
-                    f"{len(hyps)} sensor poses fit the poles equally well (with two poles "
-                    "the pose and its 180-degree turn about the pole midpoint) and the "
-                    "trial shows no walking to tell them apart",
-                    hint="set registration.pole_ambiguity: bearing (POLE1 at the smaller "
-                         "beam angle) or use three poles in an asymmetric pattern", **where)
-            sc = [motion_score((h[1], h[2], h[3]), leg_xy_field, fg) for h in hyps]
-            order = np.argsort(sc)[::-1]
-            scores = {f"pose{i}": float(s) for i, s in enumerate(sc)}
-            if not (sc[order[0]] - sc[order[1]] >= 0.2):
-                raise RegistrationError(
-                    f"the pole correspondence is ambiguous: motion evidence "
-                    f"{sc[order[0]]:.2f} vs {sc[order[1]]:.2f} (fraction of mocap leg "
-                    "points on laser returns)",
-                    hint="set registration.pole_ambiguity: bearing, or check the clock "
-                         "and the sensor height", **where)
-            best = hyps[int(order[0])]
-    worst, x, y, yaw, res, asg = best
-    per_pole = {lb: float(v) for lb, v in zip(labels, res)}
-    if worst > float(c["max_pole_residual_m"]):
-        lb = labels[int(np.argmax(res))]
+    return hyps
+
+
+def _by_bearing(hyps: list[tuple], bearing: np.ndarray, where) -> tuple:
+    """``pole_ambiguity: bearing``: the best hypothesis with the pole labels at increasing
+    beam angle."""
+    ordered = [h for h in hyps if np.all(np.diff(bearing[list(h[5])]) > 0)]
+    if not ordered:
         raise RegistrationError(
-            f"pole residual {worst * 1000:.1f} mm at {lb} exceeds "
-            f"registration.max_pole_residual_m = {c['max_pole_residual_m'] * 1000:.0f} mm "
-            f"(per pole: " + ", ".join(f"{k} {v * 1000:.1f} mm" for k, v in per_pole.items())
-            + ")", hint="a pole may have moved between calibration and recording, or the "
-                        "pole diameter in the config is wrong", **where)
-    poles = pd.DataFrame({"pole": labels, "xs_m": S[list(asg), 0], "ys_m": S[list(asg), 1],
-                          "x_m": M[:, 0], "y_m": M[:, 1], "residual_m": res})
-    return PoleFit(x, y, float(wrap_angle(yaw)), per_pole, poles, scores)
+            "no pole assignment has the pole labels at increasing bearing "
+            "(pole_ambiguity: bearing)", **where)
+    return ordered[0]
+
+
+def _by_motion(hyps: list[tuple], sensor: ScanSeries, c: dict, leg_xy_field, where
+               ) -> tuple[tuple, dict]:
+    """``pole_ambiguity: motion``: the hypothesis whose mapped leg points land on the
+    foreground returns (:func:`motion_score`), ahead of the runner-up by 0.2.
+
+    Returns the winning hypothesis and the score of each (``pose0``, ``pose1``, ...).
+    """
+    fg = None
+    if leg_xy_field is not None and len(leg_xy_field):
+        med, _ = static_background(sensor, c)
+        fg = foreground_points(sensor, med)
+    if fg is None or len(fg) == 0:
+        raise RegistrationError(
+            f"{len(hyps)} sensor poses fit the poles equally well (with two poles "
+            "the pose and its 180-degree turn about the pole midpoint) and the "
+            "trial shows no walking to tell them apart",
+            hint="set registration.pole_ambiguity: bearing (POLE1 at the smaller "
+                 "beam angle) or use three poles in an asymmetric pattern", **where)
+    sc = [motion_score((h[1], h[2], h[3]), leg_xy_field, fg) for h in hyps]
+    order = np.argsort(sc)[::-1]
+    scores = {f"pose{i}": float(s) for i, s in enumerate(sc)}
+    if not (sc[order[0]] - sc[order[1]] >= 0.2):
+        raise RegistrationError(
+            f"the pole correspondence is ambiguous: motion evidence "
+            f"{sc[order[0]]:.2f} vs {sc[order[1]]:.2f} (fraction of mocap leg "
+            "points on laser returns)",
+            hint="set registration.pole_ambiguity: bearing, or check the clock "
+                 "and the sensor height", **where)
+    return hyps[int(order[0])], scores
