@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from gaitval import consts as C
 from gaitval.config import deep_merge
 from gaitval.errors import GaitvalError
 from gaitval.io.atomic import write_csv, write_parquet, write_text
@@ -92,6 +93,10 @@ def load_ingested(ingest_dir: str | Path, row: dict):
 def register_step(ingest_dir, sheet, subjects, trial: str, config_json, out_dir) -> dict:
     """Register one trial and build its ground truth.
 
+    The trial's leg points at sensor height are computed once
+    (:func:`~gaitval.groundtruth.sensor_leg_points`) and handed to the registration (pole
+    motion evidence, clock) and then to the ground truth.
+
     Writes ``registration.json`` (the record, plus ``status`` ``ok`` or ``refused`` and the
     ``reason``) and ``groundtruth.parquet`` (empty when refused).  A refusal
     (:class:`~gaitval.errors.GaitvalError` from registration or ground truth: a pole not
@@ -99,23 +104,24 @@ def register_step(ingest_dir, sheet, subjects, trial: str, config_json, out_dir)
     hidden: the registration table shows it and later steps skip the trial.  Set
     ``registration.on_error: raise`` to stop the run instead.
     """
-    from gaitval.groundtruth import GT_COLUMNS, ground_truth
+    from gaitval.groundtruth import GT_COLUMNS, ground_truth, sensor_leg_points
     from gaitval.registration import RECORD_FIELDS, register_trial
 
     cfg = load_json(config_json)
     row, subj = trial_and_subject(sheet, subjects, trial)
     mocap, sensor = load_ingested(ingest_dir, row)
     out = Path(out_dir)
-    rec: dict = {"trial": trial, "protocol": row["protocol"], "subject": row["subject"]}
+    rec: dict = {C.TRIAL: trial, "protocol": row["protocol"], C.SUBJECT: row[C.SUBJECT]}
     try:
-        reg = register_trial(mocap, sensor, row, subj, cfg)
-        gt = ground_truth(mocap, sensor, reg, row, subj, cfg)
+        legs = sensor_leg_points(mocap, sensor, row, subj, cfg)       # once per trial
+        reg = register_trial(mocap, sensor, row, subj, cfg, legs=legs)
+        gt = ground_truth(mocap, sensor, reg, row, subj, cfg, legs=legs)
         rec.update({k: _clean(v) for k, v in reg.as_row().items()})
         rec.update(status="ok", reason="")
     except GaitvalError as exc:
         if cfg.get("registration", {}).get("on_error", "record") == "raise":
             raise exc.with_context(trial=trial) from None
-        rec.update({k: None for k in RECORD_FIELDS if k != "trial"})
+        rec.update({k: None for k in RECORD_FIELDS if k != C.TRIAL})
         rec.update(status="refused", reason=str(exc.with_context(trial=trial)))
         gt = pd.DataFrame(columns=GT_COLUMNS)
     write_parquet(gt.reset_index(drop=True), out / "groundtruth.parquet")
@@ -131,12 +137,12 @@ def registration_summary(inputs: list[str | Path], study: str, out_csv, out_stem
     from gaitval.tables import write_table
 
     rows = [load_json(p) for p in inputs]
-    cols = list(RECORD_FIELDS) + ["protocol", "subject", "status", "reason"]
-    df = pd.DataFrame(rows).reindex(columns=cols).sort_values("trial").reset_index(drop=True)
+    cols = list(RECORD_FIELDS) + ["protocol", C.SUBJECT, "status", "reason"]
+    df = pd.DataFrame(rows).reindex(columns=cols).sort_values(C.TRIAL).reset_index(drop=True)
     write_csv(df, out_csv, float_format="%.6g")
     show = df.copy()
     show["yaw_deg"] = np.degrees(show["yaw_rad"].astype(float))
-    show = show[["trial", "protocol", "x_m", "y_m", "yaw_deg", "clock_offset_s",
+    show = show[[C.TRIAL, "protocol", C.X, C.Y, "yaw_deg", C.CLOCK_OFFSET,
                  "clock_drift_ppm", "pole_residual_m", "sync_peak", "joint_centre_source",
                  "gt_frames_excluded", "status", "reason"]]
     n_ref = int((df["status"] != "ok").sum())

@@ -112,6 +112,27 @@ def test_joint_centre_preference_and_lateral_offset():
 # ---------------------------------------------------------------------------------------
 # ground truth at sensor timestamps (constructed walker)
 # ---------------------------------------------------------------------------------------
+def test_leg_points_computed_once_per_trial(monkeypatch):
+    """The pipeline's order (gaitval.steps.register_step): leg points once, handed to the
+    registration and then to the ground truth, which gives the same table as computing
+    them itself."""
+    import gaitval.groundtruth.legs as legs_mod
+    from gaitval.groundtruth import sensor_leg_points
+    from gaitval.registration import register_trial
+
+    mocap, scans = synthetic_mocap(), synthetic_scans()
+    calls = []
+    real = legs_mod.leg_points
+    monkeypatch.setattr(legs_mod, "leg_points", lambda *a, **k: calls.append(1) or real(*a, **k))
+    legs = sensor_leg_points(mocap, scans, TRIAL, SUBJECT, {})
+    reg = register_trial(mocap, scans, TRIAL, SUBJECT, {}, legs=legs)
+    gt = ground_truth(mocap, scans, reg, TRIAL, SUBJECT, {}, legs=legs)
+    assert len(calls) == 1
+    assert reg.joint_centre_source == legs.source and reg.gt_frames_excluded == legs.n_excluded
+    assert gt.equals(ground_truth(mocap, scans, reg, TRIAL, SUBJECT, {}))
+    assert len(calls) == 2          # without legs the ground truth computes its own
+
+
 def test_ground_truth_at_sensor_timestamps():
     mocap = synthetic_mocap()
     scans = synthetic_scans()

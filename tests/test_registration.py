@@ -10,6 +10,7 @@ import pandas as pd
 import pytest
 
 from gaitval.errors import RegistrationError
+from gaitval.groundtruth import sensor_leg_points
 from gaitval.registration import (estimate_clock_offset, find_pole_candidates, fit_rigid_2d,
                                   register_poles, register_trial, registration_table)
 from gaitval.registration.rigid import field_to_sensor, sensor_to_field
@@ -123,6 +124,12 @@ TRIAL = {"trial": "T01", "protocol": "tug", "sensor_height_m": H, "clock_offset_
 SUBJECT = {"subject": "S01", "leg_width_m": 2 * LEG_R}
 
 
+def register(mocap, sensor, trial, subject, cfg):
+    """The pipeline's order: the leg points once, then the registration with them."""
+    legs = sensor_leg_points(mocap, sensor, trial, subject, cfg)
+    return register_trial(mocap, sensor, trial, subject, cfg, legs=legs)
+
+
 @pytest.fixture(scope="module")
 def scene():
     return synthetic_mocap(), synthetic_scans()
@@ -208,7 +215,7 @@ def test_c3d_without_pole_markers_is_an_error(scene):
     _, scans = scene
     mocap = synthetic_mocap(poles={})
     with pytest.raises(RegistrationError, match="POLE1, POLE2") as ei:
-        register_trial(mocap, scans, TRIAL, SUBJECT, {})
+        register(mocap, scans, TRIAL, SUBJECT, {})
     assert "T01" in str(ei.value) and "synthetic" in str(ei.value)
 
 
@@ -279,7 +286,7 @@ def test_generic_offset_unix_stamps_and_noise():
 
 def test_clock_offset_recovered_from_scans(scene):
     mocap, scans = scene
-    rec = register_trial(mocap, scans, TRIAL, SUBJECT, {})
+    rec = register(mocap, scans, TRIAL, SUBJECT, {})
     assert rec.clock_offset_s == pytest.approx(2.345, abs=0.5 / 40)  # half a scan period
     assert abs(rec.clock_offset_s - 2.345) < 0.003
     assert rec.sync_peak > 0.5
@@ -289,9 +296,17 @@ def test_clock_offset_recovered_from_scans(scene):
     assert np.hypot(rec.x_m - POSE[0], rec.y_m - POSE[1]) < 0.005
 
 
+def test_lrs_registration_needs_the_leg_points(scene):
+    """Registration does not compute leg points (that would import the ground truth): an LRS
+    trial without them is a programming error that says what to pass."""
+    mocap, scans = scene
+    with pytest.raises(TypeError, match="sensor_leg_points"):
+        register_trial(mocap, scans, TRIAL, SUBJECT, {})
+
+
 def test_manual_offset_overrides(scene):
     mocap, scans = scene
-    rec = register_trial(mocap, scans, dict(TRIAL, clock_offset_s="2.5"), SUBJECT, {})
+    rec = register(mocap, scans, dict(TRIAL, clock_offset_s="2.5"), SUBJECT, {})
     assert rec.clock_offset_s == 2.5 and np.isnan(rec.sync_peak)
 
 
@@ -309,7 +324,7 @@ def test_drift_estimated_on_long_signals():
 
 def test_registration_table_columns(scene):
     mocap, scans = scene
-    rec = register_trial(mocap, scans, dict(TRIAL, clock_offset_s=2.345), SUBJECT, {})
+    rec = register(mocap, scans, dict(TRIAL, clock_offset_s=2.345), SUBJECT, {})
     df = registration_table([rec])
     assert tuple(df.columns) == RECORD_FIELDS
     assert df.loc[0, "trial"] == "T01"
@@ -363,7 +378,7 @@ def test_rollator_pose_and_clock():
                        angle_increment=float(ang[1] - ang[0]), range_min=0.02, range_max=5.6,
                        mounting_height_m=0.40, source="rollator.scan.parquet")
     trial = {"trial": "R01", "protocol": "rollator", "sensor_height_m": 0.40}
-    rec = register_trial(mocap, scans, trial, SUBJECT, {"rollator": {"sensor_mount": MOUNT}})
+    rec = register(mocap, scans, trial, SUBJECT, {"rollator": {"sensor_mount": MOUNT}})
     assert abs(rec.clock_offset_s - off) < 0.5 * 0.028
     assert np.isnan(rec.x_m) and np.isnan(rec.pole_residual_m)
 
@@ -485,10 +500,10 @@ def test_tiny_study_lrs_acceptance(tiny):
             if not all(vis):
                 # a pole the sensor never sees: the documented behaviour is a clear error
                 with pytest.raises(RegistrationError, match="pole") as ei:
-                    register_trial(mocap, scans, tr, sub, cfg)
+                    register(mocap, scans, tr, sub, cfg)
                 assert tr["trial"] in str(ei.value)
                 continue
-        rec = register_trial(mocap, scans, tr, sub, cfg)
+        rec = register(mocap, scans, tr, sub, cfg)
         n_checked += 1
         if tr["protocol"] != "rollator":
             assert np.hypot(rec.x_m - T.x_m, rec.y_m - T.y_m) < 0.005, tr["trial"]

@@ -3,20 +3,16 @@ sensor timestamps, in the field and sensor frames, with velocities.
 
 Pipeline (LRS trials)
 ---------------------
-1. Every marker is gap-filled (:func:`~gaitval.groundtruth.gaps.fill_short_gaps`, gaps up
-   to ``max_gap_s``).
-2. Knee and ankle centres (:mod:`~gaitval.groundtruth.joints`), then the leg point at the
-   scan height ``h`` (:func:`~gaitval.groundtruth.shank.point_at_height`), or, for the
-   rollator (or ``leg_point: cylinder``), the tibia-cylinder cross-section
-   (:func:`~gaitval.groundtruth.shank.fit_cylinder_cluster`: one cylinder in the tibia
-   cluster's frame, axis direction from knee - ankle, carried per frame by the cluster's
-   rigid motion).
-3. Mocap frames where either leg point is missing are counted
-   (``gt_frames_excluded``).
+1.-3. Leg points at the scan height for every mocap frame, gap-filled, from the joint
+   centres or the tibia cylinder, with the frames where either is missing counted
+   (:mod:`gaitval.groundtruth.legs`).  They are computed once per trial
+   (:func:`~gaitval.groundtruth.legs.sensor_leg_points`), used first by the registration
+   and then handed to :func:`ground_truth` (``legs``).
 4. Sensor timestamps are mapped to mocap time with the clock record,
-   ``t_mocap = (t_sensor - clock_offset_s) / (1 + clock_drift_ppm * 1e-6)``, and positions
-   are linearly interpolated there (error < 0.2 mm for a shin at 200 Hz).  A row is valid
-   when both bracketing mocap frames are valid.
+   ``t_mocap = (t_sensor - clock_offset_s) / (1 + clock_drift_ppm * 1e-6)``
+   (:func:`~gaitval.registration.clock.to_mocap_time`), and positions are linearly
+   interpolated there (error < 0.2 mm for a shin at 200 Hz).  A row is valid when both
+   bracketing mocap frames are valid.
 5. Velocities: positions low-passed (2nd-order Butterworth, 10 Hz, zero phase), then
    central differences (seed 002: "velocities resulted from simple differentiation"),
    then interpolated like the positions.  Positions themselves are not filtered unless
@@ -36,191 +32,26 @@ the log to the ``ANC1..ANC4`` markers; NaN when those markers are absent.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import pandas as pd
 
 from gaitval import consts as C
 from gaitval.errors import MarkerError, RegistrationError
 from gaitval.groundtruth.filters import differentiate, lowpass
-from gaitval.groundtruth.gaps import MAX_GAP_S, fill_short_gaps
-from gaitval.groundtruth.joints import joint_centre, source_label
-from gaitval.groundtruth.shank import cylinder_at_height, fit_cylinder_cluster, point_at_height
+from gaitval.groundtruth.gaps import fill_short_gaps
+from gaitval.groundtruth.legs import LegPoints, sensor_leg_points
+from gaitval.groundtruth.settings import DEFAULTS, gt_cfg
+from gaitval.registration.clock import to_mocap_time
+from gaitval.registration.moving import (is_moving, mount_from_cfg, rollator_labels,
+                                         rollator_pose, sensor_pose_from_rollator)
+from gaitval.registration.rigid import field_to_sensor
 from gaitval.types import MocapTrial, ScanSeries, UltrasonicLog
 
-SIDES = ("L", "R")
+__all__ = ["DEFAULTS", "GT_COLUMNS", "ground_truth", "resample", "ultrasonic_ground_truth"]
 
-#: Defaults of the ``groundtruth:`` config keys.
-DEFAULTS = {
-    "max_gap_s": MAX_GAP_S,
-    "lowpass_hz": 10.0,
-    "lowpass_order": 2,
-    "filter_positions": False,
-    "leg_point": "auto",            # auto | axis | cylinder
-    "cylinder_marker_offset_m": 0.009,
-    "tibia_markers": ["TB1", "TB2", "TB3", "TB4"],   # prefixed with L/R
-    "tx_marker": "TX",
-    "anchor_markers": ["ANC1", "ANC2", "ANC3", "ANC4"],
-}
-
-GT_COLUMNS = ["scan", "t_sensor_s", "t_mocap_s", "side", "x_m", "y_m", "xs_m", "ys_m",
-              "vx_mps", "vy_mps", "vxs_mps", "vys_mps", "valid"]
-
-
-def section(cfg: dict | None, name: str) -> dict:
-    """The ``name:`` section of a config dict, or the dict itself when it has no such key."""
-    cfg = cfg or {}
-    sub = cfg.get(name)
-    return dict(sub) if isinstance(sub, dict) else dict(cfg)
-
-
-def gt_cfg(cfg: dict | None) -> dict:
-    c = dict(DEFAULTS)
-    c.update({k: v for k, v in section(cfg, "groundtruth").items() if k in DEFAULTS})
-    return c
-
-
-def as_float(v) -> float | None:
-    """A trial-sheet / subject-table cell as float, or None when empty/NaN/unparseable."""
-    if v is None:
-        return None
-    if isinstance(v, str) and not v.strip():
-        return None
-    try:
-        f = float(v)
-    except (TypeError, ValueError):
-        return None
-    return f if np.isfinite(f) else None
-
-
-def sensor_height(sensor, trial: dict) -> float:
-    """Scan-plane height: the trial sheet's ``sensor_height_m``, else the log metadata."""
-    h = as_float((trial or {}).get("sensor_height_m"))
-    if h is None:
-        h = as_float(getattr(sensor, "mounting_height_m", None))
-    if h is None:
-        raise RegistrationError(
-            "the sensor height is unknown (empty sensor_height_m in the trial sheet and "
-            "no mounting_height_m in the log)", path=getattr(sensor, "source", None),
-            trial=(trial or {}).get("trial"), hint="fill sensor_height_m in trials.csv")
-    return h
-
-
-@dataclass
-class LegPoints:
-    """Mocap-side leg points at sensor height.
-
-    Attributes
-    ----------
-    t : ndarray (n_frames,) mocap time, seconds
-    xyz : ndarray (n_frames, 2, 3) field frame, metres; sides in order ``L, R``
-    valid : ndarray (n_frames, 2) bool
-    source : str  (``joint_centre_source``)
-    n_excluded : int  mocap frames where either leg point is missing after gap filling
-    n_filled : int  mocap frames where a used marker was gap-filled
-    markers : dict  the gap-filled marker arrays (label -> (n, 3))
-    """
-
-    t: np.ndarray
-    xyz: np.ndarray
-    valid: np.ndarray
-    source: str
-    n_excluded: int
-    n_filled: int
-    markers: dict
-
-
-def filled_markers(mocap: MocapTrial, max_gap_s: float, labels=None) -> tuple[dict, int]:
-    """Gap-fill markers; returns ({label: (n, 3)}, frames with any fill)."""
-    out, any_fill = {}, np.zeros(mocap.n_frames, dtype=bool)
-    for lb in (labels if labels is not None else mocap.labels):
-        if not mocap.has(lb):
-            continue
-        out[lb], f = fill_short_gaps(mocap.marker(lb), mocap.rate_hz, max_gap_s)
-        any_fill |= f
-    return out, int(any_fill.sum())
-
-
-def _tibia_labels(side, c):
-    return [side + m for m in c["tibia_markers"]]
-
-
-def leg_points(mocap: MocapTrial, h: float, subject: dict | None = None,
-               cfg: dict | None = None, *, cylinder: bool | None = None,
-               trial: str | None = None) -> LegPoints:
-    """Leg points at height ``h`` for both legs at every mocap frame (field frame).
-
-    Parameters
-    ----------
-    mocap : MocapTrial
-    h : float
-        Scan-plane height (metres above the floor).
-    subject : dict, optional
-        Subject-table row (joint widths for the lateral-offset joint centres).
-    cfg : dict, optional
-        ``groundtruth:`` config (see :data:`DEFAULTS`).
-    cylinder : bool, optional
-        Use the tibia-cylinder cross-section (seed 002) instead of the knee-ankle axis;
-        default from ``leg_point`` (``auto``: cylinder when every tibia marker of both legs
-        is in the C3D).
-
-    Returns
-    -------
-    LegPoints
-    """
-    c = gt_cfg(cfg)
-    want = set()
-    for s in SIDES:
-        o = "R" if s == "L" else "L"
-        want |= {s + x for x in ("FEO", "TIO", "KJC", "AJC", "KNE", "KNEin", "ANK", "ANKin",
-                                 "ASI")}
-        want |= set(_tibia_labels(s, c))
-    markers, _ = filled_markers(mocap, c["max_gap_s"], [lb for lb in mocap.labels if lb in want])
-    if cylinder is None:
-        if c["leg_point"] == "cylinder":
-            cylinder = True
-        elif c["leg_point"] == "axis":
-            cylinder = False
-        else:
-            cylinder = all(mocap.has(lb) for s in SIDES for lb in _tibia_labels(s, c))
-    n = mocap.n_frames
-    xyz = np.full((n, 2, 3), np.nan)
-    valid = np.zeros((n, 2), dtype=bool)
-    sources = {}
-    filled_any = np.zeros(n, dtype=bool)
-    for j, s in enumerate(SIDES):
-        knee, sk = joint_centre(mocap, s, "knee", subject, markers=markers, trial=trial)
-        ankle, sa = joint_centre(mocap, s, "ankle", subject, markers=markers, trial=trial)
-        sources[(s, "knee")], sources[(s, "ankle")] = sk, sa
-        if cylinder:
-            tl = _tibia_labels(s, c)
-            miss = [lb for lb in tl if lb not in markers]
-            if miss:
-                raise MarkerError(f"tibia-cylinder ground truth needs {tl}; missing {miss}",
-                                  path=mocap.path, trial=trial,
-                                  hint="set groundtruth.leg_point: axis to use the "
-                                       "knee-ankle axis instead")
-            M = np.stack([markers[lb] for lb in tl], axis=1)
-            axis = knee - ankle
-            cen, d, _ = fit_cylinder_cluster(M, axis, c["cylinder_marker_offset_m"])
-            p, ok = cylinder_at_height(cen, d, h)
-        else:
-            p, ok = point_at_height(knee, ankle, h)
-        xyz[:, j] = p
-        valid[:, j] = ok
-    src = source_label(sources)
-    if cylinder:
-        src = "tibia_cylinder"
-    for lb, arr in markers.items():
-        filled_any |= np.isfinite(arr).all(axis=1) & ~np.isfinite(mocap.marker(lb)).all(axis=1)
-    n_excl = int((~valid.all(axis=1)).sum())
-    return LegPoints(mocap.t, xyz, valid, src, n_excl, int(filled_any.sum()), markers)
-
-
-def to_mocap_time(t_sensor, clock_offset_s: float, clock_drift_ppm: float) -> np.ndarray:
-    """``t_mocap = (t_sensor - clock_offset_s) / (1 + clock_drift_ppm * 1e-6)``."""
-    return (np.asarray(t_sensor, dtype=float) - clock_offset_s) / (1.0 + clock_drift_ppm * 1e-6)
+#: Columns of an LRS trial's ground truth, in order (:func:`ground_truth`).
+GT_COLUMNS = [C.SCAN, C.T_SENSOR, C.T_MOCAP, C.SIDE, C.X, C.Y, C.XS, C.YS,
+              C.VX, C.VY, "vxs_mps", "vys_mps", C.VALID]
 
 
 def resample(t_src: np.ndarray, x: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -246,7 +77,7 @@ def resample(t_src: np.ndarray, x: np.ndarray, t: np.ndarray) -> tuple[np.ndarra
 
 
 def ground_truth(mocap: MocapTrial, sensor, reg, trial: dict, subject: dict | None,
-                 cfg: dict | None) -> pd.DataFrame:
+                 cfg: dict | None, *, legs: LegPoints | None = None) -> pd.DataFrame:
     """Ground-truth trajectories of one trial at the sensor timestamps.
 
     Parameters
@@ -262,6 +93,9 @@ def ground_truth(mocap: MocapTrial, sensor, reg, trial: dict, subject: dict | No
     cfg : dict
         Whole config or its ``groundtruth:`` section (``rollator.sensor_mount`` is read
         from the whole config for the rollator).
+    legs : LegPoints, optional
+        LRS: the trial's leg points, :func:`~gaitval.groundtruth.legs.sensor_leg_points`,
+        as handed to the registration; computed here when not given.
 
     Returns
     -------
@@ -278,15 +112,8 @@ def ground_truth(mocap: MocapTrial, sensor, reg, trial: dict, subject: dict | No
         return ultrasonic_ground_truth(mocap, sensor, reg, trial, cfg)
     if not isinstance(sensor, ScanSeries):
         raise TypeError(f"ground_truth: unsupported sensor type {type(sensor).__name__}")
-    from gaitval.registration.moving import (interp_pose, rollator_pose,
-                                             sensor_pose_from_rollator)
-    from gaitval.registration.rigid import field_to_sensor
-    from gaitval.registration.trial import is_moving, mount_from_cfg, rollator_labels
-
     c = gt_cfg(cfg)
-    tid = (trial or {}).get("trial")
-    h = sensor_height(sensor, trial)
-    lp = leg_points(mocap, h, subject, c, trial=tid)
+    lp = legs if legs is not None else sensor_leg_points(mocap, sensor, trial, subject, cfg)
     P = lp.xyz[..., :2]                                         # (n, 2, 2)
     tm = lp.t
     t_m = to_mocap_time(sensor.t, reg.clock_offset_s, reg.clock_drift_ppm)
@@ -295,36 +122,58 @@ def ground_truth(mocap: MocapTrial, sensor, reg, trial: dict, subject: dict | No
     Ppos = Pf if c["filter_positions"] else P
     moving = is_moving(trial)
     if moving:
-        rp = rollator_pose(mocap, rollator_labels(cfg), trial=tid, xyz=lp.markers
-                           if all(lb in lp.markers for lb in rollator_labels(cfg)) else None)
-        pose_m = sensor_pose_from_rollator(rp, mount_from_cfg(cfg, tid))
-        Ps = field_to_sensor(Ppos, pose_m[:, None, 0], pose_m[:, None, 1], pose_m[:, None, 2])
-        Vs = differentiate(lowpass(field_to_sensor(P, pose_m[:, None, 0], pose_m[:, None, 1],
-                                                   pose_m[:, None, 2]),
-                                   mocap.rate_hz, c["lowpass_hz"], c["lowpass_order"]), tm)
+        Ps, Vs = _relative_to_moving_sensor(mocap, P, Ppos, tm, trial, cfg, c)
     rows = []
-    for j, side in enumerate(SIDES):
-        pos, ok = resample(tm, Ppos[:, j], t_m)
-        vel, okv = resample(tm, V[:, j], t_m)
-        if moving:
-            ps, oks = resample(tm, Ps[:, j], t_m)
-            vs, _ = resample(tm, Vs[:, j], t_m)
-            ok = ok & oks
-        else:
-            ps = field_to_sensor(pos, reg.x_m, reg.y_m, reg.yaw_rad)
-            cy, sy = np.cos(reg.yaw_rad), np.sin(reg.yaw_rad)
-            vs = np.column_stack([cy * vel[:, 0] + sy * vel[:, 1],
-                                  -sy * vel[:, 0] + cy * vel[:, 1]])
-        rows.append(pd.DataFrame({
-            "scan": np.arange(sensor.n_scans, dtype=np.int64),
-            "t_sensor_s": sensor.t, "t_mocap_s": t_m, "side": side,
-            C.X: pos[:, 0], C.Y: pos[:, 1], "xs_m": ps[:, 0], "ys_m": ps[:, 1],
-            C.VX: vel[:, 0], C.VY: vel[:, 1], "vxs_mps": vs[:, 0], "vys_mps": vs[:, 1],
-            "valid": ok & np.all(np.isfinite(ps), axis=1),
-        }))
+    for j, side in enumerate(C.SIDES):
+        rel = (Ps[:, j], Vs[:, j]) if moving else None
+        rows.append(_side_rows(sensor, reg, side, tm, t_m, Ppos[:, j], V[:, j], rel))
     df = pd.concat(rows, ignore_index=True)
-    df = df.sort_values(["scan", "side"], kind="stable").reset_index(drop=True)
+    df = df.sort_values([C.SCAN, C.SIDE], kind="stable").reset_index(drop=True)
     return df[GT_COLUMNS]
+
+
+def _relative_to_moving_sensor(mocap, P, Ppos, tm, trial, cfg, c):
+    """Leg positions and velocities (n, 2, 2) in the frame of the moving sensor at the
+    mocap frames: the per-frame sensor pose from the rollator markers and the mount.
+
+    The rollator pose here comes from the raw rollator markers (a rollator-marker gap
+    leaves those frames without a sensor frame), while the registration's clock signal
+    uses the gap-filled ones (``legs.markers``); both are kept as they are so the ground
+    truth of a trial with rollator-marker gaps does not change.
+    """
+    tid = (trial or {}).get(C.TRIAL)
+    rp = rollator_pose(mocap, rollator_labels(cfg), trial=tid)
+    pose_m = sensor_pose_from_rollator(rp, mount_from_cfg(cfg, tid))
+    x, y, yaw = pose_m[:, None, 0], pose_m[:, None, 1], pose_m[:, None, 2]
+    Ps = field_to_sensor(Ppos, x, y, yaw)
+    Vs = differentiate(lowpass(field_to_sensor(P, x, y, yaw), mocap.rate_hz, c["lowpass_hz"],
+                               c["lowpass_order"]), tm)
+    return Ps, Vs
+
+
+def _side_rows(sensor, reg, side, tm, t_m, pos_m, vel_m, rel=None) -> pd.DataFrame:
+    """One side's rows at the scans: field position and velocity at mocap frames
+    (``pos_m``, ``vel_m``, (n, 2)) resampled at the scans' mocap times ``t_m``; the sensor
+    frame through the fixed pose of ``reg``, or resampled from ``rel`` = (positions,
+    velocities) relative to a moving sensor."""
+    pos, ok = resample(tm, pos_m, t_m)
+    vel, _ = resample(tm, vel_m, t_m)
+    if rel is not None:
+        ps, oks = resample(tm, rel[0], t_m)
+        vs, _ = resample(tm, rel[1], t_m)
+        ok = ok & oks
+    else:
+        ps = field_to_sensor(pos, reg.x_m, reg.y_m, reg.yaw_rad)
+        cy, sy = np.cos(reg.yaw_rad), np.sin(reg.yaw_rad)
+        vs = np.column_stack([cy * vel[:, 0] + sy * vel[:, 1],       # R(yaw)^T v
+                              -sy * vel[:, 0] + cy * vel[:, 1]])
+    return pd.DataFrame({
+        C.SCAN: np.arange(sensor.n_scans, dtype=np.int64),
+        C.T_SENSOR: sensor.t, C.T_MOCAP: t_m, C.SIDE: side,
+        C.X: pos[:, 0], C.Y: pos[:, 1], C.XS: ps[:, 0], C.YS: ps[:, 1],
+        C.VX: vel[:, 0], C.VY: vel[:, 1], "vxs_mps": vs[:, 0], "vys_mps": vs[:, 1],
+        C.VALID: ok & np.all(np.isfinite(ps), axis=1),
+    })
 
 
 def ultrasonic_ground_truth(mocap: MocapTrial, log: UltrasonicLog, reg, trial: dict,
@@ -341,7 +190,7 @@ def ultrasonic_ground_truth(mocap: MocapTrial, log: UltrasonicLog, reg, trial: d
     from gaitval.registration.trial import register_anchors
 
     c = gt_cfg(cfg)
-    tid = (trial or {}).get("trial")
+    tid = (trial or {}).get(C.TRIAL)
     tx = c["tx_marker"]
     if not mocap.has(tx):
         raise MarkerError(f"the C3D has no transmitter marker {tx!r}", path=mocap.path,
@@ -359,8 +208,8 @@ def ultrasonic_ground_truth(mocap: MocapTrial, log: UltrasonicLog, reg, trial: d
         ps = np.full_like(pos, np.nan)
     side = "" if str((trial or {}).get("protocol", "")) == "pendulum" else "R"
     return pd.DataFrame({
-        "sample": np.arange(len(log.t), dtype=np.int64), "t_sensor_s": log.t,
-        "t_mocap_s": t_m, "side": side, C.X: pos[:, 0], C.Y: pos[:, 1], C.Z: pos[:, 2],
-        "xs_m": ps[:, 0], "ys_m": ps[:, 1], "zs_m": ps[:, 2], C.VX: vel[:, 0],
-        C.VY: vel[:, 1], "vz_mps": vel[:, 2], "valid": ok & np.all(np.isfinite(pos), axis=1),
+        "sample": np.arange(len(log.t), dtype=np.int64), C.T_SENSOR: log.t,
+        C.T_MOCAP: t_m, C.SIDE: side, C.X: pos[:, 0], C.Y: pos[:, 1], C.Z: pos[:, 2],
+        C.XS: ps[:, 0], C.YS: ps[:, 1], "zs_m": ps[:, 2], C.VX: vel[:, 0],
+        C.VY: vel[:, 1], "vz_mps": vel[:, 2], C.VALID: ok & np.all(np.isfinite(pos), axis=1),
     })

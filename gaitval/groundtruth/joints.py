@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from gaitval.config import as_float
 from gaitval.errors import MarkerError
 from gaitval.types import MocapTrial
 
@@ -89,7 +90,7 @@ def joint_centre(mocap: MocapTrial, side: str, joint: str, subject: dict | None 
         return 0.5 * (_get(mocap, S + lat, markers) + _get(mocap, S + lat + "in", markers)), \
             "lateral_medial_midpoint"
     if _has(mocap, S + lat):
-        w = _float((subject or {}).get(width))
+        w = as_float((subject or {}).get(width))
         if w is None:
             raise MarkerError(
                 f"the {S} {joint} centre needs {S}{bone}/{S}{jc}, {S}{lat}+{S}{lat}in, or "
@@ -104,14 +105,6 @@ def joint_centre(mocap: MocapTrial, side: str, joint: str, subject: dict | None 
         f"no marker for the {S} {joint} centre: looked for {S}{bone}, {S}{jc}, "
         f"{S}{lat}(+{S}{lat}in)", path=mocap.path, trial=trial,
         hint="the trial needs Plug-in-Gait knee/ankle markers or joint centres")
-
-
-def _float(v):
-    try:
-        f = float(v)
-    except (TypeError, ValueError):
-        return None
-    return f if np.isfinite(f) else None
 
 
 def source_label(sources: dict) -> str:

@@ -23,11 +23,45 @@ from __future__ import annotations
 
 import numpy as np
 
+from gaitval.config import section
 from gaitval.errors import ConfigError, RegistrationError
 from gaitval.registration.rigid import wrap_angle
 from gaitval.types import MocapTrial
 
+#: Default of ``registration.rollator_markers``: front-left, front-right, rear-left, rear-right.
 ROLLATOR_MARKERS = ("RLT_FL", "RLT_FR", "RLT_RL", "RLT_RR")
+
+
+def is_moving(trial: dict | None) -> bool:
+    """True for trials whose sensor moves (protocol ``rollator``)."""
+    return str((trial or {}).get("protocol", "")).strip().lower() == "rollator"
+
+
+def rollator_labels(cfg: dict | None) -> list[str]:
+    """``registration.rollator_markers`` (default :data:`ROLLATOR_MARKERS`) as a list."""
+    return list(section(cfg, "registration").get("rollator_markers", list(ROLLATOR_MARKERS)))
+
+
+def mount_from_cfg(cfg: dict | None, trial_id=None) -> tuple[float, float, float]:
+    """``rollator.sensor_mount`` (or ``registration.sensor_mount``) as (x, y, yaw).
+
+    Raises
+    ------
+    ConfigError
+        When neither is set (the moving-sensor trial ``trial_id`` is named).
+    """
+    cfg = cfg or {}
+    m = None
+    if isinstance(cfg.get("rollator"), dict):
+        m = cfg["rollator"].get("sensor_mount")
+    if m is None:
+        m = section(cfg, "registration").get("sensor_mount")
+    if m is None:
+        raise ConfigError("rollator.sensor_mount is not set: the sensor pose on the rollator "
+                          "(x_m, y_m, yaw_rad in the rollator frame) is needed for the "
+                          f"moving-sensor trial {trial_id}",
+                          hint="set rollator.sensor_mount in config/config.yaml")
+    return parse_mount(m)
 
 
 def parse_mount(mount) -> tuple[float, float, float]:

@@ -16,6 +16,10 @@
   ``sync_peak`` NaN).  Otherwise :mod:`~gaitval.registration.clock` estimates it from leg
   occupancy (LRS) or from the transmitter-anchor distances (ultrasonic); a peak below
   ``sync_min_peak`` (0.2) is refused with a :class:`~gaitval.errors.RegistrationError`.
+
+An LRS trial is registered with the subject's leg points at sensor height handed in
+(``legs``, :class:`~gaitval.registration.legmotion.LegMotion`): the ground truth computes
+them once per trial and the same points serve registration and ground truth.
 """
 from __future__ import annotations
 
@@ -25,21 +29,25 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import pandas as pd
 
+from gaitval import consts as C
+from gaitval.config import as_float, section
 from gaitval.errors import RegistrationError
-from gaitval.groundtruth.build import (as_float, filled_markers, gt_cfg, leg_points, section,
-                                       sensor_height)
+# the ultrasonic path still reads the transmitter marker itself (gap filling, groundtruth
+# config); it is not part of the leg-point hand-over
 from gaitval.groundtruth.gaps import fill_short_gaps
+from gaitval.groundtruth.settings import gt_cfg
 from gaitval.io.ultrasonic import log_distances
 from gaitval.registration import clock as CK
 from gaitval.registration import poles as PO
-from gaitval.registration.moving import (ROLLATOR_MARKERS, parse_mount, rollator_pose,
-                                         sensor_pose_from_rollator)
 from gaitval.registration.anchors import fit_anchor_frame
-from gaitval.registration.rigid import field_to_sensor, wrap_angle
+from gaitval.registration.legmotion import LegMotion, legs_in_sensor_frame, pole_evidence
+from gaitval.registration.moving import ROLLATOR_MARKERS, is_moving
+from gaitval.registration.poledetect import static_background
+from gaitval.registration.rigid import wrap_angle
 from gaitval.types import MocapTrial, ScanSeries, UltrasonicLog
 
 #: Columns of ``registration.csv`` (issue 4), in order.
-RECORD_FIELDS = ("trial", "x_m", "y_m", "yaw_rad", "clock_offset_s", "clock_drift_ppm",
+RECORD_FIELDS = (C.TRIAL, C.X, C.Y, "yaw_rad", C.CLOCK_OFFSET, "clock_drift_ppm",
                  "pole_residual_m", "sync_peak", "joint_centre_source", "gt_frames_excluded")
 
 #: Defaults of the ``registration:`` keys read here (plus those of poles and clock).
@@ -93,6 +101,7 @@ def registration_table(records) -> pd.DataFrame:
 
 
 def reg_cfg(cfg: dict | None) -> dict:
+    """The ``registration:`` section with every default of this package filled in."""
     c = dict(DEFAULTS)
     c.update(PO.DEFAULTS)
     c.update(CK.DEFAULTS)
@@ -100,34 +109,8 @@ def reg_cfg(cfg: dict | None) -> dict:
     return c
 
 
-def is_moving(trial: dict | None) -> bool:
-    """True for trials whose sensor moves (protocol ``rollator``)."""
-    return str((trial or {}).get("protocol", "")).strip().lower() == "rollator"
-
-
-def rollator_labels(cfg) -> list[str]:
-    return list(reg_cfg(cfg)["rollator_markers"])
-
-
-def mount_from_cfg(cfg: dict | None, trial_id=None):
-    """``rollator.sensor_mount`` (or ``registration.sensor_mount``) as (x, y, yaw)."""
-    cfg = cfg or {}
-    m = None
-    if isinstance(cfg.get("rollator"), dict):
-        m = cfg["rollator"].get("sensor_mount")
-    if m is None:
-        m = section(cfg, "registration").get("sensor_mount")
-    if m is None:
-        from gaitval.errors import ConfigError
-        raise ConfigError("rollator.sensor_mount is not set: the sensor pose on the rollator "
-                          "(x_m, y_m, yaw_rad in the rollator frame) is needed for the "
-                          f"moving-sensor trial {trial_id}",
-                          hint="set rollator.sensor_mount in config/config.yaml")
-    return parse_mount(m)
-
-
 def _manual_offset(trial: dict | None) -> float | None:
-    return as_float((trial or {}).get("clock_offset_s"))
+    return as_float((trial or {}).get(C.CLOCK_OFFSET))
 
 
 def _leg_width(subject, c) -> float:
@@ -136,7 +119,7 @@ def _leg_width(subject, c) -> float:
 
 
 def register_trial(mocap: MocapTrial, sensor, trial: dict, subject: dict | None,
-                   cfg: dict | None) -> RegistrationRecord:
+                   cfg: dict | None, *, legs: LegMotion | None = None) -> RegistrationRecord:
     """Register one trial (pose, clock) and summarise its ground truth.
 
     Parameters
@@ -149,74 +132,68 @@ def register_trial(mocap: MocapTrial, sensor, trial: dict, subject: dict | None,
         Trial-sheet row: ``trial``, ``protocol``, ``sensor_height_m``, ``clock_offset_s``
         (empty = estimate).
     subject : dict or None
-        Subject-table row (``leg_width_m``, ``knee_width_m``, ``ankle_width_m``).
+        Subject-table row (``leg_width_m``).
     cfg : dict
         The whole config (sections ``registration``, ``groundtruth``, ``rollator``) or
         the ``registration`` section alone.
+    legs : LegMotion
+        LRS trials: the subject's leg points at sensor height for every mocap frame,
+        :func:`gaitval.groundtruth.sensor_leg_points` (the same object then goes to
+        :func:`gaitval.groundtruth.ground_truth`).  Unused for an ultrasonic log.
 
     Returns
     -------
     RegistrationRecord
+        ``joint_centre_source`` and ``gt_frames_excluded`` are those of ``legs`` (LRS).
 
     Raises
     ------
     RegistrationError, MarkerError, ConfigError
         With the file and trial named (poles missing/ambiguous, residual too large,
         synchronisation peak too weak, markers missing, mount not configured).
+    TypeError
+        An LRS sensor without ``legs``, or a sensor of another type.
     """
-    tid = str((trial or {}).get("trial", ""))
+    tid = str((trial or {}).get(C.TRIAL, ""))
     try:
         if isinstance(sensor, UltrasonicLog):
             return _register_ultrasonic(mocap, sensor, trial, cfg, tid)
         if isinstance(sensor, ScanSeries):
-            return _register_lrs(mocap, sensor, trial, subject, cfg, tid)
+            if legs is None:
+                raise TypeError(
+                    "register_trial: an LRS trial is registered with its leg points; pass "
+                    "legs=gaitval.groundtruth.sensor_leg_points(mocap, sensor, trial, "
+                    "subject, cfg)")
+            return _register_lrs(mocap, sensor, trial, subject, cfg, tid, legs)
     except RegistrationError as e:
         raise e.with_context(path=getattr(sensor, "source", None) or mocap.path, trial=tid)
     raise TypeError(f"register_trial: unsupported sensor type {type(sensor).__name__}")
 
 
-def legs_in_sensor_frame(mocap, lp, trial, cfg, pose=None):
-    """Mocap leg points (n, 2, 2) in the sensor frame, fixed ``pose`` or rollator per frame."""
-    P = lp.xyz[..., :2]
-    if pose is not None:
-        return field_to_sensor(P, *pose)
-    labels = rollator_labels(cfg)
-    rp = rollator_pose(mocap, labels, trial=trial.get("trial"),
-                       xyz=filled_markers(mocap, gt_cfg(cfg)["max_gap_s"], labels)[0])
-    pm = sensor_pose_from_rollator(rp, mount_from_cfg(cfg, trial.get("trial")))
-    return field_to_sensor(P, pm[:, None, 0], pm[:, None, 1], pm[:, None, 2])
-
-
-def _register_lrs(mocap, sensor, trial, subject, cfg, tid):
+def _register_lrs(mocap, sensor, trial, subject, cfg, tid, legs):
     c = reg_cfg(cfg)
-    h = sensor_height(sensor, trial)
-    lp = leg_points(mocap, h, subject, cfg, trial=tid)
     moving = is_moving(trial)
     if moving:
         pose = None
         x = y = yaw = resid = float("nan")
     else:
-        ok = lp.valid.all(axis=1)
-        pts = lp.xyz[ok][:, :, :2].reshape(-1, 2)
-        if len(pts) > 1000:
-            pts = pts[np.linspace(0, len(pts) - 1, 1000).astype(int)]
-        pf = PO.register_poles(sensor, mocap, c, leg_xy_field=pts, trial=tid)
+        pf = PO.register_poles(sensor, mocap, c, leg_xy_field=pole_evidence(legs), trial=tid)
         x, y, yaw, resid = pf.x_m, pf.y_m, pf.yaw_rad, pf.worst_residual_m
         pose = (x, y, yaw)
     manual = _manual_offset(trial)
     if manual is not None:
         ce = CK.ClockEstimate(manual, 0.0, float("nan"), "manual")
     else:
-        legs_s = legs_in_sensor_frame(mocap, lp, trial, cfg, pose)
-        legs_s[~lp.valid] = np.nan
-        bg, _ = PO.static_background(sensor, {**c, "pole_window_s": None})
+        legs_s = legs_in_sensor_frame(mocap, legs, trial, cfg, pose)
+        legs_s[~legs.valid] = np.nan
+        bg, _ = static_background(sensor, {**c, "pole_window_s": None})
         obs, obs_t, pred = CK.lrs_occupancy_signals(sensor, bg, legs_s,
                                                     _leg_width(subject, c) / 2.0, c,
                                                     moving=moving)
-        ce = CK.estimate_clock(lp.t, pred, obs_t, obs, c)
+        ce = CK.estimate_clock(legs.t, pred, obs_t, obs, c)
         _check_peak(ce, c, sensor.source, tid)
     return RegistrationRecord(tid, x, y, yaw, ce.clock_offset_s, ce.clock_drift_ppm, resid,
-                              ce.sync_peak, lp.source, lp.n_excluded)
+                              ce.sync_peak, legs.source, legs.n_excluded)
 
 
 def _check_peak(ce, c, path, tid):
