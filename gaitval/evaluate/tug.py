@@ -75,6 +75,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from gaitval import consts as C
 from gaitval.errors import GaitvalError
 from gaitval.evaluate.tug_truth import (DEFAULTS, TRUTH_COLUMNS, TUG_PHASES, _cfg, _rate,
                                         _runs, align_truth, truth_stance_intervals,
@@ -84,8 +85,8 @@ __all__ = ["DEFAULTS", "FRAME_COLUMNS", "TRUTH_COLUMNS", "TUG_PHASES", "align_tr
            "evaluate_tug_trial", "false_tracking", "stance_failures",
            "truth_stance_intervals", "tug_phase_bounds", "tug_phase_of"]
 
-FRAME_COLUMNS = ("trial", "method", "k", "t_sensor_s", "side", "x_m", "y_m", "xs_m", "ys_m",
-                 "valid", "err_x_m", "err_y_m", "observed", "interpolated", "pattern",
+FRAME_COLUMNS = (C.TRIAL, C.METHOD, "k", C.T_SENSOR, C.SIDE, C.X, C.Y, C.XS, C.YS,
+                 C.VALID, "err_x_m", "err_y_m", "observed", "interpolated", "pattern",
                  "phase", "swing", "tug_phase", "bad")
 
 
@@ -109,19 +110,19 @@ def false_tracking(frames: pd.DataFrame, cfg: dict | None = None
     bad = np.zeros(len(frames), bool)
     rows = []
     f = frames.reset_index(drop=True)
-    side = f["side"].astype(str).to_numpy()
-    t_all = f["t_sensor_s"].to_numpy(float)
+    side = f[C.SIDE].astype(str).to_numpy()
+    t_all = f[C.T_SENSOR].to_numpy(float)
     rate = _rate(np.unique(t_all)) if len(t_all) > 1 else 40.0
     min_n = max(1, int(math.ceil(c["min_bad_s"] * rate - 1e-9)))
-    idx = {s: np.flatnonzero(side == s) for s in ("L", "R")}
+    idx = {s: np.flatnonzero(side == s) for s in C.SIDES}
     if len(idx["L"]) != len(idx["R"]):
         raise GaitvalError("track has a different number of rows for L and R")
     for s, o in (("L", "R"), ("R", "L")):
         a, b = idx[s], idx[o]
-        x, y = f["x_m"].to_numpy(float)[a], f["y_m"].to_numpy(float)[a]
-        e_own = np.hypot(x - f["xs_m"].to_numpy(float)[a], y - f["ys_m"].to_numpy(float)[a])
-        e_oth = np.hypot(x - f["xs_m"].to_numpy(float)[b], y - f["ys_m"].to_numpy(float)[b])
-        ok = f["valid"].to_numpy(bool)[a] & f["valid"].to_numpy(bool)[b]
+        x, y = f[C.X].to_numpy(float)[a], f[C.Y].to_numpy(float)[a]
+        e_own = np.hypot(x - f[C.XS].to_numpy(float)[a], y - f[C.YS].to_numpy(float)[a])
+        e_oth = np.hypot(x - f[C.XS].to_numpy(float)[b], y - f[C.YS].to_numpy(float)[b])
+        ok = f[C.VALID].to_numpy(bool)[a] & f[C.VALID].to_numpy(bool)[b]
         observed = (f["observed"].to_numpy(bool)[a] if "observed" in f
                     else np.ones(len(a), bool))
         closer_other = (e_oth + c["swap_margin_m"] < e_own) & (e_own > c["swap_min_m"])
@@ -136,14 +137,14 @@ def false_tracking(frames: pd.DataFrame, cfg: dict | None = None
                 kind = "lost"
             else:
                 kind = "drift"
-            rows.append({"side": s, "kind": kind,
+            rows.append({C.SIDE: s, "kind": kind,
                          "k_start": int(f["k"].iloc[a[i0]]), "k_end": int(f["k"].iloc[a[i1 - 1]]),
                          "t_start_s": float(t_all[a[i0]]), "t_end_s": float(t_all[a[i1 - 1]]),
                          "tug_phase": str(f["tug_phase"].iloc[a[i0]]),
                          "max_error_m": float(np.nanmax(e_own[i0:i1]))})
-    ev = pd.DataFrame(rows, columns=["side", "kind", "k_start", "k_end", "t_start_s",
+    ev = pd.DataFrame(rows, columns=[C.SIDE, "kind", "k_start", "k_end", "t_start_s",
                                      "t_end_s", "tug_phase", "max_error_m"])
-    return bad, ev.sort_values(["t_start_s", "side"], kind="stable").reset_index(drop=True)
+    return bad, ev.sort_values(["t_start_s", C.SIDE], kind="stable").reset_index(drop=True)
 
 
 def stance_failures(frames: pd.DataFrame, stance: pd.DataFrame, cfg: dict | None = None
@@ -158,16 +159,16 @@ def stance_failures(frames: pd.DataFrame, stance: pd.DataFrame, cfg: dict | None
     """
     c = _cfg(cfg)
     rows = []
-    for s in ("L", "R"):
-        d = frames[frames["side"].astype(str) == s]
-        tt = d["t_sensor_s"].to_numpy(float)
-        tracked = d["valid"].to_numpy(bool)
+    for s in C.SIDES:
+        d = frames[frames[C.SIDE].astype(str) == s]
+        tt = d[C.T_SENSOR].to_numpy(float)
+        tracked = d[C.VALID].to_numpy(bool)
         st = ~d["swing"].to_numpy(bool) & tracked
         ph = d["tug_phase"].to_numpy(object)
         if not tracked.any():
             continue
         t_lo, t_hi = tt[tracked].min(), tt[tracked].max()
-        for r in stance[stance["side"] == s].itertuples(index=False):
+        for r in stance[stance[C.SIDE] == s].itertuples(index=False):
             if r.t_start_s < t_lo or r.t_end_s > t_hi:
                 continue
             sel = (tt >= r.t_start_s) & (tt <= r.t_end_s)
@@ -175,11 +176,11 @@ def stance_failures(frames: pd.DataFrame, stance: pd.DataFrame, cfg: dict | None
                 continue
             longest = max((b - a for a, b in _runs(st[sel])), default=0)
             mid = 0.5 * (r.t_start_s + r.t_end_s)
-            rows.append({"side": s, "t_start_s": r.t_start_s, "t_end_s": r.t_end_s,
+            rows.append({C.SIDE: s, "t_start_s": r.t_start_s, "t_end_s": r.t_end_s,
                          "tug_phase": str(ph[np.argmin(np.abs(tt - mid))]),
                          "identified": bool(longest >= c["min_stance_scans"]),
                          "n_stance_scans": int(st[sel].sum())})
-    return pd.DataFrame(rows, columns=["side", "t_start_s", "t_end_s", "tug_phase",
+    return pd.DataFrame(rows, columns=[C.SIDE, "t_start_s", "t_end_s", "tug_phase",
                                        "identified", "n_stance_scans"])
 
 
@@ -210,19 +211,19 @@ def evaluate_tug_trial(track: pd.DataFrame, truth: pd.DataFrame, *, trial: str =
     """
     bounds = tug_phase_bounds(truth, cfg)
     fr = align_truth(track, truth)
-    fr["tug_phase"] = tug_phase_of(fr["t_sensor_s"].to_numpy(float), bounds)
+    fr["tug_phase"] = tug_phase_of(fr[C.T_SENSOR].to_numpy(float), bounds)
     bad, events = false_tracking(fr, cfg)
     fr["bad"] = bad
-    fr.insert(0, "method", method)
-    fr.insert(0, "trial", trial)
+    fr.insert(0, C.METHOD, method)
+    fr.insert(0, C.TRIAL, trial)
     for col in ("observed", "interpolated", "swing"):
         if col not in fr:
             fr[col] = False
     fr = fr[list(FRAME_COLUMNS)]
     stance = stance_failures(fr, truth_stance_intervals(truth, cfg), cfg)
     for d in (events, stance):
-        d.insert(0, "method", method)
-        d.insert(0, "trial", trial)
+        d.insert(0, C.METHOD, method)
+        d.insert(0, C.TRIAL, trial)
     ftev = events[events["kind"].isin(["swap", "lost"])]
     ft = len(ftev) > 0
     failed = stance[~stance["identified"]] if len(stance) else stance
@@ -231,9 +232,9 @@ def evaluate_tug_trial(track: pd.DataFrame, truth: pd.DataFrame, *, trial: str =
     sf_phase = str(failed.sort_values("t_start_s")["tug_phase"].iloc[0]) if sf else ""
     category = (f"false_tracking_{ft_phase}" if ft else
                 f"stance_failure_{sf_phase}" if sf else "success")
-    v = fr[fr["valid"]]
+    v = fr[fr[C.VALID]]
     summary = pd.DataFrame([{
-        "trial": trial, "method": method, "n_scans": int(fr["k"].nunique()),
+        C.TRIAL: trial, C.METHOD: method, "n_scans": int(fr["k"].nunique()),
         "n_leg_steps": int(len(v)), "n_uo": int((v["pattern"] == "UO").sum()),
         "false_tracking": ft, "ft_phase": ft_phase, "n_ft_events": int(len(ftev)),
         "n_drift_events": int((events["kind"] == "drift").sum()),
