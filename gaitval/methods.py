@@ -91,6 +91,44 @@ METHOD_DEFINITIONS = {
     "tug_m3": {"gait_phase_association": True, "catmull_rom_interpolation": True},
 }
 
+# -- seed 001 (MTST), Table 3 definitions; everything but the detector's FS_U pattern and the
+# validation region is shared.  Δt = 0.05 s (§3.1): the loop's Δt is the period of the scans
+# it is given (dt_s None), and the MTST steps keep every n-th scan of a log so that the
+# period is mtst.scan_period_s = 0.05 s (gaitval.steps_mtst).  P0 is not given (GAP): the
+# first observation's own noise w_l/2 ≈ 0.05 m, and 0.5 m/s for a participant who stands.
+_SEED001 = "seed 001 (Yorozu et al., Sensors 2015, 15, 11151)"
+
+
+def _mtst_method(label: str, use_fs_u: bool, gate: dict[str, Any]) -> dict[str, Any]:
+    return {
+        "label": label, "paper": _SEED001,
+        "detector": {"name": "leg_patterns", "use_fs_u": use_fs_u, "max_occluder_m": 0.15,
+                     "background": {"name": "percentile", "q": 95.0, "margin_m": 0.10}},
+        # seed001 eq. (2)-(3): Q = diag(5.0², 5.0²), R = diag((w_l/2)², (w_l/2)²)
+        "filter": {"name": "kf", "q_accel_sd_mps2": 5.0, "r_sd_leg_widths": 0.5,
+                   "p0_pos_sd_m": 0.05, "p0_vel_sd_mps": 0.5},
+        "motion": {"name": "constant_velocity"},
+        "phase": {"name": "speed_thresholds", "v_st_th": 0.18, "v_sw_th": 0.37},  # eq. (9)-(10)
+        "gate": gate,
+        "associator": {"name": "gnn_assignment", "cost": "mahalanobis2"},        # eq. (6)-(8)
+        "occlusion": {"name": "uo_pseudo_update"},                                # §2.4.3
+        "init": {"name": "mtst_participant", "half_width_m": 0.675, "margin_before_m": 1.5,
+                 "max_pair_m": 0.8, "min_leg_widths": 0.7},
+        "tracker": {"dt_s": None, "sides": "walking_direction"},
+    }
+
+
+METHODS.update({
+    "mtst_m1": _mtst_method("Method 1 (no FS_U, r = 1.5 w_l)", False,
+                            {"name": "fixed_radius", "radius_leg_widths": 1.5}),
+    "mtst_m2": _mtst_method("Method 2 (FS_U, r = 1.5 w_l)", True,
+                            {"name": "fixed_radius", "radius_leg_widths": 1.5}),
+    "mtst_m3": _mtst_method("Method 3 (FS_U, r = w_l)", True,
+                            {"name": "fixed_radius", "radius_leg_widths": 1.0}),
+    "mtst_proposed": _mtst_method("Proposed (FS_U, variable region)", True,
+                                  {"name": "variable_region", "v_sw": 1.1, "v_st": 0.55}),
+})
+
 
 def set_params(method: dict[str, Any], overrides: dict[str, Any] | None) -> dict[str, Any]:
     """Copy of ``method`` with ``role__param`` (or ``tracker__param``) overrides applied."""

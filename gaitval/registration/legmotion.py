@@ -6,13 +6,13 @@ pooled over the trial, as motion evidence that tells apart pole-pose hypotheses 
 which beams the legs occupy for the clock synchronisation
 (:func:`gaitval.registration.clock.lrs_occupancy_signals`).
 
-Registration does not compute these points.  The ground truth owns them (markers ->
-gap filling -> joint centres -> point at the scan height,
-:func:`gaitval.groundtruth.legs.leg_points`); the pipeline computes them once per trial
-(:func:`gaitval.groundtruth.legs.sensor_leg_points`) and hands the same object to
-:func:`gaitval.registration.trial.register_trial` and then to
-:func:`gaitval.groundtruth.build.ground_truth`.  Anything with the attributes of
-:class:`LegMotion` will do, so registration never imports the ground truth.
+Registration does not compute these points.  The ground truth, a stage above, owns them
+(markers -> gap filling -> joint centres -> point at the scan height, its
+``legs.leg_points``); the pipeline (``steps.register_step``) computes them once per trial
+with the ground truth's ``sensor_leg_points`` and hands the same object to
+:func:`~gaitval.registration.trial.register_trial` and then to the ground truth's
+``ground_truth``.  Anything with the attributes of :class:`LegMotion` will do, so
+registration never imports the ground truth.
 """
 from __future__ import annotations
 

@@ -137,9 +137,9 @@ def register_trial(mocap: MocapTrial, sensor, trial: dict, subject: dict | None,
         The whole config (sections ``registration``, ``groundtruth``, ``rollator``) or
         the ``registration`` section alone.
     legs : LegMotion
-        LRS trials: the subject's leg points at sensor height for every mocap frame,
-        :func:`gaitval.groundtruth.sensor_leg_points` (the same object then goes to
-        :func:`gaitval.groundtruth.ground_truth`).  Unused for an ultrasonic log.
+        LRS trials: the subject's leg points at sensor height for every mocap frame, from
+        the ground truth's ``sensor_leg_points`` (the same object then goes to its
+        ``ground_truth``).  Unused for an ultrasonic log.
 
     Returns
     -------
@@ -162,8 +162,8 @@ def register_trial(mocap: MocapTrial, sensor, trial: dict, subject: dict | None,
             if legs is None:
                 raise TypeError(
                     "register_trial: an LRS trial is registered with its leg points; pass "
-                    "legs=gaitval.groundtruth.sensor_leg_points(mocap, sensor, trial, "
-                    "subject, cfg)")
+                    "legs=sensor_leg_points(mocap, sensor, trial, subject, cfg) (from the "
+                    "groundtruth package)")
             return _register_lrs(mocap, sensor, trial, subject, cfg, tid, legs)
     except RegistrationError as e:
         raise e.with_context(path=getattr(sensor, "source", None) or mocap.path, trial=tid)
