@@ -13,6 +13,7 @@ from gaitval.track.kalman import FILTERS  # noqa: F401
 from gaitval.track.kinds import TRACKER_KINDS  # noqa: F401
 from gaitval.track.motion import MOTION_MODELS  # noqa: F401
 from gaitval.track.occlusion import OCCLUSION_HANDLERS  # noqa: F401
+from gaitval.track import occlusion_mtst  # noqa: F401  (registers "uo_pseudo_update")
 from gaitval.track.phase import PHASE_MODELS  # noqa: F401
 from gaitval.track.tracker import TRACK_COLUMNS, Tracker, TrackResult  # noqa: F401
 

@@ -145,3 +145,46 @@ class GaitPhaseAssociator(Associator):
             if phase_of(a, b) not in unlikely:
                 return a, b
         return ranked[0][1], ranked[0][2]
+
+
+@ASSOCIATORS.register("gnn_assignment")
+class AssignmentGNN(Associator):
+    """Seed 001's GNN: the assignment problem on the 2 × J cost matrix D (eq. (6)–(8)).
+
+    d_{f,j} = λ²_{f,j} (``cost="mahalanobis2"``, seed001 eq. (8): "squared, no root")
+    inside leg f's validation region and ∞ outside it (seed001 eq. (7)); "the data
+    association is achieved so that the summed total distance of D can be minimized".  An
+    assignment of D pairs each leg with a different observation; an ∞ entry cannot be
+    taken, and a leg left without a finite entry gets none (UO, §2.4.3).  So "no
+    observation" has no price of its own: among the feasible associations gaitval takes
+    one with the most legs associated, and among those the least total cost — the
+    rectangular assignment problem with infeasible (∞) cells.  (The ``gnn`` associator
+    instead prices "none" at a finite d_max, so a leg may be left unassociated when its
+    only candidate is expensive; with λ² costs that would need a d_max on the λ² scale
+    that the paper does not give.)  Ties keep enumeration order (a, then b, ascending).
+
+    Parameters
+    ----------
+    cost : {"mahalanobis2", "mahalanobis"}
+        d = λ² (seed 001, default) or λ.
+    """
+
+    def __init__(self, cost: str = "mahalanobis2"):
+        super().__init__(d_max=math.inf, cost=cost)
+
+    def select(self, cand_l, cand_r, prev_phase, phase_of):
+        if len(cand_l) <= 1 and len(cand_r) <= 1:
+            a = cand_l[0][0] if cand_l else 0
+            b = cand_r[0][0] if cand_r else 0
+            if not (a and a == b):
+                return a, b                               # nothing to resolve
+        cand_l, cand_r = self.distances(cand_l), self.distances(cand_r)
+        best = (0, 0.0, 0, 0)                             # (−assigned, cost, a, b)
+        for a, da in [(0, 0.0)] + cand_l:
+            for b, db in [(0, 0.0)] + cand_r:
+                if a and a == b:
+                    continue
+                key = (-(a > 0) - (b > 0), da + db, a, b)  # seed001 eq. (6): min Σ d
+                if key < best:
+                    best = key
+        return best[2], best[3]
