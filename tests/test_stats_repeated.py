@@ -429,3 +429,52 @@ def test_icc_mixed_errors():
         icc_mixed(df, ["ref"])
     with pytest.raises(GaitvalError, match="unknown method"):
         icc_mixed(df, ["ref", "pro"], method="fast")
+
+
+# --------------------------------------------------------------------------- peer table
+def _peer_file(tmp_path, ejection) -> Path:
+    """A peer-style file (us_*/gt_*, one row per walk) with a participant column."""
+    df = pd.DataFrame({"participant": ejection["subject"].map(lambda s: f"P_{s:02d}"),
+                       "us_ef": ejection["rv"], "gt_ef": ejection["ic"]})
+    path = tmp_path / "peer.parquet"
+    df.to_parquet(path)
+    return path
+
+
+def test_peer_table_repeated_columns_come_from_the_stats_functions(tmp_path, ejection):
+    from gaitval.tables.peer import peer_agreement_table, write_peer_table
+    path = _peer_file(tmp_path, ejection)
+    t = peer_agreement_table(path).iloc[0]
+    df = pd.read_parquet(path)
+    rm = loa_nested(df, "gt_ef", "us_ef", "participant").iloc[0]
+    ic = icc_mixed(df, ["gt_ef", "us_ef"], subject="participant").iloc[0]
+    pb = proportional_bias(df, "gt_ef", "us_ef", subject="participant").iloc[0]
+    assert t["n_subjects"] == 12 and t["n"] == 60
+    for col, src in (("bias_rm", "bias"), ("loa_low_rm", "loa_low"),
+                     ("loa_high_rm_ci_high", "loa_high_ci_high"), ("sd_rm", "sd_total"),
+                     ("var_between_rm", "var_between")):
+        assert t[col] == rm[src], col
+    assert t["icc_agreement_rm"] == ic["icc_agreement"]
+    assert t["prop_bias_slope"] == pb["slope"] and t["prop_bias_p"] == pb["p"]
+    # the pooled columns are unchanged: gaitval.stats.agreement on every row
+    assert t["loa_low"] == pytest.approx(bland_altman(df["gt_ef"], df["us_ef"])["loa_low"])
+    assert t["loa_width_ratio"] == pytest.approx(
+        (t["loa_high_rm"] - t["loa_low_rm"]) / (t["loa_high"] - t["loa_low"]))
+    md = write_peer_table(path, tmp_path / "peer_agreement")[1].read_text()
+    assert "times as wide as the pooled ones" in md
+    with pytest.raises(Exception, match="participant column"):
+        peer_agreement_table(path, subject="walker")
+
+
+def test_peer_table_published_file_has_no_participants(realdata):
+    # Single et al. 2024's file has no participant column: the *_rm columns are empty
+    # and the proportional-bias check is ordinary least squares over the 90 walks
+    from gaitval.tables.peer import RM_ICC, RM_LOA, peer_agreement_table
+    path = realdata / "peer-results" / "gailo_results.parquet"
+    t = peer_agreement_table(path).set_index("parameter")
+    assert t[[*RM_LOA, *RM_ICC, "n_subjects", "loa_width_ratio"]].isna().all().all()
+    df = pd.read_parquet(path)
+    a = (df["us_cadence"] + df["gt_cadence"]) / 2
+    ref = sps.linregress(a, df["us_cadence"] - df["gt_cadence"])    # scipy reference call
+    assert t.loc["cadence", "prop_bias_slope"] == pytest.approx(ref.slope, rel=1e-10)
+    assert t.loc["cadence", "prop_bias_p"] == pytest.approx(ref.pvalue, rel=1e-10)
