@@ -118,7 +118,7 @@ def test_tiny_study_tug_end_to_end(tiny_study, tmp_path):
     """All three methods on the tiny study's TUG trials: registration and ground truth from
     gaitval's own modules, then evaluation, Tables 2–5 and the figures."""
     from gaitval.evaluate.tug import evaluate_tug_trial
-    from gaitval.groundtruth.build import ground_truth
+    from gaitval.groundtruth import ground_truth, sensor_leg_points
     from gaitval.io.c3d import read_c3d
     from gaitval.io.scanlog import read_scanlog
     from gaitval.methods import track_trial
@@ -135,8 +135,9 @@ def test_tiny_study_tug_end_to_end(tiny_study, tmp_path):
         sub = {**subs.loc[row["subject"]].to_dict(), "subject": row["subject"]}
         scans = read_scanlog(tiny_study / row["sensor_file"])
         mocap = read_c3d(tiny_study / row["mocap_file"])
-        reg = register_trial(mocap, scans, row, sub, None)
-        gt = ground_truth(mocap, scans, reg, row, sub, None)
+        legs = sensor_leg_points(mocap, scans, row, sub, None)
+        reg = register_trial(mocap, scans, row, sub, None, legs=legs)
+        gt = ground_truth(mocap, scans, reg, row, sub, None, legs=legs)
         for m in ("tug_m1", "tug_m2", "tug_m3"):
             track = track_trial(scans, m, float(sub["leg_width_m"]))
             e = evaluate_tug_trial(track, gt, trial=row["trial"], method=m)
