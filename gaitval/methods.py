@@ -91,6 +91,42 @@ METHOD_DEFINITIONS = {
     "tug_m3": {"gait_phase_association": True, "catmull_rom_interpolation": True},
 }
 
+# -- seed 002 (robotic rollator), see docs/rollator.md --------------------------------------
+# The paper's axes: y is the direction of travel (σ_ay = 5.24 > σ_ax = 1.63 m/s², and every
+# v_y error of its Table I exceeds the v_x one), x is lateral.  gaitval's laser frame on the
+# rollator has x forward from the laser (towards the user: the direction of travel) and y
+# to the laser's left, so the paper's (x, y) noise values become gaitval's (y, x).  The
+# measurement noise 0.059 m (paper x) / 0.02 m (paper y) is read as standard deviations.
+_SEED002 = "seed 002 (Chalvatzaki et al., ICRA 2017)"
+METHODS["rollator_kf"] = {
+    "label": "KF (seed 002 §II)",
+    "paper": _SEED002,
+    "detector": {"name": "rollator_window", "window_x_m": [0.10, 1.00],
+                 "window_y_m": [-0.40, 0.40], "n_sigma": 3.0, "group_gap_leg_widths": 0.5,
+                 "min_points": 5, "min_leg_widths": 0.7, "n_init": 1, "random_state": 0},
+    "filter": {"name": "kf_aniso", "q_accel_sd_mps2": [5.24, 1.63], "r_sd_m": [0.02, 0.059],
+               "p0_pos_sd_m": 0.05, "p0_vel_sd_mps": 0.5},
+    "motion": {"name": "constant_velocity"},
+    "phase": {"name": "speed_thresholds", "v_st_th": 0.47, "v_sw_th": 0.93},
+    "gate": {"name": "chi2", "g": 13.82},
+    "associator": {"name": "gnn", "d_max": 13.82 ** 0.5},
+    "occlusion": {"name": "reinit_after_lost", "n_lost": 15,
+                  "init": {"name": "facing_pair", "max_pair_m": 0.8, "min_leg_widths": 0.7}},
+    "init": {"name": "facing_pair", "max_pair_m": 0.8, "min_leg_widths": 0.7},
+    "tracker": {"dt_s": None, "sides": "as_initialised"},
+}
+# The PF (seed 002 §III) reads raw scans: its parts are its own parameters.  ``model`` is
+# learned leave-one-subject-out by the workflow (rule rollator_train, passed in as
+# kind__model); None gives geometric placeholders (gaitval.track.pf_model).
+METHODS["rollator_pf"] = {
+    "label": "PF (seed 002 §III)",
+    "paper": _SEED002,
+    "kind": {"name": "rollator_pf", "n_particles": 500, "seed": 0, "best_fraction": 0.8,
+             "resample_fraction": 0.5, "model": None, "dt_s": None,
+             "detector": METHODS["rollator_kf"]["detector"],
+             "init": METHODS["rollator_kf"]["init"]},
+}
+
 # -- seed 001 (MTST), Table 3 definitions; everything but the detector's FS_U pattern and the
 # validation region is shared.  Δt = 0.05 s (§3.1): the loop's Δt is the period of the scans
 # it is given (dt_s None), and the MTST steps keep every n-th scan of a log so that the

@@ -21,3 +21,6 @@ from gaitval.track.tracker import TRACK_COLUMNS, Tracker, TrackResult  # noqa: F
 ROLE_REGISTRIES = {"filter": FILTERS, "motion": MOTION_MODELS, "phase": PHASE_MODELS,
                    "gate": GATES, "associator": ASSOCIATORS, "occlusion": OCCLUSION_HANDLERS,
                    "init": INITIALISERS}
+# seed 002: registers the "facing_pair" initialiser and the "reinit_after_lost" handler
+from gaitval.track import reinit  # noqa: F401,E402
+from gaitval.track import pf  # noqa: F401,E402  (registers the "rollator_pf" kind)

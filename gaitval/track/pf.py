@@ -1,0 +1,213 @@
+"""Seed 002's particle-filter leg tracker: one filter of N particles per leg (§III A–E).
+
+Tracker kind ``rollator_pf`` (:class:`ParticleFilterTracker`), a
+:class:`~gaitval.track.kinds.RawScanTracker`: it reads the raw laser points and returns
+the same :class:`~gaitval.track.leg.TrackResult` as the Kalman-filter trackers.
+
+Per scan (seed 002 §III; parameters learned by :mod:`gaitval.track.pf_model`):
+
+A. Initialisation, at the first scan where the §II detector (window, grouping, K-means,
+   circle fit) finds a pair of legs (:class:`~gaitval.track.reinit.FacingPair` labels
+   them): every particle of a leg sits on its detection, with a velocity drawn from the
+   zero-mean mixture, weights 1/N; the estimate is the weighted mean.  The detector is
+   never used again.
+B. Propagation: N velocities per leg from the leg's 2-component Gaussian mixture;
+   p_k^i = p̂_{k−1} + v_k^i Δt from the leg's *previous estimate* p̂_{k−1}, as §III.B
+   prints it (the alternative, each particle from its own previous position, is not what
+   the text says).  Δt is the scan period (a gap of n periods is one step of n·Δt).
+C. Weights ω^i = p(y^i | x^i) (:func:`~gaitval.track.pf_likelihood.likelihood`),
+   normalised per leg; when every weight of a leg is 0 (no laser point near any particle)
+   the weights stay uniform: the filter predicts.
+D. When N_eff = 1/Σω̂² < N/2 for a leg: systematic resampling (the SIR step §III.D names),
+   then a random walk on each particle's velocity (the position follows,
+   p = p̂_{k−1} + v Δt, so the move stays on the propagation's support), re-weighting, and a
+   Metropolis–Hastings accept/reject per particle with probability min(1, ω*/ω): the
+   resample-move scheme §III.D describes to undo SIR's impoverishment.  The kept pairs
+   (x, ω) carry their own likelihoods into E.
+E. Estimate: the weighted mean (position and velocity) of the particles with
+   ω ≥ 0.8·max ω.
+
+All random draws come from one ``numpy.random.Generator`` seeded with ``seed``: the same
+seed and input give the same track, bit for bit.
+
+References
+----------
+Chalvatzaki G, Papageorgiou XS, Tzafestas CS, Maragos P. Comparative experimental validation
+of human gait tracking algorithms for an intelligent robotic rollator. IEEE ICRA 2017, §III.
+Arulampalam MS, Maskell S, Gordon N, Clapp T. A tutorial on particle filters for online
+nonlinear/non-Gaussian Bayesian tracking. IEEE Trans. Signal Process. 2002, 50(2), 174-188.
+Gilks WR, Berzuini C. Following a moving target — Monte Carlo inference for dynamic Bayesian
+models. J. R. Stat. Soc. B 2001, 63(1), 127-146.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from gaitval.detect import DETECTORS
+from gaitval.errors import ConfigError
+from gaitval.track.init import INITIALISERS
+from gaitval.track.kinds import TRACKER_KINDS, RawScanTracker
+from gaitval.track.leg import TrackResult, empty_result
+from gaitval.track.observations import WindowedDetections
+from gaitval.track.pf_likelihood import (PFArrays, effective_size, likelihood,
+                                         sample_velocities, systematic_resample)
+from gaitval.track.pf_model import default_pf_model
+from gaitval.track.phase import PHASE_MODELS
+from gaitval.track.tracker import step_durations
+
+#: the §II detector the PF is initialised with (same as ``rollator_kf``'s)
+DEFAULT_DETECTOR = {"name": "rollator_window"}
+DEFAULT_INIT = {"name": "facing_pair"}
+
+
+class _Scan:
+    """The scan's Cartesian points (polar → Cartesian once per trial)."""
+
+    def __init__(self, scans):
+        a = scans.angles
+        with np.errstate(invalid="ignore"):
+            self.X = scans.ranges * np.cos(a)
+            self.Y = scans.ranges * np.sin(a)
+
+    def near(self, k: int, lo: np.ndarray, hi: np.ndarray):
+        """Points of scan k inside the box lo..hi (x, y)."""
+        x, y = self.X[k], self.Y[k]
+        with np.errstate(invalid="ignore"):
+            keep = (x >= lo[0]) & (x <= hi[0]) & (y >= lo[1]) & (y <= hi[1])
+        return x[keep], y[keep]
+
+
+@TRACKER_KINDS.register("rollator_pf")
+class ParticleFilterTracker(RawScanTracker):
+    """Two particle filters, one per leg, on raw laser points (module notes).
+
+    Parameters
+    ----------
+    model : dict or None
+        The learned parameters (:func:`gaitval.track.pf_model.train_pf_model`); None:
+        :func:`~gaitval.track.pf_model.default_pf_model` for the subject's leg width.
+    n_particles : int
+        N per leg (seed 002: 500).
+    seed : int or sequence of int
+        Seed of the ``numpy.random.Generator`` every draw comes from.
+    best_fraction : float
+        §III.E: particles with ω ≥ best_fraction · max ω form the estimate (0.8).
+    resample_fraction : float
+        §III.D: resample-move when N_eff < resample_fraction · N (0.5).
+    detector, init : dict
+        The §II detector and the pair rule of the initialisation (§III.A).
+    dt_s : float or None
+        Scan period; None: the median timestamp difference.
+    """
+
+    def __init__(self, model: dict | None = None, n_particles: int = 500, seed=0,
+                 best_fraction: float = 0.8, resample_fraction: float = 0.5,
+                 detector: dict | None = None, init: dict | None = None,
+                 dt_s: float | None = None):
+        if int(n_particles) < 2:
+            raise ConfigError(f"rollator_pf: n_particles must be ≥ 2, got {n_particles!r}")
+        if not 0.0 < float(best_fraction) <= 1.0:
+            raise ConfigError(f"rollator_pf: best_fraction must be in (0, 1], got "
+                              f"{best_fraction!r}")
+        self.model = model
+        self.n_particles = int(n_particles)
+        self.seed = seed
+        self.best_fraction = float(best_fraction)
+        self.resample_fraction = float(resample_fraction)
+        self.detector = detector or dict(DEFAULT_DETECTOR)
+        self.init = init or dict(DEFAULT_INIT)
+        self.dt_s = dt_s
+
+    def start(self, scans, leg_width_m: float):
+        """§III.A: ``(k0, (2, 2) leg positions)`` from the §II detector, or None."""
+        source = WindowedDetections(DETECTORS.build(self.detector), scans, leg_width_m)
+        found = INITIALISERS.build(self.init).find(source, leg_width_m)
+        if found is None:
+            return None
+        k0, il, ir = found
+        obs = source.array(k0)
+        return k0, obs[[il, ir]]
+
+    def track(self, scans, leg_width_m) -> TrackResult:
+        P = PFArrays(self.model if self.model is not None else default_pf_model(leg_width_m))
+        rng = np.random.default_rng(self.seed)
+        res = empty_result(scans.t)
+        begun = self.start(scans, leg_width_m)
+        if begun is None:
+            return res
+        k0, p0 = begun
+        n, N = scans.n_scans, self.n_particles
+        dts = step_durations(scans.t, self.dt_s)[1] if n > 1 else np.array([0.0])
+        est = np.full((n, 2, 4), np.nan)
+        seen = np.zeros((n, 2), bool)
+        v = sample_velocities(P, rng, N, zero_mean=True)             # §III.A
+        est[k0, :, :2] = p0                                           # positions = detections
+        est[k0, :, 2:] = v.mean(axis=1)                               # MMSE, ω = 1/N
+        seen[k0] = True
+        pts = _Scan(scans)
+        for k in range(k0 + 1, n):
+            est[k], seen[k] = self.step(P, rng, pts, k, est[k - 1], float(dts[k]))
+        return self._result(res, est, seen, k0)
+
+    def step(self, P: PFArrays, rng, pts: _Scan, k: int, prev: np.ndarray, dt: float):
+        """One scan for both legs: B (propagate), C (weigh), D (resample-move), E."""
+        N = self.n_particles
+        v = sample_velocities(P, rng, N)                              # §III.B
+        pos = prev[:, None, :2] + v * dt                              # p = p̂_{k−1} + v Δt
+        lo = pos.reshape(-1, 2).min(axis=0) - (P.hx, P.hy)
+        hi = pos.reshape(-1, 2).max(axis=0) + (P.hx, P.hy)
+        X, Y = pts.near(k, lo, hi)
+        other = np.repeat(prev[::-1, :2], N, axis=0)                  # β: other leg at k−1
+        lik, cnt = likelihood(P, pos[..., 0].ravel(), pos[..., 1].ravel(), X, Y,
+                              other[:, 0], other[:, 1])               # §III.C
+        lik, cnt = lik.reshape(2, N), cnt.reshape(2, N)
+        w = _normalise(lik)
+        need = np.flatnonzero(effective_size(w) < self.resample_fraction * N)   # §III.D
+        if need.size:
+            v, lik, w = self._resample_move(P, rng, prev, dt, v, lik, w, need, X, Y)
+            pos = prev[:, None, :2] + v * dt
+        best = w >= self.best_fraction * w.max(axis=1, keepdims=True)           # §III.E
+        ws = np.where(best, w, 0.0)
+        ws /= ws.sum(axis=1, keepdims=True)
+        out = np.concatenate([np.einsum("ln,lnj->lj", ws, pos),
+                              np.einsum("ln,lnj->lj", ws, v)], axis=1)
+        return out, cnt.max(axis=1) > 0
+
+    def _resample_move(self, P, rng, prev, dt, v, lik, w, need, X, Y):
+        """§III.D for the legs in ``need``: systematic resampling, random walk on the
+        velocity, Metropolis–Hastings accept/reject with min(1, ω*/ω)."""
+        N = self.n_particles
+        idx = systematic_resample(w[need], rng.random(need.size))
+        v, lik, w = v.copy(), lik.copy(), w.copy()
+        v[need] = np.take_along_axis(v[need], idx[..., None], axis=1)
+        lik[need] = np.take_along_axis(lik[need], idx, axis=1)
+        v_new = v[need] + rng.standard_normal((need.size, N, 2)) * P.walk_sd
+        pos_new = prev[need, None, :2] + v_new * dt
+        other = np.repeat(prev[::-1][need, :2], N, axis=0)
+        lik_new, _ = likelihood(P, pos_new[..., 0].ravel(), pos_new[..., 1].ravel(), X, Y,
+                                other[:, 0], other[:, 1])
+        lik_new = lik_new.reshape(need.size, N)
+        u = rng.random((need.size, N))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            accept = (lik[need] <= 0.0) | (u * lik[need] < lik_new)   # u < ω*/ω (MH)
+        v[need] = np.where(accept[..., None], v_new, v[need])
+        lik[need] = np.where(accept, lik_new, lik[need])
+        w[need] = _normalise(lik[need])
+        return v, lik, w
+
+    def _result(self, res: TrackResult, est: np.ndarray, seen: np.ndarray, k0: int):
+        res.k_init = k0
+        res.x[:, k0:], res.y[:, k0:] = est[k0:, :, 0].T, est[k0:, :, 1].T
+        res.vx[:, k0:], res.vy[:, k0:] = est[k0:, :, 2].T, est[k0:, :, 3].T
+        res.observed[:, k0:] = seen[k0:].T
+        res.pattern[:, k0:] = np.where(seen[k0:].T, "SL", "UO")   # points weighed / none
+        phase = PHASE_MODELS.build("speed_thresholds")
+        res.phase[k0:] = [phase.identify(tuple(e[0]), tuple(e[1])) for e in est[k0:]]
+        return res
+
+
+def _normalise(lik: np.ndarray) -> np.ndarray:
+    """Weights per row summing to 1; a row of zeros (no information) becomes uniform."""
+    s = lik.sum(axis=1, keepdims=True)
+    ok = s > 0.0
+    return np.where(ok, lik / np.where(ok, s, 1.0), 1.0 / lik.shape[1])
