@@ -76,6 +76,8 @@ ICC_MIXED_COLUMNS = ("design", "n_subjects", "n_occasions", "k", "var_subject",
                      "var_occasion", "var_subject_rater", "var_residual", "var_rater",
                      "icc_agreement", "icc_consistency")
 NESTED_METHODS = ("reml", "moments", "anova")
+#: what a mixed-model fit on degenerate data raises (the result is then NaN)
+_FIT_ERRORS = (np.linalg.LinAlgError, ValueError, ZeroDivisionError)
 
 
 # ----------------------------------------------------------------------------- MOVER
@@ -220,28 +222,30 @@ def _fit_random_intercept(y: np.ndarray, X: np.ndarray, subject: np.ndarray,
                           contrast: np.ndarray) -> dict[str, float]:
     """REML fit of ``y = Xβ + b_subject + e`` (statsmodels ``MixedLM``) for one contrast.
 
-    Returns ``estimate`` (``c'β̂``), ``se``, ``df`` (Satterthwaite; ``n_subjects − 1`` when
-    ``σ̂²_b`` is on the boundary, where the Hessian is not defined), ``var_between``,
-    ``var_within`` and ``beta`` (all fixed effects).
+    Returns ``estimate`` (``c'β̂``), ``se``, ``df`` (Satterthwaite), ``var_between``,
+    ``var_within`` and ``beta`` (all fixed effects).  When ``σ̂²_b`` is on the boundary
+    (0) the model is ordinary least squares and ``df = N − p``, the limit Satterthwaite's
+    df approaches as ``σ̂²_b → 0``.
     """
     from statsmodels.regression.mixed_linear_model import MixedLM
-    from statsmodels.tools.sm_exceptions import ConvergenceWarning
 
     codes = pd.factorize(subject, sort=True)[0]
     with warnings.catch_warnings():
-        # "MLE may be on the boundary" is reported in the result (σ̂²_b = 0), not warned
-        warnings.simplefilter("ignore", ConvergenceWarning)
-        warnings.simplefilter("ignore", RuntimeWarning)
+        # statsmodels warns about a boundary or singular random-effect variance; the
+        # result says so itself (σ̂²_b = 0), so the warnings would only be noise
+        warnings.simplefilter("ignore")
         res = MixedLM(y, X, groups=codes).fit(reml=True)
     var_b = max(float(np.asarray(res.cov_re)[0, 0]), 0.0)
     var_w = float(res.scale)
-    n_sub = int(codes.max()) + 1
     _, phi = _reml_pieces(y, X, codes, max(var_b, 1e-300), var_w)
     se = float(np.sqrt(contrast @ phi @ contrast))
     if var_b > 1e-10 * var_w:
-        df = _satterthwaite_df(y, X, codes, var_b, var_w, contrast)
+        with np.errstate(all="ignore"):
+            df = _satterthwaite_df(y, X, codes, var_b, var_w, contrast)
+        if not np.isfinite(df) or df <= 0:
+            df = float(y.size - X.shape[1])
     else:
-        df = float(n_sub - 1)
+        df = float(y.size - X.shape[1])
     beta = np.asarray(res.fe_params, dtype=float)
     return {"estimate": float(contrast @ beta), "se": se, "df": df, "var_between": var_b,
             "var_within": var_w, "beta": beta}
@@ -308,7 +312,10 @@ def _nested_one(d: np.ndarray, codes: np.ndarray, agree: float, alpha: float,
                    var_between=s2_dbar - s2_w / mh, var_within=s2_w)
         comps = [(s2_dbar, n - 1), ((1 - 1 / mh) * s2_w, N - n)]
     else:
-        fit = _fit_random_intercept(d, np.ones((N, 1)), codes, np.ones(1))
+        try:
+            fit = _fit_random_intercept(d, np.ones((N, 1)), codes, np.ones(1))
+        except _FIT_ERRORS:                                     # degenerate: say so by NaN
+            return out
         bias, se, nu = fit["estimate"], fit["se"], fit["df"]
         vb, vw = fit["var_between"], fit["var_within"]
         half = sps.t.ppf(1 - alpha / 2, nu) * se                # bias ∓ t(ν) SE
@@ -547,7 +554,10 @@ def _prop_bias_one(r: np.ndarray, p: np.ndarray, codes: np.ndarray | None,
     elif n_sub < 2:
         return out
     else:
-        fit = _fit_random_intercept(d, X, codes, np.array([0.0, 1.0]))
+        try:
+            fit = _fit_random_intercept(d, X, codes, np.array([0.0, 1.0]))
+        except _FIT_ERRORS:
+            return out
         beta, se, nu = fit["beta"], fit["se"], fit["df"]
     t = beta[1] / se
     half = sps.t.ppf(1 - alpha / 2, nu) * se
@@ -680,7 +690,6 @@ def _icc_two_raters(y: np.ndarray, codes: np.ndarray | None) -> dict:
 def _icc_general(y: np.ndarray, codes: np.ndarray | None) -> dict:
     """Any k: statsmodels ``MixedLM`` on the long table (slow for many occasions)."""
     import statsmodels.formula.api as smf
-    from statsmodels.tools.sm_exceptions import ConvergenceWarning
 
     N, k = y.shape
     long = pd.DataFrame({"value": y.ravel(), "rater": np.tile(np.arange(k), N),
@@ -689,8 +698,7 @@ def _icc_general(y: np.ndarray, codes: np.ndarray | None) -> dict:
     long["subject"] = np.repeat(codes, k) if repeated else long["occasion"]
     vcf = {"occasion": "0 + C(occasion)", "rater": "0 + C(rater)"} if repeated else None
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ConvergenceWarning)
-        warnings.simplefilter("ignore", RuntimeWarning)
+        warnings.simplefilter("ignore")                 # boundary: see the components
         res = smf.mixedlm("value ~ C(rater)", long, groups="subject", re_formula="1",
                           vc_formula=vcf).fit(reml=True)
     names = [f"C(rater)[T.{j}]" for j in range(1, k)]
@@ -781,10 +789,14 @@ def icc_mixed(df: pd.DataFrame, raters: Sequence[str], subject: str | None = Non
                "n_occasions": N, "k": k}
         if n_sub >= 2 and N > (n_sub if repeated else 1) and np.ptp(y) > 0:
             c = codes if repeated else None
-            vc = (_icc_two_raters(y, c) if k == 2 and method == "auto"
-                  else _icc_general(y, c))
-            row.update(vc)
-            row.update(_icc_from(vc))
+            try:
+                vc = (_icc_two_raters(y, c) if k == 2 and method == "auto"
+                      else _icc_general(y, c))
+            except _FIT_ERRORS:                                 # degenerate: NaN row
+                vc = None
+            if vc is not None:
+                row.update(vc)
+                row.update(_icc_from(vc))
         rows.append(row)
     out = pd.DataFrame(rows, columns=[*by, *ICC_MIXED_COLUMNS])
     return out.astype({"n_subjects": int, "n_occasions": int, "k": int})
