@@ -84,12 +84,50 @@ def test_gait_phase_eq3_to_5(vl, vr, pl, pr, phase):
     assert gait_phase(pl, vl, pr, vr, 0.47, 0.93) == phase
 
 
-def test_vectorised_phases_equal_scalar():
+@pytest.mark.parametrize("vl, vr, pl, pr, phase", [
+    ((0.1, 0), (0.2, 0), (0, 0), (0.5, 0), 0),        # both below v_st_th
+    ((2.0, 0), (1.5, 0), (0, 0), (0.5, 0), 1),        # both above v_sw_th: the slower stands
+    ((1.5, 0), (2.0, 0), (0.5, 0), (1, 0), 4),
+    ((2.0, 0), (0.1, 0), (1, 0), (0.5, 0), 2),
+    ((0.8, 0), (0.6, 0), (0, 0), (0.5, 0), 1),        # between thresholds: as swing_first
+    ((0.7, 0), (0.7, 0), (0, 0), (0.5, 0), 0),        # equal speeds in the band: stance
+    ((1.2, 0), (1.2, 0), (0, 0), (0.5, 0), 5),        # Phase 5 only at equal speeds > v_sw_th
+    ((0.4, 0), (0.3, 0), (0, 0), (0.5, 0), 0),        # the faster leg below v_st_th
+])
+def test_gait_phase_stance_first_reading(vl, vr, pl, pr, phase):
+    """seed000 eq. (3) tested before eq. (4): the slower leg is always in stance."""
+    assert gait_phase(pl, vl, pr, vr, 0.47, 0.93, "stance_first") == phase
+
+
+def test_readings_differ_only_where_both_legs_exceed_v_sw_th():
+    rng = np.random.default_rng(1)
+    pl, pr = rng.normal(0, 0.3, (500, 2)), rng.normal(0, 0.3, (500, 2))
+    vl, vr = rng.normal(0, 1.0, (500, 2)), rng.normal(0, 1.0, (500, 2))
+    a = gait_phases(pl, vl, pr, vr, 0.47, 0.93, "swing_first")
+    b = gait_phases(pl, vl, pr, vr, 0.47, 0.93, "stance_first")
+    both_fast = (np.hypot(*vl.T) > 0.93) & (np.hypot(*vr.T) > 0.93)
+    assert (a != b).any() and not (a != b)[~both_fast].any()
+    assert (a[both_fast] == 5).all() and not (b == 5).any()
+
+
+def test_phase_model_reading_parameter():
+    from gaitval.errors import ConfigError
+    from gaitval.track.phase import PHASE_MODELS
+    fast_l, fast_r = (0.0, 0.0, 2.0, 0.0), (0.5, 0.0, 1.5, 0.0)
+    assert PHASE_MODELS.build("speed_thresholds").identify(fast_l, fast_r) == 5
+    m = PHASE_MODELS.build({"name": "speed_thresholds", "reading": "stance_first"})
+    assert m.identify(fast_l, fast_r) == 1
+    with pytest.raises(ConfigError, match="stance_first"):
+        PHASE_MODELS.build({"name": "speed_thresholds", "reading": "stance"})
+
+
+@pytest.mark.parametrize("reading", ["swing_first", "stance_first"])
+def test_vectorised_phases_equal_scalar(reading):
     rng = np.random.default_rng(0)
     pl, pr = rng.normal(0, 0.3, (200, 2)), rng.normal(0, 0.3, (200, 2))
     vl, vr = rng.normal(0, 1.0, (200, 2)), rng.normal(0, 1.0, (200, 2))
-    ref = [gait_phase(pl[i], vl[i], pr[i], vr[i], 0.47, 0.93) for i in range(200)]
-    np.testing.assert_array_equal(gait_phases(pl, vl, pr, vr, 0.47, 0.93), ref)
+    ref = [gait_phase(pl[i], vl[i], pr[i], vr[i], 0.47, 0.93, reading) for i in range(200)]
+    np.testing.assert_array_equal(gait_phases(pl, vl, pr, vr, 0.47, 0.93, reading), ref)
 
 
 def test_unlikely_transitions_of_section_5_2():

@@ -13,7 +13,8 @@ Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (seed 001), eq. (9)–(10).
 """
 from __future__ import annotations
 
-from gaitval.gait.phases import gait_phase_of_states
+from gaitval.gait.phases import (check_reading, gait_phase_of_states,
+                                 gait_phase_of_states_stance_first)
 from gaitval.registry import Registry
 
 PHASE_MODELS = Registry("gait phase model")
@@ -38,11 +39,21 @@ class SpeedThresholdPhases(PhaseModel):
     v_st_th, v_sw_th : float
         Stance and swing speed thresholds (m/s): seed 000 Table 2 0.47 and 0.93; seed 001
         0.18 and 0.37.
+    reading : {"swing_first", "stance_first"}
+        Which of eq. (3)–(4) decides where both hold (:mod:`gaitval.gait.phases` notes):
+        ``swing_first`` (default) lets the absolute thresholds win, so two fast legs are
+        Phase 5; ``stance_first`` puts the slower leg in stance first, so Phase 5 is all but
+        impossible.  Set per method as ``phase__reading``; TUG Tables 3–4 report both
+        (config ``tug.phase_readings``).
     """
 
-    def __init__(self, v_st_th: float = 0.47, v_sw_th: float = 0.93):
+    def __init__(self, v_st_th: float = 0.47, v_sw_th: float = 0.93,
+                 reading: str = "swing_first"):
         self.v_st_th = v_st_th
         self.v_sw_th = v_sw_th
+        self.reading = check_reading(reading)
+        self._of_states = (gait_phase_of_states_stance_first if reading == "stance_first"
+                           else gait_phase_of_states)
 
     def identify(self, l, r):
-        return gait_phase_of_states(l, r, self.v_st_th, self.v_sw_th)   # seed000 eq. (3)–(5)
+        return self._of_states(l, r, self.v_st_th, self.v_sw_th)   # seed000 eq. (3)–(5)
