@@ -50,6 +50,17 @@ class GaitParams:
     rocker_m: float = 0.025             # ankle advance over the heel in loading response
 
 
+def first_swing_s(gp: GaitParams, T: float) -> float:
+    """Duration of the first swing of gait initiation (lift-off to the first contact).
+
+    The leading leg's swing is a pendular motion of the leg whose duration depends little
+    on the step's length: the first swing from standing lasts as long as the walker's
+    steady swing, ``(1 - stance_frac) · 2 T`` (the swing phase of the cycle), while the
+    foot travels only one step length (``kinematics.swing_scale``).
+    """
+    return (1.0 - gp.stance_frac) * 2.0 * T
+
+
 @dataclass
 class Path2D:
     """A densely sampled walking path: arc length ``s``, points ``xy``, heading, curvature."""
@@ -200,7 +211,7 @@ def _walk_path(fh: _Footholds, path: Path2D, gp: GaitParams, rng: np.random.Gene
         if targets is not None and k_step < len(targets) and np.all(np.isfinite(targets[k_step])):
             foot = np.asarray(targets[k_step], dtype=float).copy()
         foot = foot + gp.place_sd_m * rng.standard_normal(2)
-        t = t + T if k_step > 0 else t + T * 0.9
+        t = t + T if k_step > 0 else t + first_swing_s(gp, T)
         fh.add(side, t, foot, h[0] + 0.03 * rng.standard_normal(),
                path.labels[int(np.searchsorted(path.s, s_new).clip(0, len(path.s) - 1))], T)
         side = 1 - side
@@ -211,8 +222,9 @@ def _walk_path(fh: _Footholds, path: Path2D, gp: GaitParams, rng: np.random.Gene
 
 
 def _pivot_steps(fh: _Footholds, path: Path2D, gp: GaitParams, rng: np.random.Generator,
-                 t: float, side: int, end_pose: tuple) -> tuple[float, int]:
-    """After the path, pivot in ``n_steps`` small steps to ``end_pose`` (turn to sit, TUG)."""
+                 t: float, side: int, end_pose: tuple, label=None) -> tuple[float, int]:
+    """After the path, pivot in ``n_steps`` small steps to ``end_pose`` (turn to sit, TUG);
+    the steps carry ``label`` (default: the path's last label)."""
     ex, ey, eh, n_piv = end_pose
     start_c = 0.5 * (np.array(fh.xy[-1]) + np.array(fh.xy[-2]))
     h_start = fh.hd[-1]
@@ -225,15 +237,15 @@ def _pivot_steps(fh: _Footholds, path: Path2D, gp: GaitParams, rng: np.random.Ge
         T = gp.step_time_s * gp.turn_time_factor * 1.2 * (1 + gp.step_cv * rng.standard_normal())
         t = t + T
         foot = c + sgn * nrm * gp.step_width_m / 2 + gp.place_sd_m * rng.standard_normal(2)
-        fh.add(side, t, foot, h, path.labels[-1], T)
+        fh.add(side, t, foot, h, path.labels[-1] if label is None else label, T)
         side = 1 - side
     return t, side
 
 
 def plan_steps(path: Path2D, gp: GaitParams, rng: np.random.Generator, *, t0: float = 0.0,
                first_side: int = 1, end_pose: tuple | None = None,
-               targets: np.ndarray | None = None, start_half_width: float | None = None
-               ) -> StepPlan:
+               targets: np.ndarray | None = None, start_half_width: float | None = None,
+               end_label=None) -> StepPlan:
     """Footholds and contact times along ``path``.
 
     Parameters
@@ -252,6 +264,9 @@ def plan_steps(path: Path2D, gp: GaitParams, rng: np.random.Generator, *, t0: fl
     start_half_width : float, optional
         Half distance between the feet before the first step (default: half step width;
         seated people keep their feet about hip width apart).
+    end_label : str, optional
+        Label of the pivot steps to ``end_pose`` and of the closing step (default: the
+        path's last label), e.g. ``turn_to_sit``.
 
     Notes
     -----
@@ -266,7 +281,7 @@ def plan_steps(path: Path2D, gp: GaitParams, rng: np.random.Generator, *, t0: fl
     _initial_stance(fh, path, hw)
     t, side = _walk_path(fh, path, gp, rng, t0, first_side, targets)
     if end_pose is not None:
-        t, side = _pivot_steps(fh, path, gp, rng, t, side, end_pose)
+        t, side = _pivot_steps(fh, path, gp, rng, t, side, end_pose, end_label)
     # closing step: the trailing foot joins the other one
     h = fh.hd[-1]
     nrm = np.array([-np.sin(h), np.cos(h)])

@@ -43,7 +43,7 @@ from gaitval.simulate.footsteps import (GaitParams, Path2D, StepPlan, make_path,
 
 __all__ = ["GaitParams", "LegState", "MID_STANCE_PHASE", "Path2D", "SWING_END_ACCEL",
            "StepPlan", "TILT_REF_STEP_PER_SHANK", "TOE_OFF_PHASE", "leg_kinematics",
-           "make_path", "plan_from_footholds", "plan_steps"]
+           "make_path", "plan_from_footholds", "plan_steps", "swing_scale"]
 
 #: Shank tilt (knee ahead of ankle, degrees) over the gait cycle (contact at phase 0, toe off
 #: at phase 0.6), measured on the real walks ``FunctionalWalk.c3d``,
@@ -162,15 +162,20 @@ def _timeline(plan: StepPlan, side: int, t: np.ndarray) -> _Timeline:
                      swing=swing, tau=tau, t_c=t_c, st_dur=st_dur, stance_prog=stance_prog)
 
 
-def _ankle_path(tl: _Timeline, t: np.ndarray, gp: GaitParams) -> tuple[np.ndarray, ...]:
+def _ankle_path(tl: _Timeline, t: np.ndarray, gp: GaitParams, a_prev: np.ndarray,
+                a_next: np.ndarray) -> tuple[np.ndarray, ...]:
     """Ankle joint centre (xy, z), foot heading, heel rise and forefoot roll at ``t``.
 
-    Returns ``(ax (n, 2), az, heading, heel, roll_dx, roll_dz)``; the model is in the notes
-    of :func:`leg_kinematics`.
+    ``a_prev``, ``a_next``: :func:`swing_scale` of the swing that ended at the last contact
+    and of the next one; a shortened swing (scale < 1) scales its forefoot roll and heel
+    rocker with it.  Returns ``(ax (n, 2), az, heading, heel, roll_dx, roll_dz)``; the model
+    is in the notes of :func:`leg_kinematics`.
     """
     tc, fxy, fh, j, jn = tl.tc, tl.fxy, tl.fh, tl.j, tl.jn
     has_next, off_next, swing, tau = tl.has_next, tl.off_next, tl.swing, tl.tau
     t_c, st_dur = tl.t_c, tl.st_dur
+    k_next, k_prev = np.minimum(a_next, 1.0), np.minimum(a_prev, 1.0)
+    roll_fwd, roll_up = gp.roll_fwd_m * k_next, gp.roll_up_m * k_next
     # foot roll over the forefoot (heel off → toe off): the ankle advances roll_fwd_m·u³
     # and rises roll_up_m·u² over the last 40 % of stance (u: 0 → 1), so it leaves the
     # floor already moving forward at 3·roll_fwd_m / (0.4·stance) (real walks: ≈ 1.5 × the
@@ -184,18 +189,18 @@ def _ankle_path(tl: _Timeline, t: np.ndarray, gp: GaitParams) -> tuple[np.ndarra
     hdg1 = fh[jn]
     dh = (hdg1 - hdg0 + np.pi) % (2 * np.pi) - np.pi
     fwd0 = np.column_stack([np.cos(hdg0), np.sin(hdg0)])
-    toe_off_xy = fxy[j] + gp.roll_fwd_m * fwd0             # ankle position at toe off
+    toe_off_xy = fxy[j] + (roll_fwd[:, None] * fwd0)       # ankle position at toe off
     # heel rocker: the heel lands with the ankle rocker_m behind its flat-foot place and
     # rolls forward over the first 25 % of stance, (1 - w)² → speed 2·rocker_m / T_load at
     # contact (real walks: the ankle still moves at ≈ 0.3–0.5 × the walking speed)
     t_load = 0.25 * np.where(np.isfinite(st_dur), st_dur, 1.0)
     w = np.where(initiating, 1.0, np.clip((t - t_c) / np.maximum(t_load, 0.02), 0.0, 1.0))
     fwd1 = np.column_stack([np.cos(hdg1), np.sin(hdg1)])
-    land_xy = fxy[jn] - gp.rocker_m * fwd1
-    v1 = 2.0 * gp.rocker_m / np.maximum(t_load, 0.02)
+    land_xy = fxy[jn] - (gp.rocker_m * k_next)[:, None] * fwd1
+    v1 = 2.0 * gp.rocker_m * k_next / np.maximum(t_load, 0.02)
     # swing: quintic from toe off (speed v0, the roll's end speed) to heel strike (speed
     # v1), terminal-swing braking SWING_END_ACCEL
-    v0 = 3.0 * gp.roll_fwd_m / roll_T
+    v0 = 3.0 * roll_fwd / roll_T
     chord = np.maximum(np.hypot(*(land_xy - toe_off_xy).T), 1e-3)
     t_sw = np.maximum(tc[jn] - off_next, 1e-6)
     s0 = np.clip(v0 * t_sw / chord, 0.0, 2.0)
@@ -203,22 +208,55 @@ def _ankle_path(tl: _Timeline, t: np.ndarray, gp: GaitParams) -> tuple[np.ndarra
     g = _hermite5(tau, s0, s1)
     heading = np.where(swing, hdg0 + dh * _minjerk(tau), hdg0)
     ax = np.where(swing[:, None], toe_off_xy + (land_xy - toe_off_xy) * g[:, None],
-                  fxy[j] + (gp.roll_fwd_m * u ** 3 - gp.rocker_m * (1 - w) ** 2)[:, None] * fwd0)
-    az = gp.ankle_height_m + gp.roll_up_m * heel
+                  fxy[j] + (roll_fwd * u ** 3 - gp.rocker_m * k_prev * (1 - w) ** 2)[:, None]
+                  * fwd0)
+    az = gp.ankle_height_m + roll_up * heel
     # swing height: the toe-off rise decays over the first 70 % of swing, plus a clearance
     # arc peaking early in swing (real walks: ankle highest at ≈ 15–25 % of swing)
-    lift = gp.roll_up_m * (1 - _smoothstep(tau / 0.7))
+    lift = roll_up * (1 - _smoothstep(tau / 0.7))
     bump = 0.045 * np.sin(np.pi * np.clip(tau / 0.6, 0.0, 1.0))
     az = np.where(swing, gp.ankle_height_m + lift + bump, az)
     fade = 1 - _smoothstep(tau / 0.7)
     heel = np.where(swing, fade, heel)
-    roll_dx = gp.roll_fwd_m * np.where(swing, fade, u ** 3)
-    roll_dz = gp.roll_up_m * heel
+    roll_dx = roll_fwd * np.where(swing, fade, u ** 3)
+    roll_dz = roll_up * heel
     return ax, az, heading, heel, roll_dx, roll_dz
 
 
+def swing_scale(travel_m: np.ndarray, gp: GaitParams) -> np.ndarray:
+    """Shank-rotation scale of a swing whose foot travels ``travel_m`` (foothold to
+    foothold), relative to the walker's steady swing (``2 · step_length``).
+
+    A swing shorter than the steady one is a geometrically scaled copy of it: the foot's
+    path and the shank's rotation shrink together (factor ``r = travel / (2 L)``), so the
+    knee, carried forward by the thigh through the whole swing, never moves back.  This is
+    the model of gait initiation (the first step from standing travels one step length,
+    not a stride: ``r ≈ 0.25``), of turning, target-adjusted and closing steps.  A longer
+    swing grows the rotation sub-linearly, ``√r``, as on the real walks (1.35 × the step
+    gave 1.15 × the shank range).
+    """
+    r = np.asarray(travel_m, dtype=float) / max(2.0 * gp.step_length_m, 1e-6)
+    return np.where(r < 1.0, r, np.sqrt(r))
+
+
+def _swing_amplitudes(tl: _Timeline, gp: GaitParams) -> tuple[np.ndarray, np.ndarray]:
+    """Per time: the scale of the swing that ended at the last contact and of the next one.
+
+    Before the first swing (initial stance) both are the first swing's; after the last
+    contact both are the last swing's.
+    """
+    fxy, j, jn, m = tl.fxy, tl.j, tl.jn, len(tl.fxy)
+    travel = np.hypot(*np.diff(fxy, axis=0).T) if m > 1 else np.zeros(0)
+    scale = swing_scale(travel, gp) if m > 1 else np.ones(1)   # scale[k]: swing k -> k+1
+    a_next = np.where(tl.has_next, scale[np.clip(j, 0, len(scale) - 1)],
+                      scale[np.clip(j - 1, 0, len(scale) - 1)])
+    a_prev = np.where(j > 0, scale[np.clip(j - 1, 0, len(scale) - 1)], a_next)
+    return a_prev, a_next
+
+
 def _shank_tilt(tl: _Timeline, t: np.ndarray, gp: GaitParams,
-                posture_tilt: np.ndarray | None) -> np.ndarray:
+                posture_tilt: np.ndarray | None, a_prev: np.ndarray, a_next: np.ndarray
+                ) -> np.ndarray:
     """Shank tilt (rad, knee ahead positive) from the gait phase.
 
     The periodic tilt curve, its scaling and the standing clamps are in the notes of
@@ -242,11 +280,19 @@ def _shank_tilt(tl: _Timeline, t: np.ndarray, gp: GaitParams,
     # 1.35 × the step gave 1.15 × the range, opensim_walking2 vs the two slower walks)
     amp = float(np.clip(np.sqrt(gp.step_length_m / gp.shank_length_m / TILT_REF_STEP_PER_SHANK),
                         0.5, 1.3))
+    # ... and per swing with the foot's travel (swing_scale); in stance the scale passes
+    # from the swing that ended at contact to the one that starts at toe off
+    a = np.where(swing | pre, a_next, a_prev + (a_next - a_prev) * _smoothstep(tl.stance_prog))
+    amp = amp * a
     tilt_deg = _TILT(phi) * amp
     # blend the last step's approach to standing (no tilt) so the body ends upright
     tilt = np.deg2rad(tilt_deg - np.where(post | pre, _TILT(MID_STANCE_PHASE) * amp, 0.0))
     if posture_tilt is not None:
-        tilt = tilt + posture_tilt
+        # the sit-to-stand lean of the shank belongs to a foot on the floor: it fades out
+        # over the pre-swing ramp before the foot's first lift-off (the swing leg's shank
+        # follows its swing) and applies again after the last contact (sitting down)
+        w = np.where(pre, 1.0 - ramp, np.where(post, 1.0, 0.0))
+        tilt = tilt + w * posture_tilt
     return tilt
 
 
@@ -271,8 +317,9 @@ def leg_kinematics(plan: StepPlan, side: int, t: np.ndarray, gp: GaitParams,
     tilt (sit-to-stand).  Constants and the real-data comparison: ``docs/simulator.md``.
     """
     tl = _timeline(plan, side, t)
-    ax, az, heading, heel, roll_dx, roll_dz = _ankle_path(tl, t, gp)
-    tilt = _shank_tilt(tl, t, gp, posture_tilt)
+    a_prev, a_next = _swing_amplitudes(tl, gp)
+    ax, az, heading, heel, roll_dx, roll_dz = _ankle_path(tl, t, gp, a_prev, a_next)
+    tilt = _shank_tilt(tl, t, gp, posture_tilt, a_prev, a_next)
     fwd = np.column_stack([np.cos(heading), np.sin(heading)])
     outward = (1.0 if side == 0 else -1.0) * np.column_stack([-np.sin(heading), np.cos(heading)])
     ankle = np.column_stack([ax, az])
