@@ -32,8 +32,8 @@ tug_return_to_chair       lateral distance of the return path from the chair's a
                           the turn to sit starts (out-and-back, seed 000 §1); pass: ≤ 0.25 m
 tug_marker_clearance      closest approach of a shank's surface to the marker cone's surface
                           during the turn (the legs go around it, not through it); pass: > 0
-tug_turn_radius           radius of the feet-midpoint path around the marker; no published
-                          value (shown; the clearance row is its check)
+tug_turn_radius           mean distance of the turning footholds from the marker; no
+                          published value (shown; the clearance row is its check)
 mtst_cross_steps          cross steps per 100 steps from the twin's truth footfalls vs seed 001
                           Table 4 (19 of 414 = 4.6); pass: inside the exact 95 % Poisson
                           interval of 19 counts (2.8–7.2 per 100)
@@ -84,7 +84,6 @@ OCCLUSION_FACTOR = 1.5
 #: Final 180° turn (turn to sit) of the instrumented TUG, healthy controls: mean, SD (s).
 TURN_TO_SIT_S = (1.7, 0.5)
 RETURN_OFFSET_MAX_M = 0.25
-MARKER_RADIUS_M = 0.06            # the TUG cone at shin height (gaitval.simulate.tug)
 #: seed 001 Table 4: cross steps, steps.
 MTST_CROSS = (19, 414)
 #: seed 003 Table 2, reference system: per-subject stride-length SD range (m).
@@ -124,3 +123,289 @@ def poisson_ci(k: int, level: float = 0.95) -> tuple[float, float]:
     a = (1 - level) / 2
     lo = 0.0 if k == 0 else stats.chi2.ppf(a, 2 * k) / 2
     return float(lo), float(stats.chi2.ppf(1 - a, 2 * k + 2) / 2)
+
+
+# --------------------------------------------------------------------------------------
+# Reading a study back
+# --------------------------------------------------------------------------------------
+def _swings(ev: pd.DataFrame, side: str) -> list[tuple[float, float]]:
+    """(foot off, next contact) of one side from a truth ``events.csv``."""
+    offs = np.sort(ev.loc[(ev["event"] == "foot_off") & (ev["side"] == side), "t_s"].to_numpy())
+    cons = np.sort(ev.loc[(ev["event"] == "foot_contact") & (ev["side"] == side),
+                          "t_s"].to_numpy())
+    out = []
+    for to in offs:
+        nxt = cons[cons > to]
+        if len(nxt):
+            out.append((float(to), float(nxt[0])))
+    return out
+
+
+def _lrs_trials(study_dir: Path) -> pd.DataFrame:
+    tr = pd.read_csv(study_dir / "trials.csv")
+    tr = tr[tr["sensor_kind"] == "lrs"]
+    return tr[[(study_dir / "truth" / t / "legs.parquet").is_file() for t in tr["trial"]]]
+
+
+def swing_minima(study_dir: Path, trial: str) -> np.ndarray:
+    """Per complete swing of a trial: the lowest forward speed of the shin point (m/s)."""
+    from gaitval.simulate.shin import point_profile
+
+    d = study_dir / "truth" / trial
+    legs, ev = pd.read_parquet(d / "legs.parquet"), pd.read_csv(d / "events.csv")
+    out = []
+    for side, g in legs.groupby("side", sort=True):
+        t = g["t_s"].to_numpy(float)
+        rate = 1.0 / float(np.median(np.diff(t)))
+        prof = point_profile(t, g[["x_m", "y_m"]].to_numpy(float), _swings(ev, side), rate)
+        out.append(prof["fwd_min"])
+    return np.concatenate(out) if out else np.array([])
+
+
+def _swing_rows(study_dir: Path, trials: pd.DataFrame, real: dict | None) -> list[dict]:
+    rows = []
+    ref = real["swing_fwd_min_mps"] if real else np.nan
+    for proto, g in trials.groupby("protocol", sort=True):
+        mins = np.concatenate([swing_minima(study_dir, t) for t in g["trial"]])
+        n_back = int(np.sum(mins < SWING_BACKWARD_MPS))
+        rows.append(_row("swing_shin_backward", proto, n_back, 0, 0, 0, "swings",
+                         f"no swing below {SWING_BACKWARD_MPS} m/s forward",
+                         "real gait; the real C3D walks' lowest swing forward speed is "
+                         f"{ref:.2f} m/s", group=GROUP_OF.get(proto, ""),
+                         note=f"{len(mins)} swings; lowest forward speed "
+                              f"{np.min(mins) if len(mins) else np.nan:.2f} m/s"))
+    return rows
+
+
+def _shin_rows(walkers: list | None, realdata: Path | None) -> tuple[list[dict], dict | None]:
+    """Shin-height peak swing and stance speed of the study's walkers vs the real walks."""
+    from gaitval.simulate.shin import MEASURES, REAL_WALKS, real_walk, sim_walk
+
+    real = None
+    if realdata is not None and all((realdata / f).is_file() for f in REAL_WALKS):
+        ms = [real_walk(realdata / f) for f in REAL_WALKS]
+        real = {k: float(np.mean([m[k] for m in ms])) for k in MEASURES}
+    rows = []
+    if not walkers:
+        return rows, real
+    by_group: dict[str, list] = {}
+    for k, (proto, group, gp) in enumerate(walkers):
+        by_group.setdefault((proto, group), []).append(sim_walk(gp, seed=k))
+    src = "real C3D walks FunctionalWalk, PiG FlatFoot, opensim_walking2 (gaitval.simulate.shin)"
+    for (proto, group), ms in by_group.items():
+        for key, check, rel in (("swing_peak_norm", "shin_swing_peak", SHIN_PEAK_REL),
+                                ("stance_norm", "shin_stance_speed", SHIN_STANCE_REL)):
+            v = float(np.mean([m[key] for m in ms]))
+            r = real[key] if real else np.nan
+            rows.append(_row(check, proto, v, r, r * (1 - rel) if real else None,
+                             r * (1 + rel) if real else None, "× walking speed",
+                             f"±{rel:.0%} of the real mean", src if real else
+                             "real data absent: not checked", group=group,
+                             note=f"{len(ms)} walkers, steady straight walks"))
+    return rows, real
+
+
+def _straight_steps(ev: pd.DataFrame, protocol: str) -> tuple[np.ndarray, np.ndarray]:
+    """Step lengths (m) and step times (s) of a trial's steady straight steps.
+
+    TUG: contacts on the outbound line after the first two (gait initiation); MTST and
+    rollator: all contacts but the first two and the closing one.  A step's length is the
+    advance along the landing foot's stride.
+    """
+    c = ev[ev["event"] == "foot_contact"].sort_values("t_s").reset_index(drop=True)
+    idx = np.arange(len(c))
+    if protocol == "tug":
+        use = (c["label"].astype(str) == "forward").to_numpy() & (idx >= 2)
+    else:
+        use = (idx >= 2) & (idx < len(c) - 1)
+    p, t = c[["x_m", "y_m"]].to_numpy(float), c["t_s"].to_numpy(float)
+    L, T = [], []
+    for i in np.flatnonzero(use):
+        stride = p[i] - p[i - 2]
+        n = np.hypot(*stride)
+        if n < 1e-6:
+            continue
+        L.append(float((p[i] - p[i - 1]) @ (stride / n)))
+        T.append(float(t[i] - t[i - 1]))
+    return np.array(L), np.array(T)
+
+
+def _step_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
+    subj = pd.read_csv(study_dir / "subjects.csv").set_index("subject")
+    rows = []
+    for proto, g in trials.groupby("protocol", sort=True):
+        sl, st = [], []
+        for _, tr in g.iterrows():
+            L, T = _straight_steps(pd.read_csv(study_dir / "truth" / tr["trial"] / "events.csv"),
+                                   proto)
+            sl.append(L / float(subj.loc[tr["subject"], "height_m"]))
+            st.append(T)
+        sl, st = np.concatenate(sl), np.concatenate(st)
+        if not len(sl):
+            continue
+        group = GROUP_OF.get(proto, "")
+        rng = STEP_RANGES.get(group)
+        for check, v, key, unit in (("step_length", float(np.mean(sl)), "step_per_height",
+                                     "body heights"),
+                                    ("cadence", 60.0 / float(np.mean(st)), "cadence_per_min",
+                                     "steps/min")):
+            lo, hi = rng[key] if rng else (None, None)
+            rows.append(_row(check, proto, v, np.nan if lo is None else (lo + hi) / 2, lo, hi,
+                             unit, "mean inside the published range" if rng else "not checked",
+                             rng["source"] if rng else "no published range for this cohort",
+                             group=group, note=f"{len(sl)} straight steps"))
+    return rows
+
+
+def _tug_phase_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
+    durations = {ph: [] for ph in TUG_PHASE_LEG_SCANS}
+    occ = {ph: [0, 0] for ph in TUG_PHASE_LEG_SCANS}
+    for t in trials["trial"]:
+        s = pd.read_parquet(study_dir / "truth" / t / "scans_legs.parquet")
+        t_end = float(pd.read_parquet(study_dir / "truth" / t / "legs.parquet")["t_s"].max())
+        s = s[(s["t_mocap_s"] >= 0) & (s["t_mocap_s"] <= t_end)]
+        dt = float(np.median(np.diff(np.unique(s["t_mocap_s"]))))
+        for ph in durations:
+            e = s[s["phase"] == ph]
+            durations[ph].append(e["scan"].nunique() * dt)
+            occ[ph][0] += int(e["occluded"].sum())
+            occ[ph][1] += len(e)
+    rows = []
+    src4 = "seed 000 Table 4, Method 2 (25 trials)"
+    for ph, n in TUG_PHASE_LEG_SCANS.items():
+        ref = n / 25 / 2 / 40.0
+        rows.append(_row("tug_phase_duration", "tug", float(np.mean(durations[ph])), ref,
+                         ref * (1 - TUG_PHASE_REL), ref * (1 + TUG_PHASE_REL), "s/trial",
+                         f"±{TUG_PHASE_REL:.0%}", src4 + ": leg-scans / 25 / 2 / 40 Hz",
+                         group="young", phase=ph))
+        k, m = TUG_OCCLUSION[ph]
+        ref = k / m
+        rows.append(_row("tug_occlusion", "tug", occ[ph][0] / max(occ[ph][1], 1), ref,
+                         ref / OCCLUSION_FACTOR, ref * OCCLUSION_FACTOR, "fraction",
+                         f"ratio within 1/{OCCLUSION_FACTOR}–{OCCLUSION_FACTOR}",
+                         src4 + f": {k}/{m}", group="young", phase=ph,
+                         note="twin: fewer than 3 returning beams on the leg (truth); paper: "
+                              "the tracker's unobservable pattern"))
+    return rows
+
+
+def _tug_path_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
+    """Turn around the marker, return to the chair and turn to sit, from the truth."""
+    from gaitval.simulate.tug import MARKER_RADIUS_M, TUG_MARKER_XY
+
+    subj = pd.read_csv(study_dir / "subjects.csv").set_index("subject")
+    mk = np.asarray(TUG_MARKER_XY, float)
+    tts, offs, clear, radii = [], [], [], []
+    for _, tr in trials.iterrows():
+        d = study_dir / "truth" / tr["trial"]
+        ev = pd.read_csv(d / "events.csv")
+        c = ev[ev["event"] == "foot_contact"].sort_values("t_s")
+        lab = c["label"].astype(str).to_numpy()
+        p = c[["x_m", "y_m"]].to_numpy(float)
+        ret = np.flatnonzero(lab == "return")
+        if (lab == "turn_to_sit").any() and len(ret) >= 2:
+            tts.append(float(c["t_s"].iloc[-1] - c["t_s"].iloc[ret[-1]]))
+            offs.append(abs(float(0.5 * (p[ret[-1], 1] + p[ret[-2], 1]))))
+        turn = np.flatnonzero(lab == "turning")
+        if len(turn) >= 2:
+            radii.append(float(np.mean(np.hypot(*(p[turn] - mk).T))))
+        ph = ev[ev["event"] == "phase_start"].set_index("label")["t_s"]
+        legs = pd.read_parquet(d / "legs.parquet")
+        m = (legs["t_s"] >= ph.get("turning", np.inf)) & (legs["t_s"] < ph.get("return", -np.inf))
+        if m.any():
+            dist = np.hypot(*(legs.loc[m, ["x_m", "y_m"]].to_numpy(float) - mk).T)
+            w = float(subj.loc[tr["subject"], "leg_width_m"])
+            clear.append(float(dist.min()) - MARKER_RADIUS_M - w / 2)
+    mu, sd = TURN_TO_SIT_S
+    src = "Aging Clin Exp Res 2020;33:1853, Table 3 (healthy controls, final 180° turn)"
+    rows = [
+        _row("tug_turn_to_sit", "tug", float(np.mean(tts)) if tts else np.nan, mu,
+             mu - 2 * sd, mu + 2 * sd, "s", "inside mean ± 2 SD", src, group="young",
+             note="last return-line contact to the last contact before sitting"),
+        _row("tug_return_to_chair", "tug", float(np.max(offs)) if offs else np.nan, 0.0,
+             None, RETURN_OFFSET_MAX_M, "m", f"≤ {RETURN_OFFSET_MAX_M} m (worst trial)",
+             "seed 000 §1: walks back to the chair (out and back); Podsiadlo & Richardson "
+             "1991", group="young", note="feet midpoint off the chair axis at the turn to sit"),
+        _row("tug_marker_clearance", "tug", float(np.min(clear)) if clear else np.nan, 0.0,
+             0.0, None, "m", "> 0 (worst trial)", "physics: the legs go around the marker",
+             group="young", note="shank surface to the cone's surface at shin height"),
+        _row("tug_turn_radius", "tug", float(np.mean(radii)) if radii else np.nan, np.nan,
+             None, None, "m", "no published value", "docs/simulator.md (choice of the "
+             "path)", group="young", note="mean distance of the turning footholds from the "
+                                          "marker (inner and outer feet)"),
+    ]
+    return rows
+
+
+def _mtst_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
+    n_cross = n_steps = 0
+    for t in trials["trial"]:
+        ev = pd.read_csv(study_dir / "truth" / t / "events.csv")
+        n_cross += int((ev["event"] == "cross_step").sum())
+        n_steps += int((ev["event"] == "foot_contact").sum())
+    k, m = MTST_CROSS
+    lo, hi = poisson_ci(k)
+    return [_row("mtst_cross_steps", "mtst", 100.0 * n_cross / max(n_steps, 1), 100.0 * k / m,
+                 100.0 * lo / m, 100.0 * hi / m, "per 100 steps",
+                 "inside the exact 95 % Poisson interval of 19 counts",
+                 "seed 001 Table 4: 19 cross steps of 414 steps", group="elderly",
+                 note=f"{n_cross} of {n_steps} steps (truth footfalls)")]
+
+
+def _treadmill_rows(study_dir: Path) -> list[dict]:
+    tr = pd.read_csv(study_dir / "trials.csv")
+    tr = tr[(tr["protocol"] == "treadmill") & (tr["speed"] == "normal")]
+    sds = [float(pd.read_csv(f)["length_m"].std()) for t in tr["trial"]
+           if (f := study_dir / "truth" / t / "strides.csv").is_file()]
+    if not sds:
+        return []
+    lo, hi = TREADMILL_STRIDE_SD_M
+    return [_row("treadmill_stride_sd", "treadmill", float(np.mean(sds)), 0.039, lo, hi, "m",
+                 "mean inside the per-subject range", "seed 003 Table 2 (Ref std, normal "
+                 "speed; average 0.039 m)", group="adult",
+                 note=f"{len(sds)} normal-speed trials, reference-system stride lengths")]
+
+
+def physics_table(study_dir: str | Path, walkers: list | None = None,
+                  realdata: str | Path | None = None) -> pd.DataFrame:
+    """All checks of one simulated study (rows as in the module table).
+
+    Parameters
+    ----------
+    study_dir : path
+        A study written by :func:`gaitval.simulate.generate_study` (reads ``trials.csv``,
+        ``subjects.csv`` and ``truth/``).
+    walkers : list of (protocol, group, GaitParams), optional
+        The study's participants, for the shin-speed rows (left out when None).
+    realdata : path, optional
+        Folder of the real C3D walks (default ``../shared/realdata/c3d`` beside the
+        checkout); the shin rows show "not checked" when it is absent.
+
+    Returns
+    -------
+    DataFrame
+        Columns :data:`COLUMNS`; ``passed`` is True/False, NaN where nothing is checked.
+    """
+    d = Path(study_dir)
+    if realdata is None:
+        realdata = Path(__file__).resolve().parents[3] / "shared" / "realdata" / "c3d"
+    realdata = Path(realdata)
+    shin_rows, real = _shin_rows(walkers, realdata if realdata.is_dir() else None)
+    lrs = _lrs_trials(d)
+    rows = _swing_rows(d, lrs, real) + shin_rows + _step_rows(d, lrs)
+    tug = lrs[lrs["protocol"] == "tug"]
+    if len(tug):
+        rows += _tug_phase_rows(d, tug) + _tug_path_rows(d, tug)
+    mtst = lrs[lrs["protocol"] == "mtst"]
+    if len(mtst):
+        rows += _mtst_rows(d, mtst)
+    rows += _treadmill_rows(d)
+    return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def write_physics(study_dir: str | Path, walkers: list | None = None,
+                  realdata: str | Path | None = None) -> Path:
+    """Write ``<study_dir>/physics.csv`` (:func:`physics_table`) and return its path."""
+    out = Path(study_dir) / "physics.csv"
+    write_csv(physics_table(study_dir, walkers, realdata), out, float_format="%.6g")
+    return out

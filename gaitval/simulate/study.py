@@ -25,6 +25,8 @@ from gaitval.io.scanlog import write_scanlog
 from gaitval.simulate import protocols as P
 from gaitval.simulate import render as RD
 from gaitval.simulate.kinematics import GaitParams
+from gaitval.simulate.mtst import TARGETS_FILE, mtst_calibration
+from gaitval.simulate.physics import write_physics
 from gaitval.simulate.sheet import (SUBJECT_COLUMNS, TRIAL_COLUMNS, sensor_clock,
                                     summarise_realism)
 
@@ -132,6 +134,9 @@ def _render_trial(out: Path, study: str, sim: P.TrialSim, subj: dict, clock: dic
         write_annotations(out / annot_rel, ann, time_base="video", time_offset_s=off,
                           rater="R1", fps=30.0)
         write_csv(sim.targets, tdir / "targets.csv", float_format="%.4f")
+        # the layout as a study input (field frame), named by study.yaml's mtst.targets
+        write_csv(sim.targets[["target", "x_m", "y_m", "color", "assigned"]],
+                  out / TARGETS_FILE.format(trial=sim.trial), float_format="%.4f")
     p = sim.walker.plan
     # walking speed: distance each foot travelled (mean of both) over the walking time
     dist = np.mean([np.sum(np.hypot(*np.diff(p.xy[p.side == k], axis=0).T)) for k in (0, 1)])
@@ -287,9 +292,11 @@ def generate_study(out_dir: Path, preset: str | dict = "default", seed: int | No
     out_dir : Path
         Study folder (created).  Receives ``trials.csv``, ``subjects.csv``,
         ``study.yaml`` (study calibrations: rollator sensor mount, pole diameter),
-        ``mocap/*.c3d``, ``lrs/*.scan.parquet``, ``annotations/*.annotations.csv`` (MTST),
+        ``mocap/*.c3d``, ``lrs/*.scan.parquet``, ``annotations/*.annotations.csv`` and
+        ``targets/*.targets.csv`` (MTST; study.yaml's ``mtst`` names them),
         the ultrasonic protocols' files (when :mod:`gaitval.simulate.ultrasonic` is
-        present), ``realism.csv`` and ``truth/`` (for tests only).
+        present), ``realism.csv``, ``physics.csv`` (the physical checks of
+        :mod:`gaitval.simulate.physics`) and ``truth/`` (for tests only).
     preset : str or dict
         ``default``, ``tiny``, ``replay`` (``config/studies/<name>.yaml``) or a dict of
         the same shape.
@@ -324,11 +331,16 @@ def generate_study(out_dir: Path, preset: str | dict = "default", seed: int | No
               out / "truth" / "sensor_pose.csv", float_format="%.9g")
     if realism:
         write_csv(summarise_realism(realism), out / "realism.csv", float_format="%.6g")
+    # the physical checks of the twin (gaitval.simulate.physics): data/<study>/physics.csv
+    write_physics(out, walkers=[(p, s["group"], gp) for p, s, gp in _subject_rows(cfg, seed)])
     mount = cfg.get("rollator", {}).get("sensor_mount",
                                         {"x_m": -0.22, "y_m": 0.0, "yaw_rad": float(np.pi)})
-    write_text(out / "study.yaml", yaml.safe_dump({
+    calibration = {
         "study": study, "seed": seed,
         "registration": {"pole_diameter_m": 2 * P.POLE_RADIUS_M},
         "rollator": {"sensor_mount": {k: float(v) for k, v in mount.items()}},
-    }, sort_keys=True))
+    }
+    if (cfg.get("mtst") or {}).get("n_subjects"):
+        calibration["mtst"] = mtst_calibration()
+    write_text(out / "study.yaml", yaml.safe_dump(calibration, sort_keys=True))
     return out / "trials.csv"

@@ -1,0 +1,87 @@
+"""The physical checks of a simulated study (gaitval.simulate.physics), run on tiny."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitval.simulate import generate_study
+from gaitval.simulate.kinematics import GaitParams, leg_kinematics, make_path, plan_steps
+from gaitval.simulate.physics import COLUMNS, SWING_BACKWARD_MPS, physics_table, poisson_ci
+from gaitval.simulate.shin import point_profile
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("tiny_physics")
+    generate_study(out, "tiny")
+    return out
+
+
+@pytest.fixture(scope="module")
+def physics(tiny) -> pd.DataFrame:
+    return pd.read_csv(tiny / "physics.csv")
+
+
+def test_simulate_writes_the_physics_table(physics):
+    assert list(physics.columns) == COLUMNS
+    assert {"swing_shin_backward", "step_length", "cadence", "tug_phase_duration",
+            "tug_occlusion", "tug_turn_to_sit", "tug_return_to_chair", "tug_marker_clearance",
+            "mtst_cross_steps", "treadmill_stride_sd"} <= set(physics["check"])
+    # every row states its reference source and its tolerance
+    assert physics["source"].notna().all() and physics["tolerance"].notna().all()
+    assert set(physics.loc[physics["check"] == "tug_occlusion", "phase"]) == {
+        "forward", "turning", "return"}
+
+
+def test_no_swinging_shin_moves_backwards(physics):
+    """Issue 10: the swing shin's forward speed stays >= 0 (within noise) in every swing,
+    gait initiation from the chair included, in every protocol."""
+    rows = physics[physics["check"] == "swing_shin_backward"]
+    assert set(rows["protocol"]) == {"tug", "mtst", "rollator"}
+    assert (rows["value"] == 0).all() and rows["passed"].astype(bool).all()
+
+
+def test_tug_path_is_out_and_back_around_the_marker(physics):
+    p = physics.set_index("check")
+    assert p.loc["tug_marker_clearance", "value"] > 0          # around the cone, not through
+    assert p.loc["tug_return_to_chair", "value"] <= 0.25       # back to the chair, no loop
+    assert 0.7 <= p.loc["tug_turn_to_sit", "value"] <= 2.7
+
+
+def test_first_step_from_standing_swings_forward():
+    """A walker starting from standing (feet side by side) takes a short first step: its
+    shin point at 0.27 m never moves back (the old kinematics swung it back at ~1 m/s)."""
+    gp = GaitParams(step_length_m=0.75, step_time_s=0.42, stance_frac=0.58,
+                    shank_length_m=0.42, roll_fwd_m=0.145, roll_up_m=0.10)
+    path = make_path((0.0, 0.0), 0.0, [("line", 4.0, "forward")])
+    plan = plan_steps(path, gp, np.random.default_rng(3), t0=0.5)
+    t = np.arange(0.0, plan.t_end + 0.5, 0.005)
+    for side in (0, 1):
+        xy = leg_kinematics(plan, side, t, gp).point_at_height(0.27)
+        f = plan.foot(side)
+        swings = [(a, b) for a, b in zip(f["t_off"], f["t_contact"]) if np.isfinite(a)]
+        prof = point_profile(t, xy, swings, 200.0)
+        assert len(prof["fwd_min"]) >= 3
+        assert prof["fwd_min"].min() > SWING_BACKWARD_MPS
+
+
+def test_poisson_interval_of_the_cross_step_count():
+    """Garwood's exact interval through the gamma distribution instead of chi-square:
+    [Gamma(19).ppf(0.025), Gamma(20).ppf(0.975)] = [11.44, 29.67] counts."""
+    from scipy.stats import gamma
+    lo, hi = poisson_ci(19)
+    assert lo == pytest.approx(gamma.ppf(0.025, 19), rel=1e-9)
+    assert hi == pytest.approx(gamma.ppf(0.975, 20), rel=1e-9)
+    assert (round(lo, 2), round(hi, 2)) == (11.44, 29.67)
+
+
+def test_physics_table_without_real_data_marks_shin_rows_unchecked(tiny, tmp_path):
+    from gaitval.simulate.study import _subject_rows, load_preset
+    walkers = [(p, s["group"], gp) for p, s, gp in _subject_rows(load_preset("tiny"), 7)]
+    t = physics_table(tiny, walkers, realdata=tmp_path / "absent")
+    shin = t[t["check"].isin(["shin_swing_peak", "shin_stance_speed"])]
+    assert len(shin) and shin["passed"].isna().all()
+    assert shin["source"].str.contains("not checked").all()
