@@ -288,6 +288,44 @@ def _add_ultrasonic_verbs(sub) -> None:
     s.set_defaults(func=cmd_ultrasonic_tables)
 
 
+def _add_mtst_verbs(sub) -> None:
+    """The MTST study (seed 001): tracking, walking parameters and evaluation, Tables 1/3/4."""
+    def run(a) -> int:
+        from gaitval import steps_mtst as S
+        if a.verb == "mtst-track":
+            S.mtst_track_step(a.sensor, a.sheet, a.subjects, a.trial, a.method, a.config,
+                              a.registration, a.out)
+        elif a.verb == "mtst-evaluate":
+            s = S.mtst_evaluate_step(a.track, a.sheet, a.subjects, a.trial, a.method,
+                                     a.config, a.registration, a.groundtruth, a.out)
+            print(s.to_string(index=False))
+        else:
+            S.mtst_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir,
+                               a.config_hash, methods=a.methods, config_json=a.config)
+        return 0
+
+    def common(s, *names):
+        for n in names:
+            s.add_argument(f"--{n}", required=True)
+        s.set_defaults(func=run)
+
+    s = sub.add_parser("mtst-track", help="track one MTST trial (every scan at Δt = 0.05 s)")
+    s.add_argument("--registration", help="registration.json (none: mtst.poles_m)")
+    common(s, "sensor", "sheet", "subjects", "trial", "method", "config", "out")
+    s = sub.add_parser("mtst-evaluate", help="contacts, target and cross steps of one trial, "
+                                             "against annotations (and mocap)")
+    s.add_argument("--registration", help="registration.json (none: mtst.poles_m)")
+    s.add_argument("--groundtruth", help="groundtruth.parquet (mocap studies)")
+    common(s, "track", "sheet", "subjects", "trial", "method", "config", "out")
+    s = sub.add_parser("mtst-tables", help="seed 001 Tables 1, 3, 4 and the trial figure")
+    s.add_argument("inputs", nargs="+", help="per-(trial, method) evaluation folders")
+    s.add_argument("--methods", nargs="+", default=None)
+    s.add_argument("--config", help="a study's config.json (mtst section)")
+    s.add_argument("--reports-dir", default="reports")
+    s.add_argument("--config-hash", default="")
+    common(s, "tables-dir", "figures-dir")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``gaitval`` argument parser: one sub-command per verb, in pipeline order."""
     p = argparse.ArgumentParser(prog="gaitval", description=__doc__.splitlines()[0])
@@ -297,6 +335,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_input_verbs(sub)
     _add_lrs_verbs(sub)
     _add_ultrasonic_verbs(sub)
+    _add_mtst_verbs(sub)
 
     s = sub.add_parser("report", help="write reports/index.md and index.html")
     s.add_argument("--reports-dir", default="reports")

@@ -27,7 +27,7 @@ from gaitval.io.trialsheet import load_subjects, load_trial_sheet
 
 #: Config sections that parameterise the analysis (copied into the per-study config).
 ANALYSIS_SECTIONS = ("registration", "groundtruth", "rollator", "tracking", "tug",
-                     "ultrasonic", "evaluation")
+                     "ultrasonic", "evaluation", "mtst")
 
 
 def study_config(config: dict, sheet: str | Path, out: str | Path) -> dict:

@@ -23,6 +23,19 @@ from gaitval.simulate.trialsim import POLE_RADIUS_M, TrialSim, _walls
 MAT_LENGTH, MAT_WIDTH = 5.85, 1.15
 TARGET_W, TARGET_L = 0.160, 0.165
 COLORS = ("red", "blue", "white")
+#: calibration poles (field frame); in :func:`mtst_calibration` the one at the smaller beam
+#: angle of the nominal sensor (beyond the goal, facing the walker) comes first
+POLES_M = ((3.0, 1.35), (5.6, -1.3))
+#: where each trial's target layout is written, relative to the study folder
+TARGETS_FILE = "targets/{trial}.targets.csv"
+
+
+def mtst_calibration() -> dict:
+    """The ``mtst:`` section of a simulated study's ``study.yaml``: what a lab measures once
+    (target layout files, the mat's centreline and the pole centres in the field frame)."""
+    return {"targets": TARGETS_FILE,
+            "mat": {"start_m": [0.0, 0.0], "goal_m": [MAT_LENGTH, 0.0], "width_m": MAT_WIDTH},
+            "poles_m": [list(p) for p in POLES_M]}
 
 
 def mtst_targets(rng) -> pd.DataFrame:
@@ -147,7 +160,7 @@ def build_mtst(rng, study, subj, gp, trial, rep, sensor_pose, cfg, color, stick,
     apath = make_path((-0.6, -0.75), 0.0, [("line", MAT_LENGTH + 0.7, "walk")])
     aplan = plan_steps(apath, agp, rng, t0=t0 + 0.1, first_side=int(rng.integers(0, 2)))
     attendant = Walker(plan=aplan, gp=agp, leg_width_m=0.11)
-    poles = np.array([[5.6, -1.3], [3.0, 1.35]])
+    poles = np.array([POLES_M[1], POLES_M[0]])
     circles = [(x, y, POLE_RADIUS_M, ID_POLE) for x, y in poles]
     t_end = plan.t_end + float(rng.uniform(0.8, 1.2))
     targets = targets.assign(assigned=targets["color"] == color)
