@@ -31,8 +31,8 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from gaitval.io.ultrasonic import anchor_positions, log_distances  # noqa: E402
 from gaitval.track.ukf import cv_matrices, run_toa_ukf, toa_ranges  # noqa: E402
-from gaitval.ultrasonic import log_distances  # noqa: E402
 
 W = np.array([30.0, 25.0, 10.0])
 V = np.array([11.0, 9.3, 9.0, 9.0]) * 1e-6
@@ -62,7 +62,7 @@ def _tiny(tmp: Path):
 def _prepare(log):
     d = log_distances(log)
     d[~np.all(np.isfinite(d), axis=1)] = np.nan          # predict-only rows for both filters
-    A = log.anchors[["x_m", "y_m", "z_m"]].to_numpy(float)
+    A = anchor_positions(log.anchors)
     return np.asarray(log.t, float), d, A
 
 

@@ -302,13 +302,15 @@ def ultrasonic_track_step(ingest_dir, trial: str, config_json, noise_json, out_p
                           ) -> pd.DataFrame:
     """UKF track of one treadmill trial (seed 003 eq. 3-13).
 
-    V comes from the pendulum identification (``noise.json``); W stays the configured
-    walking value (``ultrasonic.ukf.W_sigma_mps2``) unless ``ultrasonic.use_identified_W``
-    is true: the pendulum's slow arc gives a W far too small for a heel (see
-    :func:`gaitval.ultrasonic.identify_noise`).
+    The tracker is the role :data:`gaitval.evaluate.ultrasonic_config.TRACKER` built from
+    ``ultrasonic.ukf`` (:func:`~gaitval.evaluate.ultrasonic_config.build_tracker`).  V comes
+    from the pendulum identification (``noise.json``); W stays the configured walking value
+    (``ultrasonic.ukf.W_sigma_mps2``) unless ``ultrasonic.use_identified_W`` is true: the
+    pendulum's slow arc gives a W far too small for a heel (see
+    :func:`gaitval.stats.noise.identify_noise`).
     """
+    from gaitval.evaluate.ultrasonic_config import build_tracker
     from gaitval.io.ultrasonic import read_ultrasonic
-    from gaitval.ultrasonic import track_ultrasonic_trial
 
     cfg = dict(load_json(config_json).get("ultrasonic") or {})
     noise = load_json(noise_json)
@@ -318,7 +320,7 @@ def ultrasonic_track_step(ingest_dir, trial: str, config_json, noise_json, out_p
         ukf["W_sigma_mps2"] = noise["ukf"]["W_sigma_mps2"]
     cfg["ukf"] = ukf
     log = read_ultrasonic(Path(ingest_dir) / "sensor.parquet", trial=trial)
-    track = track_ultrasonic_trial(log, cfg, trial=trial)
+    track = build_tracker(cfg).track(log, trial=trial)
     track.attrs = {}
     write_parquet(track, out_parquet)
     return track
@@ -327,9 +329,9 @@ def ultrasonic_track_step(ingest_dir, trial: str, config_json, noise_json, out_p
 def gait_parameters_step(track_parquet, ingest_dir, sheet, subjects, trial: str,
                          config_json, out_parquet) -> pd.DataFrame:
     """Gait parameters per stride for reference and system (seed 003 eq. 16-22)."""
+    from gaitval.evaluate.ultrasonic import gait_parameters
     from gaitval.io.ingest import read_mocap_parquet
     from gaitval.io.ultrasonic import read_ultrasonic
-    from gaitval.ultrasonic import gait_parameters
 
     cfg = load_json(config_json).get("ultrasonic") or {}
     row, subj = trial_and_subject(sheet, subjects, trial)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from gaitval.gait.strides import (autocorr_symmetry, autocorr_unbiased, dominant_period,
-                                  stride_table)
+                                  match_strides, stride_table)
 
 
 def test_unbiased_autocorrelation_by_hand():
@@ -82,3 +82,14 @@ def test_symmetry_of_periodic_and_asymmetric_signals():
     amp = np.where((t // 1.2) % 2 == 0, 1.0, 0.6)
     asym = autocorr_symmetry(amp * np.sin(2 * np.pi * t / 1.2), fs, 1.2)
     assert asym["R1"] < sym["R1"] and asym["symmetry"] > 1.05
+
+
+def test_match_strides_by_start_time_each_system_stride_once():
+    import pandas as pd
+
+    ref = pd.DataFrame({"t_start_s": [0.0, 1.0, 2.0, 3.0], "stride_duration": 1.0})
+    sys = pd.DataFrame({"t_start_s": [0.05, 1.4, 2.1, 2.15]})
+    # 1.0 -> nearest 1.4 is 0.4 s away (> 0.25 T); 2.0 -> 2.1; 3.0 -> 2.15 (0.85 s away)
+    assert match_strides(ref, sys, 0.25) == [(0, 0), (2, 2)]
+    assert match_strides(ref, sys, 0.5) == [(0, 0), (1, 1), (2, 2)]
+    assert match_strides(ref, sys.iloc[:0], 0.25) == []

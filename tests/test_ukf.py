@@ -151,3 +151,52 @@ def test_lost_filter_reinitialises_by_trilateration():
                     reinit_after=10)
     assert r.reinit[0] and r.reinit[200:215].any()
     assert np.abs(r.x[-1, :3] - pos[-1]).max() < 0.005
+
+
+# -- the filter as a tracker role (registry UKF_TRACKERS, built from config) ---------------
+def _log(n=300, seed=6):
+    import pandas as pd
+
+    from gaitval.types import UltrasonicLog
+
+    rng = np.random.default_rng(seed)
+    t, pos = _path(n)
+    d = toa_ranges(pos, ANCHORS) + rng.standard_normal((n, 4)) * SIG
+    d[40, 1] = np.nan                                    # a missing echo
+    anchors = pd.DataFrame({"anchor": ["ANC1", "ANC2", "ANC3", "ANC4"], "x_m": ANCHORS[:, 0],
+                            "y_m": ANCHORS[:, 1], "z_m": ANCHORS[:, 2]})
+    return UltrasonicLog(t=t, temperature_c=np.full(n, 20.0), anchors=anchors,
+                         distance_m=d), d
+
+
+def test_toa_ukf_role_is_built_from_config_and_runs_the_filter():
+    from gaitval.errors import ConfigError
+    from gaitval.track.ukf import TRACK_COLUMNS, UKF_TRACKERS, ToaUkf
+
+    assert "toa_ukf" in UKF_TRACKERS.names()
+    default = UKF_TRACKERS.build("toa_ukf")
+    assert isinstance(default, ToaUkf) and default.W_sigma_mps2 == [30.0, 25.0, 10.0]
+    tracker = UKF_TRACKERS.build({"name": "toa_ukf", "W_sigma_mps2": list(W),
+                                  "V_m2": list(SIG ** 2), "gate_sigma": 3.0})
+    log, d = _log()
+    tr = tracker.track(log, trial="t1")
+    assert list(tr.columns) == TRACK_COLUMNS
+    r = run_toa_ukf(log.t, d, ANCHORS, W_sigma=W, V=SIG ** 2, init_guess=GUESS,
+                    gate_sigma=3.0)
+    assert np.array_equal(tr[["x_m", "y_m", "z_m"]].to_numpy(), r.x[:, :3], equal_nan=True)
+    assert tr["used_anchors"].iloc[40] == 3
+    with pytest.raises(ConfigError, match="toa_ukf"):
+        UKF_TRACKERS.build({"name": "toa_ukf", "W_sigma": [1, 1, 1]})   # not a config name
+    with pytest.raises(ConfigError, match="V_m2 has 3 entries"):
+        UKF_TRACKERS.build({"name": "toa_ukf", "V_m2": [1e-5] * 3}).track(log)
+
+
+def test_ultrasonic_config_defaults_are_the_roles():
+    from dataclasses import asdict
+
+    from gaitval.evaluate.ultrasonic_config import DEFAULT_CFG, build_tracker
+    from gaitval.track.ukf import ToaUkf
+
+    assert DEFAULT_CFG["ukf"] == {k: v for k, v in asdict(ToaUkf()).items()
+                                  if k != "mirror_guard"}
+    assert build_tracker({"ultrasonic": {"ukf": {"alpha": 0.5}}}).alpha == 0.5

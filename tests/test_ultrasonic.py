@@ -1,5 +1,7 @@
-"""Ultrasonic pipeline (seed 003): ranging, registration, alignment, noise identification,
-gait parameters against the simulator's truth, Table 1 and the simulator itself."""
+"""Ultrasonic pipeline (seed 003) stage by stage: ranging (io), anchor registration
+(registration), camera reference and its gap rule (groundtruth), the UKF tracker role
+(track), alignment and gait parameters (evaluate), noise identification (stats), against the
+simulator's truth; Table 1 and the simulator itself."""
 from __future__ import annotations
 
 import hashlib
@@ -8,8 +10,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from gaitval import ultrasonic as U
+from gaitval.evaluate.alignment import align_xcorr
+from gaitval.evaluate.pendulum import pendulum_errors
+from gaitval.evaluate.ultrasonic import GAIT_COLUMNS, PARAMETERS, gait_parameters
+from gaitval.evaluate.ultrasonic_config import build_tracker
+from gaitval.io.ultrasonic import distance_to_tof, speed_of_sound, tof_to_distance
+from gaitval.registration.anchors import fit_anchor_frame
 from gaitval.simulate import ultrasonic as S
+from gaitval.stats.noise import identify_noise
+from gaitval.track.ukf import TRACK_COLUMNS
 from gaitval.types import MocapTrial
 
 CFG = {**S.DEFAULTS, "duration_s": 30.0, "pendulum_duration_s": 12.0}
@@ -50,33 +59,74 @@ def pendulums():
 
 def test_tof_to_distance_by_hand():
     # eq. (2): v_s = 331.5 + 0.6 * 20 = 343.5 m/s;  eq. (1): d = 1 ms * 343.5 m/s
-    assert U.speed_of_sound(20.0) == pytest.approx(343.5)
-    assert U.speed_of_sound(0.0) == pytest.approx(331.5)
-    d = U.tof_to_distance(np.array([[1e-3, np.nan], [2e-3, 5e-4]]), np.array([20.0, 30.0]))
+    assert speed_of_sound(20.0) == pytest.approx(343.5)
+    assert speed_of_sound(0.0) == pytest.approx(331.5)
+    tof = np.array([[1e-3, np.nan], [2e-3, 5e-4]])
+    d = tof_to_distance(tof, np.array([20.0, 30.0]))
     assert d[0, 0] == pytest.approx(0.3435)
     assert np.isnan(d[0, 1])
     assert d[1] == pytest.approx([2e-3 * 349.5, 5e-4 * 349.5])
+    # the inverse, and the simulator's physical law through the same eq. (1)
+    back = distance_to_tof(d, np.array([20.0, 30.0]))
+    assert np.allclose(back, tof, equal_nan=True, rtol=1e-15, atol=0)
+    t_phys = distance_to_tof(0.3435, 20.0, speed=S.speed_of_sound_true)
+    assert t_phys == pytest.approx(0.3435 / (331.3 * np.sqrt(1 + 20.0 / 273.15)))
 
 
-def test_register_anchors_recovers_a_known_pose():
+def _anchor_mocap(labels, seed=5, n=10):
+    R, o = _board(seed)
+    xyz = np.repeat((S.PAPER_ANCHORS @ R.T + o)[None], n, axis=0)
+    return R, o, MocapTrial(path="x.c3d", rate_hz=100.0, first_frame=1, labels=labels,
+                            xyz=xyz[:, :len(labels)])
+
+
+def test_anchor_fit_recovers_a_known_pose_with_either_centre():
     anchors = pd.DataFrame({"anchor": ["A", "B", "C", "D"], "x_m": S.PAPER_ANCHORS[:, 0],
                             "y_m": S.PAPER_ANCHORS[:, 1], "z_m": S.PAPER_ANCHORS[:, 2]})
-    R, o = _board(5)
-    xyz = np.repeat((S.PAPER_ANCHORS @ R.T + o)[None], 10, axis=0)
-    mocap = MocapTrial(path="x.c3d", rate_hz=100.0, first_frame=1,
-                       labels=["ANC1", "ANC2", "ANC3", "ANC4"], xyz=xyz)
-    R2, o2, rms = U.register_anchors(mocap, anchors)
-    assert R2 == pytest.approx(R, abs=1e-9) and o2 == pytest.approx(o, abs=1e-9)
-    assert rms < 1e-9
+    R, o, mocap = _anchor_mocap(["ANC1", "ANC2", "ANC3", "ANC4"])
+    for centre in ("median", "mean"):
+        fit = fit_anchor_frame(mocap, anchors, centre=centre)
+        assert fit.R == pytest.approx(R, abs=1e-9) and fit.t == pytest.approx(o, abs=1e-9)
+        assert fit.rms_m < 1e-9 and fit.markers == ["ANC1", "ANC2", "ANC3", "ANC4"]
+        p_us = np.array([[0.1, 0.2, -0.3]])
+        assert fit.to_ultrasonic(p_us @ R.T + o) == pytest.approx(p_us, abs=1e-12)
 
 
-def test_missing_receiver_marker_is_a_marker_error(treadmill):
-    from gaitval.errors import MarkerError
+def test_anchor_fit_uses_three_markers_and_refuses_two(treadmill):
+    from gaitval.errors import RegistrationError
+    anchors = treadmill["log"].anchors
+    R, o, mocap = _anchor_mocap(["ANC1", "ANC2", "XXX", "ANC4"])
+    fit = fit_anchor_frame(mocap, anchors, trial="t1")          # three are enough
+    assert fit.markers == ["ANC1", "ANC2", "ANC4"]
+    assert fit.R == pytest.approx(R, abs=1e-9)
+    _, _, two = _anchor_mocap(["ANC1", "XXX", "YYY", "ANC4"])
+    with pytest.raises(RegistrationError, match="2 usable anchor marker"):
+        fit_anchor_frame(two, anchors, trial="t1")
+
+
+def test_reference_bridges_gaps_linearly_and_flags_long_ones(treadmill):
+    from gaitval.groundtruth.gaps import fill_short_gaps
+    from gaitval.groundtruth.reference import reference_trajectory
     mo = treadmill["mocap"]
-    bad = MocapTrial(path="bad.c3d", rate_hz=200.0, first_frame=1,
-                     labels=["TX", "ANC1", "ANC2", "XXX", "ANC4"], xyz=mo.xyz[:, :5])
-    with pytest.raises(MarkerError, match="ANC3"):
-        U.register_anchors(bad, treadmill["log"].anchors, trial="t1")
+    i = mo.labels.index("TX")
+    xyz = mo.xyz.copy()
+    xyz[:, i] = np.linspace(0, 1, len(xyz))[:, None] * [1.0, 2.0, 3.0]    # a straight line
+    xyz[100:110, i] = np.nan                   # 10 frames = 0.05 s: short
+    xyz[500:560, i] = np.nan                   # 60 frames = 0.30 s: long
+    xyz[:3, i] = np.nan                        # at the start: never trusted
+    gapped = MocapTrial(path="g.c3d", rate_hz=mo.rate_hz, first_frame=1, labels=mo.labels,
+                        xyz=xyz)
+    ref = reference_trajectory(gapped, treadmill["log"].anchors, max_gap_s=0.2)
+    assert list(np.flatnonzero(ref["gap"])) == [0, 1, 2] + list(range(500, 560))
+    assert ref[["x_m", "y_m", "z_m"]].notna().all().all()          # every frame bridged
+    # linear bridging of a straight line is exact (the fit only rotates and shifts it)
+    p = ref[["x_m", "y_m", "z_m"]].to_numpy()
+    step = np.diff(p[3:], axis=0)
+    assert np.allclose(step, step[0], atol=1e-12)
+    # the same filler's default method leaves the long gap and the start missing
+    f, short = fill_short_gaps(xyz[:, i], mo.rate_hz, 0.2)
+    assert np.isnan(f[500:560]).all() and np.isnan(f[:3]).all()
+    assert short[100:110].all() and not short[500:560].any()
 
 
 def test_align_xcorr_finds_a_fractional_lag_on_a_gait_like_signal():
@@ -88,12 +138,12 @@ def test_align_xcorr_finds_a_fractional_lag_on_a_gait_like_signal():
     x = np.sin(2 * np.pi * np.interp(t, phase, np.arange(len(phase))))
     ref = x[100:1800]
     sys = x[100 + 37:1200]                    # sys[i] = ref[i + 37]  ->  lag = +37
-    assert U.align_xcorr(ref, sys, fs) == pytest.approx(37.0, abs=0.1)
+    assert align_xcorr(ref, sys, fs) == pytest.approx(37.0, abs=0.1)
 
 
 def test_track_of_a_treadmill_trial_is_within_millimetres(treadmill):
-    tr = U.track_ultrasonic_trial(treadmill["log"], {})
-    assert list(tr.columns) == U.TRACK_COLUMNS
+    tr = build_tracker({}).track(treadmill["log"])
+    assert list(tr.columns) == TRACK_COLUMNS
     meta, truth = treadmill["meta"], treadmill["truth"]
     tm = (tr["t_s"] - meta["clock_offset_s"]) / (1 + meta["clock_drift_ppm"] * 1e-6)
     err = np.column_stack([tr[c] - np.interp(tm, truth["t_s"], truth[u])
@@ -106,19 +156,19 @@ def test_track_of_a_treadmill_trial_is_within_millimetres(treadmill):
 
 
 def test_gait_parameters_agree_with_reference_and_truth(treadmill):
-    tr = U.track_ultrasonic_trial(treadmill["log"], {})
+    tr = build_tracker({}).track(treadmill["log"])
     row = {"study": "s", "trial": "t1", "subject": "US01", "speed": "normal",
            "clock_offset_s": np.nan}
-    g = U.gait_parameters(tr, treadmill["mocap"], row, SUBJECT, {})
-    assert list(g.columns) == U.GAIT_COLUMNS
-    assert set(g["parameter"]) == set(U.PARAMETERS)
+    g = gait_parameters(tr, treadmill["mocap"], row, SUBJECT, {})
+    assert list(g.columns) == GAIT_COLUMNS
+    assert set(g["parameter"]) == set(PARAMETERS)
     assert g.attrs["clock_offset_s"] == pytest.approx(treadmill["meta"]["clock_offset_s"],
                                                       abs=0.005)
     n_true = len(treadmill["strides"])
     assert g.attrs["n_matched"] >= n_true - 4
     by = g.set_index("parameter")
     rmse = {p: float(np.sqrt(np.mean((by.loc[p, "system"] - by.loc[p, "reference"]) ** 2)))
-            for p in U.PARAMETERS}
+            for p in PARAMETERS}
     # the paper's RMSEs (Tables 2-6): 0.027 m, 0.035 s, 0.036 m/s, 0.013, 0.034
     assert rmse["stride_length"] < 0.04
     assert rmse["stride_duration"] < 0.05
@@ -134,9 +184,9 @@ def test_gait_parameters_agree_with_reference_and_truth(treadmill):
 
 
 def test_manual_clock_offset_overrides_the_estimate(treadmill):
-    tr = U.track_ultrasonic_trial(treadmill["log"], {})
+    tr = build_tracker({}).track(treadmill["log"])
     off = treadmill["meta"]["clock_offset_s"]
-    g = U.gait_parameters(tr, treadmill["mocap"], {"trial": "t1", "clock_offset_s": off},
+    g = gait_parameters(tr, treadmill["mocap"], {"trial": "t1", "clock_offset_s": off},
                           SUBJECT, {})
     assert g.attrs["clock_offset_s"] == off
 
@@ -144,7 +194,7 @@ def test_manual_clock_offset_overrides_the_estimate(treadmill):
 def test_noise_identification_recovers_simulated_V(pendulums, tmp_path):
     trials = [(lg, mo) for lg, mo, _ in pendulums]
     cfg = {"noise_id": {"W_grid_mps2": [1.0, 5.0, 30.0]}}
-    res = U.identify_noise(trials, cfg)
+    res = identify_noise(trials, cfg)
     true_sd = np.sqrt(CFG["noise_V_m2"])
     got_sd = np.sqrt(res["V_m2"])
     assert got_sd == pytest.approx(true_sd, rel=0.1)           # eq. (23)
@@ -155,7 +205,7 @@ def test_noise_identification_recovers_simulated_V(pendulums, tmp_path):
     assert set(res["W_sigma_mps2"]) <= {1.0, 5.0, 30.0}
     # a marker up to 2 mm off the transducer head (the default) adds its own scatter:
     # eq. (23) pools trials with different marker offsets, so V comes out larger
-    off = U.identify_noise([(lg, mo) for lg, mo, _ in _pendulums(0.002)],
+    off = identify_noise([(lg, mo) for lg, mo, _ in _pendulums(0.002)],
                            {"noise_id": {"W_grid_mps2": [5.0]}})
     assert np.sqrt(off["V_m2"]) == pytest.approx(true_sd, rel=0.25)
     assert np.mean(off["V_m2"]) > np.mean(res["V_m2"])
@@ -163,7 +213,7 @@ def test_noise_identification_recovers_simulated_V(pendulums, tmp_path):
     # Table 1 from the errors at the identified noise
     from gaitval.tables.ultrasonic_table1 import table1, write_ultrasonic_table1
     ucfg = {**cfg, "ukf": {"W_sigma_mps2": res["W_sigma_mps2"], "V_m2": res["V_m2"]}}
-    err = U.pendulum_errors(trials, ucfg, aligned=res["_aligned"])
+    err = pendulum_errors(trials, ucfg, aligned=res["_aligned"])
     t1 = table1(err)
     assert list(t1["axis"]) == ["X", "Y", "Z"]
     assert t1["net_rmse_mm"].iloc[-1] == pytest.approx(
@@ -207,8 +257,8 @@ def test_end_to_end_through_files(tmp_path):
     row = trials.iloc[0].to_dict()
     log = read_ultrasonic(tmp_path / row["sensor_file"], trial=row["trial"])
     mocap = read_c3d(tmp_path / row["mocap_file"], trial=row["trial"])
-    tr = U.track_ultrasonic_trial(log, {}, trial=row["trial"])
-    g = U.gait_parameters(tr, mocap, row, {"subject": row["subject"]}, {},
+    tr = build_tracker({}).track(log, trial=row["trial"])
+    g = gait_parameters(tr, mocap, row, {"subject": row["subject"]}, {},
                           anchors=log.anchors)
     sl = g[g["parameter"] == "stride_duration"]
     assert len(sl) >= 15
@@ -217,7 +267,7 @@ def test_end_to_end_through_files(tmp_path):
 
 def test_track_that_never_finds_a_stride_is_an_error_not_an_empty_table(treadmill):
     from gaitval.errors import GaitvalError
-    tr = U.track_ultrasonic_trial(treadmill["log"], {})
+    tr = build_tracker({}).track(treadmill["log"])
     tr[["x_m", "y_m", "z_m"]] = 0.1                      # a track that never moves
     with pytest.raises(GaitvalError, match="no stride"):
-        U.gait_parameters(tr, treadmill["mocap"], {"trial": "t1"}, SUBJECT, {})
+        gait_parameters(tr, treadmill["mocap"], {"trial": "t1"}, SUBJECT, {})

@@ -181,6 +181,38 @@ def stride_table(x: np.ndarray, fs: float, *, t0: float = 0.0, maxima: np.ndarra
         "cadence": 1.0 / T})                                                # eq. (22)
 
 
+def match_strides(ref: pd.DataFrame, sys: pd.DataFrame,
+                  tolerance: float = 0.25) -> list[tuple[int, int]]:
+    """Pair the strides of two systems that segmented the same walk.
+
+    Parameters
+    ----------
+    ref, sys : DataFrame
+        Stride tables (:func:`stride_table`) of the reference and of the system, on one
+        clock.
+    tolerance : float
+        A system stride matches a reference stride when it is the nearest by start time
+        and starts within ``tolerance`` of that reference stride's duration; each system
+        stride is used once (the first reference stride to claim it keeps it).
+
+    Returns
+    -------
+    list of (int, int)
+        Row positions ``(i_ref, i_sys)`` in reference order.
+    """
+    pairs, used = [], set()
+    ts = sys["t_start_s"].to_numpy()
+    for i, r in enumerate(ref.itertuples()):
+        if ts.size == 0:
+            break
+        j = int(np.argmin(np.abs(ts - r.t_start_s)))
+        if j in used or abs(ts[j] - r.t_start_s) > tolerance * r.stride_duration:
+            continue
+        used.add(j)
+        pairs.append((i, j))
+    return pairs
+
+
 def autocorr_symmetry(a: np.ndarray, fs: float, period_s: float, *,
                       search_frac: float = 0.3) -> dict[str, float]:
     """Stride regularity ``R1``, ``R2`` and symmetry ``R2 / R1`` of one signal window.

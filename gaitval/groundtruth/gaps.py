@@ -7,6 +7,13 @@ spline through up to four valid samples on each side of the gap (a local spline,
 distant gap or outlier cannot influence the fill).  Longer gaps, and missing samples at the
 start or end of a trajectory, stay NaN and are counted by the caller as frames excluded
 from every later metric.
+
+``method="linear"`` is the rule of seed 003's camera reference
+(:mod:`gaitval.groundtruth.reference`, which resamples the marker linearly, §4.1): every
+missing frame is interpolated linearly in time between the valid frames on either side,
+long gaps included and the ends held at the first / last valid value, so the trajectory can
+be resampled and filtered; ``was_filled`` still marks only the short interior gaps, so a
+caller can flag the rest (``missing & ~was_filled``) as not to be trusted.
 """
 from __future__ import annotations
 
@@ -25,32 +32,46 @@ def nan_runs(missing: np.ndarray) -> list[tuple[int, int]]:
 
 
 def fill_short_gaps(x: np.ndarray, rate_hz: float, max_gap_s: float = MAX_GAP_S,
-                    n_side: int = 4) -> tuple[np.ndarray, np.ndarray]:
-    """Fill interior gaps of at most ``max_gap_s`` with a local cubic spline.
+                    n_side: int = 4, *, method: str = "spline",
+                    t: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Fill interior gaps of at most ``max_gap_s`` (module notes).
 
     Parameters
     ----------
-    x : ndarray (n_frames, ...) 
+    x : ndarray (n_frames, ...)
         Trajectory (e.g. (n, 3) marker positions in metres); a frame is missing when any
         of its values is NaN.
     rate_hz : float
         Sampling rate (Hz).
     max_gap_s : float
-        Longest gap that is filled (seconds); ``floor(max_gap_s * rate_hz + 1e-9)`` frames.
+        Longest gap that counts as short (seconds).  ``"spline"``: at most
+        ``floor(max_gap_s * rate_hz + 1e-9)`` frames; ``"linear"``: ``n / rate_hz`` not
+        above ``max_gap_s``.
     n_side : int
-        Valid samples taken on each side of a gap for the spline (fewer at the edges or
+        ``"spline"``: valid samples taken on each side of a gap (fewer at the edges or
         between gaps; with two samples in all the fill is linear).
+    method : {"spline", "linear"}
+        ``"spline"``: short interior gaps filled by a local cubic spline, the rest left NaN.
+        ``"linear"``: every missing frame interpolated linearly in time (module notes).
+    t : ndarray (n_frames,), optional
+        ``"linear"``: the frame times (s); default ``arange(n_frames) / rate_hz``.
 
     Returns
     -------
     filled : ndarray, same shape as ``x``
     was_filled : ndarray (n_frames,) bool
+        Frames of the short interior gaps that were filled.
     """
+    if method not in ("spline", "linear"):
+        raise ValueError(f"method must be 'spline' or 'linear', not {method!r}")
     x = np.asarray(x, dtype=float)
     out = x.copy()
     flat = out.reshape(len(x), -1)
     missing = ~np.all(np.isfinite(flat), axis=1)
     flat[missing] = np.nan
+    if method == "linear":
+        tt = np.arange(len(x)) / rate_hz if t is None else np.asarray(t, dtype=float)
+        return out, _fill_linear(flat, missing, tt, rate_hz, max_gap_s)
     filled = np.zeros(len(x), dtype=bool)
     max_len = int(np.floor(max_gap_s * rate_hz + 1e-9))
     if max_len < 1 or not missing.any():
@@ -75,3 +96,19 @@ def fill_short_gaps(x: np.ndarray, rate_hz: float, max_gap_s: float = MAX_GAP_S,
                 flat[idx, j] = np.interp(idx, knots, flat[knots, j])
         filled[idx] = True
     return out, filled
+
+
+def _fill_linear(flat: np.ndarray, missing: np.ndarray, t: np.ndarray, rate_hz: float,
+                 max_gap_s: float) -> np.ndarray:
+    """``method="linear"`` in place on ``flat`` (n, k); returns ``was_filled``."""
+    filled = np.zeros(len(flat), dtype=bool)
+    ok = ~missing
+    if ok.sum() < 2:
+        return filled
+    for k in range(flat.shape[1]):
+        flat[missing, k] = np.interp(t[missing], t[ok], flat[ok, k])
+    for s, e in nan_runs(missing):
+        long_gap = (e - s) / max(rate_hz, 1e-9) > max_gap_s
+        if not (long_gap or s == 0 or e == len(flat)):
+            filled[s:e] = True
+    return filled

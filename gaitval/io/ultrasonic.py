@@ -88,7 +88,8 @@ def distance_to_tof(d_m, temp_c, *, speed=speed_of_sound):
     """Time of flight of a range, ``t = d / v_s(T_c)``: seed003 eq. (1) solved for ``t``.
 
     Same shapes and ``speed`` as :func:`tof_to_distance`, of which it is the inverse; the
-    simulator passes its own physical law (:func:`gaitval.simulate.us_sensor.speed_of_sound_true`).
+    simulator passes its own physical law
+    (:func:`gaitval.simulate.us_sensor.speed_of_sound_true`).
     """
     d = np.asarray(d_m, dtype=float)
     return d / _per_sample(speed(temp_c), d)                              # seed003 eq. (1)

@@ -1,6 +1,7 @@
 """Error summary of a measurement system against a reference (seed 003 Tables 2–6).
 
 The differences are ``d = pro - ref`` (system minus reference) for every paired row.
+:func:`rmse` is gaitval's one root-mean-square error (scalar or vector errors).
 """
 from __future__ import annotations
 
@@ -11,6 +12,30 @@ from gaitval.stats._checks import as_by, groups, numeric, require_columns
 
 SUMMARY_COLUMNS = ("n", "ref_mean", "ref_std", "pro_mean", "pro_std", "diff_mean",
                    "diff_std", "rmse", "mad", "rmse_pct", "peak_abs_error")
+
+
+def rmse(e, axis: int | None = None) -> float:
+    """Root mean square of errors: ``sqrt(mean(e^2))``.
+
+    Parameters
+    ----------
+    e : array_like
+        Errors (no NaN: drop them first).
+    axis : int, optional
+        The axis along which each error is a vector (e.g. ``1`` for (n, 3) position
+        errors): then ``sqrt(mean(|e_i|^2))``, the RMSE of the Euclidean error.
+
+    Returns
+    -------
+    float
+        NaN when ``e`` is empty.
+    """
+    e = np.asarray(e, dtype=float)
+    if e.size == 0:
+        return float("nan")
+    if axis is None:
+        return float(np.sqrt(np.mean(e ** 2)))                # RMSE = sqrt(mean(d^2))
+    return float(np.sqrt(np.mean(np.sum(e ** 2, axis=axis))))
 
 
 def _std(x: np.ndarray) -> float:
@@ -32,16 +57,16 @@ def summarize_errors(ref: np.ndarray, pro: np.ndarray) -> dict[str, float]:
         out["n"] = 0
         return out
     d = pro - ref
-    rmse = float(np.sqrt(np.mean(d ** 2)))             # RMSE = sqrt(mean(d^2))
+    e_rms = rmse(d)
     ref_mean = float(np.mean(ref))
     return {
         "n": n,
         "ref_mean": ref_mean, "ref_std": _std(ref),
         "pro_mean": float(np.mean(pro)), "pro_std": _std(pro),
         "diff_mean": float(np.mean(d)), "diff_std": _std(d),
-        "rmse": rmse,
+        "rmse": e_rms,
         "mad": float(np.mean(np.abs(d))),              # MAD = mean(|d|), as seed 002 uses it
-        "rmse_pct": 100.0 * rmse / ref_mean if ref_mean != 0 else float("nan"),
+        "rmse_pct": 100.0 * e_rms / ref_mean if ref_mean != 0 else float("nan"),
         "peak_abs_error": float(np.max(np.abs(d))),
     }
 

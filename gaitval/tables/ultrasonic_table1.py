@@ -14,6 +14,10 @@ import numpy as np
 import pandas as pd
 
 from gaitval.config import deep_merge
+from gaitval.evaluate.pendulum import pendulum_errors
+from gaitval.evaluate.ultrasonic_config import resolve_cfg
+from gaitval.stats.noise import identify_noise, noise_to_config
+from gaitval.stats.summary import rmse
 from gaitval.tables.render import write_table
 
 #: Seed 003 Table 1 (mm), transcribed: mean, std, RMSE, Net RMSE per axis.  The paper's
@@ -29,7 +33,7 @@ def table1(errors: pd.DataFrame) -> pd.DataFrame:
     Parameters
     ----------
     errors : DataFrame
-        Output of :func:`gaitval.ultrasonic.pendulum_errors`: ``ex_m, ey_m, ez_m``
+        Output of :func:`gaitval.evaluate.pendulum.pendulum_errors`: ``ex_m, ey_m, ez_m``
         (UKF estimate minus camera, ultrasonic frame) pooled over the pendulum trials.
 
     Returns
@@ -45,13 +49,13 @@ def table1(errors: pd.DataFrame) -> pd.DataFrame:
     for axis, col in (("X", "ex_m"), ("Y", "ey_m"), ("Z", "ez_m")):
         e = errors[col].to_numpy(dtype=float)
         e = e[np.isfinite(e)] * 1000.0                         # m -> mm for the display
-        rmse = float(np.sqrt(np.mean(e ** 2)))
-        acc += rmse ** 2
+        e_rms = rmse(e)
+        acc += e_rms ** 2
         pub = PUBLISHED_MM[axis]
         rows.append({"axis": axis, "direction": AXIS_NAMES[axis], "n_samples": int(e.size),
                      "mean_mm": float(e.mean()), "mean_mm_published": pub[0],
                      "std_mm": float(e.std(ddof=1)), "std_mm_published": pub[1],
-                     "rmse_mm": rmse, "rmse_mm_published": pub[2],
+                     "rmse_mm": e_rms, "rmse_mm_published": pub[2],
                      "net_rmse_mm": float(np.sqrt(acc)), "net_rmse_mm_published": pub[3]})
     return pd.DataFrame(rows)
 
@@ -60,7 +64,7 @@ def write_ultrasonic_table1(errors: pd.DataFrame, stem: str | Path,
                             noise: dict | None = None) -> list[Path]:
     """Render Table 1 to ``<stem>.csv/.md/.tex`` (stem e.g. ``reports/tables/ultrasonic_table1``).
 
-    ``noise`` (the dict of :func:`gaitval.ultrasonic.identify_noise`) adds the identified V
+    ``noise`` (the dict of :func:`gaitval.stats.noise.identify_noise`) adds the identified V
     and W to the notes.
     """
     df = table1(errors)
@@ -92,19 +96,18 @@ def build_ultrasonic_table1(trials, stem: str | Path, cfg: dict | None = None, *
         The pendulum trials.
     stem : path without suffix, e.g. ``reports/tables/ultrasonic_table1``.
     cfg : dict
-        The ``ultrasonic`` configuration (see :data:`gaitval.ultrasonic.DEFAULT_CFG`).
+        The ``ultrasonic`` configuration
+        (see :data:`gaitval.evaluate.ultrasonic_config.DEFAULT_CFG`).
 
     Returns
     -------
     paths : list of Path
         The CSV, Markdown and LaTeX files.
     noise : dict
-        :func:`gaitval.ultrasonic.noise_to_config` of the identification (plain numbers).
+        :func:`gaitval.stats.noise.noise_to_config` of the identification (plain numbers).
     """
-    from gaitval import ultrasonic as U
-
-    res = U.identify_noise(trials, cfg, names=names)
-    ucfg = deep_merge(U.resolve_cfg(cfg), {"ukf": {"W_sigma_mps2": res["W_sigma_mps2"],
-                                                 "V_m2": res["V_m2"]}})
-    err = U.pendulum_errors(trials, ucfg, names=names, aligned=res["_aligned"])
-    return write_ultrasonic_table1(err, stem, res), U.noise_to_config(res)
+    res = identify_noise(trials, cfg, names=names)
+    ucfg = deep_merge(resolve_cfg(cfg), {"ukf": {"W_sigma_mps2": res["W_sigma_mps2"],
+                                               "V_m2": res["V_m2"]}})
+    err = pendulum_errors(trials, ucfg, names=names, aligned=res["_aligned"])
+    return write_ultrasonic_table1(err, stem, res), noise_to_config(res)

@@ -4,7 +4,9 @@ The filter follows seed 003 §3.2 line by line: state ``[x y z vx vy vz]`` (eq. 
 constant-velocity transition with acceleration noise (eq. 4–5), range measurement to each
 receiver (anchor) (eq. 6), scaled sigma points (eq. 7, 12, 13), a-priori statistics (eq. 8),
 measurement sigma points drawn again from the predicted covariance (eq. 9), gain (eq. 10)
-and a-posteriori statistics (eq. 11).
+and a-posteriori statistics (eq. 11).  :class:`ToaUkf` is the filter as a tracker role
+(``toa_ukf`` in :data:`UKF_TRACKERS`), built from config ``ultrasonic.ukf``; its
+:meth:`ToaUkf.track` turns one ultrasonic log into a track table.
 
 Two things the paper leaves open are made explicit here:
 
@@ -39,35 +41,33 @@ Parameters Using a Low-Cost Ultrasonic Motion Analysis System. *Sensors* 2014, 1
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
+import pandas as pd
 from scipy.linalg.lapack import dposv as _posv, dpotrf as _potrf
 
+from gaitval.errors import ConfigError, TimestampError
+from gaitval.io.ultrasonic import anchor_positions, log_distances
+from gaitval.registry import Registry
+from gaitval.types import UltrasonicLog
+
 N_STATE = 6
+#: Columns of a track (:meth:`ToaUkf.track`).
+TRACK_COLUMNS = ["t_s", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps",
+                 "used_anchors", "rejected_anchors"]
+#: Trackers of one transmitter from its ranges (seed 003); config ``ultrasonic.ukf``.
+UKF_TRACKERS = Registry("ultrasonic tracker")
+_NO_ANCHOR = np.zeros(0, dtype=np.intp)
 
 
 def ukf_weights(n: int = N_STATE, alpha: float = 1e-3, beta: float = 2.0,
                 kappa: float = 0.0) -> tuple[np.ndarray, np.ndarray, float]:
     """Sigma-point weights of the scaled unscented transform.
 
-    Parameters
-    ----------
-    n : int
-        State dimension.
-    alpha, beta, kappa : float
-        Spread, prior-distribution and secondary scaling parameters (seed 003 uses
-        ``1e-3``, ``2``, ``0``).
-
-    Returns
-    -------
-    Wm, Wc : ndarray, shape (2n+1,)
-        Weights of the mean and of the covariance.
-    lam : float
-        The scaling factor lambda.
-
-    Notes
-    -----
+    ``n`` is the state dimension; ``alpha, beta, kappa`` the spread, prior-distribution and
+    secondary scaling parameters (seed 003 uses ``1e-3``, ``2``, ``0``).  Returns ``Wm``,
+    ``Wc`` (shape (2n+1,): weights of the mean and of the covariance) and ``lambda``:
     ``lambda = alpha^2 (n + kappa) - n`` (eq. 13);
     ``W0m = lambda/(n+lambda)``, ``W0c = lambda/(n+lambda) + 1 - alpha^2 + beta``,
     ``Wim = Wic = 1/(2(n+lambda))`` (eq. 12).
@@ -124,21 +124,12 @@ def trilaterate(d: np.ndarray, anchors: np.ndarray, guess: np.ndarray,
 class ToaUkfResult:
     """What :func:`run_toa_ukf` returns (arrays aligned with the input samples).
 
-    Attributes
-    ----------
-    x : ndarray, shape (n, 6)
-        A-posteriori state ``[x y z vx vy vz]`` (metres, m/s) per sample.
-    P_diag : ndarray, shape (n, 6)
-        Diagonal of the a-posteriori covariance.
-    used : ndarray, shape (n, m), bool
-        Anchors whose range entered the update.
-    rejected : ndarray, shape (n, m), bool
-        Anchors dropped by the innovation gate (finite range judged an outlier).
-    reinit : ndarray, shape (n,), bool
-        Samples at which the filter was (re-)initialised by trilateration.
-    reflected : ndarray, shape (n,), bool
-        Samples at which the state was reflected back to the physical side of a planar
-        receiver array (see module notes).
+    ``x`` (n, 6): a-posteriori state ``[x y z vx vy vz]`` (metres, m/s); ``P_diag`` (n, 6):
+    diagonal of the a-posteriori covariance; ``used`` (n, m): anchors whose range entered
+    the update; ``rejected`` (n, m): anchors dropped by the innovation gate (finite range
+    judged an outlier); ``reinit`` (n,): samples at which the filter was (re-)initialised
+    by trilateration; ``reflected`` (n,): samples at which the state was reflected back to
+    the physical side of a planar receiver array (module notes).
     """
 
     x: np.ndarray
@@ -147,6 +138,14 @@ class ToaUkfResult:
     rejected: np.ndarray
     reinit: np.ndarray
     reflected: np.ndarray
+
+    @classmethod
+    def start(cls, finite: np.ndarray) -> "ToaUkfResult":
+        """Before the first sample: no state, every finite range counted as used."""
+        n, m = finite.shape
+        return cls(x=np.full((n, N_STATE), np.nan), P_diag=np.full((n, N_STATE), np.nan),
+                   used=finite.copy(), rejected=np.zeros((n, m), dtype=bool),
+                   reinit=np.zeros(n, dtype=bool), reflected=np.zeros(n, dtype=bool))
 
 
 def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
@@ -159,31 +158,25 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
 
     Parameters
     ----------
-    t : ndarray, shape (n,)
-        Sample times (s), increasing.  ``Delta t_k = t_{k+1} - t_k`` (eq. 5).
-    d : ndarray, shape (n, m)
-        Measured ranges (m) to the ``m`` anchors; NaN where no echo arrived.
-    anchors : ndarray, shape (m, 3)
-        Receiver positions (m).
+    t, d, anchors : ndarray, shapes (n,), (n, m), (m, 3)
+        Sample times (s, increasing; ``Delta t_k = t_{k+1} - t_k``, eq. 5), measured
+        ranges (m) to the ``m`` anchors (NaN where no echo arrived), anchor positions (m).
     W_sigma : array_like, shape (3,)
-        Process-noise standard deviations ``sigma_wx, sigma_wy, sigma_wz`` (acceleration,
-        m/s^2): ``W = diag(sigma^2)`` (eq. 4–5).
+        Process-noise sds per axis (acceleration, m/s^2): ``W = diag(sigma^2)`` (eq. 4–5).
     V : array_like, shape (m,) or (m, m)
         Measurement-noise covariance (m^2): per-anchor variances ``e_j^2`` or a full matrix.
     alpha, beta, kappa : float
         Unscented-transform parameters (eq. 12–13).
     init_guess : array_like, shape (3,), optional
-        Starting point of the trilateration that initialises the filter; it selects the
-        side of a planar receiver array.  Default: the anchor centroid.
+        Start of the trilateration that initialises the filter; it selects the side of a
+        planar receiver array.  Default: the anchor centroid.
     init_sigma_pos, init_sigma_vel : float
         Standard deviations of the initial covariance (position m, velocity m/s).
-    gate_sigma : float
-        Innovation gate in predicted standard deviations; ``inf`` disables gating.
-    max_reject : int
-        Most anchors the gate may drop in one step; when more fail it, none is dropped.
-    min_anchors : int
-        Fewer usable anchors than this for ``reinit_after`` steps triggers a re-initialisation.
-    reinit_after : int
+    gate_sigma, max_reject : float, int
+        Innovation gate in predicted sds (``inf``: no gating) and the most anchors it may
+        drop in one step (when more fail it, none is dropped).
+    min_anchors, reinit_after : int
+        Fewer usable anchors than ``min_anchors`` for ``reinit_after`` steps re-initialises.
     mirror_guard : bool
         Keep the state on the ``init_guess`` side of a planar array (module notes).
 
@@ -193,153 +186,232 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
 
     Notes
     -----
-    Prediction (eq. 8, closed form for the linear model)::
-
-        X_{k+1/k} = A X_{k/k},   P_{k+1/k} = A P_{k/k} A^T + G W G^T
-
-    Update (eq. 9–11): sigma points ``chi = [X, X + B, X - B]`` with
-    ``B = chol((n + lambda) P_{k+1/k})``, ``Y_i = h(chi_i)`` (eq. 6),
-    ``Pyy = sum Wc (Y_i - Y)(Y_i - Y)^T + V``, ``Pxy = sum Wc (chi_i - X)(Y_i - Y)^T``,
-    ``K = Pxy Pyy^-1``, ``X += K (d - Y)``, ``P -= K Pyy K^T``.
+    Per sample: (re-)initialise by trilateration when needed, predict (eq. 8, closed form),
+    update from the anchors that pass the gate (eq. 9–11, :func:`_update`), reflect a
+    mirror state back.
     """
     t = np.asarray(t, dtype=float)
     d = np.asarray(d, dtype=float)
     anchors = np.asarray(anchors, dtype=float)
-    n_s, m = d.shape
-    Wm, Wc, lam = ukf_weights(N_STATE, alpha, beta, kappa)
-    Wq = np.diag(np.asarray(W_sigma, dtype=float) ** 2)
-    V = np.asarray(V, dtype=float)
-    Vm = np.diag(V) if V.ndim == 1 else V
-    scale = N_STATE + lam
+    n_s = len(d)
+    mdl = _Model(anchors, W_sigma, V, alpha, beta, kappa, gate_sigma, max_reject)
     guess = anchors.mean(axis=0) if init_guess is None else np.asarray(init_guess, float)
+    normal, centre = _mirror_plane(anchors, guess, mirror_guard and init_guess is not None)
     P0 = np.diag([init_sigma_pos ** 2] * 3 + [init_sigma_vel ** 2] * 3)
-
-    out_x = np.full((n_s, N_STATE), np.nan)
-    out_p = np.full((n_s, N_STATE), np.nan)
-    used = np.zeros((n_s, m), dtype=bool)
-    rejected = np.zeros((n_s, m), dtype=bool)
-    reinit = np.zeros(n_s, dtype=bool)
-    reflected = np.zeros(n_s, dtype=bool)
-    # planar array: the plane's normal pointing to the physical side (that of the guess)
-    centre = anchors.mean(axis=0)
-    _, sv, vt = np.linalg.svd(anchors - centre)
-    normal = None
-    if mirror_guard and m >= 3 and sv[-1] < 1e-3 * max(sv[0], 1e-12) \
-            and init_guess is not None:
-        normal = vt[-1] * np.sign(vt[-1] @ (guess - centre) or 1.0)
-
-    # constant pieces of eq. (5): A = I + dt E,  G W G^T = dt^4/4 Q4 + dt^3/2 Q3 + dt^2 Q2
-    E = np.zeros((N_STATE, N_STATE))
-    E[0, 3] = E[1, 4] = E[2, 5] = 1.0
-    I6 = np.eye(N_STATE)
-    q = np.diag(Wq)
-    Q4 = np.zeros((N_STATE, N_STATE))
-    Q4[:3, :3] = np.diag(q)
-    Q3 = np.zeros((N_STATE, N_STATE))
-    Q3[:3, 3:] = Q3[3:, :3] = np.diag(q)
-    Q2 = np.zeros((N_STATE, N_STATE))
-    Q2[3:, 3:] = np.diag(q)
-    # sigma-point offsets chi_i - X = S B^T with S = [0; I; -I] (eq. 7)
-    S = np.vstack([np.zeros((1, N_STATE)), I6, -I6])
-    Wc_col = Wc[:, None]
-    gate2 = float(gate_sigma) ** 2
-    use_gate = np.isfinite(gate_sigma)
     finite = np.isfinite(d)
     n_finite = finite.sum(axis=1)
-    used[:] = finite
-
-    x = None
-    P = None
+    res = ToaUkfResult.start(finite)
+    x = P = last_dt = None
     starved = 0
-    last_dt = None
-    A = AT = Q = None
     for k in range(n_s):
-        dk = d[k]
         if x is None or starved >= reinit_after:
-            p0 = trilaterate(dk, anchors, guess)   # from the guess: its side of the array
-            if not np.all(np.isfinite(p0)):
-                if x is None:
-                    used[k] = False
-                    continue                       # wait for a sample with >= 3 ranges
-            else:
-                x = np.concatenate([p0, np.zeros(3)])
-                P = P0.copy()
-                reinit[k] = True
-                starved = 0
-                out_x[k] = x
-                out_p[k] = P.diagonal()
+            p0 = trilaterate(d[k], anchors, guess)   # from the guess: its side of the array
+            if np.all(np.isfinite(p0)):
+                x, P, starved = np.concatenate([p0, np.zeros(3)]), P0.copy(), 0
+                res.reinit[k] = True
+                res.x[k], res.P_diag[k] = x, P.diagonal()
                 continue
-        # -- a-priori statistics, eq. (8) (closed form of the unscented transform for A)
+            if x is None:
+                res.used[k] = False
+                continue                       # wait for a sample with >= 3 ranges
         dt = t[k] - t[k - 1]
         if dt != last_dt:
-            A = I6 + dt * E
-            AT = A.T
-            Q = (0.25 * dt ** 4) * Q4 + (0.5 * dt ** 3) * Q3 + (dt * dt) * Q2  # G W G^T
+            A, AT, Q = mdl.transition(dt)
             last_dt = dt
         x = A @ x                                                # X_{k+1/k} = A X_{k/k}
-        P = A @ P @ AT + Q                                       # A P A^T + G W G^T
-        n_ok = int(n_finite[k])
-        if n_ok == 0:
+        P = A @ P @ AT + Q                                       # A P A^T + G W G^T, eq. (8)
+        if n_finite[k] == 0:
             starved += 1
-            out_x[k] = x
-            out_p[k] = P.diagonal()
-            continue
-        # -- sigma points from the predicted covariance, eq. (9) with eq. (7)
-        B, info = _potrf(scale * P, lower=1)
-        if info != 0:
-            P = 0.5 * (P + P.T) + 1e-12 * I6
-            B, info = _potrf(scale * P, lower=1)
-        dX = S @ B.T
-        diff = (x[:3] + dX[:, :3])[:, None, :] - anchors
-        Ysig = np.sqrt((diff * diff).sum(axis=2))                # Y_i = h(chi_i), eq. (6)
-        ybar = Wm @ Ysig                                         # eq. (9)
-        dY = Ysig - ybar
-        WdY = Wc_col * dY
-        Pyy = dY.T @ WdY + Vm                                    # eq. (10)
-        Pxy = dX.T @ WdY                                         # eq. (10)
-        nu = dk - ybar
-        ok = None
-        mismatch = False
-        # -- per-anchor innovation gate (multipath), see module notes
-        if use_gate and (nu * nu > gate2 * Pyy.diagonal()).any():
-            z = np.abs(nu) / np.sqrt(Pyy.diagonal())
-            z[~finite[k]] = 0.0
-            bad = np.flatnonzero(z * z > gate2)
-            if bad.size <= max_reject:        # else: the model, not multipath (keep all)
-                rejected[k, bad] = True
-                used[k, bad] = False
-                n_ok -= bad.size
-                ok = used[k]
-            else:
-                mismatch = True
-                if n_ok < m:
-                    ok = finite[k]
-        elif n_ok < m:
-            ok = finite[k]
-        if n_ok == m:
-            _, KT, info = _posv(Pyy, Pxy.T)                      # K = Pxy Pyy^-1, eq. (10)
-            x = x + nu @ KT                                      # eq. (11)
-            P = P - KT.T @ Pxy.T                                 # P - K Pyy K^T, eq. (11)
-        elif n_ok > 0:
-            s = np.flatnonzero(ok)
-            Pxy_s = Pxy[:, s]
-            _, KT, info = _posv(Pyy[np.ix_(s, s)], Pxy_s.T)
-            x = x + nu[s] @ KT
-            P = P - KT.T @ Pxy_s.T
-        P += P.T
-        P *= 0.5
-        if normal is not None:
-            h = normal @ (x[:3] - centre)
-            if h < 0.0:                       # behind the receiver plane: the mirror image
-                x = x.copy()
-                x[:3] -= 2.0 * h * normal
-                x[3:] -= 2.0 * (normal @ x[3:]) * normal
-                reflected[k] = True
-        starved = starved + 1 if (n_ok < min_anchors or mismatch) else 0
-        p00 = P[0, 0]
-        if p00 != p00 or abs(x[0]) > 1e3:                         # numerically lost
-            starved = reinit_after
-        out_x[k] = x
-        out_p[k] = P.diagonal()
-    return ToaUkfResult(x=out_x, P_diag=out_p, used=used, rejected=rejected, reinit=reinit,
-                        reflected=reflected)
+        else:
+            x, P, n_ok, mismatch = _update(mdl, x, P, d[k], int(n_finite[k]), res, k)
+            if normal is not None:
+                x, res.reflected[k] = _reflect(x, normal, centre)
+            starved = starved + 1 if (n_ok < min_anchors or mismatch) else 0
+            p00 = P[0, 0]
+            if p00 != p00 or abs(x[0]) > 1e3:                     # numerically lost
+                starved = reinit_after
+        res.x[k], res.P_diag[k] = x, P.diagonal()
+    return res
+
+
+class _Model:
+    """The constant pieces of one run: weights (eq. 12–13), noises, eq. (5) and the gate."""
+
+    def __init__(self, anchors, W_sigma, V, alpha, beta, kappa, gate_sigma, max_reject):
+        self.anchors = anchors
+        self.Wm, Wc, lam = ukf_weights(N_STATE, alpha, beta, kappa)
+        self.Wc_col = Wc[:, None]
+        self.scale = N_STATE + lam
+        V = np.asarray(V, dtype=float)
+        self.Vm = np.diag(V) if V.ndim == 1 else V
+        I6 = np.eye(N_STATE)
+        self.S = np.vstack([np.zeros((1, N_STATE)), I6, -I6])   # chi_i - X = S B^T, eq. (7)
+        # eq. (5): A = I + dt E,  G W G^T = dt^4/4 Q4 + dt^3/2 Q3 + dt^2 Q2,  W = diag(q)
+        q = np.asarray(W_sigma, dtype=float) ** 2
+        self.E = np.zeros((N_STATE, N_STATE))
+        self.E[0, 3] = self.E[1, 4] = self.E[2, 5] = 1.0
+        self.Q4, self.Q3, self.Q2 = (np.zeros((N_STATE, N_STATE)) for _ in range(3))
+        self.Q4[:3, :3] = np.diag(q)
+        self.Q3[:3, 3:] = self.Q3[3:, :3] = np.diag(q)
+        self.Q2[3:, 3:] = np.diag(q)
+        self.gate2 = float(gate_sigma) ** 2
+        self.use_gate = bool(np.isfinite(gate_sigma))
+        self.max_reject = max_reject
+
+    def transition(self, dt: float):
+        """``A``, ``A^T`` and ``G W G^T`` of eq. (5) for one time step."""
+        A = np.eye(N_STATE) + dt * self.E
+        Q = (0.25 * dt ** 4) * self.Q4 + (0.5 * dt ** 3) * self.Q3 + (dt * dt) * self.Q2
+        return A, A.T, Q
+
+
+def _mirror_plane(anchors: np.ndarray, guess: np.ndarray, guard: bool):
+    """Normal of a planar array pointing to the physical side (the guess's), or None."""
+    centre = anchors.mean(axis=0)
+    _, sv, vt = np.linalg.svd(anchors - centre)
+    if guard and len(anchors) >= 3 and sv[-1] < 1e-3 * max(sv[0], 1e-12):
+        return vt[-1] * np.sign(vt[-1] @ (guess - centre) or 1.0), centre
+    return None, centre
+
+
+def _sigma_statistics(mdl: _Model, x: np.ndarray, P: np.ndarray):
+    """Sigma points from the predicted covariance and the measurement statistics.
+
+    Returns ``P`` (symmetrised if its Cholesky factor failed), ``ybar`` (eq. 9) and
+    ``Pyy``, ``Pxy`` (eq. 10).
+    """
+    B, info = _potrf(mdl.scale * P, lower=1)                      # eq. (7)
+    if info != 0:
+        P = 0.5 * (P + P.T) + 1e-12 * np.eye(N_STATE)
+        B, info = _potrf(mdl.scale * P, lower=1)
+    dX = mdl.S @ B.T
+    diff = (x[:3] + dX[:, :3])[:, None, :] - mdl.anchors
+    Ysig = np.sqrt((diff * diff).sum(axis=2))                # Y_i = h(chi_i), eq. (6)
+    ybar = mdl.Wm @ Ysig                                         # eq. (9)
+    dY = Ysig - ybar
+    WdY = mdl.Wc_col * dY
+    Pyy = dY.T @ WdY + mdl.Vm                                    # eq. (10)
+    Pxy = dX.T @ WdY                                             # eq. (10)
+    return P, ybar, Pyy, Pxy
+
+
+def _gate(mdl: _Model, nu: np.ndarray, Pyy: np.ndarray, finite: np.ndarray):
+    """Per-anchor innovation gate (multipath, module notes), once some ``|nu_j|`` exceeds
+    ``gate_sigma sqrt(Pyy_jj)``: the anchors to drop and whether more than ``max_reject``
+    failed (then none is dropped: the motion model, not multipath, is the likely culprit).
+    """
+    z = np.abs(nu) / np.sqrt(Pyy.diagonal())
+    z[~finite] = 0.0
+    bad = np.flatnonzero(z * z > mdl.gate2)
+    return (bad, False) if bad.size <= mdl.max_reject else (_NO_ANCHOR, True)
+
+
+def _update(mdl: _Model, x, P, dk, n_ok: int, res: ToaUkfResult, k: int):
+    """A-posteriori statistics (eq. 9–11) from the anchors that pass the gate.
+
+    Sigma points ``chi = [X, X + B, X - B]`` with ``B = chol((n + lambda) P)``,
+    ``Y_i = h(chi_i)`` (eq. 6), ``Pyy = sum Wc (Y_i - Y)(Y_i - Y)^T + V``,
+    ``Pxy = sum Wc (chi_i - X)(Y_i - Y)^T``, ``K = Pxy Pyy^-1``, ``X += K (d - Y)``,
+    ``P -= K Pyy K^T``.  Marks the dropped anchors in ``res``; returns ``x``, ``P``, the
+    number of anchors used and whether the gate saw a model mismatch.
+    """
+    P, ybar, Pyy, Pxy = _sigma_statistics(mdl, x, P)
+    nu = dk - ybar
+    bad, mismatch = _NO_ANCHOR, False
+    if mdl.use_gate and (nu * nu > mdl.gate2 * Pyy.diagonal()).any():
+        bad, mismatch = _gate(mdl, nu, Pyy, res.used[k])
+    if bad.size:
+        res.rejected[k, bad] = True
+        res.used[k, bad] = False
+        n_ok -= bad.size
+    if n_ok == len(dk):
+        _, KT, info = _posv(Pyy, Pxy.T)                          # K = Pxy Pyy^-1, eq. (10)
+        x = x + nu @ KT                                          # eq. (11)
+        P = P - KT.T @ Pxy.T                                     # P - K Pyy K^T, eq. (11)
+    elif n_ok > 0:
+        s = np.flatnonzero(res.used[k])
+        Pxy_s = Pxy[:, s]
+        _, KT, info = _posv(Pyy[np.ix_(s, s)], Pxy_s.T)
+        x = x + nu[s] @ KT
+        P = P - KT.T @ Pxy_s.T
+    P += P.T
+    P *= 0.5
+    return x, P, n_ok, mismatch
+
+
+def _reflect(x: np.ndarray, normal: np.ndarray, centre: np.ndarray):
+    """A state behind the receiver plane (the mirror image) reflected back; and whether."""
+    h = normal @ (x[:3] - centre)
+    if h < 0.0:
+        x = x.copy()
+        x[:3] -= 2.0 * h * normal
+        x[3:] -= 2.0 * (normal @ x[3:]) * normal
+        return x, True
+    return x, False
+
+
+@UKF_TRACKERS.register("toa_ukf")
+@dataclass
+class ToaUkf:
+    """The UKF of seed 003 as a tracker role, with the parameters of :func:`run_toa_ukf`
+    under their config names (``ultrasonic.ukf``): ``W_sigma_mps2`` (W_sigma, m/s^2),
+    ``V_m2`` (V, m^2 per anchor), ``init_guess_m``, ``init_sigma_pos_m``,
+    ``init_sigma_vel_mps``; the others keep their names.
+
+    Defaults: seed 003 §3.2 and §4.3.  §4.3.1 gives W as 30, 25, 10 "mm/s"; with G of
+    eq. (5) w is an acceleration, and a heel needs tens of m/s^2, so the numbers are read
+    as m/s^2.  V is §4.3.2's diag(11, 9.3, 9, 9) mm^2.
+    """
+
+    alpha: float = 1e-3
+    beta: float = 2.0
+    kappa: float = 0.0
+    W_sigma_mps2: list = field(default_factory=lambda: [30.0, 25.0, 10.0])
+    V_m2: list = field(default_factory=lambda: [11e-6, 9.3e-6, 9e-6, 9e-6])
+    gate_sigma: float = 4.0
+    max_reject: int = 2
+    min_anchors: int = 3
+    reinit_after: int = 10
+    init_guess_m: list = field(default_factory=lambda: [0.16, 0.10, -0.30])
+    init_sigma_pos_m: float = 0.05
+    init_sigma_vel_mps: float = 1.0
+    mirror_guard: bool = True
+
+    def track(self, log: UltrasonicLog, *, trial: str | None = None) -> pd.DataFrame:
+        """Track the transmitter of one ultrasonic log (seed 003 §3.2).
+
+        Returns a DataFrame with one row per log sample, columns :data:`TRACK_COLUMNS`:
+        ``t_s`` (ultrasonic clock), ``x_m, y_m, z_m`` (ultrasonic frame), ``vx_mps, vy_mps,
+        vz_mps``, ``used_anchors`` (ranges that entered the update), ``rejected_anchors``
+        (finite ranges the multipath gate dropped); ``attrs``: ``anchors`` (the anchor
+        table, records), ``n_reinit``, ``n_reflected``.
+        """
+        t = np.asarray(log.t, dtype=float)
+        if t.size < 2 or np.any(np.diff(t) <= 0):
+            raise TimestampError("ultrasonic sample times must increase strictly",
+                                 path=log.source or None, trial=trial,
+                                 hint="see the log's timestamp issues (gaitval inspect)")
+        d = log_distances(log)
+        anchors = anchor_positions(log.anchors)
+        V = np.asarray(self.V_m2, dtype=float)
+        if V.shape[0] != anchors.shape[0]:
+            raise ConfigError(f"ultrasonic.ukf.V_m2 has {V.shape[0]} entries but the log "
+                              f"has {anchors.shape[0]} anchors", path=log.source or None,
+                              trial=trial)
+        r = run_toa_ukf(
+            t, d, anchors, W_sigma=np.asarray(self.W_sigma_mps2, float), V=V,
+            alpha=self.alpha, beta=self.beta, kappa=self.kappa,
+            init_guess=np.asarray(self.init_guess_m, float),
+            init_sigma_pos=self.init_sigma_pos_m, init_sigma_vel=self.init_sigma_vel_mps,
+            gate_sigma=self.gate_sigma, max_reject=int(self.max_reject),
+            min_anchors=int(self.min_anchors), reinit_after=int(self.reinit_after),
+            mirror_guard=self.mirror_guard)
+        df = pd.DataFrame({"t_s": t, "x_m": r.x[:, 0], "y_m": r.x[:, 1], "z_m": r.x[:, 2],
+                           "vx_mps": r.x[:, 3], "vy_mps": r.x[:, 4], "vz_mps": r.x[:, 5],
+                           "used_anchors": r.used.sum(axis=1).astype(np.int64),
+                           "rejected_anchors": r.rejected.sum(axis=1).astype(np.int64)})
+        df.attrs["anchors"] = log.anchors.to_dict("records")
+        df.attrs["n_reinit"] = int(r.reinit.sum())
+        df.attrs["n_reflected"] = int(r.reflected.sum())
+        return df
+

@@ -1,0 +1,185 @@
+"""Seed 003 Tables 7, 8 and C1: normality, speed comparison (paired t-tests) and ANOVA.
+
+References
+----------
+Qi, Y.; Soh, C.B.; Gunawan, E.; Low, K.-S.; Thomas, R. Estimation of spatial-temporal gait
+parameters using a low-cost ultrasonic motion analysis system. Sensors 2014, 14(8),
+15434–15457 (seed 003), §4.4 and Tables 2–8, C1.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from gaitval.errors import GaitvalError
+from gaitval.stats import anova_oneway, normality, paired_ttest
+from gaitval.stats.summary import summarize_errors
+from gaitval.tables import _published_qi2014 as pub
+from gaitval.tables.ultrasonic_params import (PARAM_INFO, PARAMETERS, SPEEDS,
+                                              SUMMARY_PARAMETERS, check_gait_params, select)
+
+
+def table7(gait_params: pd.DataFrame, speed: str = "normal", column: str = "system",
+           method: str = "lilliefors") -> pd.DataFrame:
+    """Normality of each gait parameter (seed 003 Table 7), done as a normality test.
+
+    Parameters
+    ----------
+    gait_params : DataFrame
+        The gait parameter table.
+    speed : str
+        Speed whose strides are pooled over subjects (``"all"`` pools every speed).
+    column : {"system", "reference"}
+        Which system's estimates are tested (the paper: "the estimated parameters").
+    method : {"lilliefors", "jarque_bera"}
+        See :func:`gaitval.stats.normality`.
+
+    Returns
+    -------
+    DataFrame
+        One row per parameter S, T, V, hS, vS: ``parameter``, ``symbol``, ``unit``, ``n``,
+        ``mean``, ``std``, ``ci95_low``, ``ci95_high``, ``method``, ``statistic``, ``p``,
+        ``H`` (1 = normality rejected at 5%), and the published ``mean_published``,
+        ``std_published``, ``H_published``, ``p_published``, ``ci95_low_published``,
+        ``ci95_high_published``.
+
+    Notes
+    -----
+    The paper's Table 7 reports H = 0 and p = 1.000 for a null hypothesis of "mean is
+    zero" (§4.4.2); that is not a normality test and its p-values cannot be reproduced.
+    gaitval tests normality itself (Lilliefors by default, MATLAB ``lillietest``'s test).
+    """
+    if column not in ("system", "reference"):
+        raise GaitvalError(f"table7: column must be 'system' or 'reference', not {column!r}")
+    df = check_gait_params(gait_params)
+    parts = [select(df, p, None if speed == "all" else speed, "table7")
+             for p in SUMMARY_PARAMETERS]
+    nt = normality(pd.concat(parts), column, by="parameter", method=method)
+    nt = nt.set_index("parameter").loc[list(SUMMARY_PARAMETERS)].reset_index()
+    nt.insert(1, "symbol", [PARAM_INFO[p][0] for p in nt["parameter"]])
+    nt.insert(2, "unit", [PARAM_INFO[p][2] for p in nt["parameter"]])
+    names = ["mean", "std", "H", "p", "ci95_low", "ci95_high"]
+    published = speed == "normal" and column == "system"
+    for i, name in enumerate(names):
+        nt[name + "_published"] = [pub.TABLE_7[p][i] if published else np.nan
+                                   for p in nt["parameter"]]
+    return nt
+
+
+def _per_subject(df: pd.DataFrame) -> pd.DataFrame:
+    """Per (parameter, speed, subject): mean ref, mean pro, RMSE (the Table 8 inputs)."""
+    rows = []
+    for (param, speed, subject), sub in df.groupby(["parameter", "speed", "subject"],
+                                                   sort=True):
+        e = summarize_errors(sub["reference"].to_numpy(), sub["system"].to_numpy())
+        for q, v in (("ref", e["ref_mean"]), ("pro", e["pro_mean"]), ("rmse", e["rmse"])):
+            rows.append({"parameter": param, "speed": speed, "subject": subject,
+                         "quantity": q, "value": v})
+    return pd.DataFrame(rows, columns=["parameter", "speed", "subject", "quantity", "value"])
+
+
+def table8(gait_params: pd.DataFrame, alpha: float = 0.05) -> pd.DataFrame:
+    """Gait parameters at slow, normal and fast speed with paired t-tests (Table 8).
+
+    For every parameter present and quantity ``ref`` (subject mean of the reference),
+    ``pro`` (subject mean of the system) and ``rmse`` (subject RMSE of system − reference),
+    the per-subject values are summarised across subjects (mean, sample std) at each
+    speed, and slow and fast are each compared with normal by a paired t-test over
+    subjects (:func:`gaitval.stats.paired_ttest`, ``pair_by="subject"``).
+
+    Returns
+    -------
+    DataFrame
+        One row per (parameter, quantity): ``parameter``, ``symbol``, ``unit``,
+        ``quantity``, ``slow_mean``, ``slow_std``, ``slow_p``, ``slow_significant``,
+        ``normal_mean``, ``normal_std``, ``fast_mean``, ``fast_std``, ``fast_p``,
+        ``fast_significant``, ``n_subjects``, and ``*_published`` beside each numeric
+        column the paper prints.  ``p`` is NaN when all paired differences are equal
+        (the paper prints "NaN" for cadence RMSE).
+
+    Notes
+    -----
+    The paper's §4.2 says "two-sample t-tests" while §4.4.3 and the caption say paired
+    t-tests; gaitval pairs by subject (every subject walked at every speed).
+    """
+    df = check_gait_params(gait_params)
+    present = [p for p in PARAMETERS if p in set(df["parameter"])]
+    ps = _per_subject(df[df["parameter"].isin(present)])
+    rows = []
+    for param in present:
+        for q in ("ref", "pro", "rmse"):
+            sub = ps[(ps["parameter"] == param) & (ps["quantity"] == q)]
+            row = {"parameter": param, "symbol": PARAM_INFO[param][0],
+                   "unit": PARAM_INFO[param][2], "quantity": q}
+            for sp in SPEEDS:
+                v = sub.loc[sub["speed"] == sp, "value"].to_numpy(dtype=float)
+                v = v[np.isfinite(v)]
+                row[f"{sp}_mean"] = float(np.mean(v)) if v.size else np.nan
+                row[f"{sp}_std"] = float(np.std(v, ddof=1)) if v.size > 1 else np.nan
+                if sp != "normal":
+                    t = paired_ttest(sub, "value", "subject", "speed", sp, "normal",
+                                     alpha=alpha).iloc[0]
+                    row[f"{sp}_p"] = float(t["p"])
+                    row[f"{sp}_significant"] = bool(t["significant"])
+            row["n_subjects"] = int(sub["subject"].nunique())
+            published = pub.TABLE_8.get((param, q))
+            cols = ["slow_mean", "slow_std", "slow_p", "normal_mean", "normal_std",
+                    "fast_mean", "fast_std", "fast_p"]
+            for i, c in enumerate(cols):
+                row[c + "_published"] = published[i] if published else np.nan
+            rows.append(row)
+    order = ["parameter", "symbol", "unit", "quantity", "slow_mean", "slow_std", "slow_p",
+             "slow_significant", "normal_mean", "normal_std", "fast_mean", "fast_std",
+             "fast_p", "fast_significant", "n_subjects"]
+    out = pd.DataFrame(rows)
+    return out[order + [c for c in out.columns if c.endswith("_published")]]
+
+
+def tableC1(gait_params: pd.DataFrame, speed: str = "normal", column: str = "system",
+            max_strides_per_subject: int | None = None) -> pd.DataFrame:
+    """One-way ANOVA across subjects for S, T, V, hS, vS (seed 003 Table C1).
+
+    Parameters
+    ----------
+    gait_params : DataFrame
+        The gait parameter table.
+    speed : str
+        Speed analysed (the paper's tables are at normal speed).
+    column : {"system", "reference"}
+        Which system's estimates are analysed.
+    max_strides_per_subject : int, optional
+        Use only the first ``m`` strides (by ``stride`` number) of each subject; the
+        paper's Table C1 has 100 observations (10 subjects × 10 strides).
+
+    Returns
+    -------
+    DataFrame
+        One row per (parameter, source) with ``source`` in ``between``, ``within``,
+        ``total``: ``parameter``, ``symbol``, ``source``, ``SS``, ``df``, ``MS``, ``F``,
+        ``p`` (from :func:`gaitval.stats.anova_oneway` with ``group="subject"``), and
+        ``SS_published``, ``df_published``, ``MS_published``, ``F_published``,
+        ``p_published``.
+    """
+    if column not in ("system", "reference"):
+        raise GaitvalError(f"tableC1: column must be 'system' or 'reference', not {column!r}")
+    df = check_gait_params(gait_params)
+    frames = []
+    for param in SUMMARY_PARAMETERS:
+        sub = select(df, param, speed, "tableC1")
+        if max_strides_per_subject is not None:
+            sub = (sub.sort_values(["subject", "trial", "stride"])
+                   .groupby("subject", sort=True).head(max_strides_per_subject))
+        try:
+            a = anova_oneway(sub, column, "subject").reset_index()
+        except GaitvalError:
+            # fewer than two subjects with data: the ANOVA is undefined, say so by NaN
+            a = pd.DataFrame({"source": ["between", "within", "total"],
+                              **{c: np.nan for c in ("SS", "df", "MS", "F", "p")}})
+        a.insert(0, "parameter", param)
+        a.insert(1, "symbol", PARAM_INFO[param][0])
+        published = pub.TABLE_C1[param] if speed == "normal" else None
+        for i, c in enumerate(["SS", "df", "MS", "F", "p"]):
+            a[c + "_published"] = [published[s][i] if published else np.nan
+                                   for s in a["source"]]
+        frames.append(a)
+    return pd.concat(frames, ignore_index=True)
