@@ -19,6 +19,7 @@ include: "workflow/rules/tug.smk"
 include: "workflow/rules/mtst.smk"
 include: "workflow/rules/ultrasonic.smk"
 include: "workflow/rules/peer.smk"
+include: "workflow/rules/rollator.smk"
 include: "workflow/rules/report.smk"
 
 

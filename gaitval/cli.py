@@ -326,6 +326,52 @@ def _add_mtst_verbs(sub) -> None:
     common(s, "tables-dir", "figures-dir")
 
 
+def _add_rollator_verbs(sub) -> None:
+    """The rollator study (seed 002): PF training, KF/PF tracking, evaluation, Tables I-II."""
+    def run(a) -> int:
+        from gaitval import steps_rollator as S
+        if a.verb == "rollator-train":
+            S.rollator_train_step(a.results, a.sheet, a.subjects, a.subject, a.config, a.out)
+        elif a.verb == "rollator-track":
+            S.rollator_track_step(a.sensor, a.sheet, a.subjects, a.trial, a.method, a.config,
+                                  a.out, a.model)
+        elif a.verb == "rollator-evaluate":
+            s = S.rollator_evaluate_step(a.track, a.groundtruth, a.registration, a.ingest,
+                                         a.sheet, a.subjects, a.trial, a.method, a.config,
+                                         a.out)
+            print(s.to_string(index=False))
+        else:
+            S.rollator_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir,
+                                   a.config_hash, kf_method=a.kf, pf_method=a.pf,
+                                   models=a.models, config_json=a.config)
+        return 0
+
+    def common(s, *names):
+        for n in names:
+            s.add_argument(f"--{n}", required=True)
+        s.set_defaults(func=run)
+
+    s = sub.add_parser("rollator-train", help="learn the PF model for one held-out subject")
+    s.add_argument("--results", required=True, help="results/<study> (ingest/, register/)")
+    common(s, "sheet", "subjects", "subject", "config", "out")
+    s = sub.add_parser("rollator-track", help="track one rollator trial with the KF or PF")
+    s.add_argument("--model", help="the held-out subject's PF model (PF methods)")
+    common(s, "sensor", "sheet", "subjects", "trial", "method", "config", "out")
+    s = sub.add_parser("rollator-evaluate", help="evaluate one tracked rollator trial")
+    s.add_argument("--ingest", required=True, help="the trial's ingest folder (mocap)")
+    common(s, "track", "groundtruth", "registration", "sheet", "subjects", "trial", "method",
+           "config", "out")
+    s = sub.add_parser("rollator-tables", help="seed 002 Tables I, II and the figure")
+    s.add_argument("inputs", nargs="+", help="per-(trial, method) evaluation folders")
+    s.add_argument("--kf", default="rollator_kf")
+    s.add_argument("--pf", default="rollator_pf")
+    s.add_argument("--models", nargs="*", default=[], help="the PF models used")
+    s.add_argument("--config", help="a study's config.json (rollator section)")
+    s.add_argument("--reports-dir", default="reports")
+    s.add_argument("--config-hash", default="")
+    common(s, "tables-dir", "figures-dir")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``gaitval`` argument parser: one sub-command per verb, in pipeline order."""
     p = argparse.ArgumentParser(prog="gaitval", description=__doc__.splitlines()[0])
@@ -336,6 +382,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_lrs_verbs(sub)
     _add_ultrasonic_verbs(sub)
     _add_mtst_verbs(sub)
+    _add_rollator_verbs(sub)
 
     s = sub.add_parser("report", help="write reports/index.md and index.html")
     s.add_argument("--reports-dir", default="reports")

@@ -1,0 +1,140 @@
+# Robotic rollator (seed 002): the PF's parameters learned leave-one-subject-out, one track
+# job per (trial, method) for the KF and the PF, evaluation against the registered ground
+# truth in the moving laser frame, then Tables I, II and the turning-trial figure.
+# Paths stay under results/<study>/rollator/ with no "track/" or "evaluate/" folder, so the
+# TUG rules' unconstrained patterns never match them.
+
+
+include: "rollator_common.smk"
+
+
+rule rollator_train:
+    input:
+        others=rollator_training_inputs,
+        config=f"{RESULTS}/{{study}}/config.json",
+        sheet=lambda w: sheet_path(w.study),
+    output:
+        f"{RESULTS}/{{study}}/rollator/model/{{subject}}.json",
+    wildcard_constraints:
+        **ROLLATOR_WC,
+    params:
+        gv=GV,
+        subjects=lambda w: subjects_path(w.study),
+        results=lambda w: f"{RESULTS}/{w.study}",
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/rollator_train/{study}/{subject}.log",
+    shell:
+        "{params.gv} rollator-train --results {params.results} --sheet {input.sheet}"
+        " --subjects {params.subjects} --subject {wildcards.subject}"
+        " --config {input.config} --out {output} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+rule rollator_track:
+    input:
+        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
+        config=f"{RESULTS}/{{study}}/config.json",
+        sheet=lambda w: sheet_path(w.study),
+        model=rollator_model,
+    output:
+        f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}.track.parquet",
+    wildcard_constraints:
+        **ROLLATOR_WC,
+    params:
+        gv=GV,
+        subjects=lambda w: subjects_path(w.study),
+        model=lambda w, input: f"--model {input.model}" if input.model else "",
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/rollator_track/{study}/{method}/{trial}.log",
+    shell:
+        "{params.gv} rollator-track --sensor {input.sensor} --sheet {input.sheet}"
+        " --subjects {params.subjects} --trial {wildcards.trial} --method {wildcards.method}"
+        " --config {input.config} {params.model} --out {output}"
+        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+rule rollator_evaluate:
+    input:
+        track=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}.track.parquet",
+        gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
+        reg=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
+        mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
+        config=f"{RESULTS}/{{study}}/config.json",
+        sheet=lambda w: sheet_path(w.study),
+    output:
+        summary=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}/summary.parquet",
+        frames=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}/frames.parquet",
+    wildcard_constraints:
+        **ROLLATOR_WC,
+    params:
+        gv=GV,
+        subjects=lambda w: subjects_path(w.study),
+        ingest=lambda w, input: str(Path(input.mocap).parent),
+        out=parent_of("summary"),
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/rollator_evaluate/{study}/{method}/{trial}.log",
+    shell:
+        "{params.gv} rollator-evaluate --track {input.track} --groundtruth {input.gt}"
+        " --registration {input.reg} --ingest {params.ingest} --sheet {input.sheet}"
+        " --subjects {params.subjects} --trial {wildcards.trial} --method {wildcards.method}"
+        " --config {input.config} --out {params.out} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+rule rollator_tables:
+    input:
+        evals=lambda w: [
+            f"{RESULTS}/{study}/rollator/{method}/{trial}/summary.parquet"
+            for study in config["run"]
+            for method in rollator_methods()
+            for trial in trial_ids(study, ["rollator"])
+        ],
+        models=lambda w: [
+            f"{RESULTS}/{study}/rollator/model/{subject}.json"
+            for study in config["run"]
+            for subject in rollator_subjects(study)
+        ],
+        config=lambda w: f"{RESULTS}/{config['run'][0]}/config.json",
+    output:
+        t1=report(
+            f"{REPORTS}/tables/rollator_table1.csv",
+            caption="../report/rollator.rst",
+            category="Rollator",
+        ),
+        t2=f"{REPORTS}/tables/rollator_table2.csv",
+        imp=f"{REPORTS}/tables/rollator_improvement.csv",
+        fig=report(
+            f"{REPORTS}/figures/rollator_turning_trial.png",
+            caption="../report/rollator.rst",
+            category="Rollator",
+        ),
+    params:
+        gv=GV,
+        dirs=lambda w, input: " ".join(str(Path(p).parent) for p in input.evals),
+        kf=lambda w: rollator_cfg()["kf_method"],
+        pf=lambda w: rollator_cfg()["pf_method"],
+        tables=parent_of("t1"),
+        figures=parent_of("fig"),
+        reports=parent_of("t1", up=1),
+        chash=CONFIG_HASH,
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/rollator_tables.log",
+    shell:
+        "{params.gv} rollator-tables {params.dirs} --kf {params.kf} --pf {params.pf}"
+        " --models {input.models} --config {input.config}"
+        " --tables-dir {params.tables} --figures-dir {params.figures}"
+        " --reports-dir {params.reports} --config-hash {params.chash}"
+        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+
+
+REPORT_ITEM_FUNCS.append(
+    lambda study: (
+        [f"{REPORTS}/tables/rollator_table1.csv"] if trial_ids(study, ["rollator"]) else []
+    )
+)
