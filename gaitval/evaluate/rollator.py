@@ -157,7 +157,7 @@ def evaluate_rollator_trial(track: pd.DataFrame, truth: pd.DataFrame, known: np.
         cols[f"err_m_{s}"] = np.where(ev, err[s], np.nan)
     frames = pd.DataFrame(cols)
     return {"frames": frames[list(FRAME_COLUMNS)],
-            "summary": _summary(frames, trial, tracker, far)}
+            "summary": _summary(frames, trial, tracker, far & ~swapped)}
 
 
 def _restarts(track: pd.DataFrame, n: int) -> np.ndarray:

@@ -8,10 +8,12 @@ of consecutive frames, we re-initialize the algorithm."
 :class:`ReinitialiseAfterLost` (occlusion role ``reinit_after_lost``)
     A leg without an associated observation keeps its prediction (the loop's predict-only
     behaviour).  Once either leg has gone ``n_lost`` consecutive scans without one, the
-    handler looks at the scan again with the detector's predefined window (no prediction,
-    as at the first scan) and, if a pair of legs is there, restarts both legs on it at rest
+    algorithm is due for re-initialisation: from that scan on, the handler looks at each
+    scan again with the detector's predefined window (no prediction, as at the first scan)
+    and, at the first one with a pair of legs, restarts both legs on it at rest
     (:meth:`~gaitval.track.tracker.TrackingRun.restart`; every restart is counted in
-    ``TrackResult.restarts``).  Without a pair it tries again at the next scan.
+    ``TrackResult.restarts``), even if the loop has meanwhile gated an observation to the
+    lost leg again.
     ``n_lost`` is not given in the paper; gaitval's default is 15 scans (0.4 s at the
     UBG-04LX-F01's 37 scans/s), about one swing of an older adult's stride (≈ 1.1 s, swing
     ≈ 36 %): a leg hidden for longer than a swing has landed where a constant-velocity
@@ -102,14 +104,20 @@ class ReinitialiseAfterLost(OcclusionHandler):
             raise ConfigError(f"reinit_after_lost: initialiser {self.init!r} cannot label "
                               "the legs of one scan", hint="use init: facing_pair")
 
+    def begin(self, run):
+        return {"pending": False}
+
     def after_scan(self, state, run, k):
         L, R = run.legs
-        if max(L.n_unobserved, R.n_unobserved) < self.n_lost:
+        if max(L.n_unobserved, R.n_unobserved) >= self.n_lost:
+            state["pending"] = True                 # detection lost for n_lost scans
+        if not state["pending"]:
             return
-        obs = run.source.array(k)                  # the predefined window, as at k = 1
+        obs = run.source.array(k)                   # the predefined window, as at k = 1
         found = self.init.pair(obs, run.leg_width_m)
         if found is None:
             return                                  # keep predicting; try the next scan
         il, ir = found
         pats = ["SL"] * len(obs)
         run.restart(k, obs.tolist(), pats, il, ir)  # counted in TrackResult.restarts
+        state["pending"] = False
