@@ -225,10 +225,8 @@ def test_code_defaults_validate_and_match_the_schema(cfg):
 
 
 def test_ultrasonic_defaults_validate_and_match_the_schema(cfg):
-    mod = pytest.importorskip("gaitval.ultrasonic")
-    us = getattr(mod, "DEFAULT_CFG", None)
-    if us is None:
-        pytest.skip("gaitval.ultrasonic.DEFAULT_CFG has moved")
+    from gaitval.evaluate.ultrasonic_config import DEFAULT_CFG as us
+
     schema = load_schema()
     want = schema_defaults(schema, schema)["ultrasonic"]
     assert {k: want[k] for k in us} == us
