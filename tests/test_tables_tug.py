@@ -97,7 +97,8 @@ def test_write_tug_tables(tmp_path, data):
     f, s = data
     paths = write_tug_tables(f, s, tmp_path)
     names = sorted(p.name for p in paths)
-    assert names == sorted(f"tug_table{i}.{e}" for i in range(2, 6) for e in ("csv", "md", "tex"))
+    assert names == sorted([f"tug_table{i}.{e}" for i in range(2, 6) for e in ("csv", "md", "tex")]
+                           + [f"tug_failures.{e}" for e in ("csv", "md", "tex")])
     md = (tmp_path / "tug_table3.md").read_text()
     assert "ordering" in md
     again = write_tug_tables(f, s, tmp_path / "again")
@@ -157,7 +158,7 @@ def test_tiny_study_tug_end_to_end(tiny_study, tmp_path):
     frames, summaries = pd.concat(fr), pd.concat(su)
     events = pd.concat(ev)
     paths = write_tug_tables(frames, summaries, tmp_path / "tables")
-    assert len(paths) == 12
+    assert len(paths) == 15                  # Tables 2-5 and tug_failures
     t3 = pd.read_csv(tmp_path / "tables" / "tug_table3.csv")
     assert t3["n_trials"].tolist() == [len(tug)] * 3
     figs = write_tug_figures(frames, summaries, events, tmp_path / "figures")

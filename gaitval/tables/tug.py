@@ -21,6 +21,7 @@ import pandas as pd
 
 from gaitval.methods import METHOD_DEFINITIONS, METHODS, get_method
 from gaitval.tables.render import write_table
+from gaitval.tables.tug_evidence import DEFAULT_READING, failure_evidence, method_reading
 
 CITATION = ("Yorozu, A.; Moriguchi, T.; Takahashi, M. Improved Leg Tracking Considering Gait "
             "Phase and Spline-Based Interpolation during Turning Motion in Walk Tests. "
@@ -84,8 +85,10 @@ def _methods(summaries: pd.DataFrame) -> list[str]:
     return order + sorted(m for m in names if m not in order)
 
 
-def _label(m: str) -> str:
-    return METHODS[m]["label"] if m in METHODS else m
+def _label(m: str, definitions: Mapping | None = None) -> str:
+    base, reading = method_reading(m, definitions)
+    label = METHODS[base]["label"] if base in METHODS else base
+    return label if reading == DEFAULT_READING else f"{label}, eq. (3)-(4) {reading}"
 
 
 def _rmse(e: pd.Series) -> float:
@@ -144,6 +147,8 @@ def tug_table2(methods=("tug_m1", "tug_m2", "tug_m3"), dt_measured_s: float | No
             ("gate (P_G = 0.999)", "G", "", gate.get("g"), PUBLISHED_T2["gate_g"]),
             ("steps for the acceleration function", "N_ac", "steps", motion.get("n_ac"),
              PUBLISHED_T2["n_ac"]),
+            ("gait-phase reading of eq. (3)–(4)", "", "",
+             phase.get("reading", DEFAULT_READING) if phase else None, None),
             ("Catmull–Rom points before occlusion", "N_bo", "steps",
              occ.get("n_bo") if cr else None, None),
             ("Catmull–Rom points after occlusion", "N_ao", "steps",
@@ -158,30 +163,35 @@ def tug_table2(methods=("tug_m1", "tug_m2", "tug_m3"), dt_measured_s: float | No
     return pd.DataFrame(rows)
 
 
-def tug_table3(summaries) -> pd.DataFrame:
+def tug_table3(summaries, definitions: Mapping | None = None) -> pd.DataFrame:
     """Table 3: method definitions, false tracking, stance failures, success rate.
 
     Each failed trial is counted once, in the category of its first failure (see
-    :mod:`gaitval.evaluate.tug`).
+    :mod:`gaitval.evaluate.tug`).  A method run under the other reading of seed000
+    eq. (3)–(4) (``<method>_stance_first``, config ``tug.phase_readings``) has its own row,
+    with the published values of its base method beside it.
 
     Returns
     -------
     DataFrame
-        One row per method: ``method, label, gait_phase_association,
-        catmull_rom_interpolation, n_trials, ft_turning, ft_return, ft_forward,
-        sf_turning, sf_other, n_success, success_rate`` and the ``*_published`` columns.
+        One row per method: ``method, base_method, phase_reading, label,
+        gait_phase_association, catmull_rom_interpolation, n_trials, ft_turning,
+        ft_return, ft_forward, sf_turning, sf_other, n_success, success_rate`` and the
+        ``*_published`` columns.
     """
     s = _concat(summaries)
     rows = []
     for m in _methods(s):
         d = s[s["method"].astype(str) == m]
         cat = d["category"].astype(str)
-        pub = PUBLISHED_T3.get(m, {})
-        defs = METHOD_DEFINITIONS.get(m, {})
+        base, reading = method_reading(m, definitions)
+        pub = PUBLISHED_T3.get(base, {})
+        defs = METHOD_DEFINITIONS.get(base, {})
         n = len(d)
         ns = int((cat == "success").sum())
         rows.append({
-            "method": m, "label": _label(m),
+            "method": m, "base_method": base, "phase_reading": reading,
+            "label": _label(m, definitions),
             "gait_phase_association": defs.get("gait_phase_association"),
             "catmull_rom_interpolation": defs.get("catmull_rom_interpolation"),
             "n_trials": n,
@@ -209,15 +219,18 @@ def _success_frames(frames: pd.DataFrame, summaries: pd.DataFrame) -> pd.DataFra
     return f[f["valid"].astype(bool)]
 
 
-def tug_table4(frames, summaries) -> pd.DataFrame:
+def tug_table4(frames, summaries, definitions: Mapping | None = None) -> pd.DataFrame:
     """Table 4: occlusion rate and RMSE per TUG phase over tracking-success trials.
+
+    Methods run under the other reading of eq. (3)–(4) have their own rows, as in
+    :func:`tug_table3`.
 
     Returns
     -------
     DataFrame
         One row per method and TUG phase (forward, turning, return, total):
-        ``method, label, tug_phase, n_success_trials, n_uo, n_steps, occlusion_rate,
-        rmse_x_m, rmse_y_m`` and the ``*_published`` columns.
+        ``method, base_method, phase_reading, label, tug_phase, n_success_trials, n_uo,
+        n_steps, occlusion_rate, rmse_x_m, rmse_y_m`` and the ``*_published`` columns.
     """
     f, s = _concat(frames), _concat(summaries)
     good = _success_frames(f, s)
@@ -225,14 +238,16 @@ def tug_table4(frames, summaries) -> pd.DataFrame:
     for m in _methods(s):
         d = good[good["method"].astype(str) == m]
         n_ok = int(s[(s["method"].astype(str) == m) & s["success"].astype(bool)].shape[0])
+        base, reading = method_reading(m, definitions)
         for ph in PHASES + ("total",):
             e = d if ph == "total" else d[d["tug_phase"].astype(str) == ph]
             n = len(e)
             uo = int((e["pattern"].astype(str) == "UO").sum())
-            pub = PUBLISHED_T4.get(m, {}).get(ph)
+            pub = PUBLISHED_T4.get(base, {}).get(ph)
             rows.append({
-                "method": m, "label": _label(m), "tug_phase": ph, "n_success_trials": n_ok,
-                "n_success_trials_published": PUBLISHED_T4_SUCCESS.get(m, np.nan),
+                "method": m, "base_method": base, "phase_reading": reading,
+                "label": _label(m, definitions), "tug_phase": ph, "n_success_trials": n_ok,
+                "n_success_trials_published": PUBLISHED_T4_SUCCESS.get(base, np.nan),
                 "n_uo": uo, "n_steps": n, "occlusion_rate": uo / n if n else np.nan,
                 "n_uo_published": pub[0] if pub else np.nan,
                 "n_steps_published": pub[1] if pub else np.nan,
@@ -244,7 +259,7 @@ def tug_table4(frames, summaries) -> pd.DataFrame:
                                              "n_steps_published"])
 
 
-def tug_table5(frames, summaries) -> pd.DataFrame:
+def tug_table5(frames, summaries, definitions: Mapping | None = None) -> pd.DataFrame:
     """Table 5: time steps and RMSE per leg observation state (tracking-success trials).
 
     Returns
@@ -259,10 +274,11 @@ def tug_table5(frames, summaries) -> pd.DataFrame:
     for m in _methods(s):
         d = good[good["method"].astype(str) == m]
         uo = d["pattern"].astype(str) == "UO"
+        base = method_reading(m, definitions)[0]
         for state, e in (("observable", d[~uo]), ("unobservable", d[uo])):
-            pub = PUBLISHED_T5.get(m, {}).get(state)
+            pub = PUBLISHED_T5.get(base, {}).get(state)
             rows.append({
-                "method": m, "label": _label(m), "observation_state": state,
+                "method": m, "label": _label(m, definitions), "observation_state": state,
                 "time_steps": len(e), "time_steps_published": pub[0] if pub else np.nan,
                 "rmse_x_m": _rmse(e["err_x_m"]), "rmse_x_m_published": pub[1] if pub else np.nan,
                 "rmse_y_m": _rmse(e["err_y_m"]), "rmse_y_m_published": pub[2] if pub else np.nan,
@@ -271,18 +287,25 @@ def tug_table5(frames, summaries) -> pd.DataFrame:
 
 
 def _ordering_notes(t3: pd.DataFrame, t4: pd.DataFrame, t5: pd.DataFrame) -> list[str]:
+    """Success-rate ordering per reading of eq. (3)–(4) against the paper's, and whether
+    Method 3 beats Method 2 in the turning phase and when unobservable (paper: it does)."""
     notes = []
-    ms = [m for m in ("tug_m1", "tug_m2", "tug_m3") if m in set(t3["method"])]
-    if len(ms) >= 2:
-        rate = t3.set_index("method")["success_rate"]
+    paper_order = ("tug_m3", "tug_m2", "tug_m1")
+    for reading, g in t3.groupby("phase_reading", sort=False):
+        g = g[g["base_method"].isin(paper_order)].set_index("base_method")
+        ms = [m for m in ("tug_m1", "tug_m2", "tug_m3") if m in g.index]
+        if len(ms) < 2:
+            continue
+        rate = g["success_rate"]
         got = sorted(ms, key=lambda m: (-rate[m], ms.index(m)))
-        paper = [m for m in ("tug_m3", "tug_m2", "tug_m1") if m in ms]
-        if got != paper:
-            notes.append("Reproduced success-rate ordering (" + " ≥ ".join(got)
-                         + ") differs from the paper's (" + " > ".join(paper) + ").")
-        else:
-            notes.append("Reproduced success-rate ordering matches the paper ("
-                         + " > ".join(paper) + ").")
+        paper = [m for m in paper_order if m in ms]
+        counts = ", ".join(f"{m} {int(g.loc[m, 'n_success'])}/{int(g.loc[m, 'n_trials'])}"
+                           f" (paper {g.loc[m, 'n_success_published']}/"
+                           f"{g.loc[m, 'n_trials_published']})" for m in ms)
+        verdict = ("matches the paper's" if got == paper else
+                   "differs from the paper's (" + " > ".join(paper) + ")")
+        notes.append(f"Reading {reading} of eq. (3)-(4): success {counts}; ordering "
+                     + " ≥ ".join(got) + f" {verdict}.")
     for t, key, label in ((t4, ("tug_phase", "turning"), "turning-phase RMSE"),
                           (t5, ("observation_state", "unobservable"), "unobservable RMSE")):
         d = t[t[key[0]] == key[1]].set_index("method")
@@ -295,10 +318,26 @@ def _ordering_notes(t3: pd.DataFrame, t4: pd.DataFrame, t5: pd.DataFrame) -> lis
     return notes
 
 
+def _evidence_notes(ev: pd.DataFrame, t3: pd.DataFrame, per_method: int = 3) -> list[str]:
+    """Where each method failed (category counts) and the first failures' evidence."""
+    notes = []
+    for m in t3["method"]:
+        e = ev[ev["method"] == m]
+        if not len(e):
+            continue
+        cats = e["category"].value_counts()
+        notes.append(f"{m} failed {len(e)} trial(s): "
+                     + ", ".join(f"{c} {n}" for c, n in cats.items())
+                     + ". First failures (tug_failures lists every one): "
+                     + " | ".join(e["evidence"].head(per_method)) + ".")
+    return notes
+
+
 def write_tug_tables(frames, summaries, out_dir: str | Path, *,
                      methods=("tug_m1", "tug_m2", "tug_m3"),
-                     dt_measured_s: float | None = None) -> list[Path]:
-    """Write ``tug_table2..5.{csv,md,tex}`` into ``out_dir`` (via ``write_table``).
+                     dt_measured_s: float | None = None,
+                     evaluation: dict | None = None) -> list[Path]:
+    """Write ``tug_table2..5`` and ``tug_failures`` (``.csv, .md, .tex``) into ``out_dir``.
 
     Parameters
     ----------
@@ -308,29 +347,44 @@ def write_tug_tables(frames, summaries, out_dir: str | Path, *,
         Usually ``reports/tables``.
     methods : sequence of str, or mapping of str to dict
         The methods of Table 2: names, or name -> the definition actually run (see
-        :func:`tug_table2`).
+        :func:`tug_table2`); the definitions also tell which reading of eq. (3)–(4) each
+        method ran.
+    evaluation : dict, optional
+        The evaluation rules the trials were evaluated with (``evaluation.tug``), for the
+        stance-failure evidence.
     """
     out = Path(out_dir)
     f, s = _concat(frames), _concat(summaries)
+    defs = methods if isinstance(methods, Mapping) else None
     t2 = tug_table2(methods, dt_measured_s)
-    t3, t4, t5 = tug_table3(s), tug_table4(f, s), tug_table5(f, s)
+    t3, t4, t5 = tug_table3(s, defs), tug_table4(f, s, defs), tug_table5(f, s, defs)
+    ev = failure_evidence(f, s, defs, evaluation)
     common = [f"Source: {CITATION}.",
               "Reproduced values from gaitval's evaluation of each trial; *_published "
               "columns transcribed from the paper."]
+    readings = ("Rows with phase_reading stance_first ran the same method with seed000 "
+                "eq. (3) tested before eq. (4) (the slower leg is in stance first; "
+                "gaitval.gait.phases); the paper's text allows both readings, its "
+                "published values are shown beside both.")
     notes = _ordering_notes(t3, t4, t5)
     paths = []
     paths += write_table(t2, out / "tug_table2", caption="TUG leg tracking: parameters used "
-                         "(seed 000 Table 2). N_bo, N_ao and the background model are not "
-                         "given in the paper.", notes=common)
+                         "(seed 000 Table 2). N_bo, N_ao, the background model and the reading "
+                         "of eq. (3)–(4) are not given in the paper.", notes=common)
     paths += write_table(t3, out / "tug_table3", caption="TUG leg tracking: method "
                          "definitions and tracking results per method (seed 000 Table 3). "
                          "Each failed trial counted once, in the TUG phase of its first "
                          "failure; ft_forward and sf_other have no published counterpart.",
-                         notes=common + notes)
+                         notes=common + [readings] + notes + _evidence_notes(ev, t3))
     paths += write_table(t4, out / "tug_table4", caption="TUG leg tracking: occlusion rate "
                          "and RMSE of the leg trajectory per TUG phase over tracking-success "
-                         "trials (seed 000 Table 4; sensor frame x/y).", notes=common + notes)
+                         "trials (seed 000 Table 4; sensor frame x/y).",
+                         notes=common + [readings] + notes)
     paths += write_table(t5, out / "tug_table5", caption="TUG leg tracking: time steps and "
                          "RMSE per leg observation state over tracking-success trials "
                          "(seed 000 Table 5).", notes=common + notes)
+    paths += write_table(ev, out / "tug_failures", caption="TUG leg tracking: the first "
+                         "failure of every trial a method did not track, with what the "
+                         "tracker saw in the 0.5 s before (leg patterns, unobservable scans, "
+                         "gait phases of eq. (3)–(5)); evidence for Table 3.", notes=common)
     return paths
