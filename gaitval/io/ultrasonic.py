@@ -142,7 +142,7 @@ def write_ultrasonic(path: str | Path, log: UltrasonicLog, *, transmitter: str =
 
 
 def read_ultrasonic(path: str | Path, *, trial: str | None = None) -> UltrasonicLog:
-    """Read a gaitval ultrasonic log (seconds, metres, degC; NaN = no echo)."""
+    """Read an ultrasonic log in gaitval's format (seconds, metres, degC; NaN = no echo)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 

@@ -244,7 +244,7 @@ class _Model:
         self.scale = N_STATE + lam
         V = np.asarray(V, dtype=float)
         self.Vm = np.diag(V) if V.ndim == 1 else V
-        I6 = np.eye(N_STATE)
+        self.I6 = I6 = np.eye(N_STATE)
         self.S = np.vstack([np.zeros((1, N_STATE)), I6, -I6])   # chi_i - X = S B^T, eq. (7)
         # eq. (5): A = I + dt E,  G W G^T = dt^4/4 Q4 + dt^3/2 Q3 + dt^2 Q2,  W = diag(q)
         q = np.asarray(W_sigma, dtype=float) ** 2
@@ -260,7 +260,7 @@ class _Model:
 
     def transition(self, dt: float):
         """``A``, ``A^T`` and ``G W G^T`` of eq. (5) for one time step."""
-        A = np.eye(N_STATE) + dt * self.E
+        A = self.I6 + dt * self.E
         Q = (0.25 * dt ** 4) * self.Q4 + (0.5 * dt ** 3) * self.Q3 + (dt * dt) * self.Q2
         return A, A.T, Q
 
@@ -282,7 +282,7 @@ def _sigma_statistics(mdl: _Model, x: np.ndarray, P: np.ndarray):
     """
     B, info = _potrf(mdl.scale * P, lower=1)                      # eq. (7)
     if info != 0:
-        P = 0.5 * (P + P.T) + 1e-12 * np.eye(N_STATE)
+        P = 0.5 * (P + P.T) + 1e-12 * mdl.I6
         B, info = _potrf(mdl.scale * P, lower=1)
     dX = mdl.S @ B.T
     diff = (x[:3] + dX[:, :3])[:, None, :] - mdl.anchors
