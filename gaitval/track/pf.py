@@ -49,7 +49,7 @@ from gaitval.track.init import INITIALISERS
 from gaitval.track.kinds import TRACKER_KINDS, RawScanTracker
 from gaitval.track.leg import TrackResult, empty_result
 from gaitval.track.observations import WindowedDetections
-from gaitval.track.pf_likelihood import (PFArrays, effective_size, likelihood,
+from gaitval.track.pf_likelihood import (PFArrays, effective_size, likelihood, near_points,
                                          sample_velocities, systematic_resample)
 from gaitval.track.pf_model import default_pf_model
 from gaitval.track.phase import PHASE_MODELS
@@ -68,13 +68,6 @@ class _Scan:
         with np.errstate(invalid="ignore"):
             self.X = scans.ranges * np.cos(a)
             self.Y = scans.ranges * np.sin(a)
-
-    def near(self, k: int, lo: np.ndarray, hi: np.ndarray):
-        """Points of scan k inside the box lo..hi (x, y)."""
-        x, y = self.X[k], self.Y[k]
-        with np.errstate(invalid="ignore"):
-            keep = (x >= lo[0]) & (x <= hi[0]) & (y >= lo[1]) & (y <= hi[1])
-        return x[keep], y[keep]
 
 
 @TRACKER_KINDS.register("rollator_pf")
@@ -154,13 +147,8 @@ class ParticleFilterTracker(RawScanTracker):
         N = self.n_particles
         v = sample_velocities(P, rng, N)                              # §III.B
         pos = prev[:, None, :2] + v * dt                              # p = p̂_{k−1} + v Δt
-        lo = pos.reshape(-1, 2).min(axis=0) - (P.hx, P.hy)
-        hi = pos.reshape(-1, 2).max(axis=0) + (P.hx, P.hy)
-        X, Y = pts.near(k, lo, hi)
-        other = np.repeat(prev[::-1, :2], N, axis=0)                  # β: other leg at k−1
-        lik, cnt = likelihood(P, pos[..., 0].ravel(), pos[..., 1].ravel(), X, Y,
-                              other[:, 0], other[:, 1])               # §III.C
-        lik, cnt = lik.reshape(2, N), cnt.reshape(2, N)
+        X, Y = pts.X[k], pts.Y[k]
+        lik, cnt = self._weigh(P, pos, prev, X, Y, (0, 1))            # §III.C
         w = _normalise(lik)
         need = np.flatnonzero(effective_size(w) < self.resample_fraction * N)   # §III.D
         if need.size:
@@ -173,6 +161,18 @@ class ParticleFilterTracker(RawScanTracker):
                               np.einsum("ln,lnj->lj", ws, v)], axis=1)
         return out, cnt.max(axis=1) > 0
 
+    @staticmethod
+    def _weigh(P, pos, prev, X, Y, legs):
+        """Likelihoods and contour counts of the particles of ``legs`` (rows of ``pos``);
+        β against the other leg's estimate at k−1."""
+        lik = np.zeros(pos.shape[:2])
+        cnt = np.zeros(pos.shape[:2], dtype=np.intp)
+        for i, f in enumerate(legs):
+            px, py = pos[i, :, 0], pos[i, :, 1]
+            Xn, Yn = near_points(P, X, Y, px, py)
+            lik[i], cnt[i] = likelihood(P, px, py, Xn, Yn, prev[1 - f, 0], prev[1 - f, 1])
+        return lik, cnt
+
     def _resample_move(self, P, rng, prev, dt, v, lik, w, need, X, Y):
         """§III.D for the legs in ``need``: systematic resampling, random walk on the
         velocity, Metropolis–Hastings accept/reject with min(1, ω*/ω)."""
@@ -183,13 +183,9 @@ class ParticleFilterTracker(RawScanTracker):
         lik[need] = np.take_along_axis(lik[need], idx, axis=1)
         v_new = v[need] + rng.standard_normal((need.size, N, 2)) * P.walk_sd
         pos_new = prev[need, None, :2] + v_new * dt
-        other = np.repeat(prev[::-1][need, :2], N, axis=0)
-        lik_new, _ = likelihood(P, pos_new[..., 0].ravel(), pos_new[..., 1].ravel(), X, Y,
-                                other[:, 0], other[:, 1])
-        lik_new = lik_new.reshape(need.size, N)
+        lik_new, _ = self._weigh(P, pos_new, prev, X, Y, need)
         u = rng.random((need.size, N))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            accept = (lik[need] <= 0.0) | (u * lik[need] < lik_new)   # u < ω*/ω (MH)
+        accept = (lik[need] <= 0.0) | (u * lik[need] < lik_new)       # u < ω*/ω (MH)
         v[need] = np.where(accept[..., None], v_new, v[need])
         lik[need] = np.where(accept, lik_new, lik[need])
         w[need] = _normalise(lik[need])

@@ -2,8 +2,8 @@
 
 :class:`PFArrays` turns a model (:mod:`gaitval.track.pf_model`) into the arrays the
 per-scan steps use; :func:`sample_velocities` draws from the Gaussian mixtures (§III.A–B);
-:func:`likelihood` weighs every particle of both legs against one scan in one pass
-(§III.C); :func:`effective_size` and :func:`systematic_resample` serve §III.D.
+:func:`likelihood` weighs one leg's particles against the scan's points near them
+(§III.C, vectorised over particles × points); :func:`effective_size` and :func:`systematic_resample` serve §III.D.
 
 Notes
 -----
@@ -35,8 +35,9 @@ class PFArrays:
     ----------
     w : (2, 2) mixture weights per leg; mean : (2, 2, 2); chol : (2, 2, 2, 2) Cholesky
     factors of the covariances; hx, hy : window half-sizes; mu, inv_sd, norm, pi : (4,)
-    per region; count_pdf : (T,); gamma_a, gamma_scale, gamma_lognorm : β's constants;
-    walk_sd : (2,) m/s.
+    per region R1..R4; abc, pi_code : the same per pair code (see :func:`likelihood`);
+    count_pdf : (T,); gamma_a, gamma_scale, gamma_lognorm : β's constants; walk_sd : (2,)
+    m/s.
     """
 
     def __init__(self, model: dict):
@@ -53,6 +54,13 @@ class PFArrays:
         self.inv_sd = 1.0 / sd
         self.norm = 1.0 / (sd * math.sqrt(2.0 * math.pi))
         self.pi = np.asarray(reg["pi"], dtype=float)
+        # per pair code 0..3 = R1, R2, R4, R3 (see likelihood): exponent coefficients
+        # A d² + B d + C of π-free N(d | μ, σ), and π in the same order
+        order = [0, 1, 3, 2]
+        mu, isd = self.mu[order], self.inv_sd[order]
+        self.abc = np.column_stack([-0.5 * isd ** 2, mu * isd ** 2,
+                                    -0.5 * (mu * isd) ** 2 + np.log(self.norm[order])])
+        self.pi_code = self.pi[order]
         self.count_pdf = np.asarray(model["count_pdf"], dtype=float)
         ga = model["gamma"]
         self.gamma_a, self.gamma_scale = float(ga["a"]), float(ga["scale"])
@@ -84,36 +92,54 @@ def gamma_pdf(P: PFArrays, d: np.ndarray) -> np.ndarray:
     return np.where(d > 0, np.exp(lp), 0.0)
 
 
+def near_points(P: PFArrays, X: np.ndarray, Y: np.ndarray, px: np.ndarray, py: np.ndarray):
+    """The points (of X, Y) that can be in the lower half-window of some particle:
+    x in [min px − h_x, max px), y in [min py − h_y, max py + h_y]."""
+    with np.errstate(invalid="ignore"):
+        keep = ((X >= px.min() - P.hx) & (X < px.max()) & (Y >= py.min() - P.hy)
+                & (Y <= py.max() + P.hy))
+    return X[keep], Y[keep]
+
+
 def likelihood(P: PFArrays, px: np.ndarray, py: np.ndarray, X: np.ndarray, Y: np.ndarray,
-               ox: np.ndarray, oy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Observation likelihood of K particles against one scan's points (module notes).
+               ox: float, oy: float) -> tuple[np.ndarray, np.ndarray]:
+    """Observation likelihood of one leg's K particles against a scan's points.
 
     Parameters
     ----------
     P : PFArrays
-    px, py : (K,) particle positions (both legs stacked), sensor frame.
-    X, Y : (M,) the scan's points near the particles.
-    ox, oy : (K,) the other leg's estimate for each particle (for β).
+    px, py : (K,) particle positions, sensor frame.
+    X, Y : (M,) the scan's points (those of :func:`near_points` suffice).
+    ox, oy : float or (K,) the other leg's estimate (for β).
 
     Returns
     -------
-    weights : (K,) unnormalised p(y|x) (seed002 §III.C)
+    weights : (K,) unnormalised p(y|x) (seed002 §III.C, module notes)
     counts : (K,) contour points (points in R1..R4 of the particle's window)
+
+    Notes
+    -----
+    Per pair, with u = x_particle − x_point (> 0: the point is in the lower half) and
+    v = y_particle − y_point: in the window when 0 < u ≤ h_x and |v| ≤ h_y; inner when
+    |v| < u; code = inner + 2·[v ≥ 0] (0: R1, 1: R2, 2: R4, 3: R3).  The normal density is
+    evaluated as exp(A d² + B d + C) with A = −1/(2σ²), B = μ/σ², C = −μ²/(2σ²) + ln(1/(σ√2π)),
+    which is N(d | μ, σ) term for term, with one table look-up per pair.
     """
-    K = len(px)
-    dx = X[None, :] - px[:, None]
-    dy = Y[None, :] - py[:, None]
-    inwin = (dx < 0.0) & (dx >= -P.hx) & (np.abs(dy) <= P.hy)        # window ∩ lower half
-    row, col = np.nonzero(inwin)
-    dxm, dym = dx[row, col], dy[row, col]
-    inner = (np.abs(dym) < -dxm).astype(np.intp)
-    r = np.where(dym > 0.0, inner, 3 - inner)                          # R1..R4 → 0..3
-    z = (np.sqrt(dxm * dxm + dym * dym) - P.mu[r]) * P.inv_sd[r]
-    dens = np.exp(-0.5 * z * z) * P.norm[r]                           # N(d | μ_Rm, Σ_Rm)
-    key = row * 4 + r
+    K, M = len(px), len(X)
+    u = np.subtract.outer(px, X)
+    v = np.subtract.outer(py, Y)
+    av = np.abs(v)
+    idx = np.flatnonzero((u > 0.0) & (u <= P.hx) & (av <= P.hy))    # window ∩ lower half
+    uu, vv = u.ravel()[idx], v.ravel()[idx]
+    code = (av.ravel()[idx] < uu).astype(np.intp)
+    code += 2 * (vv >= 0.0)
+    d2 = uu * uu + vv * vv
+    co = P.abc[code]                                                   # (n, 3): A, B, C
+    dens = np.exp(co[:, 0] * d2 + co[:, 1] * np.sqrt(d2) + co[:, 2])  # N(d | μ_Rm, Σ_Rm)
+    key = (idx // M) * 4 + code if M else idx
     sums = np.bincount(key, weights=dens, minlength=4 * K).reshape(K, 4)
     cnts = np.bincount(key, minlength=4 * K).reshape(K, 4)
-    region_term = (sums / np.maximum(cnts, 1)) @ P.pi                 # Σ_m π_Rm · N(...)
+    region_term = (sums / np.maximum(cnts, 1)) @ P.pi_code            # Σ_m π_Rm · N(...)
     n = cnts.sum(axis=1)
     lam = P.count_pdf[np.minimum(n, len(P.count_pdf) - 1)]            # λ_i
     beta = gamma_pdf(P, np.hypot(px - ox, py - oy))                    # β_i
