@@ -4,7 +4,10 @@ This module and its three parts are the only code in gaitval that knows the C3D 
 they use ezc3d [1]_.  Everything read is in metres and seconds
 (:class:`~gaitval.types.MocapTrial`).  The reader is :mod:`gaitval.io.c3d_read`, the
 writer :mod:`gaitval.io.c3d_write`, the format's constants and the checks made before
-ezc3d opens a file :mod:`gaitval.io.c3d_format`; their public names are re-exported here,
+ezc3d opens a file :mod:`gaitval.io.c3d_format` (header, data size) and
+:mod:`gaitval.io.c3d_params` (parameter section); ezc3d itself runs in a child process
+(:mod:`gaitval.io.isolate`), so a file that crashes it is an error, not a crash of
+gaitval.  Their public names are re-exported here,
 so ``from gaitval.io.c3d import read_c3d, write_c3d`` is the way to use them.
 
 Conventions (also in ``docs/formats.md``)

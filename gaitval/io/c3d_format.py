@@ -13,104 +13,153 @@ References
 """
 from __future__ import annotations
 
+import math
+import struct
 from pathlib import Path
 from typing import Any
 
 from gaitval.errors import FileFormatError
+from gaitval.io.c3d_params import ParameterProblem, Parameters, float_at, parse_parameters
 
 #: metres per file unit
 UNIT_SCALE = {"mm": 1e-3, "cm": 1e-2, "m": 1.0}
 EVENT_COLUMNS = ["context", "label", "t_s"]
 _PROCESSORS = {84: "Intel", 85: "DEC", 86: "MIPS (SGI)"}
+#: numeric parameters that must be finite and >= 0 (True) or > 0 (False) wherever present
+_FINITE = ((("POINT", "RATE"), False), (("POINT", "FRAMES"), True),
+           (("ANALOG", "RATE"), True), (("TRIAL", "CAMERA_RATE"), True),
+           (("EVENT", "USED"), True), (("POINT", "USED"), True), (("ANALOG", "USED"), True))
 
 
 def _precheck(path: Path, trial: str | None) -> dict[str, Any]:
-    """Check the file exists and looks like a C3D file before ezc3d sees it.
+    """Check the header, the parameter section and the data's size before ezc3d sees them.
 
-    Returns the processor type and the header's first/last frame words (Intel files).  Raises FileFormatError for a missing file, a file that is
-    not C3D, or a processor type ezc3d cannot read (MIPS/SGI big-endian files).
+    Returns the processor type, the header's first/last frame words and the frame count
+    the file announces.  Raises FileFormatError for a missing file, a file that is not
+    C3D, a processor type ezc3d cannot read (MIPS/SGI), a corrupt parameter section
+    (:func:`gaitval.io.c3d_params.parse_parameters`), values that are not finite or
+    contradict each other (header vs parameters), and a data section shorter than the
+    frames it announces — for every processor type.
     """
     if not path.is_file():
         raise FileFormatError("C3D file not found", path=path, trial=trial)
+    size = path.stat().st_size
     with open(path, "rb") as fh:
         head = fh.read(512)
         if len(head) < 512 or head[1] != 0x50:
             raise FileFormatError("not a C3D file (the header's second byte is not 0x50)",
                                   path=path, trial=trial)
-        param_block = head[0]
-        fh.seek(max(param_block - 1, 0) * 512)
+        ps = (max(head[0], 1) - 1) * 512                    # parameter section offset
+        fh.seek(ps)
         phead = fh.read(4)
-    if len(phead) < 4:
-        raise FileFormatError(f"C3D file is truncated: the parameter section (block "
-                              f"{param_block}) lies beyond the end of the file",
-                              path=path, trial=trial)
-    proc = _PROCESSORS.get(phead[3])
+        if len(phead) < 4:
+            raise FileFormatError(f"C3D file is truncated: the parameter section (block "
+                                  f"{head[0]}) lies beyond the end of the file ({size} "
+                                  "bytes)", path=path, trial=trial)
+        proc = _processor(phead[3], path, trial)
+        hdr = _header(head)
+        ds = (hdr["data_start"] - 1) * 512                  # data section offset
+        if ds >= size:
+            raise FileFormatError(f"C3D file is truncated: the data section (block "
+                                  f"{hdr['data_start']}) lies beyond the end of the file "
+                                  f"({size} bytes)", path=path, trial=trial)
+        if head[0] < 2 or ds <= ps:
+            raise FileFormatError(f"the C3D header is corrupt: parameters at block {head[0]}"
+                                  f", data at block {hdr['data_start']}", path=path,
+                                  trial=trial, hint="re-export the file from the capture "
+                                                    "software")
+        fh.seek(0)
+        section = fh.read(ds)
+    try:
+        params = Parameters(parse_parameters(section, ps, ds), dec=proc == "DEC")
+    except ParameterProblem as exc:
+        raise FileFormatError(f"the C3D parameter section is corrupt: {exc}", path=path,
+                              trial=trial, hint="re-export the file from the capture "
+                                                "software") from None
+    if proc == "DEC":                                      # header floats in DEC format
+        hdr.update(scale=float_at(head, 12, True), rate=float_at(head, 20, True))
+    expected = _check_layout(hdr, params, size, path, trial)
+    return {"processor": proc, "first_frame_word": hdr["first"],
+            "last_frame_word": hdr["last"], "frames_expected": expected}
+
+
+def _header(head: bytes) -> dict[str, Any]:
+    """The header words gaitval checks (C3D User Guide: 16-bit words 2-5, 9, 10; floats
+    at words 7-8 and 11-12, IEEE here and re-read for DEC files)."""
+    w = struct.unpack_from("<11H", head, 2)                 # words 2..12
+    return {"n_points": w[0], "n_analog": w[1], "first": w[2], "last": w[3],
+            "data_start": w[7], "analog_per_frame": w[8],
+            "scale": float_at(head, 12, False), "rate": float_at(head, 20, False)}
+
+
+def _processor(code: int, path: Path, trial: str | None) -> str:
+    proc = _PROCESSORS.get(code)
     if proc is None:
-        raise FileFormatError(f"unknown C3D processor type {phead[3]} (expected 84 Intel, "
+        raise FileFormatError(f"unknown C3D processor type {code} (expected 84 Intel, "
                               "85 DEC or 86 MIPS)", path=path, trial=trial)
     if proc.startswith("MIPS"):
         raise FileFormatError("C3D file uses the MIPS (SGI) big-endian processor format, "
                               "which ezc3d cannot read", path=path, trial=trial,
                               hint="convert it to Intel format, e.g. by opening and saving "
                                    "it in Mokka or Vicon Nexus")
-    problem = _walk_parameters(path)
-    if problem:
-        raise FileFormatError(f"the C3D parameter section is corrupt: {problem}",
-                              path=path, trial=trial,
-                              hint="re-export the file from the capture software")
-    # header words 4 and 5 (1-based, 16-bit): first and last frame of the 3-D data
-    first_w, last_w = (int.from_bytes(head[i:i + 2], "little") for i in (6, 8))
-    return {"processor": proc, "first_frame_word": first_w, "last_frame_word": last_w}
+    return proc
 
 
-def _walk_parameters(path: Path) -> str | None:
-    """Walk the parameter section's linked list; return the first structural problem.
+def _check_layout(hdr: dict, params: Parameters, size: int, path: Path,
+                  trial: str | None) -> int:
+    """Finite, consistent header and parameters; a data section that holds every frame.
 
-    C3D User Guide: each group/parameter record is ``name length (int8, negative = locked),
-    id (int8, negative = group), name, offset to the next record (int16)``; a parameter
-    then has ``type (int8), n_dims (uint8), dims, data``.  ezc3d 1.7.2 spends tens of
-    seconds (or crashes) on some corrupt sections, so gaitval checks the chain first:
-    printable names, pointers that stay inside the file, data that fits before the next
-    record.  Little-endian (Intel/DEC) files only; returns None when the chain is sound.
+    Returns the number of frames the file announces.
     """
-    b = path.read_bytes()
-    i = (b[0] - 1) * 512 + 4
-    last = "the section start"
-    groups: dict[int, str] = {}
-    for _ in range(100_000):
-        if i + 2 > len(b):
-            return f"the record after {last} lies beyond the end of the file"
-        nch = int.from_bytes(b[i:i + 1], "little", signed=True)
-        gid = int.from_bytes(b[i + 1:i + 2], "little", signed=True)
-        if nch == 0 or gid == 0:
-            return None                                   # end of the parameter section
-        name = b[i + 2:i + 2 + abs(nch)]
-        if len(name) < abs(nch) or not all(0x20 <= c <= 0x7E for c in name):
-            return f"the record after {last} has an unreadable name {name!r}"
-        p = i + 2 + abs(nch)
-        nxt = int.from_bytes(b[p:p + 2], "little", signed=True)
-        label = name.decode("ascii")
-        if gid < 0:
-            groups[-gid] = label
-        else:
-            label = f"{groups.get(gid, f'group {gid}')}:{label}"
-            t = int.from_bytes(b[p + 2:p + 3], "little", signed=True)
-            nd = b[p + 3] if p + 3 < len(b) else 0
-            size = abs(t)
-            for d in b[p + 4:p + 4 + nd]:
-                size *= d
-            end = p + 4 + nd + size
-            if nxt > 0 and end > p + nxt:
-                return (f"parameter {label} holds {size} bytes of data, "
-                        f"more than the {nxt - 4 - nd} bytes before the next record "
-                        "(bad parameter offset)")
-        if nxt == 0:
-            return None                                   # last record
-        if nxt < 0 or p + nxt >= len(b):
-            return f"record {label} points to the next record at offset {nxt}, outside the file"
-        last = f"{'group' if gid < 0 else 'parameter'} {label}"
-        i = p + nxt
-    return "the parameter section does not end"
+    def refuse(problem: str):
+        raise FileFormatError(problem, path=path, trial=trial,
+                              hint="re-export the file from the capture software")
+
+    for (group, name), allow_zero in _FINITE:
+        for v in params.numbers(group, name) or ():
+            if not math.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
+                refuse(f"{group}:{name} is {v!r}; it must be a finite number "
+                       f"{'>= 0' if allow_zero else '> 0'}")
+    if not math.isfinite(hdr["scale"]):
+        refuse(f"the header's scale factor is {hdr['scale']!r}")
+    for (group, name), want in ((("POINT", "USED"), hdr["n_points"]),
+                                (("POINT", "DATA_START"), hdr["data_start"])):
+        got = params.first(group, name)
+        if got and int(got) & 0xFFFF != want:     # 0: not filled in (c3d.org's Dance)
+            refuse(f"{group}:{name} is {got:g} but the header says {want}")
+    p_scale = params.first("POINT", "SCALE")
+    if p_scale is not None and (p_scale < 0) != (hdr["scale"] < 0):
+        refuse(f"POINT:SCALE ({p_scale:g}) and the header's scale factor ({hdr['scale']:g}) "
+               "disagree on whether the points are floats")
+    if params.first("POINT", "RATE") is None and not hdr["rate"] > 0:
+        refuse(f"the point rate is {hdr['rate']!r} and POINT:RATE is absent")
+    if hdr["last"] < hdr["first"] and hdr["n_points"] + hdr["n_analog"] and \
+            not params.first("POINT", "FRAMES"):
+        refuse(f"the header's last frame ({hdr['last']}) is before its first "
+               f"({hdr['first']})")
+    return _check_size(hdr, params, size, path, trial)
+
+
+def _check_size(hdr: dict, params: Parameters, size: int, path: Path,
+                trial: str | None) -> int:
+    """The data section must hold the frames the header announces (POINT:FRAMES where the
+    header's 16-bit last-frame word is saturated); returns the larger of the two counts,
+    which the reader compares with what ezc3d read."""
+    n_header = hdr["last"] - hdr["first"] + 1 if hdr["last"] >= hdr["first"] else 0
+    p_frames = params.first("POINT", "FRAMES")
+    p_frames = 0 if p_frames is None else int(p_frames)
+    # frame numbers above 65535 do not fit the header's words: ezc3d writes 65535 as the
+    # last frame, other writers let them wrap; POINT:FRAMES then holds the count
+    wrapped = hdr["last"] == 0xFFFF or hdr["last"] < hdr["first"]
+    expected = p_frames if wrapped and p_frames > 0 else n_header
+    bpv = 4 if hdr["scale"] < 0 else 2                       # float or int16 samples
+    frame_bytes = bpv * (4 * hdr["n_points"] + hdr["n_analog"])
+    room = size - (hdr["data_start"] - 1) * 512
+    if frame_bytes and expected * frame_bytes > room:
+        raise FileFormatError(f"C3D file is truncated: the header announces {expected} "
+                              f"frames of {frame_bytes} bytes, the data section holds "
+                              f"{room // frame_bytes}", path=path, trial=trial)
+    return max(expected, p_frames if 0 < p_frames < 0xFFFF else 0)
 
 
 def _ezc3d_reason(exc: Exception) -> str:
@@ -127,18 +176,50 @@ def _ezc3d_reason(exc: Exception) -> str:
         return f"unsupported processor type (ezc3d: {msg})"
     if "valid c3d" in low:
         return "not a valid C3D file (ezc3d cannot parse the header)"
-    return f"ezc3d cannot read it: {type(exc).__name__}: {msg}"
+    return f"ezc3d cannot read it: {getattr(exc, 'type_name', type(exc).__name__)}: {msg}"
 
 
-def _open_ezc3d(path: Path, trial: str | None):
-    """ezc3d.c3d(path) with every failure turned into one FileFormatError.
+def _open_ezc3d(path: Path, trial: str | None) -> dict[str, Any]:
+    """What gaitval reads of ``ezc3d.c3d(path)``, with every failure one FileFormatError.
 
+    ezc3d runs in a child process (:func:`gaitval.io.isolate.run_isolated`): should a file
+    that passed the checks above still crash or stall it, the child dies, not gaitval.
     ``ignore_bad_formatting`` is deliberately never used: with ezc3d 1.7.2 it crashes the
     interpreter (segmentation fault) on ``c3dorg_sample18_bad_parameter_section.c3d``.
-    """
-    import ezc3d
 
+    Returns
+    -------
+    dict
+        ``header`` and ``parameters`` as ezc3d gives them (parameters: group -> name ->
+        ``{"value": ...}``), ``data`` with ``points`` and ``meta_points.residuals``, and
+        ``n_analogs`` (the analog samples themselves are not read).
+    """
+    from gaitval.io.isolate import ChildError, run_isolated
+
+    timeout = 60.0 + 20.0 * path.stat().st_size / 1e6         # generous: ~1 s/MB is usual
     try:
-        return ezc3d.c3d(str(path))
-    except Exception as exc:  # ezc3d raises OSError, RuntimeError, ValueError, IndexError
+        return run_isolated(_extract, str(path), path=path, trial=trial, what="ezc3d",
+                            timeout_s=timeout)
+    except ChildError as exc:  # ezc3d raises OSError, RuntimeError, ValueError, IndexError
         raise FileFormatError(_ezc3d_reason(exc), path=path, trial=trial) from None
+
+
+def _extract(path: str) -> dict[str, Any]:
+    """Open ``path`` with ezc3d and copy out plain, picklable values (runs in the child)."""
+    import ezc3d
+    import numpy as np
+
+    c = ezc3d.c3d(path)
+    params = {g: {n: {"value": v["value"]} for n, v in grp.items() if n != "__METADATA__"}
+              for g, grp in c["parameters"].items()}
+    h = c["header"]
+    header = {"points": {"first_frame": int(h["points"]["first_frame"]),
+                         "frame_rate": float(h["points"]["frame_rate"])},
+              "analogs": {"frame_rate": float(h["analogs"]["frame_rate"])},
+              "events": {"events_time": np.asarray(h["events"]["events_time"], dtype=float),
+                         "events_label": [str(s) for s in h["events"]["events_label"]]}}
+    data = {"points": np.asarray(c["data"]["points"], dtype=np.float64),
+            "meta_points": {"residuals": np.asarray(c["data"]["meta_points"]["residuals"],
+                                                    dtype=np.float64)}}
+    return {"header": header, "parameters": params, "data": data,
+            "n_analogs": int(c["data"]["analogs"].shape[1])}

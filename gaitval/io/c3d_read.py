@@ -14,6 +14,7 @@ References
 from __future__ import annotations
 
 import logging
+import math
 from pathlib import Path
 from typing import Any
 
@@ -197,10 +198,16 @@ def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "s
 
     rate = _first_number(_param(c, "POINT", "RATE"), None)
     rate = float(rate) if rate else float(c["header"]["points"]["frame_rate"])
-    if not rate > 0:
-        raise FileFormatError("C3D point rate is zero", path=path, trial=trial)
+    if not (math.isfinite(rate) and rate > 0):
+        raise FileFormatError(f"C3D point rate is {rate!r} (POINT:RATE, or the header's "
+                              "rate); it must be a finite number > 0", path=path, trial=trial)
     ff, header_ff = _first_frame(c)
     events, ev_source = _events(c)
+    bad = np.flatnonzero(~np.isfinite(events["t_s"].to_numpy(dtype=np.float64)))
+    if bad.size:
+        raise FileFormatError(f"event {events['label'].iloc[bad[0]]!r} has time "
+                              f"{events['t_s'].iloc[bad[0]]!r} ({ev_source} section); event "
+                              "times must be finite", path=path, trial=trial)
     company = " ".join(_strings(_param(c, "MANUFACTURER", "COMPANY")))
     software = " ".join(_strings(_param(c, "MANUFACTURER", "SOFTWARE")))
     meta: dict[str, Any] = {
@@ -209,7 +216,7 @@ def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "s
         "duplicates": dups,
         "n_zero_gaps": int(zero.sum()),
         "units_assumed": units_assumed,
-        "n_analogs": int(c["data"]["analogs"].shape[1]),
+        "n_analogs": int(c["n_analogs"]),
         "analog_rate_hz": float(c["header"]["analogs"]["frame_rate"]),
         "events_source": ev_source,
         "manufacturer": " / ".join(s for s in (company, software) if s),
@@ -226,14 +233,9 @@ def _point_data(c, pre: dict, path: Path, trial: str | None) -> np.ndarray:
     (or ``POINT:FRAMES``) announces is truncated."""
     pts = np.asarray(c["data"]["points"], dtype=np.float64)   # (4, n_points, n_frames)
     n_frames = int(pts.shape[2])
-    # ezc3d shrinks its header to what it could read, so compare with the raw header
-    # words (meaningful below 65535 frames) and POINT:FRAMES
-    expected = 0
-    if pre["processor"] == "Intel" and 0 < pre["last_frame_word"] < 65535:
-        expected = pre["last_frame_word"] - pre["first_frame_word"] + 1
-    p_frames = _first_number(_param(c, "POINT", "FRAMES"), 0)
-    if p_frames and 0 < int(p_frames) < 65535:
-        expected = max(expected, int(p_frames))
+    # ezc3d shrinks its header to what it could read, so compare with what the raw header
+    # words and POINT:FRAMES announce (c3d_format._precheck)
+    expected = pre["frames_expected"]          # header words and POINT:FRAMES, any processor
     if n_frames == 0:
         raise FileFormatError("C3D file holds no point frames (empty or truncated)",
                               path=path, trial=trial)
