@@ -2,7 +2,10 @@
 
 Every file gaitval writes goes through :func:`atomic_path`: the content is written to a
 temporary file in the same folder and renamed over the target only when complete, so an
-interrupted run never leaves a half-written file that looks complete.
+interrupted run never leaves a half-written file that looks complete.  The file gets the
+permissions a plain ``open(path, "w")`` would give it (``0o666`` less the umask): the
+temporary file ``mkstemp`` makes is private (``0o600``), which left every report, table
+and figure unreadable to other users and to a web server.
 """
 from __future__ import annotations
 
@@ -12,6 +15,20 @@ import tempfile
 from pathlib import Path
 
 import pandas as pd
+
+
+def _umask() -> int:
+    """The process's umask (read without changing it where /proc allows)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 @contextlib.contextmanager
@@ -26,6 +43,7 @@ def atomic_path(path: str | Path):
     os.close(fd)
     try:
         yield Path(tmp)
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
