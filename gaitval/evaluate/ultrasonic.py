@@ -147,7 +147,7 @@ def _stride_rows(base: dict, st_r: pd.DataFrame, st_s: pd.DataFrame,
         r, s = st_r.iloc[i], st_s.iloc[j]
         for p in _PER_STRIDE:
             rv, sv = float(r[p]), float(s[p])
-            if p.endswith("_norm"):                      # eq. (18), (21): n = matched strides
+            if p.endswith("_norm"):              # seed003 eq. (18), (21): n = matched strides
                 rv, sv = float(r[p.replace("_norm", "")]) / n, \
                     float(s[p.replace("_norm", "")]) / n
             rows.append({**base, "stride": int(r["stride"]), "parameter": p,

@@ -59,8 +59,8 @@ def autocorr_unbiased(a: np.ndarray, max_lag: int | None = None,
     if n == 0:
         return np.zeros(0)
     max_lag = n - 1 if max_lag is None else int(min(max_lag, n - 1))
-    raw = correlate(a, a, mode="full", method="auto")[n - 1:n + max_lag]   # eq. (14)
-    A = raw / (n - np.arange(max_lag + 1))                                  # eq. (16)
+    raw = correlate(a, a, mode="full", method="auto")[n - 1:n + max_lag]   # seed003 eq. (14)
+    A = raw / (n - np.arange(max_lag + 1))                          # seed003 eq. (16)
     if normalise and A[0] != 0:
         A = A / A[0]
     return A
@@ -167,18 +167,18 @@ def stride_table(x: np.ndarray, fs: float, *, t0: float = 0.0, maxima: np.ndarra
     if subsample:
         pos = pos + np.array([_parabolic(x, int(i)) for i in maxima])
     i0, i1 = maxima[:-1], maxima[1:]
-    S = np.array([2.0 * (np.nanmax(x[a:b + 1]) - np.nanmin(x[a:b + 1]))   # eq. (17)
+    S = np.array([2.0 * (np.nanmax(x[a:b + 1]) - np.nanmin(x[a:b + 1]))   # seed003 eq. (17)
                   for a, b in zip(i0, i1)])
-    T = np.diff(pos) / fs                                                   # eq. (19)
+    T = np.diff(pos) / fs                                           # seed003 eq. (19)
     n = len(S) if n_norm is None else int(n_norm)
-    V = S / T                                                               # eq. (20)
+    V = S / T                                                       # seed003 eq. (20)
     return pd.DataFrame({
         "stride": np.arange(len(S)), "i_start": i0, "i_end": i1,
         "t_start_s": t0 + pos[:-1] / fs, "t_end_s": t0 + pos[1:] / fs,
-        "stride_length": S, "stride_length_norm": S / n,                    # eq. (18)
+        "stride_length": S, "stride_length_norm": S / n,            # seed003 eq. (18)
         "stride_duration": T, "stride_velocity": V,
-        "stride_velocity_norm": V / n,                                      # eq. (21)
-        "cadence": 1.0 / T})                                                # eq. (22)
+        "stride_velocity_norm": V / n,                              # seed003 eq. (21)
+        "cadence": 1.0 / T})                                        # seed003 eq. (22)
 
 
 def match_strides(ref: pd.DataFrame, sys: pd.DataFrame,

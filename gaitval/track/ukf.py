@@ -72,8 +72,8 @@ def ukf_weights(n: int = N_STATE, alpha: float = 1e-3, beta: float = 2.0,
     ``W0m = lambda/(n+lambda)``, ``W0c = lambda/(n+lambda) + 1 - alpha^2 + beta``,
     ``Wim = Wic = 1/(2(n+lambda))`` (eq. 12).
     """
-    lam = alpha ** 2 * (n + kappa) - n                       # eq. (13)
-    Wm = np.full(2 * n + 1, 1.0 / (2.0 * (n + lam)))          # eq. (12)
+    lam = alpha ** 2 * (n + kappa) - n               # seed003 eq. (13)
+    Wm = np.full(2 * n + 1, 1.0 / (2.0 * (n + lam)))  # seed003 eq. (12)
     Wc = Wm.copy()
     Wm[0] = lam / (n + lam)
     Wc[0] = lam / (n + lam) + 1.0 - alpha ** 2 + beta
@@ -219,7 +219,7 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
             A, AT, Q = mdl.transition(dt)
             last_dt = dt
         x = A @ x                                                # X_{k+1/k} = A X_{k/k}
-        P = A @ P @ AT + Q                                       # A P A^T + G W G^T, eq. (8)
+        P = A @ P @ AT + Q                               # A P A^T + G W G^T, seed003 eq. (8)
         if n_finite[k] == 0:
             starved += 1
         else:
@@ -245,8 +245,10 @@ class _Model:
         V = np.asarray(V, dtype=float)
         self.Vm = np.diag(V) if V.ndim == 1 else V
         self.I6 = I6 = np.eye(N_STATE)
-        self.S = np.vstack([np.zeros((1, N_STATE)), I6, -I6])   # chi_i - X = S B^T, eq. (7)
-        # eq. (5): A = I + dt E,  G W G^T = dt^4/4 Q4 + dt^3/2 Q3 + dt^2 Q2,  W = diag(q)
+        # chi_i - X = S B^T, seed003 eq. (7)
+        self.S = np.vstack([np.zeros((1, N_STATE)), I6, -I6])
+        # seed003 eq. (5): A = I + dt E,  G W G^T = dt^4/4 Q4 + dt^3/2 Q3 + dt^2 Q2,
+        # W = diag(q)
         q = np.asarray(W_sigma, dtype=float) ** 2
         self.E = np.zeros((N_STATE, N_STATE))
         self.E[0, 3] = self.E[1, 4] = self.E[2, 5] = 1.0
@@ -280,18 +282,18 @@ def _sigma_statistics(mdl: _Model, x: np.ndarray, P: np.ndarray):
     Returns ``P`` (symmetrised if its Cholesky factor failed), ``ybar`` (eq. 9) and
     ``Pyy``, ``Pxy`` (eq. 10).
     """
-    B, info = _potrf(mdl.scale * P, lower=1)                      # eq. (7)
+    B, info = _potrf(mdl.scale * P, lower=1)              # seed003 eq. (7)
     if info != 0:
         P = 0.5 * (P + P.T) + 1e-12 * mdl.I6
         B, info = _potrf(mdl.scale * P, lower=1)
     dX = mdl.S @ B.T
     diff = (x[:3] + dX[:, :3])[:, None, :] - mdl.anchors
-    Ysig = np.sqrt((diff * diff).sum(axis=2))                # Y_i = h(chi_i), eq. (6)
-    ybar = mdl.Wm @ Ysig                                         # eq. (9)
+    Ysig = np.sqrt((diff * diff).sum(axis=2))        # Y_i = h(chi_i), seed003 eq. (6)
+    ybar = mdl.Wm @ Ysig                                 # seed003 eq. (9)
     dY = Ysig - ybar
     WdY = mdl.Wc_col * dY
-    Pyy = dY.T @ WdY + mdl.Vm                                    # eq. (10)
-    Pxy = dX.T @ WdY                                             # eq. (10)
+    Pyy = dY.T @ WdY + mdl.Vm                            # seed003 eq. (10)
+    Pxy = dX.T @ WdY                                     # seed003 eq. (10)
     return P, ybar, Pyy, Pxy
 
 
@@ -325,9 +327,9 @@ def _update(mdl: _Model, x, P, dk, n_ok: int, res: ToaUkfResult, k: int):
         res.used[k, bad] = False
         n_ok -= bad.size
     if n_ok == len(dk):
-        _, KT, info = _posv(Pyy, Pxy.T)                          # K = Pxy Pyy^-1, eq. (10)
-        x = x + nu @ KT                                          # eq. (11)
-        P = P - KT.T @ Pxy.T                                     # P - K Pyy K^T, eq. (11)
+        _, KT, info = _posv(Pyy, Pxy.T)                  # K = Pxy Pyy^-1, seed003 eq. (10)
+        x = x + nu @ KT                                  # seed003 eq. (11)
+        P = P - KT.T @ Pxy.T                             # P - K Pyy K^T, seed003 eq. (11)
     elif n_ok > 0:
         s = np.flatnonzero(res.used[k])
         Pxy_s = Pxy[:, s]
