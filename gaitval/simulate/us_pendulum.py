@@ -17,7 +17,8 @@ import numpy as np
 import pandas as pd
 
 from gaitval.simulate.us_sensor import (ANCHOR_IDS, PAPER_ANCHORS, _anchor_log, _clock,
-                                        _ranges_to_tof, _temperature, _to_field)
+                                        _ranges_to_tof, _temperature, _to_field,
+                                        received_amplitude)
 
 def _pendulum_theta(t: np.ndarray, L: float, theta0: float, zeta: float, t_release: float
                     ) -> np.ndarray:
@@ -75,10 +76,15 @@ def simulate_pendulum_trial(rng: np.random.Generator, cfg: dict, R: np.ndarray,
     xyz[:, 1:] = anchors_f[None]
     xyz = xyz + cfg["mocap_noise_m"] * rng.standard_normal(xyz.shape)
     p_true = tx_at(th_all[len(t_m):])
-    d_true = np.linalg.norm(p_true[:, None, :] - PAPER_ANCHORS[None], axis=2)
+    to_rx = PAPER_ANCHORS[None] - p_true[:, None, :]
+    d_true = np.linalg.norm(to_rx, axis=2)
+    # the transducer faces the board (its axis, the board's normal, is also the swing's
+    # rotation axis, so it keeps facing it); the receivers face back (threshold detection)
+    cos_tx = to_rx[..., 2] / d_true
+    amp = received_amplitude(d_true, cos_tx, cos_tx)
     temp_true, temp_log = _temperature(rng, t_us)
     tof, counts = _ranges_to_tof(d_true, temp_true, rng, np.asarray(cfg["noise_V_m2"]),
-                                 cfg["multipath_prob"], cfg["dropout_prob"])
+                                 cfg["multipath_prob"], cfg["dropout_prob"], amplitude=amp)
     truth_tx = pd.DataFrame({"t_s": t_m, "x_m": tx_f[:, 0], "y_m": tx_f[:, 1],
                              "z_m": tx_f[:, 2], "xu_m": tx_u[:, 0], "yu_m": tx_u[:, 1],
                              "zu_m": tx_u[:, 2]})

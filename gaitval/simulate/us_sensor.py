@@ -7,6 +7,18 @@ field, the speed of sound of dry air (the simulator's physics, not the pipeline'
 eq. (2)), true ranges to logged times of flight (noise, multipath, dropouts, 1 us tick),
 the logged air temperature, the ultrasonic log's clock, and the camera's noise and gaps.
 
+Threshold detection of the burst (issue 10; :func:`received_amplitude`,
+:func:`detection_delay_m`): each anchor stops its counter when the received 40 kHz burst
+(8 pulses, seed 003 §3.1) first crosses a fixed threshold.  The burst's amplitude falls
+with the transmitter's and the receiver's directivity (circular pistons, −6 dB at ±40°),
+spherical spreading and air absorption (1.3 dB/m) and fluctuates from ping to ping (5 %);
+its envelope rises over the first cycles (a resonant transducer pair, τ = Q/π cycles,
+Q = 20).  A weaker burst crosses the threshold later in its first cycle, or only in a later
+cycle (a cycle slip of one wavelength, 8.6 mm), or not at all (a missed echo).  The
+threshold is where an on-axis burst at the paper's maximum range of 20 m (seed 003 §5)
+still crosses at its last cycle; the firmware's fixed delay is that of an on-axis burst
+at 0.5 m (a one-time calibration).
+
 References
 ----------
 Qi, Y.; Soh, C.B.; Gunawan, E.; Low, K.-S.; Thomas, R. Estimation of Spatial-Temporal Gait
@@ -47,19 +59,102 @@ def board_pose(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     return R, o
 
 
+#: The burst (seed 003 §3.1): 8 pulses at 40 kHz.
+BURST_HZ = 40_000.0
+BURST_CYCLES = 8
+#: ``k a`` of a circular-piston transducer whose beam is −6 dB at ±40° (the 80° beam of
+#: common open-type 40 kHz transducers): ``2 J1(x)/x = 1/2`` at ``x = 2.215 = k a sin 40°``.
+PISTON_KA = 2.215 / np.sin(np.deg2rad(40.0))
+#: Envelope rise of a resonant transducer pair, in cycles: ``τ = Q/π`` with ``Q = 20``.
+ENVELOPE_TAU_CYCLES = 20.0 / np.pi
+#: Air absorption at 40 kHz, about 20 °C and 50 % relative humidity (ISO 9613-1), dB/m.
+ABSORPTION_DB_PER_M = 1.3
+#: Ping-to-ping fluctuation of the received amplitude (relative sd: air turbulence, supply).
+AMPLITUDE_SD = 0.05
+#: The paper's maximum propagation distance (seed 003 §5), which sets the threshold.
+MAX_RANGE_M = 20.0
+#: The firmware's fixed delay is that of an on-axis burst at this range (calibration).
+CALIBRATION_RANGE_M = 0.5
+
+
+def piston_directivity(cos_theta) -> np.ndarray:
+    """Far-field directivity ``2 J1(ka sin θ) / (ka sin θ)`` of a circular piston (≥ 0)."""
+    from scipy.special import j1
+
+    c = np.clip(np.asarray(cos_theta, dtype=float), -1.0, 1.0)
+    x = PISTON_KA * np.sqrt(1.0 - c * c)
+    d = np.where(x < 1e-9, 1.0, 2.0 * j1(np.maximum(x, 1e-9)) / np.maximum(x, 1e-9))
+    return np.where(c > 0, np.abs(d), 0.0)             # nothing radiates backwards
+
+
+def received_amplitude(d_m, cos_tx, cos_rx) -> np.ndarray:
+    """Burst amplitude at a receiver relative to an on-axis burst at 1 m: both pistons'
+    directivity, spherical spreading ``1/d`` and air absorption."""
+    d = np.asarray(d_m, dtype=float)
+    return (piston_directivity(cos_tx) * piston_directivity(cos_rx) / d
+            * 10.0 ** (-ABSORPTION_DB_PER_M * d / 20.0))
+
+
+def _crossing_cycles(amp: np.ndarray, threshold: float) -> np.ndarray:
+    """Time (in cycles) at which ``amp · env(t) · sin(2π t)`` first reaches ``threshold``
+    (positive half-cycles, envelope taken at each half-cycle's peak); NaN: never."""
+    amp = np.asarray(amp, dtype=float)
+    ratio = threshold / np.maximum(amp, 1e-12)
+    # first cycle k whose peak (t = k + 1/4) reaches the threshold: env(k + 1/4) >= ratio
+    need = -ENVELOPE_TAU_CYCLES * np.log(np.clip(1.0 - ratio, 1e-300, None)) - 0.25
+    k = np.where(ratio < 1.0, np.maximum(np.ceil(need), 0.0), np.inf)
+    env = 1.0 - np.exp(-(k + 0.25) / ENVELOPE_TAU_CYCLES)
+    within = np.asarray(np.arcsin(np.clip(ratio / np.where(np.isfinite(env), env, 1.0),
+                                          0.0, 1.0)) / (2.0 * np.pi))
+    return np.where(k < BURST_CYCLES, k + within, np.nan)
+
+
+def _threshold() -> float:
+    """Detection threshold: an on-axis burst at :data:`MAX_RANGE_M` reaches it at the peak
+    of its last cycle."""
+    a_max = received_amplitude(MAX_RANGE_M, 1.0, 1.0)
+    return float(a_max * (1.0 - np.exp(-(BURST_CYCLES - 0.75) / ENVELOPE_TAU_CYCLES)))
+
+
+def detection_delay_m(amplitude: np.ndarray, wavelength_m) -> np.ndarray:
+    """Extra range (m) the threshold detector adds to a burst of relative ``amplitude``,
+    beyond the calibrated delay of an on-axis burst at :data:`CALIBRATION_RANGE_M`; NaN
+    where the burst never reaches the threshold (a missed echo)."""
+    h = _threshold()
+    t_cal = _crossing_cycles(received_amplitude(CALIBRATION_RANGE_M, 1.0, 1.0), h)
+    return (_crossing_cycles(amplitude, h) - t_cal) * np.asarray(wavelength_m, dtype=float)
+
+
 def _ranges_to_tof(d_true: np.ndarray, temp_c: np.ndarray, rng: np.random.Generator,
-                   V_m2: np.ndarray, multipath_prob: float, dropout_prob: float
-                   ) -> tuple[np.ndarray, dict]:
-    """True ranges -> logged times of flight (noise, multipath, dropouts, 1 us tick)."""
+                   V_m2: np.ndarray, multipath_prob: float, dropout_prob: float,
+                   amplitude: np.ndarray | None = None) -> tuple[np.ndarray, dict]:
+    """True ranges -> logged times of flight (noise, multipath, dropouts, 1 us tick).
+
+    ``amplitude`` (n, m): the bursts' relative amplitudes (:func:`received_amplitude`);
+    when given, each range also carries the threshold detector's delay
+    (:func:`detection_delay_m`, amplitude fluctuating by :data:`AMPLITUDE_SD` per ping) and
+    a burst below the threshold is a missed echo.
+    """
     n, m = d_true.shape
     d = d_true + rng.standard_normal((n, m)) * np.sqrt(V_m2)[None, :]
     mp = rng.random((n, m)) < multipath_prob
     d = d + mp * rng.uniform(0.05, 0.5, size=(n, m))
+    counts = {}
+    if amplitude is not None:
+        lam = speed_of_sound_true(temp_c)[:, None] / BURST_HZ
+        amp = amplitude * (1.0 + AMPLITUDE_SD * rng.standard_normal((n, m)))
+        delay = detection_delay_m(amp, lam)
+        base = detection_delay_m(amplitude, lam)        # without the ping's fluctuation
+        d = d + delay
+        counts = {"n_missed_echo": int(np.isnan(delay).sum()),
+                  "n_cycle_slip": int(np.sum(np.abs(delay - base) > 0.5 * lam)),
+                  "detection_delay_mm_p5_p95": [float(v) for v in 1e3 * np.nanpercentile(
+                      delay, [5, 95])] if np.isfinite(delay).any() else [np.nan, np.nan]}
     tof = distance_to_tof(d, temp_c, speed=speed_of_sound_true)      # seed003 eq. (1)
     tof = np.round(tof * 1e6) * 1e-6                         # 16-bit counter, 1 us tick
     drop = rng.random((n, m)) < dropout_prob
     tof[drop] = np.nan
-    return tof, {"n_multipath": int(mp.sum()), "n_dropout": int(drop.sum())}
+    return tof, {"n_multipath": int(mp.sum()), "n_dropout": int(drop.sum()), **counts}
 
 
 def _temperature(rng: np.random.Generator, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -6,6 +6,33 @@ posterior-heel path and foot pitch through loading, heel rise and swing
 (:func:`heel_path`), the heel, toe and transmitter points (:func:`foot_points`), and one
 whole trial in memory (:func:`simulate_treadmill_trial`).
 
+Error sources of the paper's set-up added in issue 10 (seed 003 §4.1, §5):
+
+* **stride-to-stride variability of real gait**: stride times are not independent from
+  stride to stride but persistently correlated (fractional Gaussian noise, Hurst exponent
+  :data:`STRIDE_HURST` = 0.8: the DFA α ≈ 0.75–0.9 of healthy young adults' stride
+  intervals, Hausdorff et al. 1995), with the same coefficient of variation as before;
+* **strap motion**: the transmitter is held on the heel by an elastic strap (§4.1); each
+  heel strike sets the housing oscillating on it, a damped oscillation of 2–4 mm at
+  :data:`STRAP_HZ` (ζ = :data:`STRAP_DAMPING`) along the belt and downwards (the motion
+  artefact of strap- and skin-mounted sensors after heel strike, Forner-Cordero et al.
+  2008).  The camera marker ``TX`` sits on the shoe beside the housing (the paper's
+  Fig. 1a: markers on the foot), so it does not share the wobble;
+* **transmitter directivity**: the transducer points at the board's centre when the foot
+  is flat (§4.1: "pointing towards the four anchors") and turns with the foot's pitch; the
+  burst each receiver gets is weaker off both axes, which the threshold detector turns into
+  a later detection, a cycle slip or a missed echo (:mod:`gaitval.simulate.us_sensor`).
+
+References
+----------
+Hausdorff JM, Peng CK, Ladin Z, Wei JY, Goldberger AL. Is walking a random walk? Evidence
+for long-range correlations in stride interval of human gait. J Appl Physiol
+1995;78:349–358.
+
+Forner-Cordero A, Mateu-Arce M, Forner-Cordero I, Alcántara E, Moreno JC, Pons JL. Study
+of the motion artefacts of skin-mounted inertial sensors under different attachment
+conditions. Physiol Meas 2008;29:N21–N31.
+
 References
 ----------
 Qi, Y.; Soh, C.B.; Gunawan, E.; Low, K.-S.; Thomas, R. Estimation of Spatial-Temporal Gait
@@ -19,12 +46,53 @@ import pandas as pd
 
 from gaitval.simulate.us_sensor import (ANCHOR_IDS, PAPER_ANCHORS, _anchor_log, _clock,
                                         _mocap_noise_and_gaps, _ranges_to_tof, _temperature,
-                                        _to_field, _to_us_frame)
+                                        _to_field, _to_us_frame, received_amplitude)
 
 #: Population stride duration (s) at the belt speeds of the paper's Table 8.
 _T_OF_SPEED = (np.array([0.54, 0.99, 1.40]), np.array([1.645, 1.180, 1.006]))
 
 _FOOT_MARKERS = ["RHEE", "RTOE", "LHEE", "LTOE"]
+#: Hurst exponent of the stride-time fluctuations (persistent; Hausdorff et al. 1995).
+STRIDE_HURST = 0.8
+#: The strap-held housing after heel strike: amplitude range (m), frequency, damping ratio,
+#: and the direction of the first excursion (along the belt, downwards; field x, z).
+STRAP_AMPLITUDE_M = (0.002, 0.004)
+STRAP_HZ = 15.0
+STRAP_DAMPING = 0.25
+STRAP_DIRECTION = np.array([0.8, 0.0, -0.6])
+
+
+def fgn(n: int, hurst: float, rng: np.random.Generator) -> np.ndarray:
+    """``n`` samples of unit-variance fractional Gaussian noise (Davies–Harte method).
+
+    Autocovariance ``γ(k) = (|k+1|^{2H} - 2|k|^{2H} + |k-1|^{2H}) / 2``, embedded in a
+    circulant of size ``2n`` whose eigenvalues come from one FFT.
+    """
+    k = np.arange(n + 1, dtype=float)
+    g = 0.5 * ((k + 1) ** (2 * hurst) - 2 * k ** (2 * hurst) + np.abs(k - 1) ** (2 * hurst))
+    row = np.concatenate([g, g[-2:0:-1]])                  # circulant first row, size 2n
+    lam = np.clip(np.fft.fft(row).real, 0.0, None)
+    m = len(row)
+    z = rng.standard_normal(m) + 1j * rng.standard_normal(m)
+    x = np.fft.fft(np.sqrt(lam / m) * z).real[:n]
+    return x / max(float(np.std(x)), 1e-12)
+
+
+def strap_motion(t: np.ndarray, t_hs: np.ndarray, amps: np.ndarray) -> np.ndarray:
+    """(n, 3) displacement of the strap-held transmitter from its place on the heel (field).
+
+    After the heel strike at ``t_hs[j]`` (the latest before ``t``):
+    ``A_j exp(-ζωτ) sin(ω_d τ) · STRAP_DIRECTION``, ``τ = t - t_hs[j]``,
+    ``ω = 2π STRAP_HZ``, ``ω_d = ω sqrt(1 - ζ²)``; earlier strikes have died out (ζω ≈ 24/s).
+    """
+    j = np.searchsorted(t_hs, t, side="right") - 1
+    tau = np.where(j >= 0, t - t_hs[np.clip(j, 0, None)], np.inf)
+    w = 2 * np.pi * STRAP_HZ
+    wd = w * np.sqrt(1 - STRAP_DAMPING ** 2)
+    a = np.where(np.isfinite(tau), amps[np.clip(j, 0, len(amps) - 1)], 0.0)
+    tau = np.where(np.isfinite(tau), tau, 0.0)
+    u = a * np.exp(-STRAP_DAMPING * w * tau) * np.sin(wd * tau)
+    return u[:, None] * (STRAP_DIRECTION / np.linalg.norm(STRAP_DIRECTION))[None, :]
 
 
 def _hermite(s, p0, v0, p1, v1, D):
@@ -42,7 +110,7 @@ def stride_plan(rng: np.random.Generator, duration_s: float, T_mean: float, v: f
                 cv: float, t0: float) -> dict:
     """Foot-strike times and places of one foot on the treadmill (field x, metres)."""
     n = int(np.ceil((duration_s + 2.0 - t0) / (T_mean * (1 - 3 * cv)))) + 5
-    T = T_mean * (1.0 + cv * rng.standard_normal(n))
+    T = T_mean * (1.0 + cv * fgn(n, STRIDE_HURST, rng))     # persistent fluctuations
     # the plan starts three strides before t0 so that the whole ultrasonic log (which may
     # start before the capture) lies inside it
     t_hs = t0 - T[0] - T[1] - T[2] + np.concatenate([[0.0], np.cumsum(T)])
@@ -128,6 +196,31 @@ def foot_points(t: np.ndarray, plan: dict, y0: float, rng_phase: float, side: st
     return out
 
 
+def _burst_amplitudes(tx: np.ndarray, pitch: np.ndarray, anchors_f: np.ndarray,
+                      R: np.ndarray, o: np.ndarray, y_tx: float, z_heel: float
+                      ) -> np.ndarray:
+    """(n, 4) relative burst amplitude at each receiver (``us_sensor.received_amplitude``).
+
+    The transducer's axis points at the board's centre from the transmitter's place on a
+    flat foot at the board's middle (x = board centre, heel on the belt) and pitches with
+    the foot; the receivers' axes are the board's normal towards the subject.
+    """
+    centre = _to_field(PAPER_ANCHORS.mean(axis=0), R, o)
+    rest = np.array([centre[0], y_tx - 0.04, z_heel + 0.01])
+    a0 = (centre - rest) / np.linalg.norm(centre - rest)       # foot flat: pitch 0
+    c, s = np.cos(pitch), np.sin(pitch)
+    axis = np.column_stack([a0[0] * c + a0[2] * s, np.full_like(c, a0[1]),
+                            -a0[0] * s + a0[2] * c])           # foot-fixed, pitched
+    to_rx = anchors_f[None, :, :] - tx[:, None, :]
+    dist = np.linalg.norm(to_rx, axis=2)
+    unit = to_rx / dist[..., None]
+    normal = -R[:, 2]                                          # board normal to the subject
+    normal = normal if normal @ (rest - centre) > 0 else -normal
+    cos_tx = np.einsum("nk,nmk->nm", axis, unit)
+    cos_rx = -unit @ normal
+    return received_amplitude(dist, cos_tx, cos_rx)
+
+
 def simulate_treadmill_trial(rng: np.random.Generator, cfg: dict, subject: dict,
                              speed_mps: float, R: np.ndarray, o: np.ndarray):
     """One treadmill trial in memory: mocap (labels, xyz), log, truth tables."""
@@ -149,6 +242,9 @@ def simulate_treadmill_trial(rng: np.random.Generator, cfg: dict, subject: dict,
     marker_offset = rng.uniform(-0.004, 0.004, 3)
     pts = foot_points(t_m, plan_r, y_r, phase, "R", marker_offset)
     pts.update(foot_points(t_m, plan_l, y_r + 0.15, phase + np.pi, "L"))
+    # the housing wobbles on its strap after each strike; the marker on the shoe does not
+    strap_amps = rng.uniform(*STRAP_AMPLITUDE_M, size=len(plan_r["t_hs"]))
+    pts["TXA"] = pts["TXA"] + strap_motion(t_m, plan_r["t_hs"], strap_amps)
     anchors_f = _to_field(PAPER_ANCHORS, R, o)
     labels = ["TX"] + ANCHOR_IDS + _FOOT_MARKERS
     xyz = np.empty((len(t_m), len(labels), 3))
@@ -159,11 +255,14 @@ def simulate_treadmill_trial(rng: np.random.Generator, cfg: dict, subject: dict,
     xyz = _mocap_noise_and_gaps(rng, xyz, labels, rate, cfg["mocap_noise_m"])
 
     t_us, t_true, offset, drift = _clock(rng, dur, us_rate)
-    tx_us_t = foot_points(t_true, plan_r, y_r, phase, "R")["TXA"]
+    tx_us_t = (foot_points(t_true, plan_r, y_r, phase, "R")["TXA"]
+               + strap_motion(t_true, plan_r["t_hs"], strap_amps))
     d_true = np.linalg.norm(tx_us_t[:, None, :] - anchors_f[None], axis=2)
+    amp = _burst_amplitudes(tx_us_t, heel_path(t_true, plan_r)[2], anchors_f, R, o, y_r,
+                            plan_r["z_h"])
     temp_true, temp_log = _temperature(rng, t_us)
     tof, counts = _ranges_to_tof(d_true, temp_true, rng, np.asarray(cfg["noise_V_m2"]),
-                                 cfg["multipath_prob"], cfg["dropout_prob"])
+                                 cfg["multipath_prob"], cfg["dropout_prob"], amplitude=amp)
 
     t_hs = plan_r["t_hs"]
     keep = (t_hs[:-1] >= 0) & (t_hs[1:] <= dur)
