@@ -1,13 +1,15 @@
 """``gaitval <verb>``: the pipeline's steps by hand, one verb per rule family.
 
 Run ``gaitval --help`` or ``gaitval <verb> --help``.  Every verb reads files and writes
-files; a user error prints one line ``gaitval: error: ...`` naming the file, the trial and
-the problem, and exits with status 2.
+files; a data error prints one line ``gaitval: error: ...`` naming the file, the trial and
+the problem, and exits with status 1; a usage error exits with 2
+(:mod:`gaitval.cli_exit`).  ``-v``/``-q`` before or after the verb: more or less progress.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import logging
 import sys
 from pathlib import Path
 
@@ -24,8 +26,15 @@ def cmd_inspect(a) -> int:
 
 
 def cmd_validate(a) -> int:
-    from gaitval.io.trialsheet import load_trial_sheet
-    df = load_trial_sheet(a.sheet, a.subjects, check_files=not a.no_file_check)
+    from gaitval.io.trialsheet import sheet_problems
+    df, problems = sheet_problems(a.sheet, a.subjects, check_files=not a.no_file_check,
+                                  allow_outside_paths=a.allow_outside_paths or None)
+    if problems:
+        for p in problems:
+            print(f"gaitval: error: {p}", file=sys.stderr)
+        print(f"{a.sheet}: {len(problems)} problem{'s' * (len(problems) > 1)}",
+              file=sys.stderr)
+        return 1
     counts = df.groupby("protocol").size().to_dict()
     print(f"{a.sheet}: {len(df)} trials OK ({', '.join(f'{k}: {v}' for k, v in counts.items())})")
     return 0
@@ -37,6 +46,8 @@ def cmd_simulate(a) -> int:
     if Path(preset).suffix in (".yaml", ".yml") and Path(preset).is_file():
         import yaml
         preset = yaml.safe_load(Path(preset).read_text())
+    logging.getLogger("gaitval").info("simulating study %s into %s (the default preset "
+                                      "takes about a minute) ...", a.preset, a.out)
     sheet = generate_study(Path(a.out), preset, seed=a.seed)
     print(f"wrote {sheet}")
     return 0
@@ -167,6 +178,8 @@ def _add_input_verbs(sub) -> None:
     s.add_argument("sheet")
     s.add_argument("--subjects", help="subject table (default: subjects.csv beside the sheet)")
     s.add_argument("--no-file-check", action="store_true")
+    s.add_argument("--allow-outside-paths", action="store_true",
+                   help="accept paths outside the sheet's folder (default: as study.yaml says)")
     s.set_defaults(func=cmd_validate)
 
     s = sub.add_parser("simulate", help="generate a simulated study (raw files + truth/)")
@@ -388,16 +401,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--reports-dir", default="reports")
     s.add_argument("--studies", nargs="*", default=[])
     s.set_defaults(func=cmd_report)
+    from gaitval.cli_exit import add_verbosity
+    add_verbosity(p, sub)
     return p
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one verb; exit codes 0 ok, 1 data/analysis error, 2 usage (gaitval.cli_exit)."""
+    from gaitval.cli_exit import configure_logging, run_verb
     args = build_parser().parse_args(argv)
-    try:
-        return int(args.func(args) or 0)
-    except GaitvalError as exc:
-        print(f"gaitval: error: {exc}", file=sys.stderr)
-        return 2
+    configure_logging(args.verbose, args.quiet)
+    return run_verb(args.func, args)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -57,10 +57,15 @@ def test_index_lists_items_with_provenance_and_missing_tables(tmp_path):
                             "tables/tug_table4.tex"]
 
 
-def test_cli_user_error_is_one_line_and_exit_2(tmp_path, capsys):
+def test_cli_user_error_is_one_line_per_problem_and_exit_1(tmp_path, capsys):
+    """Exit codes (README): 1 for a data error, 2 for a usage error (issue 15)."""
     sheet = tmp_path / "trials.csv"
     sheet.write_text("study,protocol\nx,tug\n")
     rc = main(["validate", str(sheet)])
     err = capsys.readouterr().err.strip().splitlines()
-    assert rc == 2 and len(err) == 1
-    assert err[0].startswith("gaitval: error: [file ") and "missing required column" in err[0]
+    assert rc == 1 and err[-1].endswith("2 problems")      # every problem, then the count
+    assert all(e.startswith("gaitval: error: [file ") for e in err[:-1])
+    assert "missing required column" in err[0] and "subject table not found" in err[1]
+    with pytest.raises(SystemExit) as exc:
+        main(["validate"])
+    assert exc.value.code == 2

@@ -3,16 +3,21 @@
 The trial sheet is the study manifest a lab fills in: one row per trial.  Its columns and
 types are defined by the JSON schemas ``workflow/schemas/trials.schema.yaml`` and
 ``workflow/schemas/subjects.schema.yaml`` (documented in ``docs/formats.md``).  Paths in the
-sheet are relative to the sheet's folder.
+sheet are relative to the sheet's folder and must stay inside it, unless the study allows
+others (``allow_outside_paths: true`` in the ``study.yaml`` beside the sheet, or the
+``allow_outside_paths`` argument): a sheet cannot make gaitval read ``../../etc/passwd``.
 
-:func:`load_trial_sheet` validates every row against the schema and checks what a schema
-cannot: unique trial ids, subjects present in the subject table, files that exist, a topic
-for every ROS bag.  Any problem raises one :class:`~gaitval.errors.TrialSheetError` naming
-the file, the row (line number and trial id) and the column.
+:func:`sheet_problems` validates every row against the schema and checks what a schema
+cannot: finite numbers, unique trial ids, subjects present in the subject table, files
+that exist and stay inside the sheet's folder, a sensor file that fits the sensor kind, a
+topic for every ROS bag.  It returns *every* problem (``gaitval validate`` lists them all);
+:func:`load_trial_sheet` raises them as one :class:`~gaitval.errors.TrialSheetError`, each
+naming the file, the row (line number and trial id) and the column.
 """
 from __future__ import annotations
 
 import difflib
+import math
 from functools import lru_cache
 from pathlib import Path
 
@@ -20,7 +25,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from gaitval.errors import TrialSheetError
+from gaitval.errors import GaitvalError, TrialSheetError
 
 SCHEMA_DIR = Path(__file__).resolve().parents[2] / "workflow" / "schemas"
 TRUE = {"true", "yes", "1", "y", "t"}
@@ -44,13 +49,17 @@ def _coerce(value: str, spec: dict):
     if v == "":
         return None
     t = spec.get("type")
-    if t == "number":
-        return float(v)
-    if t == "integer":
-        f = float(v)
-        if not f.is_integer():
+    if t in ("number", "integer"):
+        try:
+            f = float(v)
+        except ValueError:
+            raise ValueError(f"{v!r} is not a number") from None
+        if not math.isfinite(f):
+            raise ValueError(f"{v!r} is not a finite number (leave the cell empty when the "
+                             "value is unknown)")
+        if t == "integer" and not f.is_integer():
             raise ValueError(f"{v!r} is not a whole number")
-        return int(f)
+        return int(f) if t == "integer" else f
     if t == "boolean":
         if v.lower() in TRUE:
             return True
@@ -60,53 +69,69 @@ def _coerce(value: str, spec: dict):
     return v
 
 
-def _read_table(path: Path, kind: str, schema: dict) -> tuple[pd.DataFrame, list[dict]]:
+def _read_csv(path: Path, kind: str) -> pd.DataFrame:
+    """The table as strings; TrialSheetError when it is missing or not UTF-8 CSV."""
+    try:
+        if not path.is_file():
+            raise TrialSheetError(f"{kind} not found", path=path)
+        return pd.read_csv(path, dtype=str, keep_default_na=False, comment=None,
+                           encoding="utf-8")
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError,
+            ValueError) as exc:
+        raise TrialSheetError(f"cannot parse {kind} as UTF-8 CSV: {exc}", path=path,
+                              hint="save it as CSV (UTF-8) with a header row") from None
+    except OSError as exc:
+        raise TrialSheetError(f"cannot read {kind}: {exc.strerror or exc}", path=path) from None
+
+
+def _read_table(path: Path, kind: str, schema: dict, problems: list
+                ) -> tuple[pd.DataFrame, list[dict]]:
+    """Rows that pass the schema as typed records (``row_line``: the row's line number);
+    every problem appended to ``problems``."""
     import jsonschema
 
-    if not path.is_file():
-        raise TrialSheetError(f"{kind} not found", path=path)
-    try:
-        raw = pd.read_csv(path, dtype=str, keep_default_na=False, comment=None)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise TrialSheetError(f"cannot parse {kind} as CSV: {exc}", path=path) from None
+    raw = _read_csv(path, kind)
     props = schema["properties"]
-    unknown = [c for c in raw.columns if c not in props]
-    for c in unknown:
+    for c in raw.columns:
         close = difflib.get_close_matches(c, list(props), n=1, cutoff=0.75)
-        if close:
-            raise TrialSheetError(f"unknown column {c!r}; did you mean {close[0]!r}?",
-                                  path=path)
+        if c not in props and close:
+            problems.append(TrialSheetError(f"unknown column {c!r}; did you mean "
+                                            f"{close[0]!r}?", path=path))
     missing = [c for c in schema.get("required", []) if c not in raw.columns]
     if missing:
-        raise TrialSheetError(f"missing required column(s) {missing}", path=path)
+        problems.append(TrialSheetError(f"missing required column(s) {missing}", path=path))
+        return raw, []
     validator = jsonschema.Draft202012Validator(schema)
     records = []
     key = "trial" if "trial" in raw.columns else "subject"
     for i, row in enumerate(raw.to_dict("records")):
-        line = i + 2  # header is line 1
         ident = row.get(key, "")
-        where = f"row {line} ({key} {ident!r})" if ident else f"row {line}"
-        rec = {}
+        where = f"row {i + 2} ({key} {ident!r})" if ident else f"row {i + 2}"  # header: 1
+        trial = ident if key == "trial" and ident else None
+        rec, bad = {}, set()
         for col, val in row.items():
             try:
                 cv = _coerce(str(val), props.get(col, {"type": "string"}))
             except ValueError as exc:
-                raise TrialSheetError(f"{where}, column {col!r}: {exc}", path=path,
-                                      trial=ident if key == "trial" else None) from None
+                problems.append(TrialSheetError(f"{where}, column {col!r}: {exc}", path=path,
+                                                trial=trial))
+                bad.add(col)
+                continue
             if cv is not None:
                 rec[col] = cv
-        errors = sorted(validator.iter_errors(rec), key=lambda e: list(e.path))
-        if errors:
-            e = errors[0]
+        ok = not bad
+        for e in sorted(validator.iter_errors(rec), key=lambda e: list(e.path)):
             col = e.path[0] if e.path else None
-            if e.validator == "required":
-                msg = e.message.replace("is a required property", "is required but empty")
-            else:
-                msg = e.message
+            if e.validator == "required" and any(f"'{c}'" in e.message for c in bad):
+                continue                                  # said already: not a number
+            msg = (e.message.replace("is a required property", "is required but empty")
+                   if e.validator == "required" else e.message)
             colpart = f", column {col!r}" if col is not None else ""
-            raise TrialSheetError(f"{where}{colpart}: {msg}", path=path,
-                                  trial=ident if key == "trial" else None)
-        records.append(rec)
+            problems.append(TrialSheetError(f"{where}{colpart}: {msg}", path=path,
+                                            trial=trial))
+            ok = False
+        if ok:
+            records.append({**rec, "row_line": i + 2})
     return raw, records
 
 
@@ -126,20 +151,159 @@ def _frame(records: list[dict], schema: dict, columns: list[str]) -> pd.DataFram
     return df
 
 
-def load_subjects(path: str | Path) -> pd.DataFrame:
-    """Read and validate a subject table; returns one row per subject (index: subject)."""
-    path = Path(path)
+def _subject_problems(path: Path, problems: list) -> pd.DataFrame:
     schema = load_schema("subjects")
-    raw, records = _read_table(path, "subject table", schema)
-    df = _frame(records, schema, list(raw.columns))
-    dup = df["subject"][df["subject"].duplicated()]
-    if len(dup):
-        raise TrialSheetError(f"subject {dup.iloc[0]!r} appears more than once", path=path)
-    return df.set_index("subject", drop=False)
+    raw, records = _read_table(path, "subject table", schema, problems)
+    df = _frame(records, schema, list(raw.columns) + ["row_line"])
+    for subject, rows in df.groupby("subject", sort=False)["row_line"]:
+        if len(rows) > 1:
+            problems.append(TrialSheetError(f"subject {subject!r} appears on rows "
+                                            f"{[int(r) for r in rows]}", path=path))
+    df = df.drop_duplicates("subject").set_index("subject", drop=False)
+    # subjects on rows with a problem still exist: the sheet's rows need not say so again
+    df.attrs["all_ids"] = set(raw["subject"]) if "subject" in raw.columns else set(df.index)
+    return df
+
+
+def load_subjects(path: str | Path) -> pd.DataFrame:
+    """Read and validate a subject table; returns one row per subject (index: subject).
+
+    Raises
+    ------
+    TrialSheetError
+        Every problem found, each naming the row and column.
+    """
+    problems: list[GaitvalError] = []
+    df = _subject_problems(Path(path), problems)
+    raise_all(problems)
+    return df.drop(columns="row_line")
+
+
+def raise_all(problems: list[GaitvalError]) -> None:
+    """Raise the problems as one TrialSheetError (the first's file; one line each)."""
+    if len(problems) == 1:
+        raise problems[0]
+    if problems:
+        lines = "\n".join(f"  - {p.problem}" for p in problems)
+        raise TrialSheetError(f"{len(problems)} problems:\n{lines}", path=problems[0].path)
+
+
+def _allows_outside(sheet: Path) -> bool:
+    """``allow_outside_paths: true`` in the study.yaml beside the sheet."""
+    cal = sheet.parent / "study.yaml"
+    try:
+        with open(cal, encoding="utf-8") as fh:
+            study = yaml.safe_load(fh)
+    except (OSError, yaml.YAMLError, UnicodeDecodeError):
+        return False
+    return isinstance(study, dict) and study.get("allow_outside_paths") is True
+
+
+def sheet_problems(path: str | Path, subjects: str | Path | None = None, *,
+                   check_files: bool = True, allow_outside_paths: bool | None = None
+                   ) -> tuple[pd.DataFrame, list[GaitvalError]]:
+    """Every problem of a trial sheet and its subject table, and the rows that passed.
+
+    Parameters are those of :func:`load_trial_sheet`.  Returns ``(frame, problems)``;
+    ``frame`` holds the rows without a schema problem (index: trial).
+    """
+    path = Path(path).resolve()
+    problems: list[GaitvalError] = []
+    schema = load_schema("trials")
+    raw, records = _read_table(path, "trial sheet", schema, problems)
+    cols = list(dict.fromkeys(list(schema["properties"]) + list(raw.columns)))
+    df = _frame(records, schema, cols + ["row_line"])
+    for trial, rows in df.groupby("trial", sort=False)["row_line"]:
+        if len(rows) > 1:
+            problems.append(TrialSheetError(f"trial id {trial!r} appears on rows "
+                                            f"{[int(r) for r in rows]}; trial ids must be "
+                                            "unique", path=path, trial=trial))
+    sub_path = Path(subjects) if subjects is not None else path.parent / "subjects.csv"
+    try:
+        subj = _subject_problems(sub_path, problems)
+    except TrialSheetError as exc:
+        problems.append(exc)
+        subj = None
+    if allow_outside_paths is None:
+        allow_outside_paths = _allows_outside(path)
+    for r in df.itertuples(index=False):
+        _row_problems(r, path, subj, sub_path, check_files, allow_outside_paths, problems)
+    for col, new in (("mocap_file", "mocap_path"), ("sensor_file", "sensor_path"),
+                     ("annotation_file", "annotation_path")):
+        df[new] = [_absolute(path.parent, v) for v in df[col]]
+    df = df.drop_duplicates("trial").drop(columns="row_line")
+    return df.set_index("trial", drop=False), problems
+
+
+def _absolute(base: Path, rel: str) -> str:
+    if not rel:
+        return ""
+    try:
+        return str((base / rel).resolve())
+    except (OSError, RuntimeError, ValueError):
+        return str(base / rel)
+
+
+_SENSOR_SUFFIXES = {"ultrasonic": (".us.parquet",),
+                    "lrs": (".scan.parquet", ".bag", ".db3", ".mcap", "")}
+
+
+def _row_problems(r, sheet: Path, subj, sub_path: Path, check_files: bool,
+                  allow_outside: bool, problems: list) -> None:
+    """What a schema cannot check about one row (appended to ``problems``)."""
+    base, where = sheet.parent, f"row {r.row_line} (trial {r.trial!r})"
+
+    def add(col: str, problem: str, hint: str | None = None):
+        problems.append(TrialSheetError(f"{where}, column {col!r}: {problem}", path=sheet,
+                                        trial=r.trial, hint=hint))
+
+    if subj is not None and r.subject not in subj.attrs.get("all_ids", subj.index):
+        add("subject", f"{r.subject!r} is not in the subject table {sub_path}")
+    for col in ("mocap_file", "sensor_file", "annotation_file"):
+        rel = getattr(r, col)
+        if rel:
+            _path_problem(base, rel, col, check_files, allow_outside, add)
+    name = r.sensor_file.lower()
+    if r.sensor_file and not any(name.endswith(x) for x in _SENSOR_SUFFIXES[r.sensor_kind]
+                                 if x) and not _is_dir(base / r.sensor_file):
+        add("sensor_file", f"{r.sensor_file!r} is not a {r.sensor_kind} log (expected "
+            f"{', '.join(x for x in _SENSOR_SUFFIXES[r.sensor_kind] if x)}"
+            f"{' or a ROS 2 bag folder' if r.sensor_kind == 'lrs' else ''})")
+    is_bag = name.endswith(".bag") or _is_dir(base / r.sensor_file)
+    if r.sensor_kind == "lrs" and is_bag and not r.sensor_topic:
+        add("sensor_topic", "a ROS bag needs the LaserScan topic",
+            "run `gaitval inspect FILE` to list the topics")
+
+
+def _is_dir(p: Path) -> bool:
+    try:
+        return p.is_dir()
+    except (OSError, ValueError):
+        return False
+
+
+def _path_problem(base: Path, rel: str, col: str, check_files: bool, allow_outside: bool,
+                  add) -> None:
+    """A path that is too long, leaves the sheet's folder, or names no file."""
+    try:
+        target = (base / rel).resolve()
+        inside = target.is_relative_to(base.resolve())
+        exists = target.exists()
+    except (OSError, RuntimeError, ValueError) as exc:
+        add(col, f"path {rel[:60]!r}{'...' if len(rel) > 60 else ''} cannot be used: "
+            f"{getattr(exc, 'strerror', None) or exc}")
+        return
+    if not inside and not allow_outside:
+        add(col, f"path {rel!r} leads outside the trial sheet's folder {base}",
+            "put the files beside the sheet, or set allow_outside_paths: true in the "
+            "study.yaml beside it (docs/formats.md)")
+    elif check_files and not exists:
+        add(col, f"file {rel!r} not found (looked in {base})")
 
 
 def load_trial_sheet(path: str | Path, subjects: str | Path | None = None, *,
-                     check_files: bool = True) -> pd.DataFrame:
+                     check_files: bool = True, allow_outside_paths: bool | None = None
+                     ) -> pd.DataFrame:
     """Read and validate a trial sheet.
 
     Parameters
@@ -147,6 +311,8 @@ def load_trial_sheet(path: str | Path, subjects: str | Path | None = None, *,
     path : the trial sheet (CSV).
     subjects : the subject table; default ``subjects.csv`` beside the sheet.
     check_files : check that every referenced file exists.
+    allow_outside_paths : accept paths that leave the sheet's folder (absolute paths,
+        ``../``); None: as the ``study.yaml`` beside the sheet says (default: no).
 
     Returns
     -------
@@ -158,38 +324,10 @@ def load_trial_sheet(path: str | Path, subjects: str | Path | None = None, *,
     Raises
     ------
     TrialSheetError
-        Naming the file, row (line number and trial id) and column.
+        Every problem found, each naming the file, row (line number and trial id) and
+        column.
     """
-    path = Path(path).resolve()
-    schema = load_schema("trials")
-    raw, records = _read_table(path, "trial sheet", schema)
-    cols = list(dict.fromkeys(list(schema["properties"]) + list(raw.columns)))
-    df = _frame(records, schema, cols)
-    dup = df["trial"][df["trial"].duplicated()]
-    if len(dup):
-        rows = [int(i) + 2 for i in np.flatnonzero(df["trial"].to_numpy() == dup.iloc[0])]
-        raise TrialSheetError(f"trial id {dup.iloc[0]!r} appears on rows {rows}; trial ids "
-                              "must be unique", path=path)
-    sub_path = Path(subjects) if subjects is not None else path.parent / "subjects.csv"
-    subj = load_subjects(sub_path)
-    base = path.parent
-    for i, r in enumerate(df.itertuples(index=False)):
-        where = f"row {i + 2} (trial {r.trial!r})"
-        if r.subject not in subj.index:
-            raise TrialSheetError(f"{where}, column 'subject': {r.subject!r} is not in the "
-                                  f"subject table {sub_path}", path=path, trial=r.trial)
-        is_bag = r.sensor_file.endswith(".bag") or (base / r.sensor_file).is_dir()
-        if r.sensor_kind == "lrs" and is_bag and not r.sensor_topic:
-            raise TrialSheetError(f"{where}, column 'sensor_topic': a ROS bag needs the "
-                                  "LaserScan topic", path=path, trial=r.trial,
-                                  hint="run `gaitval inspect FILE` to list the topics")
-        if check_files:
-            for col in ("mocap_file", "sensor_file", "annotation_file"):
-                rel = getattr(r, col)
-                if rel and not (base / rel).exists():
-                    raise TrialSheetError(f"{where}, column {col!r}: file {rel!r} not found "
-                                          f"(looked in {base})", path=path, trial=r.trial)
-    for col, new in (("mocap_file", "mocap_path"), ("sensor_file", "sensor_path"),
-                     ("annotation_file", "annotation_path")):
-        df[new] = [str((base / v).resolve()) if v else "" for v in df[col]]
-    return df.set_index("trial", drop=False)
+    df, problems = sheet_problems(path, subjects, check_files=check_files,
+                                  allow_outside_paths=allow_outside_paths)
+    raise_all(problems)
+    return df
