@@ -30,6 +30,7 @@ import pandas as pd
 
 from gaitval.errors import FileFormatError
 from gaitval.io.atomic import write_text
+from gaitval.io.guard import loader, number
 
 MAGIC = "# gaitval-annotations v1"
 COLUMNS = ["t_s", "event", "side", "target", "value", "rater"]
@@ -53,6 +54,7 @@ def write_annotations(path: str | Path, events: pd.DataFrame, *, time_base: str 
     return write_text(path, "\n".join(head) + "\n" + body)
 
 
+@loader("annotation file")
 def read_annotations(path: str | Path, *, trial: str | None = None
                      ) -> tuple[pd.DataFrame, dict]:
     """Read an annotation file.
@@ -68,7 +70,12 @@ def read_annotations(path: str | Path, *, trial: str | None = None
     path = Path(path)
     if not path.is_file():
         raise FileFormatError("annotation file not found", path=path, trial=trial)
-    text = path.read_text(encoding="utf-8")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise FileFormatError(f"not UTF-8 text (byte 0x{exc.object[exc.start]:02X} at "
+                              f"position {exc.start})", path=path, trial=trial,
+                              hint="save it as CSV (UTF-8); see docs/formats.md") from None
     lines = text.splitlines()
     if not lines or lines[0].strip() != MAGIC:
         raise FileFormatError(f"first line must be '{MAGIC}'", path=path, trial=trial,
@@ -94,9 +101,12 @@ def read_annotations(path: str | Path, *, trial: str | None = None
             raise FileFormatError(f"annotation table has no '{c}' column", path=path,
                                   trial=trial)
     t = pd.to_numeric(df["t_s"], errors="coerce")
-    if t.isna().any():
-        row = int(np.flatnonzero(t.isna().to_numpy())[0]) + n_head + 2
-        raise FileFormatError(f"t_s is not a number on line {row}", path=path, trial=trial)
+    bad = ~np.isfinite(t.to_numpy(dtype=np.float64, na_value=np.nan))
+    if bad.any():
+        row = int(np.flatnonzero(bad)[0]) + n_head + 2
+        raise FileFormatError(f"t_s is not a number on line {row} "
+                              f"({df['t_s'].iloc[row - n_head - 2]!r}; times must be finite)",
+                              path=path, trial=trial)
     df["t_s"] = t.astype(float)
     for c in COLUMNS:
         if c not in df:
@@ -107,10 +117,7 @@ def read_annotations(path: str | Path, *, trial: str | None = None
         i = int(np.flatnonzero(bad_side.to_numpy())[0])
         raise FileFormatError(f"side must be L, R or empty, found {df['side'].iloc[i]!r} on "
                               f"line {i + n_head + 2}", path=path, trial=trial)
-    try:
-        offset = float(meta.get("time_offset_s", 0.0))
-    except ValueError:
-        raise FileFormatError("time_offset_s in the header is not a number", path=path,
-                              trial=trial) from None
+    offset = number({"time_offset_s": meta.get("time_offset_s", 0.0)}, "time_offset_s",
+                    path, trial, what="annotation header")
     df["t_mocap_s"] = df["t_s"] + offset
     return df[COLUMNS + ["t_mocap_s"]], meta

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from gaitval.errors import FileFormatError
+from gaitval.io.guard import loader
 
 KINDS = ("c3d", "rosbag", "scanlog", "ultrasonic", "annotations")
 
@@ -36,7 +37,12 @@ def kind_of(path: str | Path) -> str:
 
     p = Path(path)
     name = p.name.lower()
-    if not p.exists():
+    try:
+        found = p.exists()
+    except (OSError, ValueError) as exc:                   # e.g. a name too long
+        raise FileFormatError(f"cannot use this path: {getattr(exc, 'strerror', None) or exc}",
+                              path=str(path)[:200]) from None
+    if not found:
         raise FileFormatError("file not found", path=p)
     if name.endswith(".c3d"):
         return "c3d"
@@ -128,6 +134,7 @@ def _describe_annotations(path: Path) -> dict[str, Any]:
     }
 
 
+@loader("file")
 def describe(path: str | Path, *, topic: str | None = None) -> dict[str, Any]:
     """Describe any supported file (see the module table) as a JSON-serialisable dict.
 

@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from gaitval.errors import FileFormatError
+from gaitval.io.guard import loader
 from gaitval.io.scanlog import check_timestamps, clean_ranges
 from gaitval.types import ScanSeries
 
@@ -149,6 +150,7 @@ def _read_topic(reader, topic: str, path: Path, trial: str | None) -> dict[str, 
     }
 
 
+@loader("ROS bag")
 def read_rosbag_scans(path: str | Path, topic: str | None = None, *,
                       trial: str | None = None) -> ScanSeries:
     """Read one ``sensor_msgs/LaserScan`` topic of a ROS 1 bag or ROS 2 bag folder.
@@ -185,6 +187,7 @@ def read_rosbag_scans(path: str | Path, topic: str | None = None, *,
         d = _read_topic(reader, chosen, path, trial)
     finally:
         reader.close()
+    _check_geometry(d, chosen, path, trial)
     ranges, n_bad = clean_ranges(d["raw"], d["range_min"], d["range_max"])
     return ScanSeries(
         t=d["t"], ranges=ranges, angle_min=d["angle_min"],
@@ -195,6 +198,22 @@ def read_rosbag_scans(path: str | Path, topic: str | None = None, *,
         meta={"topic": chosen, "frame_id": ",".join(d["frame_ids"]),
               "time_source": d["time_source"], "scan_time_s": d["scan_time_s"],
               "time_increment_s": d["time_increment_s"], "format": "rosbag"})
+
+
+def _check_geometry(d: dict, topic: str, path: Path, trial: str | None) -> None:
+    """Finite angles and valid ranges in the first message (what every scan is read with)."""
+    where = f"LaserScan topic {topic}, first message"
+    for key in ("angle_min", "angle_increment", "range_min", "range_max"):
+        if not np.isfinite(d[key]):
+            raise FileFormatError(f"{where}: {key} is {d[key]!r}", path=path, trial=trial)
+    if d["angle_increment"] == 0:
+        raise FileFormatError(f"{where}: angle_increment is 0", path=path, trial=trial)
+    if not 0 <= d["range_min"] < d["range_max"]:
+        raise FileFormatError(f"{where}: range_min {d['range_min']:g} and range_max "
+                              f"{d['range_max']:g} do not make a valid range", path=path,
+                              trial=trial)
+    if not np.all(np.isfinite(d["t"])):
+        raise FileFormatError(f"{where}: timestamps are not finite", path=path, trial=trial)
 
 
 def scan_summary(s: ScanSeries) -> dict[str, Any]:
@@ -226,6 +245,7 @@ def scan_summary(s: ScanSeries) -> dict[str, Any]:
     }
 
 
+@loader("ROS bag")
 def describe_rosbag(path: str | Path, topic: str | None = None, *,
                     trial: str | None = None) -> dict[str, Any]:
     """What gaitval sees in a bag, as a JSON-serialisable dict (for ``gaitval inspect``).

@@ -39,6 +39,7 @@ import pandas as pd
 
 from gaitval.errors import FileFormatError
 from gaitval.io.atomic import atomic_path
+from gaitval.io.guard import json_meta, loader, number
 from gaitval.types import ScanSeries
 
 META_KEY = b"gaitval:scanlog"
@@ -120,24 +121,26 @@ def write_scanlog(path: str | Path, series: ScanSeries, *, range_unit: str = "mm
     return Path(path)
 
 
+@loader("scan log")
 def read_scanlog(path: str | Path, *, trial: str | None = None) -> ScanSeries:
     """Read a gaitval scan log into a :class:`~gaitval.types.ScanSeries` (metres, NaN = no return).
 
     Raises
     ------
     FileFormatError
-        Missing file, not Parquet, missing metadata, or a ``ranges`` column whose length
-        does not match ``n_beams``.
+        Missing file, not Parquet, missing or non-JSON metadata, a metadata field that is
+        missing, not a finite number or contradicts another (``range_min_m`` above
+        ``range_max_m``, ``angle_increment_rad`` 0), a newer version, non-finite
+        timestamps, or a ``ranges`` column whose length does not match ``n_beams``.
     """
     import pyarrow.parquet as pq
-    import pyarrow as pa
 
     path = Path(path)
     if not path.is_file():
         raise FileFormatError("scan log not found", path=path, trial=trial)
     try:
         tab = pq.read_table(path)
-    except (pa.ArrowInvalid, OSError) as exc:
+    except Exception as exc:  # noqa: BLE001 - pyarrow: ArrowInvalid, OSError, ...
         raise FileFormatError(f"not a readable Parquet scan log: {exc}", path=path,
                               trial=trial) from None
     md = tab.schema.metadata or {}
@@ -145,39 +148,74 @@ def read_scanlog(path: str | Path, *, trial: str | None = None) -> ScanSeries:
         raise FileFormatError("Parquet file has no 'gaitval:scanlog' metadata; is it a "
                               "gaitval scan log?", path=path, trial=trial,
                               hint="see docs/formats.md")
-    try:
-        meta = json.loads(md[META_KEY])
-        nb = int(meta["n_beams"])
-        unit = meta["range_unit"]
-        amin = float(meta["angle_min_rad"])
-        ainc = float(meta["angle_increment_rad"])
-        rmin = float(meta["range_min_m"])
-        rmax = float(meta["range_max_m"])
-    except (KeyError, ValueError, TypeError) as exc:
-        raise FileFormatError(f"scan-log metadata incomplete: {exc}", path=path,
-                              trial=trial) from None
-    if meta.get("version", 1) > VERSION:
-        raise FileFormatError(f"scan-log version {meta['version']} is newer than this "
-                              f"gaitval reads ({VERSION})", path=path, trial=trial)
+    meta = json_meta(md[META_KEY], META_KEY.decode(), path, trial)
+    g = _meta_fields(meta, path, trial)
     for col in ("t_s", "ranges"):
         if col not in tab.column_names:
             raise FileFormatError(f"scan log has no '{col}' column", path=path, trial=trial)
-    t = tab["t_s"].to_numpy().astype(np.float64)
-    col = tab["ranges"].combine_chunks()
-    values = col.flatten().to_numpy(zero_copy_only=False)
-    if values.size != nb * len(t):
-        raise FileFormatError(f"ranges hold {values.size} values, expected "
-                              f"{len(t)} scans x {nb} beams", path=path, trial=trial)
-    raw = values.reshape(len(t), nb).astype(np.float64)
-    if unit == "mm":
+    t, raw = _columns(tab, g["n_beams"], path, trial)
+    if g["unit"] == "mm":
         raw = raw / 1000.0
-    elif unit != "m":
-        raise FileFormatError(f"unknown range_unit {unit!r} (expected 'mm' or 'm')",
-                              path=path, trial=trial)
-    ranges, n_bad = clean_ranges(raw, rmin, rmax)
+    ranges, n_bad = clean_ranges(raw, g["rmin"], g["rmax"])
     return ScanSeries(
-        t=t, ranges=ranges, angle_min=amin, angle_increment=ainc, range_min=rmin,
-        range_max=rmax, sensor_model=str(meta.get("sensor_model", "unknown")),
-        mounting_height_m=meta.get("mounting_height_m"), source=str(path),
+        t=t, ranges=ranges, angle_min=g["amin"], angle_increment=g["ainc"],
+        range_min=g["rmin"], range_max=g["rmax"],
+        sensor_model=str(meta.get("sensor_model", "unknown")),
+        mounting_height_m=g["height"], source=str(path),
         timestamp_issues=check_timestamps(t), n_no_return_raw=n_bad,
         meta={k: v for k, v in meta.items() if k not in {"n_beams"}})
+
+
+def _meta_fields(meta: dict, path: Path, trial: str | None) -> dict:
+    """The metadata fields the reader uses, checked (finite, in range, consistent)."""
+    kw = {"path": path, "trial": trial, "what": "scan-log metadata"}
+    version = number(meta, "version", optional=True, **kw)
+    if version is not None and version > VERSION:
+        raise FileFormatError(f"scan-log version {meta['version']} is newer than this "
+                              f"gaitval reads ({VERSION})", path=path, trial=trial)
+    g = {"n_beams": number(meta, "n_beams", above=0, integer=True, **kw),
+         "amin": number(meta, "angle_min_rad", **kw),
+         "ainc": number(meta, "angle_increment_rad", **kw),
+         "rmin": number(meta, "range_min_m", minimum=0, **kw),
+         "rmax": number(meta, "range_max_m", above=0, **kw),
+         "height": number(meta, "mounting_height_m", above=0, optional=True, **kw),
+         "unit": meta.get("range_unit")}
+    if g["ainc"] == 0:
+        raise FileFormatError("scan-log metadata field 'angle_increment_rad' is 0: every "
+                              "beam would point the same way", path=path, trial=trial)
+    if g["rmin"] >= g["rmax"]:
+        raise FileFormatError(f"scan-log metadata: range_min_m ({g['rmin']:g}) is not below "
+                              f"range_max_m ({g['rmax']:g})", path=path, trial=trial)
+    if g["unit"] not in ("mm", "m"):
+        raise FileFormatError(f"unknown range_unit {g['unit']!r} (expected 'mm' or 'm')",
+                              path=path, trial=trial)
+    return g
+
+
+def _columns(tab, nb: int, path: Path, trial: str | None) -> tuple[np.ndarray, np.ndarray]:
+    """``t_s`` (finite) and ``ranges`` as (n_scans, n_beams) float64."""
+    import pyarrow as pa
+
+    try:
+        t = tab["t_s"].to_numpy().astype(np.float64)
+    except (pa.ArrowException, ValueError, TypeError) as exc:
+        raise FileFormatError(f"column 't_s' is not numeric: {exc}", path=path,
+                              trial=trial) from None
+    bad = np.flatnonzero(~np.isfinite(t))
+    if bad.size:
+        raise FileFormatError(f"column 't_s' holds {t[bad[0]]!r} at scan {int(bad[0])}; "
+                              "timestamps must be finite", path=path, trial=trial)
+    col = tab["ranges"].combine_chunks()
+    if not pa.types.is_list(col.type) and not pa.types.is_fixed_size_list(col.type) \
+            and not pa.types.is_large_list(col.type):
+        raise FileFormatError(f"column 'ranges' is {col.type}, not a list of ranges per "
+                              "scan", path=path, trial=trial)
+    values = col.flatten()
+    if not (pa.types.is_integer(values.type) or pa.types.is_floating(values.type)):
+        raise FileFormatError(f"column 'ranges' holds {values.type}, not numbers",
+                              path=path, trial=trial)
+    values = values.to_numpy(zero_copy_only=False)
+    if values.size != nb * len(t) or col.null_count:
+        raise FileFormatError(f"ranges hold {values.size} values, expected "
+                              f"{len(t)} scans x {nb} beams", path=path, trial=trial)
+    return t, values.reshape(len(t), nb).astype(np.float64)

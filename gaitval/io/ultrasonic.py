@@ -40,6 +40,7 @@ import pandas as pd
 
 from gaitval.errors import FileFormatError, TimestampError
 from gaitval.io.atomic import atomic_path
+from gaitval.io.guard import json_meta, loader, number
 from gaitval.io.scanlog import check_timestamps
 from gaitval.types import UltrasonicLog
 
@@ -141,9 +142,18 @@ def write_ultrasonic(path: str | Path, log: UltrasonicLog, *, transmitter: str =
     return Path(path)
 
 
+@loader("ultrasonic log")
 def read_ultrasonic(path: str | Path, *, trial: str | None = None) -> UltrasonicLog:
-    """Read an ultrasonic log in gaitval's format (seconds, metres, degC; NaN = no echo)."""
-    import pyarrow as pa
+    """Read an ultrasonic log in gaitval's format (seconds, metres, degC; NaN = no echo).
+
+    Raises
+    ------
+    FileFormatError
+        Missing file, not Parquet, missing or non-JSON metadata, anchors that are not a
+        list of ``{anchor, x_m, y_m, z_m}`` with finite coordinates and distinct names, an
+        unknown ``quantity``, missing or non-numeric columns, non-finite times or
+        temperatures (the row is named).
+    """
     import pyarrow.parquet as pq
 
     path = Path(path)
@@ -151,21 +161,18 @@ def read_ultrasonic(path: str | Path, *, trial: str | None = None) -> Ultrasonic
         raise FileFormatError("ultrasonic log not found", path=path, trial=trial)
     try:
         tab = pq.read_table(path)
-    except (pa.ArrowInvalid, OSError) as exc:
+    except Exception as exc:  # noqa: BLE001 - pyarrow: ArrowInvalid, OSError, ...
         raise FileFormatError(f"not a readable Parquet ultrasonic log: {exc}", path=path,
                               trial=trial) from None
     md = tab.schema.metadata or {}
     if META_KEY not in md:
         raise FileFormatError("Parquet file has no 'gaitval:ultrasonic' metadata",
                               path=path, trial=trial, hint="see docs/formats.md")
-    meta = json.loads(md[META_KEY])
-    try:
-        anchors = pd.DataFrame(meta["anchors"])[["anchor", "x_m", "y_m", "z_m"]]
-        quantity = meta["quantity"]
-    except (KeyError, TypeError) as exc:
-        raise FileFormatError(f"ultrasonic metadata incomplete: {exc}", path=path,
-                              trial=trial) from None
-    fmt = {"tof": "tof_{}_s", "distance": "dist_{}_m"}.get(quantity)
+    meta = json_meta(md[META_KEY], META_KEY.decode(), path, trial)
+    anchors = _anchors(meta, path, trial)
+    quantity = meta.get("quantity")
+    fmt = {"tof": "tof_{}_s", "distance": "dist_{}_m"}.get(quantity) \
+        if isinstance(quantity, str) else None
     if fmt is None:
         raise FileFormatError(f"unknown quantity {quantity!r} (expected 'tof' or "
                               "'distance')", path=path, trial=trial)
@@ -174,17 +181,59 @@ def read_ultrasonic(path: str | Path, *, trial: str | None = None) -> Ultrasonic
     if missing:
         raise FileFormatError(f"ultrasonic log lacks columns {missing}", path=path,
                               trial=trial)
-    df = tab.select(need).to_pandas()
-    data = df[need[2:]].to_numpy(dtype=np.float64, copy=True)
+    cols = _numeric_columns(tab, need, path, trial)
+    data = np.column_stack([cols[c] for c in need[2:]]) if len(need) > 2 else \
+        np.empty((len(cols["t_s"]), 0))
     with np.errstate(invalid="ignore"):
         data[~np.isfinite(data) | (data <= 0)] = np.nan
-    t = df["t_s"].to_numpy(dtype=np.float64)
-    issues = check_timestamps(t)
-    log = UltrasonicLog(t=t, temperature_c=df["temperature_c"].to_numpy(dtype=np.float64),
+    t = cols["t_s"]
+    log = UltrasonicLog(t=t, temperature_c=cols["temperature_c"],
                         anchors=anchors.reset_index(drop=True), source=str(path),
-                        meta={**meta, "timestamp_issues": issues})
+                        meta={**meta, "timestamp_issues": check_timestamps(t)})
     if quantity == "tof":
         log.tof_s = data
     else:
         log.distance_m = data
     return log
+
+
+def _anchors(meta: dict, path: Path, trial: str | None) -> pd.DataFrame:
+    """``meta["anchors"]`` checked: a list of objects with a name and finite x, y, z."""
+    raw = meta.get("anchors")
+    if not isinstance(raw, list) or not raw:
+        raise FileFormatError(f"ultrasonic metadata incomplete: 'anchors' must be a "
+                              f"non-empty list, not {type(raw).__name__}", path=path,
+                              trial=trial)
+    rows = []
+    for k, a in enumerate(raw):
+        if not isinstance(a, dict) or not isinstance(a.get("anchor"), (str, int)):
+            raise FileFormatError(f"ultrasonic metadata: anchor {k} must be an object with "
+                                  "a name 'anchor'", path=path, trial=trial)
+        xyz = [number(a, c, path, trial, what=f"ultrasonic metadata: anchor {a['anchor']!r}")
+               for c in ("x_m", "y_m", "z_m")]
+        rows.append((str(a["anchor"]), *xyz))
+    df = pd.DataFrame(rows, columns=["anchor", "x_m", "y_m", "z_m"])
+    if df["anchor"].duplicated().any():
+        raise FileFormatError(f"ultrasonic metadata: anchor "
+                              f"{df['anchor'][df['anchor'].duplicated()].iloc[0]!r} is listed "
+                              "twice", path=path, trial=trial)
+    return df
+
+
+def _numeric_columns(tab, names: list[str], path: Path, trial: str | None
+                     ) -> dict[str, np.ndarray]:
+    """Columns as float64; times and temperatures must be finite (the row is named)."""
+    out = {}
+    for c in names:
+        try:
+            out[c] = np.asarray(tab[c].to_numpy(), dtype=np.float64).copy()
+        except Exception as exc:  # noqa: BLE001 - pyarrow/numpy conversion of odd types
+            raise FileFormatError(f"column {c!r} is not numeric ({exc})", path=path,
+                                  trial=trial) from None
+        if c in ("t_s", "temperature_c"):
+            bad = np.flatnonzero(~np.isfinite(out[c]))
+            if bad.size:
+                raise FileFormatError(f"column {c!r} holds {out[c][bad[0]]!r} at row "
+                                      f"{int(bad[0])}; it must be finite", path=path,
+                                      trial=trial)
+    return out

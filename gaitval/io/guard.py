@@ -1,0 +1,82 @@
+"""Shared checks of the loaders: numbers from metadata, and the last line of defence.
+
+Every loader checks the fields it reads and raises :class:`~gaitval.errors.FileFormatError`
+naming the file and the field.  :func:`loader` wraps a loader so that anything it did not
+foresee (a library's own exception on a file nobody imagined) still reaches the user as a
+FileFormatError naming the file, never a traceback; such an error carries
+``unexpected = True`` so the fuzz harness (``tests/fuzz/``) counts it as a gap to close.
+"""
+from __future__ import annotations
+
+import functools
+import json
+import math
+from pathlib import Path
+from typing import Any, Callable
+
+from gaitval.errors import FileFormatError, GaitvalError
+
+
+def loader(kind: str) -> Callable:
+    """Decorator: ``f(path, *args, trial=None, **kw)`` raises only GaitvalError."""
+    def deco(func: Callable) -> Callable:
+        @functools.wraps(func)
+        def wrapper(path, *args, **kw):
+            try:
+                return func(path, *args, **kw)
+            except GaitvalError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - anything else: still name the file
+                err = FileFormatError(f"cannot read this {kind}: {type(exc).__name__}: "
+                                      f"{str(exc)[:300]}", path=path, trial=kw.get("trial"),
+                                      hint="check the file with `gaitval inspect`; if it "
+                                           "looks right, please report it")
+                err.unexpected = True
+                raise err from None
+        return wrapper
+    return deco
+
+
+def json_meta(raw: bytes, key: str, path: Path, trial: str | None) -> dict[str, Any]:
+    """Parse a JSON metadata object; FileFormatError naming ``key`` otherwise."""
+    try:
+        meta = json.loads(raw)
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise FileFormatError(f"metadata {key!r} is not valid JSON: {exc}", path=path,
+                              trial=trial) from None
+    if not isinstance(meta, dict):
+        raise FileFormatError(f"metadata {key!r} must be a JSON object, not "
+                              f"{type(meta).__name__}", path=path, trial=trial)
+    return meta
+
+
+def number(meta: dict, key: str, path: Path, trial: str | None, *, what: str = "metadata",
+           minimum: float | None = None, above: float | None = None,
+           optional: bool = False, integer: bool = False) -> float | int | None:
+    """``meta[key]`` as a finite number within bounds; FileFormatError naming the field."""
+    v = meta.get(key)
+    if v is None:
+        if optional:
+            return None
+        raise FileFormatError(f"{what} incomplete: field {key!r} is missing", path=path,
+                              trial=trial,
+                              hint="see docs/formats.md")
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        if isinstance(v, str):
+            try:
+                v = float(v)
+            except ValueError:
+                v = None
+        if not isinstance(v, float):
+            raise FileFormatError(f"{what} field {key!r} is {meta.get(key)!r}, not a number",
+                                  path=path, trial=trial)
+    v = float(v)
+    bad = (not math.isfinite(v) or (minimum is not None and v < minimum)
+           or (above is not None and v <= above) or (integer and not v.is_integer()))
+    if bad:
+        bounds = (f" >= {minimum:g}" if minimum is not None else "") + \
+                 (f" > {above:g}" if above is not None else "")
+        raise FileFormatError(f"{what} field {key!r} is {meta.get(key)!r}; it must be a "
+                              f"finite {'whole ' if integer else ''}number{bounds}",
+                              path=path, trial=trial)
+    return int(v) if integer else v
