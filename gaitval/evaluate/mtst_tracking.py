@@ -25,8 +25,9 @@ Rater events (the paper's reference; a study without mocap)
     consecutive annotated contacts matched only by the other leg's system contacts is a
     **false (swap)**; ``min_run`` consecutive annotated contacts with no system contact of
     either leg is **lost**; ``min_run`` consecutive system contacts of a leg that match no
-    annotated contact is **false (other object)** — a track that steps where and when the
-    participant did not (the attendant's cadence, the stick).  One miss alone is a contact
+    annotated contact (nor stands in for the other leg's, as in a swap) is **false (other
+    object)** — a track that steps where and when the participant did not (the
+    attendant's cadence, the stick).  One miss alone is a contact
     error (Table 4), two in a row mean the track did not follow the leg through a gait
     cycle.
 
@@ -126,6 +127,7 @@ def tracking_vs_annotations(steps: pd.DataFrame, contacts: pd.DataFrame,
         The system contacts, with ``matched`` (bool: paired with an annotated contact).
     """
     n = int(_cfg(cfg)["min_run"])
+    swapped = steps.loc[steps["match"] < 0, "match_other"].to_numpy(int)
     rows = []
     for side in ("L", "R"):
         s = steps[steps["side"] == side].sort_values("t_ann_s")
@@ -137,7 +139,9 @@ def tracking_vs_annotations(steps: pd.DataFrame, contacts: pd.DataFrame,
                 rows.append((side, kind, float(t[i]), float(t[min(i + n, len(t)) - 1])))
         c = contacts[contacts["side"] == side].sort_values("t_sensor_s")
         tc = c["t_sensor_s"].to_numpy(float)
-        for i in _run_starts(~c["matched"].to_numpy(bool), n):
+        # a contact in the other leg's window is a swap's, not another object's
+        foreign = ~c["matched"].to_numpy(bool) & ~np.isin(c.index.to_numpy(), swapped)
+        for i in _run_starts(foreign, n):
             rows.append((side, "false_other", float(tc[i]), float(tc[min(i + n, len(tc)) - 1])))
     out = pd.DataFrame([r + ("annotations",) for r in rows], columns=list(EVENT_COLUMNS))
     return _verdict(out), out.sort_values("t_start_s", kind="stable").reset_index(drop=True)

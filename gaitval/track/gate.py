@@ -54,6 +54,19 @@ class Gate:
                 enumerate(zip(filter.lam2_all(prior, obs), obs), 1)
                 if admits(lam2, math.hypot(zx - px, zy - py), ctx)]
 
+    @staticmethod
+    def within_radius(filter, prior, obs, r: float) -> list[tuple[int, float]]:
+        """``(j, λ²)`` of the observations closer than ``r`` to the prediction (seed001
+        eq. (5)); λ² only for those (the radius gates' fast path, same result as
+        :meth:`candidates` with ``admits = dist < r``)."""
+        px, py = filter.pos(prior)
+        r2 = r * r
+        inside = [j for j, (zx, zy) in enumerate(obs, 1)
+                  if (zx - px) * (zx - px) + (zy - py) * (zy - py) < r2]
+        if not inside:
+            return []
+        return list(zip(inside, filter.lam2_all(prior, [obs[j - 1] for j in inside])))
+
 
 @GATES.register("chi2")
 class ChiSquareGate(Gate):
@@ -94,6 +107,9 @@ class FixedRadiusGate(Gate):
 
     def admits(self, lam2, dist, ctx):
         return dist < self.radius(ctx)              # seed001 eq. (5)
+
+    def candidates(self, filter, prior, obs, ctx):
+        return self.within_radius(filter, prior, obs, self.radius(ctx))   # seed001 eq. (5)
 
 
 @GATES.register("variable_region")
@@ -144,3 +160,6 @@ class VariableValidationRegion(Gate):
 
     def admits(self, lam2, dist, ctx):
         return dist < self.radius(ctx)              # seed001 eq. (5)
+
+    def candidates(self, filter, prior, obs, ctx):
+        return self.within_radius(filter, prior, obs, self.radius(ctx))   # seed001 eq. (5)
