@@ -501,3 +501,68 @@ def test_peer_table_published_file_has_no_participants(realdata):
     ref = sps.linregress(a, df["us_cadence"] - df["gt_cadence"])    # scipy reference call
     assert t.loc["cadence", "prop_bias_slope"] == pytest.approx(ref.slope, rel=1e-10)
     assert t.loc["cadence", "prop_bias_p"] == pytest.approx(ref.pvalue, rel=1e-10)
+
+
+# --------------------------------------------------------------------------- ultrasonic
+def _gait_params(seed: int = 4) -> pd.DataFrame:
+    """Gait-parameter table (tables.ultrasonic_params contract): 4 subjects x 8 strides
+    per speed, each subject with its own bias of the system (so strides are clustered)."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    for s in range(1, 5):
+        bias = {p: rng.normal(0, 0.02) for p in ("stride_length", "stride_duration",
+                                                 "stride_velocity", "h_symmetry",
+                                                 "v_symmetry")}
+        for speed in ("slow", "normal", "fast"):
+            for k in range(8):
+                for p, b in bias.items():
+                    ref = 1.0 + 0.05 * rng.normal()
+                    rows.append(dict(study="t", trial=f"S{s}_{speed}", subject=f"S{s}",
+                                     speed=speed, stride=k, parameter=p, unit="-",
+                                     reference=ref, system=ref + b + 0.01 * rng.normal()))
+    return pd.DataFrame(rows)
+
+
+def test_ultrasonic_table2_agreement_columns_come_from_the_stats_functions():
+    from gaitval.stats import agreement
+    from gaitval.tables.ultrasonic import table2
+    from gaitval.tables.ultrasonic_subjects import agreement_note
+    gp = _gait_params()
+    t = table2(gp).set_index("subject")
+    sub = gp[(gp["parameter"] == "stride_length") & (gp["speed"] == "normal")]
+    rm = loa_nested(sub, "reference", "system", "subject").iloc[0]
+    pooled = agreement(sub, "reference", "system").iloc[0]
+    avg = t.loc["average"]
+    assert avg["loa_low_rm_m"] == rm["loa_low"] and avg["loa_high_rm_m"] == rm["loa_high"]
+    assert avg["loa_high_rm_ci_high_m"] == rm["loa_high_ci_high"]
+    assert avg["sd_between_rm_m"] == pytest.approx(np.sqrt(rm["var_between"]))
+    assert avg["loa_low_m"] == pooled["loa_low"]                  # all strides pooled
+    assert avg["loa_high_ci_high_m"] == pooled["loa_high_ci_high"]
+    s1 = sub[sub["subject"] == "S1"]
+    ba = bland_altman(s1["reference"], s1["system"])              # S1's own strides
+    assert t.loc["S1", "loa_low_m"] == pytest.approx(ba["loa_low"], rel=1e-12)
+    assert np.isnan(t.loc["S1", "loa_low_rm_m"]) and np.isnan(t.loc["peak", "loa_low_m"])
+    # subjects differ in bias, so the repeated-measures limits are wider, their CIs longer
+    assert avg["loa_width_ratio"] > 1 and avg["loa_ci_ratio"] > 1
+    note = agreement_note(table2(gp), "stride_length")
+    assert f"{avg['loa_width_ratio']:.2f} times as wide" in note
+    assert "4 subjects, 32 strides" in note
+
+
+def test_ultrasonic_agreement_table_rows_and_figure(tmp_path):
+    from gaitval.report.stats_figures import bland_altman_figure
+    from gaitval.tables.ultrasonic_agreement import agreement_table
+    gp = _gait_params()
+    t = agreement_table(gp)
+    assert len(t) == 15 and set(t["speed"]) == {"slow", "normal", "fast"}
+    row = t[(t["parameter"] == "stride_duration") & (t["speed"] == "fast")].iloc[0]
+    sub = gp[(gp["parameter"] == "stride_duration") & (gp["speed"] == "fast")]
+    ic = icc_mixed(sub, ["reference", "system"], subject="subject").iloc[0]
+    assert row["icc_agreement_rm"] == ic["icc_agreement"]
+    assert row["var_stride_rm"] == ic["var_occasion"] and row["n_subjects"] == 4
+    # the figure colours points by subject and draws both sets of limits; same bytes
+    a = bland_altman_figure(sub, "reference", "system", tmp_path / "a.png",
+                            subject="subject")
+    b = bland_altman_figure(sub, "reference", "system", tmp_path / "b.png",
+                            subject="subject", limits=row)
+    assert a.read_bytes() == b.read_bytes()

@@ -6,8 +6,10 @@
 - :func:`figure5_speed_effects` — like Figure 5: mean ± std at slow / normal / fast speed
   for reference and system, ``*`` where a paired t-test against normal speed gives
   p < 0.05 (from :func:`gaitval.tables.ultrasonic.table8`).
-- :func:`bland_altman_figure` — one Bland–Altman plot (bias, limits of agreement and their
-  95% CIs from :func:`gaitval.stats.agreement`).
+- :func:`bland_altman_figure` — one Bland–Altman plot: points coloured by subject, the
+  pooled bias and limits (every stride independent, :func:`gaitval.stats.agreement`) and
+  the repeated-measures ones (subjects as a random effect, :func:`gaitval.stats.loa_nested`)
+  with their 95% CIs, as :mod:`gaitval.tables.ultrasonic_agreement` tabulates them.
 
 Every figure is written with :func:`gaitval.report.figures.save_figure` (deterministic
 PNG).  The figures take the tidy tables; they never recompute a statistic the tables hold.
@@ -20,9 +22,10 @@ import numpy as np
 import pandas as pd
 
 from gaitval.report.figures import plt, save_figure
-from gaitval.stats import agreement
+from gaitval.stats import agreement, loa_nested
 from gaitval.tables.ultrasonic import (PARAM_INFO, PARAMETERS, SPEEDS, SUMMARY_PARAMETERS,
                                        _subject_order, check_gait_params, table8)
+from gaitval.tables.ultrasonic_agreement import POOLED, REPEATED, agreement_table
 
 
 def _label(param: str) -> str:
@@ -114,30 +117,111 @@ def figure5_speed_effects(table8_df: pd.DataFrame, path: str | Path) -> Path:
     return save_figure(fig, path)
 
 
-def bland_altman_figure(df: pd.DataFrame, ref: str, pro: str, path: str | Path,
-                        title: str = "", unit: str = "") -> Path:
-    """Bland–Altman plot: difference vs mean with bias, limits of agreement and 95% CIs."""
+def _limits(df: pd.DataFrame, ref: str, pro: str, subject: str | None) -> dict:
+    """Pooled (and, with subjects, repeated-measures) limits named as the agreement table."""
     a = agreement(df, ref, pro).iloc[0]
+    out = {c: float(a[src]) for c, src in POOLED.items()}
+    if subject is not None:
+        rm = loa_nested(df, ref, pro, subject).iloc[0]
+        out.update({c: float(rm[src]) for c, src in REPEATED.items()})
+    return out
+
+
+def bland_altman_figure(df: pd.DataFrame, ref: str, pro: str, path: str | Path,
+                        title: str = "", unit: str = "", subject: str | None = None,
+                        limits=None) -> Path:
+    """Bland–Altman plot: difference vs mean, pooled and repeated-measures limits.
+
+    Parameters
+    ----------
+    df : DataFrame
+        One row per pair.
+    ref, pro : str
+        Reference and system columns; the plot shows ``pro − ref`` against their mean.
+    path : path
+        PNG to write.
+    title, unit : str
+        Title (default: the limits) and unit of the axes.
+    subject : str, optional
+        Subject column: points are coloured by subject and the repeated-measures bias and
+        limits (subjects as a random effect) are drawn beside the pooled ones.
+    limits : mapping, optional
+        The row of :func:`gaitval.tables.ultrasonic_agreement.agreement_table` for these
+        pairs (``bias``, ``loa_low`` … and the ``*_rm`` columns); computed when omitted.
+
+    Notes
+    -----
+    Pooled (every pair independent): grey, dashed limits, grey bands for the 95% CIs.
+    Repeated measures: black, solid limits, 95% CIs as bars at the right edge (with few
+    subjects they can be far wider than the points, so they are not drawn as bands).
+    """
+    lim = dict(limits) if limits is not None else _limits(df, ref, pro, subject)
     r = pd.to_numeric(df[ref], errors="coerce").to_numpy(dtype=float)
     p = pd.to_numeric(df[pro], errors="coerce").to_numpy(dtype=float)
     ok = np.isfinite(r) & np.isfinite(p)
     mean, diff = (r[ok] + p[ok]) / 2, p[ok] - r[ok]
-    fig, ax = plt.subplots(figsize=(5, 4))
-    ax.scatter(mean, diff, s=10, color="k")
-    for key, style in (("bias", "-"), ("loa_low", "--"), ("loa_high", "--")):
-        if np.isfinite(a[key]):
-            ax.axhline(a[key], color="k", ls=style, lw=1)
-    for lo, hi in (("bias_ci_low", "bias_ci_high"), ("loa_low_ci_low", "loa_low_ci_high"),
-                   ("loa_high_ci_low", "loa_high_ci_high")):
-        if np.isfinite(a[lo]) and np.isfinite(a[hi]):
-            ax.axhspan(a[lo], a[hi], color="0.85", zorder=0)
+    fig, ax = plt.subplots(figsize=(6, 4.2))
+    if subject is not None:
+        subs = df[subject].astype(str).to_numpy()[ok]
+        order = _subject_order(subs)
+        cmap = plt.get_cmap("tab10" if len(order) <= 10 else "tab20")
+        for i, s in enumerate(order):
+            sel = subs == s
+            ax.scatter(mean[sel], diff[sel], s=10, color=cmap(i % cmap.N), label=s)
+    else:
+        ax.scatter(mean, diff, s=10, color="k")
+    _pooled_lines(ax, lim)
+    has_rm = subject is not None and np.isfinite(lim.get("loa_low_rm", np.nan))
+    if has_rm:
+        _repeated_lines(ax, lim, mean)
     u = f" ({unit})" if unit and unit != "-" else ""
     ax.set_xlabel(f"mean of reference and system{u}")
     ax.set_ylabel(f"system - reference{u}")
-    ax.set_title(title or f"{pro} vs {ref}: bias {a['bias']:.3g}, "
-                 f"LoA [{a['loa_low']:.3g}, {a['loa_high']:.3g}]", fontsize=9)
+    text = (f"pooled: bias {lim['bias']:.3g}, LoA [{lim['loa_low']:.3g}, "
+            f"{lim['loa_high']:.3g}]")
+    if has_rm:
+        text += (f"\nrepeated measures: bias {lim['bias_rm']:.3g}, LoA "
+                 f"[{lim['loa_low_rm']:.3g}, {lim['loa_high_rm']:.3g}]")
+    ax.set_title((title + "\n" if title else "") + text, fontsize=8)
+    ax.legend(fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     fig.tight_layout()
     return save_figure(fig, path)
+
+
+def _pooled_lines(ax, lim: dict) -> None:
+    """Pooled bias (thin) and limits (dashed) in grey, their 95% CIs as grey bands."""
+    for key, style, label in (("bias", "-", "pooled bias"),
+                              ("loa_low", "--", "pooled limits (strides independent)"),
+                              ("loa_high", "--", None)):
+        if np.isfinite(lim.get(key, np.nan)):
+            ax.axhline(lim[key], color="0.5", ls=style, lw=1, label=label)
+    for lo, hi in (("bias_ci_low", "bias_ci_high"), ("loa_low_ci_low", "loa_low_ci_high"),
+                   ("loa_high_ci_low", "loa_high_ci_high")):
+        if np.isfinite(lim.get(lo, np.nan)) and np.isfinite(lim.get(hi, np.nan)):
+            ax.axhspan(lim[lo], lim[hi], color="0.9", zorder=0)
+
+
+def _repeated_lines(ax, lim: dict, mean: np.ndarray) -> None:
+    """Repeated-measures bias and limits in black; 95% CIs as capped bars at the right.
+
+    The bars stand beside the points (bias, lower limit, upper limit from left to right)
+    and are cut by the axes when, with few subjects, they are far wider than the data.
+    """
+    ax.axhline(lim["bias_rm"], color="k", lw=1, label="repeated-measures bias")
+    ax.axhline(lim["loa_low_rm"], color="k", lw=1.6,
+               label="repeated-measures limits (subjects random)")
+    ax.axhline(lim["loa_high_rm"], color="k", lw=1.6)
+    ylo, yhi = ax.get_ylim()
+    ylo, yhi = min(ylo, lim["loa_low_rm"]), max(yhi, lim["loa_high_rm"])
+    span = float(np.ptp(mean)) if mean.size > 1 and np.ptp(mean) > 0 else 1.0
+    x0 = (float(np.max(mean)) if mean.size else 0.0) + 0.05 * span
+    for i, key in enumerate(("bias_rm", "loa_low_rm", "loa_high_rm")):
+        lo, hi = lim.get(f"{key}_ci_low", np.nan), lim.get(f"{key}_ci_high", np.nan)
+        if np.isfinite(lo) and np.isfinite(hi):
+            ax.errorbar([x0 + 0.04 * span * i], [lim[key]], yerr=[[lim[key] - lo],
+                        [hi - lim[key]]], fmt="none", ecolor="k", elinewidth=0.8,
+                        capsize=2, label="95% CIs, repeated measures" if i == 0 else None)
+    ax.set_ylim(ylo, yhi)
 
 
 def write_ultrasonic_figures(gait_params: pd.DataFrame, out_dir: str | Path,
@@ -145,18 +229,22 @@ def write_ultrasonic_figures(gait_params: pd.DataFrame, out_dir: str | Path,
     """Write Figure A1-, B1- and 5-like figures and one Bland–Altman plot per parameter.
 
     Files: ``ultrasonic_figA1.png``, ``ultrasonic_figB1.png``, ``ultrasonic_fig5.png``,
-    ``ultrasonic_bland_altman_<parameter>.png`` (strides at ``speed``).
+    ``ultrasonic_bland_altman_<parameter>.png`` (strides at ``speed``, coloured by subject,
+    pooled and repeated-measures limits from
+    :func:`gaitval.tables.ultrasonic_agreement.agreement_table`).
     """
     out_dir = Path(out_dir)
     df = check_gait_params(gait_params)
     paths = [figure_a1_histograms(df, out_dir / "ultrasonic_figA1.png", speed),
              figure_b1_boxplots(df, out_dir / "ultrasonic_figB1.png", speed),
              figure5_speed_effects(table8(df), out_dir / "ultrasonic_fig5.png")]
+    limits = agreement_table(df, parameters=PARAMETERS, speeds=[speed])
     for p in PARAMETERS:
         sub = df[(df["parameter"] == p) & (df["speed"] == speed)]
         if sub.empty:
             continue
         paths.append(bland_altman_figure(
             sub, "reference", "system", out_dir / f"ultrasonic_bland_altman_{p}.png",
-            title=f"Bland-Altman: {_label(p)}, {speed} speed", unit=PARAM_INFO[p][2]))
+            title=f"Bland-Altman: {_label(p)}, {speed} speed", unit=PARAM_INFO[p][2],
+            subject="subject", limits=limits[limits["parameter"] == p].iloc[0]))
     return paths

@@ -253,7 +253,8 @@ def _reml_fit(y: np.ndarray, X: np.ndarray, codes: np.ndarray) -> tuple[float, f
                               method="bounded", options={"xatol": 1e-10})
         if res.fun <= vals[i]:
             lam = float(np.exp(res.x))
-    s2w = profiled(lam)[1]
+    with np.errstate(divide="ignore"):
+        s2w = profiled(lam)[1]
     return lam * s2w, s2w
 
 
@@ -704,11 +705,15 @@ def _icc_two_raters(y: np.ndarray, codes: np.ndarray | None) -> dict:
         delta, var_delta = float(np.mean(dif)), vd_w / N
         occ = float("nan")
     else:
-        fd = _fit_random_intercept(dif, one, codes, np.ones(1))
         fm = _fit_random_intercept(mean, one, codes, np.ones(1))
-        vd_b, vd_w, vm_b, vm_w = (fd["var_between"], fd["var_within"], fm["var_between"],
-                                  fm["var_within"])
-        delta, var_delta = fd["estimate"], fd["se"] ** 2
+        vm_b, vm_w = fm["var_between"], fm["var_within"]
+        if np.ptp(dif) == 0:                    # the raters agree exactly: no error
+            vd_b = vd_w = var_delta = 0.0
+            delta = float(dif[0])
+        else:
+            fd = _fit_random_intercept(dif, one, codes, np.ones(1))
+            vd_b, vd_w = fd["var_between"], fd["var_within"]
+            delta, var_delta = fd["estimate"], fd["se"] ** 2
         occ = max(vm_w - vd_w / 4, 0.0)                         # σ²_o = V_m,w − σ²_e/2
     res = vd_w / 2                                              # σ²_e = V_d,w / 2
     sr = vd_b / 2 if codes is not None else float("nan")        # σ²_sr = V_d,b / 2

@@ -29,8 +29,8 @@ from gaitval.tables.ultrasonic_params import (CITATION, GAIT_PARAM_COLUMNS, PARA
                                               TABLE_PARAMETER, check_gait_params,
                                               subject_order)
 from gaitval.tables.ultrasonic_stats import table7, table8, tableC1
-from gaitval.tables.ultrasonic_subjects import (subject_table, table2, table3, table4,
-                                                table5, table6)
+from gaitval.tables.ultrasonic_subjects import (agreement_note, subject_table, table2,
+                                                table3, table4, table5, table6)
 
 __all__ = ["CITATION", "GAIT_PARAM_COLUMNS", "PARAM_INFO", "PARAMETERS", "SPEEDS",
            "SUMMARY_PARAMETERS", "TABLE_PARAMETER", "build_ultrasonic_tables",
@@ -119,8 +119,11 @@ def write_ultrasonic_tables(gait_params_df: pd.DataFrame, out_dir: str | Path) -
     out_dir = Path(out_dir)
     caps = _captions()
     paths: list[Path] = []
+    per_subject = {f"table{k}": p for k, p in TABLE_PARAMETER.items()}
     for name, table in build_ultrasonic_tables(gait_params_df).items():
         caption, notes = caps[name]
+        if name in per_subject:                 # pooled vs repeated-measures limits
+            notes = [*notes, agreement_note(table, per_subject[name])]
         paths += write_table(table, out_dir / f"ultrasonic_{name}", caption=caption,
                              notes=notes, digits=5 if name == "tableC1" else 3)
     return paths

@@ -11,10 +11,26 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from scipy import stats as sps
+
 from gaitval.stats import error_summary
 from gaitval.tables import _published_qi2014 as pub
+from gaitval.tables.ultrasonic_agreement import agreement_row
 from gaitval.tables.ultrasonic_params import (PARAM_INFO, check_gait_params, select,
                                               subject_order)
+
+#: agreement columns after the published ones (issue 16): table column (before the unit
+#: suffix) -> column of :func:`gaitval.tables.ultrasonic_agreement.agreement_row` shown on
+#: the ``average`` row; ``loa_low``/``loa_high`` also on every subject row (its strides)
+AGREEMENT_COLUMNS = {"loa_low": "loa_low", "loa_high": "loa_high",
+                     "loa_low_ci_low": "loa_low_ci_low",
+                     "loa_high_ci_high": "loa_high_ci_high",
+                     "bias_rm": "bias_rm", "loa_low_rm": "loa_low_rm",
+                     "loa_high_rm": "loa_high_rm", "loa_low_rm_ci_low": "loa_low_rm_ci_low",
+                     "loa_high_rm_ci_high": "loa_high_rm_ci_high"}
+#: average-row columns without a unit suffix (SDs carry it: see :func:`subject_table`)
+AGREEMENT_RATIOS = ("loa_width_ratio", "loa_ci_ratio", "icc_agreement_rm",
+                    "icc_consistency_rm")
 
 
 def subject_table(gait_params: pd.DataFrame, parameter: str,
@@ -41,6 +57,22 @@ def subject_table(gait_params: pd.DataFrame, parameter: str,
         ``diff_mean<u>`` (mean of system − reference), ``rmse<u>``, and the published
         ``ref_mean<u>_published`` … ``rmse<u>_published`` where the paper gives them
         (``<u>`` is the unit suffix, e.g. ``_m``; none for symmetries).
+
+        Then agreement columns (not in the paper; issue 16), see
+        :func:`gaitval.tables.ultrasonic_agreement.agreement_row`:
+
+        - ``loa_low<u>``, ``loa_high<u>``: Bland–Altman limits (bias ∓ 1.96 SD of the
+          differences) of the row's strides — the subject's own on a subject row, all
+          strides pooled as independent pairs on the ``average`` row (empty on ``peak``);
+        - ``average`` row only: the pooled limits' outer 95% CI bounds
+          ``loa_low_ci_low<u>``, ``loa_high_ci_high<u>``; the repeated-measures bias and
+          limits (subjects as a random effect) ``bias_rm<u>``, ``loa_low_rm<u>``,
+          ``loa_high_rm<u>`` with outer MOVER 95% bounds ``loa_low_rm_ci_low<u>``,
+          ``loa_high_rm_ci_high<u>``; the between- and within-subject SDs of the
+          differences ``sd_between_rm<u>``, ``sd_within_rm<u>``; ``loa_width_ratio``
+          (repeated-measures over pooled limit width), ``loa_ci_ratio`` (the same for the
+          CI of the upper limit), ``icc_agreement_rm``, ``icc_consistency_rm`` (ICC from
+          variance components).
     """
     df = check_gait_params(gait_params)
     sub = select(df, parameter, speed, f"table for {parameter}")
@@ -67,7 +99,61 @@ def subject_table(gait_params: pd.DataFrame, parameter: str,
         vals = dict(zip(pub.SUBJECT_KEYS, published[s])) if published else {}
         out[s + u + "_published"] = [vals.get(k, np.nan) for k in out["paper_subject"]]
     out["n_strides"] = out["n_strides"].astype(int)
-    return out
+    return _with_agreement(out, sub, es, order, parameter, speed, u)
+
+
+def _with_agreement(out: pd.DataFrame, sub: pd.DataFrame, es: pd.DataFrame, order: list,
+                    parameter: str, speed: str, u: str) -> pd.DataFrame:
+    """Append the agreement columns of :func:`subject_table` (issue 16)."""
+    nan = np.full(len(out), np.nan)
+    n_sub = len(order)
+    row = agreement_row(sub, parameter, speed)
+    z = sps.norm.ppf(0.975)                               # limits: bias ∓ 1.96 SD
+    cols = {}
+    for name, src in AGREEMENT_COLUMNS.items():
+        col = nan.copy()
+        col[n_sub] = row[src]                             # the average row
+        cols[name + u] = col
+    bias = es.loc[order, "diff_mean"].to_numpy(dtype=float)
+    sd = es.loc[order, "diff_std"].to_numpy(dtype=float)
+    cols["loa_low" + u][:n_sub] = bias - z * sd           # each subject's own limits
+    cols["loa_high" + u][:n_sub] = bias + z * sd
+    for name, var in (("sd_between_rm", "var_between_rm"), ("sd_within_rm", "var_within_rm")):
+        col = nan.copy()
+        col[n_sub] = np.sqrt(row[var])
+        cols[name + u] = col
+    for name in AGREEMENT_RATIOS:
+        col = nan.copy()
+        col[n_sub] = row[name]
+        cols[name] = col
+    return pd.concat([out, pd.DataFrame(cols, index=out.index)], axis=1)
+
+
+def agreement_note(table: pd.DataFrame, parameter: str) -> str:
+    """Table note on the agreement columns of :func:`subject_table`: which is which, and
+    how much wider the repeated-measures limits are than the pooled ones."""
+    u = PARAM_INFO[parameter][1]
+    avg = table.set_index("subject").loc["average"]
+    text = ("Agreement columns (not in the paper): loa_low/loa_high are Bland-Altman "
+            "limits (bias -/+ 1.96 SD of Pro - Ref) of the row's strides - a subject's own "
+            "on its row, all strides pooled as if independent on the average row, with "
+            "the pooled limits' outer 95% CI bounds loa_low_ci_low/loa_high_ci_high "
+            "(Bland & Altman 1999). *_rm (average row only) treat the strides as repeated "
+            "measures of each subject (Bland & Altman 2007; Zou 2013): bias_rm from a "
+            "random-intercept model (REML), limits bias_rm -/+ 1.96 sqrt(sd_between_rm^2 "
+            "+ sd_within_rm^2) with outer MOVER 95% bounds; icc_*_rm from the variance "
+            "components subject, stride, subject x system and residual.")
+    ratio, ci = avg["loa_width_ratio"], avg["loa_ci_ratio"]
+    if not np.isfinite(ratio):
+        return text + (" The repeated-measures limits need two subjects and a subject "
+                       "with two strides; they are empty here.")
+    n_sub = len(table) - 2                                # rows: subjects, average, peak
+    return text + (f" Here the repeated-measures limits [{avg['loa_low_rm' + u]:.3g}, "
+                   f"{avg['loa_high_rm' + u]:.3g}] are {ratio:.2f} times as wide as the "
+                   f"pooled [{avg['loa_low' + u]:.3g}, {avg['loa_high' + u]:.3g}] and the "
+                   f"95% CI of the upper limit {ci:.1f} times as long ({n_sub} subjects, "
+                   f"{int(avg['n_strides'])} strides): the subject, not the stride, is the "
+                   "unit of replication.")
 
 
 def table2(gait_params, speed="normal"):
