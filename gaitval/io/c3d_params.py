@@ -44,6 +44,12 @@ NUMERIC = {("POINT", "USED"), ("POINT", "RATE"), ("POINT", "SCALE"), ("POINT", "
            ("TRIAL", "ACTUAL_START_FIELD"), ("TRIAL", "ACTUAL_END_FIELD"),
            ("EVENT", "USED"), ("EVENT", "TIMES"), ("ROTATION", "USED"),
            ("ROTATION", "RATE"), ("ROTATION", "DATA_START"), ("SUBJECTS", "USED")}
+#: of those, the ones ezc3d reads a first value of (an empty one crashes it)
+SCALAR = {("POINT", "USED"), ("POINT", "RATE"), ("POINT", "SCALE"), ("POINT", "FRAMES"),
+          ("POINT", "DATA_START"), ("ANALOG", "USED"), ("ANALOG", "RATE"),
+          ("ANALOG", "GEN_SCALE"), ("FORCE_PLATFORM", "USED"), ("TRIAL", "CAMERA_RATE"),
+          ("ROTATION", "USED"), ("ROTATION", "RATE"), ("ROTATION", "DATA_START"),
+          ("EVENT", "USED"), ("SUBJECTS", "USED")}
 #: parameters read as text
 TEXT = {("POINT", "UNITS"), ("POINT", "LABELS"), ("POINT", "DESCRIPTIONS"),
         ("ANALOG", "LABELS"), ("ANALOG", "UNITS"), ("ANALOG", "FORMAT"),
@@ -177,6 +183,10 @@ def _assemble(groups: dict[int, str], raw: list) -> dict[tuple[str, str], Param]
                                    "section does not define")
         key = (groups[gid], name)
         p = Param(key[0], name, ptype, dims, data)
+        if ptype == -1 and not dims:
+            raise ParameterProblem(f"text parameter {p.label} has no dimensions")
+        if key in SCALAR and not data:
+            raise ParameterProblem(f"{p.label} holds no value (a dimension is 0)")
         if ptype == -1:
             why = _text_problem(data.replace(b"\x00", b" "))
             if why:

@@ -154,7 +154,8 @@ def _frame(records: list[dict], schema: dict, columns: list[str]) -> pd.DataFram
 def _subject_problems(path: Path, problems: list) -> pd.DataFrame:
     schema = load_schema("subjects")
     raw, records = _read_table(path, "subject table", schema, problems)
-    df = _frame(records, schema, list(raw.columns) + ["row_line"])
+    cols = list(dict.fromkeys(["subject"] + list(raw.columns)))   # as the file has them
+    df = _frame(records, schema, cols + ["row_line"])
     for subject, rows in df.groupby("subject", sort=False)["row_line"]:
         if len(rows) > 1:
             problems.append(TrialSheetError(f"subject {subject!r} appears on rows "

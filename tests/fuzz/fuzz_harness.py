@@ -1,0 +1,196 @@
+"""Fuzz harness: every mutant is read in a child process with a time-out and rlimits, and
+must end as a load or a gaitval error that names the file.
+
+Outcomes of one mutant (``run_mutant``):
+
+``load``          the loader returned
+``error``         a GaitvalError naming the mutant's file
+``unnamed``       a GaitvalError that does not name the file          (a failure)
+``foreign``       any other exception, or a GaitvalError marked ``unexpected`` by
+                  ``gaitval.io.guard.loader`` (an exception nobody foresaw)  (a failure)
+``crash``         the child died from a signal (segmentation fault ...)   (a failure)
+``hang``          the child did not finish within the time-out            (a failure)
+
+A native crash or stall that gaitval itself contained (ezc3d in its child process,
+``gaitval.io.isolate``) is an ``error`` whose detail starts with ``contained``; the summary
+counts those too.  Why no hypothesis/atheris: the inputs are mutants of real binary files
+whose interesting structure (C3D parameter records, Parquet metadata) the mutators below
+target directly; what must hold is about a *process* (it may not die or hang), which needs
+a fork per input, and reproducibility comes from (kind, seed, index) alone.
+"""
+from __future__ import annotations
+
+import json
+import os
+import resource
+import select
+import signal
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import fuzz_mutators as M  # noqa: E402
+import fuzz_seeds as S  # noqa: E402
+
+KINDS = ("c3d", "bag", "scanlog", "ultrasonic", "annotations", "sheet")
+FAILURES = ("unnamed", "foreign", "crash", "hang")
+
+
+def make_mutant(kind: str, seed: int, index: int, work: Path) -> tuple[Path, str]:
+    """Write mutant ``index`` of ``kind`` under ``work``; (path to read, description)."""
+    rng = np.random.default_rng([seed, KINDS.index(kind), index])
+    d = work / f"{kind}_{index}"
+    d.mkdir(parents=True, exist_ok=True)
+    if kind in ("c3d", "bag"):
+        seeds = M.C3D_SEEDS if kind == "c3d" else M.BAG_SEEDS
+        name = seeds[index % len(seeds)]
+        src = M.REALDATA / ("c3d" if kind == "c3d" else "lrs") / name
+        data = src.read_bytes()
+        data, what = (M.c3d_mutation if kind == "c3d" else M.byte_mutation)(data, rng)
+        out = d / (f"m.{kind}")
+        out.write_bytes(data)
+        return out, f"{name}: {what}"
+    if kind in ("scanlog", "ultrasonic"):
+        out = d / ("m.scan.parquet" if kind == "scanlog" else "m.us.parquet")
+        return out, M.parquet_mutation(kind, out, rng)
+    if kind == "annotations":
+        out = d / "m.annotations.csv"
+        data, what = M.text_mutation(S.annotations_text(), rng)
+        out.write_bytes(data)
+        return out, f"annotations: {what}"
+    sheet, subjects = S.sheet_texts()
+    for rel in ("m/a.c3d", "l/a.scan.parquet", "l/a.bag", "a.annotations.csv"):
+        (d / rel).parent.mkdir(parents=True, exist_ok=True)
+        (d / rel).write_bytes(b"")
+    which = "trials.csv" if rng.random() < 0.7 else "subjects.csv"
+    text = sheet if which == "trials.csv" else subjects
+    data, what = M.text_mutation(text, rng)
+    (d / "trials.csv").write_text(sheet)
+    (d / "subjects.csv").write_text(subjects)
+    (d / which).write_bytes(data)
+    return d / "trials.csv", f"{which}: {what}"
+
+
+def read_target(kind: str, path: Path) -> None:
+    """What ``gaitval inspect`` and the loaders do with a file of this kind."""
+    if kind == "sheet":
+        from gaitval.io.trialsheet import load_trial_sheet
+        load_trial_sheet(path)
+        return
+    from gaitval.io.inspect import describe
+    describe(path)
+    if kind == "bag":
+        from gaitval.io.rosbag import read_rosbag_scans
+        read_rosbag_scans(path, None)
+
+
+def _child(kind: str, path: Path, name_part: str, wfd: int, cpu_s: int) -> None:
+    code = 0
+    try:
+        import logging
+        logging.getLogger("gaitval").setLevel(logging.ERROR)     # no duplicate-label notes
+        resource.setrlimit(resource.RLIMIT_CPU, (cpu_s, cpu_s + 5))
+        resource.setrlimit(resource.RLIMIT_AS, (_vm_bytes() + (4 << 30),) * 2)
+        try:
+            read_target(kind, path)
+            out = {"outcome": "load", "detail": ""}
+        except Exception as exc:  # noqa: BLE001 - classified here
+            out = classify(exc, name_part)
+        os.write(wfd, json.dumps(out).encode()[:60000])
+    except BaseException:  # noqa: BLE001
+        code = 3
+    finally:
+        os._exit(code)
+
+
+def _vm_bytes() -> int:
+    """This process's virtual size (the address-space rlimit is set this much higher)."""
+    with open("/proc/self/status", encoding="ascii") as fh:
+        for line in fh:
+            if line.startswith("VmSize:"):
+                return int(line.split()[1]) * 1024
+    return 0
+
+
+def classify(exc: Exception, name_part: str) -> dict:
+    from gaitval.errors import GaitvalError
+    msg = f"{type(exc).__name__}: {exc}"[:300]
+    if not isinstance(exc, GaitvalError):
+        return {"outcome": "foreign", "detail": msg}
+    if getattr(exc, "unexpected", False):
+        return {"outcome": "foreign", "detail": "wrapped " + msg}
+    if name_part not in str(exc):
+        return {"outcome": "unnamed", "detail": msg}
+    contained = "crashed reading it" in str(exc) or "did not finish" in str(exc)
+    return {"outcome": "error", "detail": ("contained " if contained else "") + msg}
+
+
+def run_mutant(kind: str, path: Path, timeout_s: float = 150.0) -> dict:
+    """Read ``path`` in a forked child (rlimit on CPU time; wall-clock time-out)."""
+    name_part = str(path.parent if kind == "sheet" else path)
+    rfd, wfd = os.pipe()
+    t0 = time.monotonic()
+    pid = os.fork()
+    if pid == 0:
+        os.close(rfd)
+        _child(kind, path, name_part, wfd, int(timeout_s))
+    os.close(wfd)
+    ready, _, _ = select.select([rfd], [], [], timeout_s)
+    data = b""
+    if ready:
+        while chunk := os.read(rfd, 65536):
+            data += chunk
+    os.close(rfd)
+    if not ready:
+        os.kill(pid, signal.SIGKILL)
+    _, status = os.waitpid(pid, 0)
+    dt = time.monotonic() - t0
+    if not ready:
+        return {"outcome": "hang", "detail": f"no answer within {timeout_s:.0f} s", "s": dt}
+    if os.WIFSIGNALED(status):
+        sig = os.WTERMSIG(status)
+        return {"outcome": "hang" if sig == signal.SIGXCPU else "crash",
+                "detail": f"signal {signal.Signals(sig).name}", "s": dt}
+    try:
+        return {**json.loads(data), "s": dt}
+    except ValueError:
+        return {"outcome": "crash", "detail": f"exit {os.waitstatus_to_exitcode(status)}, "
+                                              "no answer", "s": dt}
+
+
+def fuzz_one(task: tuple[str, int, int, str]) -> dict:
+    """One (kind, seed, index, work folder) task: make the mutant, read it, clean up."""
+    import shutil
+    kind, seed, index, work = task
+    path, what = make_mutant(kind, seed, index, Path(work))
+    res = run_mutant(kind, path)
+    shutil.rmtree(Path(work) / f"{kind}_{index}", ignore_errors=True)
+    return {"kind": kind, "index": index, "what": what, **res}
+
+
+def summarise(results: list[dict]) -> dict[str, dict[str, int]]:
+    """Counts per kind: mutants, loads, errors (contained), and each failure."""
+    table: dict[str, dict[str, int]] = {}
+    for r in results:
+        row = table.setdefault(r["kind"], {"mutants": 0, "load": 0, "error": 0,
+                                           "contained": 0, **{f: 0 for f in FAILURES}})
+        row["mutants"] += 1
+        row[r["outcome"]] += 1
+        row["contained"] += r["detail"].startswith("contained")
+    return table
+
+
+def format_table(table: dict[str, dict[str, int]]) -> str:
+    cols = ["mutants", "load", "error", "contained", "crash", "hang", "foreign", "unnamed"]
+    lines = [f"{'file type':<12}" + "".join(f"{c:>10}" for c in cols)]
+    total = {c: 0 for c in cols}
+    for kind in KINDS:
+        if kind in table:
+            lines.append(f"{kind:<12}" + "".join(f"{table[kind][c]:>10}" for c in cols))
+            for c in cols:
+                total[c] += table[kind][c]
+    lines.append(f"{'all':<12}" + "".join(f"{total[c]:>10}" for c in cols))
+    return "\n".join(lines)

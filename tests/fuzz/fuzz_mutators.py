@@ -1,0 +1,182 @@
+"""Mutants of every file kind gaitval reads, made deterministically from (kind, seed, index).
+
+Seeds: the real C3D files and ROS bags in ``../shared/realdata/`` (read from there, never
+copied into the repository) and small generated scan logs, ultrasonic logs, annotation
+files and trial sheets.  Mutations: byte flips and runs of 0x00/0xFF/0x80, truncation,
+zeroed and random chunks, inserted and deleted bytes; for C3D also the parameter section's
+type, dimension and pointer bytes and the header's words (huge integers); for Parquet logs
+their JSON metadata (NaN, inf, huge integers, wrong types, missing keys) and columns; for
+CSV files cells (NaN, inf, empty, 5,000 characters, ``../../etc/passwd``), encodings
+(UTF-16, Latin-1) and structure.  Each mutant is one file (or a folder for a sheet) and a
+one-line description of what was done to it.
+"""
+from __future__ import annotations
+
+import json
+import struct
+from pathlib import Path
+
+import numpy as np
+
+REALDATA = (Path(__file__).resolve().parents[2] / ".." / "shared" / "realdata").resolve()
+C3D_SEEDS = ["Gait_MotionAnalysis.c3d", "c3dorg_sample01_Eb015pi.c3d",
+             "PiG_Calibration-FlatFoot-Full.c3d", "c3dorg_sample09_PlugInC3D.c3d",
+             "FunctionalWalk.c3d", "c3dorg_sample04_sub_labels.c3d"]
+BAG_SEEDS = ["positive_1.bag"]
+ODD_VALUES = [float("nan"), float("inf"), float("-inf"), 0, -1, 1e308, 2 ** 70, -2 ** 63,
+              "abc", "", [], {}, None, True, [1, 2], "1e999", "NaN"]
+ODD_CELLS = ["nan", "inf", "-inf", "", "1e999", "-1", "0", "x" * 5000, "../../etc/passwd",
+             "/etc/passwd", "é", "\x00", "1,5", '"', "true", "99999999999999999999"]
+
+
+def byte_mutation(data: bytes, rng: np.random.Generator) -> tuple[bytes, str]:
+    """One generic byte-level mutation."""
+    b = bytearray(data)
+    n = len(b)
+    op = int(rng.integers(8))
+    if op == 0:
+        k = int(rng.integers(1, 9))
+        for i in rng.integers(0, n, k):
+            b[int(i)] = int(rng.integers(256))
+        return bytes(b), f"{k} random bytes"
+    if op == 1:
+        i, v = int(rng.integers(n)), int(rng.choice([0x00, 0xFF, 0x80, 0x7F]))
+        b[i] = v
+        return bytes(b), f"byte {i} -> 0x{v:02X}"
+    if op == 2:
+        i = int(rng.integers(n))
+        return bytes(b[:i]), f"first {i} bytes"
+    if op in (3, 4):
+        i, m = int(rng.integers(n)), int(rng.integers(1, 2048))
+        b[i:i + m] = bytes(m) if op == 3 else rng.bytes(m)
+        return bytes(b[:n]), f"{'zeroed' if op == 3 else 'random'} chunk {i}+{m}"
+    if op == 5:
+        i, m = int(rng.integers(n)), int(rng.integers(1, 64))
+        return bytes(b[:i] + rng.bytes(m) + b[i:]), f"{m} bytes inserted at {i}"
+    if op == 6:
+        i, m = int(rng.integers(n)), int(rng.integers(1, 64))
+        return bytes(b[:i] + b[i + m:]), f"{m} bytes deleted at {i}"
+    i = int(rng.integers(max(n - 8, 1)))
+    b[i:i + 4] = struct.pack("<i", int(rng.choice([2 ** 31 - 1, -2 ** 31, 65535, -1])))
+    return bytes(b[:n]), f"huge int32 at {i}"
+
+
+def _c3d_positions(data: bytes) -> dict[str, list[int]]:
+    """Offsets of the parameter records' type/dimension/pointer bytes and header words."""
+    pos = {"type": [], "dims": [], "ptr": [], "text": [],
+           "header": [2, 4, 6, 8, 12, 16, 18, 20]}
+    i = (max(data[0], 1) - 1) * 512 + 4
+    for _ in range(5000):
+        if i + 2 > len(data):
+            break
+        nch, gid = struct.unpack_from("<bb", data, i)
+        if nch == 0 or gid == 0:
+            break
+        p = i + 2 + abs(nch)
+        nxt = struct.unpack_from("<h", data, p)[0] if p + 2 <= len(data) else 0
+        pos["ptr"].append(p)
+        if gid > 0 and p + 4 <= len(data):
+            pos["type"].append(p + 2)
+            pos["dims"].append(p + 3)
+            if data[p + 2] == 0xFF:
+                pos["text"].append(p + 4 + data[p + 3])
+        if nxt <= 0:
+            break
+        i = p + nxt
+    return pos
+
+
+def c3d_mutation(data: bytes, rng: np.random.Generator) -> tuple[bytes, str]:
+    """A structure-aware C3D mutation half the time, a generic one otherwise."""
+    if rng.random() < 0.5:
+        return byte_mutation(data, rng)
+    pos = _c3d_positions(data)
+    field = str(rng.choice([k for k, v in pos.items() if v]))
+    i = int(rng.choice(pos[field]))
+    b = bytearray(data)
+    if field in ("ptr", "header"):
+        v = int(rng.choice([0, 1, -1, 32767, -32768, 0x7FFF, 4, 600, 65535]))
+        b[i:i + 2] = struct.pack("<H", v & 0xFFFF)
+    elif field == "text":
+        v = int(rng.choice([0xFF, 0x80, 0xC3, 0x01, 0x00]))
+        b[min(i + int(rng.integers(0, 4)), len(b) - 1)] = v
+    else:
+        v = int(rng.choice([0xFF, 0x00, 0x03, 0x7F, 0x80, 0x04, 0x02, 0x01, 0x09]))
+        b[i] = v
+    return bytes(b), f"c3d {field} at {i} -> {v}"
+
+
+def _write_parquet(path: Path, cols: dict, key: bytes, meta) -> None:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.table(cols)
+    raw = meta if isinstance(meta, bytes) else json.dumps(meta).encode()
+    pq.write_table(table.replace_schema_metadata({key: raw}), path)
+
+
+def parquet_mutation(kind: str, path: Path, rng: np.random.Generator) -> str:
+    """Write a scan log or ultrasonic log with mutated metadata, columns or bytes."""
+    import pyarrow as pa
+
+    import fuzz_seeds
+    cols, key, meta = fuzz_seeds.parquet_parts(kind)
+    op = int(rng.integers(4))
+    what = "valid"
+    if op == 0:                                           # a metadata value
+        k = str(rng.choice(sorted(meta)))
+        meta[k] = ODD_VALUES[int(rng.integers(len(ODD_VALUES)))]
+        what = f"meta {k} = {meta[k]!r}"[:80]
+    elif op == 1:                                         # a metadata key dropped / junk JSON
+        if rng.random() < 0.5:
+            k = str(rng.choice(sorted(meta)))
+            del meta[k]
+            what = f"meta {k} missing"
+        else:
+            meta = rng.bytes(int(rng.integers(1, 40)))
+            what = "meta random bytes"
+    elif op == 2:                                         # a column
+        c = str(rng.choice(sorted(cols)))
+        v = ODD_VALUES[int(rng.integers(3))]
+        n = len(cols["t_s"])
+        choice = int(rng.integers(3))
+        if choice == 0 and c != "ranges":
+            arr = np.asarray(cols[c], dtype=float).copy()
+            arr[int(rng.integers(n))] = v
+            cols[c] = arr
+        elif choice == 1:
+            cols[c] = pa.array(["x"] * n)
+        else:
+            cols.pop(c)
+        what = f"column {c} #{choice}"
+    _write_parquet(path, cols, key, meta)
+    if op == 3:
+        data, what = byte_mutation(path.read_bytes(), rng)
+        path.write_bytes(data)
+    return f"{kind}: {what}"
+
+
+def text_mutation(text: str, rng: np.random.Generator, cells: bool = True
+                  ) -> tuple[bytes, str]:
+    """Mutate a CSV text: a cell, a line, or its encoding."""
+    lines = text.splitlines()
+    op = int(rng.integers(5 if cells else 4))
+    if op == 0:
+        return text.encode("utf-16"), "UTF-16"
+    if op == 1:
+        return text.encode("utf-8") + b"\xff\xfe\xe9", "non-UTF-8 bytes"
+    if op == 2 and len(lines) > 1:
+        i = int(rng.integers(len(lines)))
+        lines.insert(i, lines[i] if rng.random() < 0.5 else ",,,,")
+        return "\n".join(lines).encode(), f"line {i} doubled or blank"
+    if op == 3:
+        i = int(rng.integers(len(lines)))
+        del lines[i]
+        return "\n".join(lines).encode(), f"line {i} deleted"
+    i = int(rng.integers(len(lines)))
+    parts = lines[i].split(",")
+    j = int(rng.integers(len(parts)))
+    parts[j] = ODD_CELLS[int(rng.integers(len(ODD_CELLS)))]
+    lines[i] = ",".join(parts)
+    return "\n".join(lines).encode("utf-8", "surrogatepass"), \
+        f"line {i} cell {j} = {parts[j][:20]!r}"
