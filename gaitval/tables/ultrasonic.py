@@ -76,7 +76,18 @@ def _captions() -> dict[str, tuple[str, list[str]]]:
         "vs normal (significant: p < 0.05, the paper's *). " + common,
         ["The paper's §4.2 calls the test 'two-sample', §4.4.3 'paired'; gaitval pairs "
          "by subject.", "p is empty (NaN) when every paired difference is equal, as the "
-         "paper prints NaN for cadence RMSE."])
+         "paper prints NaN for cadence RMSE.",
+         "NS = S/n and NV = V/n (eq. 18, 21) divide by the number of strides n. gaitval's "
+         "n is the number of matched strides of each 5-min trial (about 180 slow, 250 "
+         "normal, 300 fast at the paper's stride durations 1.645/1.180/1.006 s), so its NS "
+         "is about S/250 = 0.005 m at normal speed. The paper's values imply n = S/NS = "
+         "V/NV of about 12 strides slow (0.884/0.075, 0.539/0.044), 27 normal "
+         "(1.169/0.043, 0.990/0.035) and 26 fast (1.410/0.054, 1.402/0.053), and their "
+         "std (as large as the mean at slow speed) implies n varied widely between "
+         "subjects: the paper normalised by the strides of an analysed segment, not of the "
+         "whole 5 min (its Table C1 uses 10 strides per subject). With n of that size "
+         "gaitval's NS would be 0.04-0.07 m; the NS and NV rows compare definitions of n, "
+         "not accuracy (their RMSE, about 0.001, is S's and V's RMSE divided by n)."])
     caps["tableC1"] = (
         "Reproduces Table C1 of Qi et al. 2014: one-way ANOVA of the ultrasonic "
         "estimates of S, T, V, hS, vS across subjects at normal speed (between groups = "
