@@ -93,7 +93,8 @@ def rollator_table1(frames: pd.DataFrame, summary: pd.DataFrame, kf: str, pf: st
             for tag, method in (("kf", kf), ("pf", pf)):
                 e = g[g["tracker"] == method]
                 s = summarize_errors(e[f"{p}_true"].to_numpy(), e[f"{p}_est"].to_numpy())
-                row[f"n_{tag}"], row[f"rmse_{tag}"], row[f"mad_{tag}"] = s["n"], s["rmse"], s["mad"]
+                row.update({f"n_{tag}": s["n"], f"rmse_{tag}": s["rmse"],
+                            f"mad_{tag}": s["mad"]})
             vals = pub.get(p, (np.nan,) * 4)
             for name, v in zip(("rmse_kf", "rmse_pf", "mad_kf", "mad_pf"), vals):
                 row[f"{name}_published"] = v / 100.0                     # cm -> m

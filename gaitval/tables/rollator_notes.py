@@ -19,7 +19,8 @@ def table1_notes(t1: pd.DataFrame, imp: pd.DataFrame, model_sources=()) -> list[
         wp, npub = _wins(t1[f"{st}_kf_published"], t1[f"{st}_pf_published"])
         r = imp[imp["statistic"] == st.upper()].iloc[0]
         notes.append(f"{st.upper()}: PF below KF in {w} of {n} cells here, {wp} of {npub} "
-                     f"published for the same rows; mean reduction {r['improvement_pct']:.1f} % here, "
+                     "published for the same rows; mean reduction "
+                     f"{r['improvement_pct']:.1f} % here, "
                      f"{r['improvement_pct_published_cells']:.1f} % from the published cells, "
                      f"~{r['improvement_pct_paper_text']:.0f} % in the paper's text.")
     for p in ("x", "y", "vx", "vy"):

@@ -1,13 +1,14 @@
-"""The particle filter's arithmetic, vectorised over both legs' particles (seed 002 §III).
+"""The particle filter's arithmetic, vectorised over particles (seed 002 §III).
 
 :class:`PFArrays` turns a model (:mod:`gaitval.track.pf_model`) into the arrays the
 per-scan steps use; :func:`sample_velocities` draws from the Gaussian mixtures (§III.A–B);
 :func:`likelihood` weighs one leg's particles against the scan's points near them
-(§III.C, vectorised over particles × points); :func:`effective_size` and :func:`systematic_resample` serve §III.D.
+(§III.C, vectorised over particles × points); :func:`effective_size` and
+:func:`systematic_resample` serve §III.D.
 
 Notes
 -----
-seed002 §III.C: p(y|x_i) = β_i · [λ_i · Σ_{m=1..4} π_Rm · N(d_Rm | μ_Rm, Σ_Rm)], where the
+seed002 §III.C: p(y|x_i) = β_i · [λ_i · Σ_{m=1..4} π_Rm · N(d_Rm | μ_Rm, Σ_Rm)]; the
 points y are those inside the rectangle (±h_x, ±h_y) centred on particle i, R0 (the half
 farther from the laser) is ignored, d_Rm are the distances of the points of region R_m to
 the particle, λ_i is the count kernel at the number of points in R1..R4, and β_i the Gamma
@@ -122,8 +123,9 @@ def likelihood(P: PFArrays, px: np.ndarray, py: np.ndarray, X: np.ndarray, Y: np
     Per pair, with u = x_particle − x_point (> 0: the point is in the lower half) and
     v = y_particle − y_point: in the window when 0 < u ≤ h_x and |v| ≤ h_y; inner when
     |v| < u; code = inner + 2·[v ≥ 0] (0: R1, 1: R2, 2: R4, 3: R3).  The normal density is
-    evaluated as exp(A d² + B d + C) with A = −1/(2σ²), B = μ/σ², C = −μ²/(2σ²) + ln(1/(σ√2π)),
-    which is N(d | μ, σ) term for term, with one table look-up per pair.
+    evaluated as exp(A d² + B d + C) with A = −1/(2σ²), B = μ/σ² and
+    C = −μ²/(2σ²) + ln(1/(σ√2π)), which is N(d | μ, σ) term for term, with one table
+    look-up per pair.
     """
     K, M = len(px), len(X)
     u = np.subtract.outer(px, X)
