@@ -32,18 +32,22 @@ position along the belt.  Within stride j (heel strike at ``u = 0``):
   velocity) to the next foot strike, arriving slightly retracting (vx = -0.2 v) and
   descending (vz = -0.2 m/s): forward arc with heel lift (peak ~0.2 m).
 
-The transmitter is rigidly attached to the heel (acoustic centre 2 cm forward, 4 cm lateral,
-1 cm up of the posterior heel point ``RHEE``); its camera marker ``TX`` sits on the housing
-within 4 mm (per axis, drawn per trial) of the acoustic centre and turns with the foot,
-so the camera reference and the ultrasonic ranges do not see exactly the same point; toe markers
-follow from the foot pitch.  (Pendulum trials: the marker is aligned with the transducer
+The transmitter is strapped to the heel (acoustic centre 2 cm forward, 4 cm lateral, 1 cm
+up of the posterior heel point ``RHEE``) and wobbles on its elastic strap after each heel
+strike (2–4 mm, 15 Hz, damped; :mod:`gaitval.simulate.us_treadmill`); its camera marker
+``TX`` sits on the shoe beside it, within 4 mm (per axis, drawn per trial) of the acoustic
+centre at rest, and turns with the foot but does not wobble, so the camera reference and
+the ultrasonic ranges do not see exactly the same point; toe markers follow from the foot
+pitch.  Stride times fluctuate as persistent fractional Gaussian noise (H = 0.8).  (Pendulum trials: the marker is aligned with the transducer
 head to within 2 mm, as the paper built that experiment to do.)
 
 *Ranging*: time of flight with the speed of sound of dry air ``331.3 sqrt(1 + T/273.15)``
 (the physics; the pipeline uses the paper's linear eq. (2), ``331.5 + 0.6 T``, whose
 0.1 % error at room temperature is part of what it must live with), Gaussian noise with the
-paper's ``V = diag(11, 9.3, 9, 9) mm^2`` converted to seconds, a 1 us counter tick,
-occasional multipath (a late echo: path longer by 0.05-0.5 m, probability
+paper's ``V = diag(11, 9.3, 9, 9) mm^2`` converted to seconds, the threshold detector's
+delay (the burst's amplitude falls off both transducers' axes and with distance: later
+detection, cycle slips of one wavelength or missed echoes; :mod:`gaitval.simulate.us_sensor`),
+a 1 us counter tick, occasional multipath (a late echo: path longer by 0.05-0.5 m, probability
 ``multipath_prob`` per anchor and sample) and missing echoes (``dropout_prob``).  Air
 temperature drifts slowly around 22-26 degC and is logged with 0.0625 degC resolution.
 
