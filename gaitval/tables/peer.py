@@ -37,7 +37,8 @@ RM_LOA = {"bias_rm": "bias", "bias_rm_ci_low": "bias_ci_low",
           "var_between_rm": "var_between", "var_within_rm": "var_within",
           "loa_low_rm": "loa_low", "loa_high_rm": "loa_high",
           "loa_low_rm_ci_low": "loa_low_ci_low", "loa_low_rm_ci_high": "loa_low_ci_high",
-          "loa_high_rm_ci_low": "loa_high_ci_low", "loa_high_rm_ci_high": "loa_high_ci_high"}
+          "loa_high_rm_ci_low": "loa_high_ci_low",
+          "loa_high_rm_ci_high": "loa_high_ci_high"}
 #: table column -> column of :func:`gaitval.stats.icc_mixed`
 RM_ICC = {"icc_agreement_rm": "icc_agreement", "icc_consistency_rm": "icc_consistency"}
 #: table column -> column of :func:`gaitval.stats.proportional_bias`

@@ -1,4 +1,4 @@
-"""Agreement of the ultrasonic system with the camera reference, pooled and repeated-measures.
+"""Agreement of the ultrasonic system with the camera reference: pooled, repeated measures.
 
 Issue 16.  The paper reports per-subject means, SDs and RMSEs; a validation reviewer also
 asks for the bias and limits of agreement, and with many strides per subject those must
@@ -35,7 +35,8 @@ REPEATED = {"bias_rm": "bias", "bias_rm_ci_low": "bias_ci_low",
             "sd_rm": "sd_total", "var_between_rm": "var_between",
             "var_within_rm": "var_within", "loa_low_rm": "loa_low",
             "loa_high_rm": "loa_high", "loa_low_rm_ci_low": "loa_low_ci_low",
-            "loa_low_rm_ci_high": "loa_low_ci_high", "loa_high_rm_ci_low": "loa_high_ci_low",
+            "loa_low_rm_ci_high": "loa_low_ci_high",
+            "loa_high_rm_ci_low": "loa_high_ci_low",
             "loa_high_rm_ci_high": "loa_high_ci_high"}
 #: ICC from variance components: table column -> column of :func:`gaitval.stats.icc_mixed`
 ICC_RM = {"icc_agreement_rm": "icc_agreement", "icc_consistency_rm": "icc_consistency",

@@ -118,7 +118,8 @@ def _with_agreement(out: pd.DataFrame, sub: pd.DataFrame, es: pd.DataFrame, orde
     sd = es.loc[order, "diff_std"].to_numpy(dtype=float)
     cols["loa_low" + u][:n_sub] = bias - z * sd           # each subject's own limits
     cols["loa_high" + u][:n_sub] = bias + z * sd
-    for name, var in (("sd_between_rm", "var_between_rm"), ("sd_within_rm", "var_within_rm")):
+    for name, var in (("sd_between_rm", "var_between_rm"),
+                      ("sd_within_rm", "var_within_rm")):
         col = nan.copy()
         col[n_sub] = np.sqrt(row[var])
         cols[name + u] = col
