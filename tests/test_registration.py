@@ -421,7 +421,9 @@ def test_ultrasonic_anchor_frame_and_clock():
                                               "z_m": anchors_us[:, 2]}), source="t.us.parquet")
     assert anchor_distances(log) == pytest.approx(dist, abs=1e-12)
     trial = {"trial": "U01", "protocol": "treadmill"}
-    rec = register_trial(mocap, log, trial, None, {})
+    from gaitval.groundtruth import sensor_leg_points
+    rec = register_trial(mocap, log, trial, None, {},
+                         legs=sensor_leg_points(mocap, log, trial, None, {}))
     assert rec.yaw_rad == pytest.approx(yaw, abs=1e-6)
     assert (rec.x_m, rec.y_m) == pytest.approx((1.0, -0.5), abs=1e-6)
     assert abs(rec.clock_offset_s - off) < 0.5 / 50
@@ -543,7 +545,9 @@ def test_tiny_study_ultrasonic_acceptance(tiny):
         mocap = read_c3d(out / tr["mocap_file"])
         log = _read_us_log(out / tr["sensor_file"])
         meta = json.loads((out / "truth" / tr["trial"] / "meta.json").read_text())
-        rec = register_trial(mocap, log, tr, None, cfg)
+        from gaitval.groundtruth import sensor_leg_points
+        rec = register_trial(mocap, log, tr, None, cfg,
+                             legs=sensor_leg_points(mocap, log, tr, None, cfg))
         assert abs(rec.clock_offset_s - meta["clock_offset_s"]) < 0.5 / log.rate_hz, tr["trial"]
         assert rec.pole_residual_m < 0.005
         gt = ground_truth(mocap, log, rec, tr, None, cfg)

@@ -31,7 +31,7 @@ from gaitval.groundtruth.joints import joint_centre, source_label
 from gaitval.groundtruth.settings import gt_cfg
 from gaitval.groundtruth.shank import cylinder_at_height, fit_cylinder_cluster, point_at_height
 from gaitval.registration.moving import is_moving, rollator_labels
-from gaitval.types import MocapTrial, ScanSeries
+from gaitval.types import MocapTrial, ScanSeries, UltrasonicLog
 
 #: Marker names (after the side letter) the leg points may use, besides the tibia cluster.
 LEG_MARKERS = ("FEO", "TIO", "KJC", "AJC", "KNE", "KNEin", "ANK", "ANKin", "ASI")
@@ -194,8 +194,8 @@ def sensor_leg_points(mocap: MocapTrial, sensor, trial: dict, subject: dict | No
     LegPoints or None
         :func:`leg_points` at :func:`sensor_height`; for a moving sensor (protocol
         ``rollator``) ``markers`` also holds the gap-filled rollator markers, from which
-        registration computes the sensor's per-frame pose.  None for a sensor that is not
-        a laser scanner (an ultrasonic log).
+        registration computes the sensor's per-frame pose.  For an ultrasonic log the
+        points the sensor ranges instead: :func:`transmitter_points`.
 
     Raises
     ------
@@ -204,9 +204,11 @@ def sensor_leg_points(mocap: MocapTrial, sensor, trial: dict, subject: dict | No
     MarkerError
         Markers missing for the joint centres or the tibia cylinder.
     """
+    tid = str((trial or {}).get(C.TRIAL, ""))
+    if isinstance(sensor, UltrasonicLog):
+        return transmitter_points(mocap, cfg, trial=tid)
     if not isinstance(sensor, ScanSeries):
         return None
-    tid = str((trial or {}).get(C.TRIAL, ""))
     try:
         h = sensor_height(sensor, trial)
     except RegistrationError as e:
@@ -216,3 +218,25 @@ def sensor_leg_points(mocap: MocapTrial, sensor, trial: dict, subject: dict | No
         rollator, _ = filled_markers(mocap, gt_cfg(cfg)["max_gap_s"], rollator_labels(cfg))
         lp = replace(lp, markers={**lp.markers, **rollator})
     return lp
+
+
+def transmitter_points(mocap: MocapTrial, cfg: dict | None, trial: str = "") -> LegPoints:
+    """The heel transmitter marker (``groundtruth.tx_marker``) gap-filled like the leg
+    points (``groundtruth.max_gap_s``), as the one "point" an ultrasonic system ranges:
+    ``xyz`` has shape (n_frames, 1, 3), ``source`` is ``"tx_marker"``.
+
+    Raises
+    ------
+    MarkerError
+        The C3D has no transmitter marker.
+    """
+    g = gt_cfg(cfg)
+    tx = g["tx_marker"]
+    if not mocap.has(tx):
+        raise MarkerError(f"the C3D has no transmitter marker {tx!r}", path=mocap.path,
+                          trial=trial, hint="set groundtruth.tx_marker")
+    X, _ = fill_short_gaps(mocap.marker(tx), mocap.rate_hz, g["max_gap_s"])
+    ok = np.isfinite(X).all(axis=1)
+    return LegPoints(t=np.asarray(mocap.t, dtype=float), xyz=X[:, None, :], valid=ok[:, None],
+                     source="tx_marker", n_excluded=int((~ok).sum()), n_filled=0,
+                     markers={tx: X})

@@ -32,10 +32,6 @@ import pandas as pd
 from gaitval import consts as C
 from gaitval.config import as_float, section
 from gaitval.errors import RegistrationError
-# the ultrasonic path still reads the transmitter marker itself (gap filling, groundtruth
-# config); it is not part of the leg-point hand-over
-from gaitval.groundtruth.gaps import fill_short_gaps
-from gaitval.groundtruth.settings import gt_cfg
 from gaitval.io.ultrasonic import log_distances
 from gaitval.registration import clock as CK
 from gaitval.registration import poles as PO
@@ -137,9 +133,10 @@ def register_trial(mocap: MocapTrial, sensor, trial: dict, subject: dict | None,
         The whole config (sections ``registration``, ``groundtruth``, ``rollator``) or
         the ``registration`` section alone.
     legs : LegMotion
-        LRS trials: the subject's leg points at sensor height for every mocap frame, from
-        the ground truth's ``sensor_leg_points`` (the same object then goes to its
-        ``ground_truth``).  Unused for an ultrasonic log.
+        The mocap points the sensor sees, from the ground truth's ``sensor_leg_points``
+        (the same object then goes to its ``ground_truth``): LRS trials the subject's leg
+        points at sensor height for every mocap frame; an ultrasonic log the gap-filled
+        heel transmitter.
 
     Returns
     -------
@@ -156,14 +153,14 @@ def register_trial(mocap: MocapTrial, sensor, trial: dict, subject: dict | None,
     """
     tid = str((trial or {}).get(C.TRIAL, ""))
     try:
+        if isinstance(sensor, (UltrasonicLog, ScanSeries)) and legs is None:
+            raise TypeError(
+                "register_trial: a trial is registered with the mocap points its sensor "
+                "sees; pass legs=sensor_leg_points(mocap, sensor, trial, subject, cfg) (from "
+                "the groundtruth package)")
         if isinstance(sensor, UltrasonicLog):
-            return _register_ultrasonic(mocap, sensor, trial, cfg, tid)
+            return _register_ultrasonic(mocap, sensor, trial, cfg, tid, legs)
         if isinstance(sensor, ScanSeries):
-            if legs is None:
-                raise TypeError(
-                    "register_trial: an LRS trial is registered with its leg points; pass "
-                    "legs=sensor_leg_points(mocap, sensor, trial, subject, cfg) (from the "
-                    "groundtruth package)")
             return _register_lrs(mocap, sensor, trial, subject, cfg, tid, legs)
     except RegistrationError as e:
         raise e.with_context(path=getattr(sensor, "source", None) or mocap.path, trial=tid)
@@ -235,16 +232,10 @@ def anchor_distances(log: UltrasonicLog) -> np.ndarray:
     return log_distances(log)
 
 
-def _register_ultrasonic(mocap, log, trial, cfg, tid):
+def _register_ultrasonic(mocap, log, trial, cfg, tid, tx):
     c = reg_cfg(cfg)
-    g = gt_cfg(cfg)
-    tx = g["tx_marker"]
-    if not mocap.has(tx):
-        from gaitval.errors import MarkerError
-        raise MarkerError(f"the C3D has no transmitter marker {tx!r}", path=mocap.path,
-                          trial=tid, hint="set groundtruth.tx_marker")
-    X, _ = fill_short_gaps(mocap.marker(tx), mocap.rate_hz, g["max_gap_s"])
-    n_excl = int((~np.isfinite(X).all(axis=1)).sum())
+    X = tx.xyz[:, 0, :]                    # the gap-filled transmitter (ground truth's)
+    n_excl = tx.n_excluded
     try:
         R, t, res = register_anchors(mocap, log, cfg, trial=tid)
         yaw = float(wrap_angle(math.atan2(R[1, 0], R[0, 0])))
