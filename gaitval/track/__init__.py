@@ -3,7 +3,8 @@
 Roles and their registries: ``FILTERS`` (kalman), ``MOTION_MODELS`` (motion),
 ``PHASE_MODELS`` (phase), ``GATES`` (gate), ``ASSOCIATORS`` (associate),
 ``OCCLUSION_HANDLERS`` (occlusion), ``INITIALISERS`` (init), and ``TRACKER_KINDS`` (kinds:
-detect-then-track, or a tracker that reads raw scans such as a particle filter).
+detect-then-track, or a tracker that reads raw scans such as a particle filter); and
+``UKF_TRACKERS`` (ukf: trackers of an ultrasonic log's ranges, seed 003).
 """
 from gaitval.track.associate import ASSOCIATORS  # noqa: F401
 from gaitval.track.gate import GATES  # noqa: F401
@@ -16,6 +17,7 @@ from gaitval.track.occlusion import OCCLUSION_HANDLERS  # noqa: F401
 from gaitval.track import occlusion_mtst  # noqa: F401  (registers "uo_pseudo_update")
 from gaitval.track.phase import PHASE_MODELS  # noqa: F401
 from gaitval.track.tracker import TRACK_COLUMNS, Tracker, TrackResult  # noqa: F401
+from gaitval.track.ukf import UKF_TRACKERS  # noqa: F401
 
 #: every role registry, by the role's key in a method entry
 ROLE_REGISTRIES = {"filter": FILTERS, "motion": MOTION_MODELS, "phase": PHASE_MODELS,
