@@ -179,7 +179,7 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
         "and the tracking success rate; published values beside. Reference 'mocap': the "
         "track against the mocap leg points (stands in for the paper's video check); "
         "'rater events': from the rater's contacts only (what a study without mocap "
-        "has)."), notes=table3_notes(t3))
+        "has)."), notes=table3_notes(t3, data.get("events"), data.get("track_field")))
     paths += write_table(t4, td / "mtst_table4", digits=1, caption=(
         "Seed 001 Table 4: target-step judgement and cross-step detection against the "
         "rater annotations on the trials the proposed method tracked successfully; "
