@@ -31,7 +31,7 @@ from scipy import stats as sps
 from gaitval.errors import GaitvalError
 from gaitval.stats import (anova_oneway, bland_altman, icc, icc_mixed, loa_nested,
                            loa_replicates, mover_limits, proportional_bias)
-from gaitval.stats.repeated import _reml_pieces
+from gaitval.stats._mixed import _reml_pieces
 
 DATA = Path(__file__).parent / "data" / "bland_altman_2007_ejection.csv"
 

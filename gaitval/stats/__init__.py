@@ -20,8 +20,8 @@ columns are listed under *Returns* in its docstring, so renderers never recomput
 from gaitval.stats.agreement import agreement, bland_altman, icc, two_way_mean_squares
 from gaitval.stats.anova import anova_oneway
 from gaitval.stats.normality import normality
-from gaitval.stats.repeated import (icc_mixed, loa_nested, loa_replicates, mover_limits,
-                                    proportional_bias)
+from gaitval.stats.icc_mixed import icc_mixed
+from gaitval.stats.repeated import loa_nested, loa_replicates, mover_limits, proportional_bias
 from gaitval.stats.summary import error_summary, summarize_errors
 from gaitval.stats.ttest import paired_t, paired_ttest
 
