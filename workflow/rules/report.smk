@@ -1,4 +1,5 @@
-# Gather every table and figure of the studies in `run` into reports/index.{md,html}.
+# Gather every table and figure of the studies in `run` into reports/index.{md,html}, with
+# the verdict table (reports/verdicts.*) on top.
 
 
 rule report:
@@ -7,6 +8,7 @@ rule report:
     output:
         md=report(f"{REPORTS}/index.md", caption="../report/index.rst", category="Report"),
         html=f"{REPORTS}/index.html",
+        verdicts=multiext(f"{REPORTS}/verdicts", ".csv", ".md", ".tex"),
     params:
         gv=GV,
         reports=parent_of("md"),
