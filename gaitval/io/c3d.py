@@ -80,7 +80,8 @@ def describe_c3d(path: str | Path, *, trial: str | None = None) -> dict[str, Any
     ``gaps`` (label -> number of frames missing, only markers with gaps),
     ``gap_fraction`` (missing samples / all samples), ``events`` (list of
     ``{context, label, t_s}``), ``prefixes``, ``prefix_stripped`` (bool),
-    ``duplicates``, ``n_zero_gaps``, ``n_analogs``, ``analog_rate_hz``, ``manufacturer``.
+    ``duplicates``, ``n_zero_gaps``, ``n_analogs``, ``analog_rate_hz``, ``manufacturer``,
+    ``vertical_axis`` (the stored axis that points up; see :mod:`gaitval.io.c3d_axes`).
     """
     tr = read_c3d(path, trial=trial)
     miss = np.isnan(tr.xyz[:, :, 0])
@@ -112,4 +113,5 @@ def describe_c3d(path: str | Path, *, trial: str | None = None) -> dict[str, Any
         "n_analogs": int(tr.meta["n_analogs"]),
         "analog_rate_hz": float(tr.meta["analog_rate_hz"]),
         "manufacturer": tr.meta["manufacturer"],
+        "vertical_axis": tr.meta["vertical_axis"],
     }

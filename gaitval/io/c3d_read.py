@@ -22,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from gaitval.errors import FileFormatError
+from gaitval.io.c3d_axes import detect_vertical, to_z_up
 from gaitval.io.c3d_format import EVENT_COLUMNS, UNIT_SCALE, _open_ezc3d, _precheck
 from gaitval.types import MocapTrial
 
@@ -145,8 +146,8 @@ def _first_frame(c) -> tuple[int, int]:
     return header_ff, header_ff
 
 
-def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "suffix"
-             ) -> MocapTrial:
+def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "suffix",
+             vertical: str = "auto") -> MocapTrial:
     """Read the marker trajectories of a C3D file (metres, seconds, NaN gaps).
 
     Parameters
@@ -158,6 +159,11 @@ def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "s
         Policy for labels that are equal after prefix stripping: ``suffix`` keeps every
         marker and names later ones ``LABEL#2``, ``LABEL#3`` (listed in
         ``meta["duplicates"]``); ``error`` raises :class:`FileFormatError`.
+    vertical : {"auto", "z", "+y", "-y", "+x", "-x", "-z"}
+        Which stored axis points up.  ``auto`` reads it from the markers
+        (:func:`gaitval.io.c3d_axes.detect_vertical`) and turns a y-up (or x-up) file into
+        gaitval's z-up field frame, logging a warning; ``z`` refuses a file whose markers
+        say otherwise; an explicit axis is rotated to +z without looking.
 
     Returns
     -------
@@ -195,6 +201,7 @@ def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "s
     zero = np.all(xyz == 0.0, axis=2) & ~neg                     # all-zero coordinates
     gap = neg | zero | ~np.all(np.isfinite(xyz), axis=2)
     xyz[gap] = np.nan
+    xyz, up = _vertical(xyz, vertical, path, trial)
 
     rate = _first_number(_param(c, "POINT", "RATE"), None)
     rate = float(rate) if rate else float(c["header"]["points"]["frame_rate"])
@@ -223,6 +230,7 @@ def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "s
         "processor": pre["processor"],
         "first_frame_header": header_ff,
         "subjects": _strings(_param(c, "SUBJECTS", "NAMES")),
+        "vertical_axis": up,
     }
     return MocapTrial(path=str(path), rate_hz=rate, first_frame=int(ff), labels=labels,
                       xyz=xyz, events=events, units=units, meta=meta)
@@ -244,6 +252,28 @@ def _point_data(c, pre: dict, path: Path, trial: str | None) -> np.ndarray:
                               f"frames, the data section holds {n_frames}",
                               path=path, trial=trial)
     return pts
+
+
+def _vertical(xyz: np.ndarray, vertical: str, path: Path, trial: str | None
+              ) -> tuple[np.ndarray, str]:
+    """Markers in the z-up field frame, and which stored axis was up (see read_c3d)."""
+    if vertical not in ("auto", "z") + tuple(f"{s}{a}" for s in "+-" for a in "xyz"):
+        raise ValueError(f"vertical must be 'auto', 'z' or an axis such as '+y', not "
+                         f"{vertical!r}")
+    if vertical not in ("auto", "z"):
+        return (xyz if vertical == "+z" else to_z_up(xyz, vertical)), vertical
+    up, _ = detect_vertical(xyz)
+    if up is None or up == "+z":
+        return xyz, up or "+z (as stored; the markers do not tell)"
+    if vertical == "z":
+        raise FileFormatError(f"the markers say {up} points up (their heights barely change "
+                              "and the body spans it), but gaitval's field frame has +z up",
+                              path=path, trial=trial,
+                              hint="read it with vertical='auto' (the default), which turns "
+                                   "it to z up, or re-export it z-up")
+    log.warning("%s: the markers say %s points up; rotated to gaitval's z-up field frame",
+                path, up)
+    return to_z_up(xyz, up), up
 
 
 def _units(c, path: Path, trial: str | None) -> tuple[str, bool]:
