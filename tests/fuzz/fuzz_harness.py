@@ -161,6 +161,26 @@ def run_mutant(kind: str, path: Path, timeout_s: float = 150.0) -> dict:
                                               "no answer", "s": dt}
 
 
+def warm_up() -> None:
+    """Import every reader and load the schemas once, before the children are forked (a
+    child that imports ezc3d, rosbags or jsonschema itself spends most of its time so)."""
+    import ezc3d  # noqa: F401
+    import jsonschema  # noqa: F401
+    import pyarrow.parquet  # noqa: F401
+    import rosbags.highlevel  # noqa: F401
+    import rosbags.typesys  # noqa: F401
+
+    import gaitval.io.annotations  # noqa: F401
+    import gaitval.io.c3d  # noqa: F401
+    import gaitval.io.inspect  # noqa: F401
+    import gaitval.io.rosbag  # noqa: F401
+    import gaitval.io.scanlog  # noqa: F401
+    import gaitval.io.ultrasonic  # noqa: F401
+    from gaitval.io.trialsheet import load_schema
+    load_schema("trials")
+    load_schema("subjects")
+
+
 def fuzz_one(task: tuple[str, int, int, str]) -> dict:
     """One (kind, seed, index, work folder) task: make the mutant, read it, clean up."""
     import shutil
