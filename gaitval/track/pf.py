@@ -30,6 +30,10 @@ E. Estimate: the weighted mean (position and velocity) of the particles with
 All random draws come from one ``numpy.random.Generator`` seeded with ``seed``: the same
 seed and input give the same track, bit for bit.
 
+Output columns as every tracker's: ``observed`` (and pattern ``SL``) when some particle of
+the leg had laser points in its window, else ``UO``; ``phase`` from seed 000's speed
+thresholds on the estimates (for the table's completeness; the PF does not use it).
+
 References
 ----------
 Chalvatzaki G, Papageorgiou XS, Tzafestas CS, Maragos P. Comparative experimental validation
