@@ -8,13 +8,22 @@ Each creates ``.venv`` and installs gaitval into it (``pip install -e .[test]``)
 use, and again only when ``pyproject.toml`` changes.  Extra arguments go to Snakemake
 (``report``) or pytest (``test``), e.g. ``python3 run.py report --config 'run=["tiny"]'``.
 Also: ``python3 run.py bench benchmarks/NAME.py`` (installs the benchmark-only extras).
+
+Resuming after a kill (power cut, killed cluster job): ``report`` finds Snakemake's lock
+left behind in ``.snakemake/locks``; when no live Snakemake works in this folder it
+removes it (``snakemake --unlock``), ends the job processes the dead run left behind
+(they would keep writing), and goes on; the profile's ``rerun-incomplete`` redoes the jobs
+that were cut off.  Outputs are written atomically, so the tables come out byte-identical
+to an uninterrupted run.
 """
 from __future__ import annotations
 
 import hashlib
 import os
+import signal
 import subprocess
 import sys
+import time
 import venv
 from pathlib import Path
 
@@ -42,6 +51,87 @@ def ensure_env(extras: str) -> None:
     stamp.write_text(key)
 
 
+# -- resuming after a kill ---------------------------------------------------------------
+def _workdir(args: list[str]) -> Path:
+    """The folder Snakemake works in: --directory/-d, else this checkout."""
+    for i, a in enumerate(args):
+        if a in ("--directory", "-d") and i + 1 < len(args):
+            return Path(args[i + 1]).resolve()
+        if a.startswith("--directory="):
+            return Path(a.split("=", 1)[1]).resolve()
+    return ROOT
+
+
+def _processes() -> dict[int, tuple[int, str, str]]:
+    """pid -> (parent pid, command line, working folder) of the processes we may see."""
+    out = {}
+    for d in Path("/proc").iterdir():
+        if not d.name.isdigit():
+            continue
+        try:
+            cmd = (d / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+            ppid = int((d / "stat").read_text().rsplit(")", 1)[1].split()[1])
+            cwd = os.readlink(d / "cwd")
+        except (OSError, ValueError, IndexError):
+            continue
+        out[int(d.name)] = (ppid, cmd, cwd)
+    return out
+
+
+def _is_snakemake(cmd: str) -> bool:
+    words = cmd.split()[:3]
+    return any(Path(w).name.startswith("snakemake") for w in words) or \
+        "-m snakemake" in cmd
+
+
+def clear_stale_lock(cmd: list[str], env: dict, workdir: Path) -> bool:
+    """Remove a lock no live Snakemake holds, and the dead run's job processes.
+
+    Returns False when another Snakemake is working in ``workdir`` (it says so)."""
+    locks = workdir / ".snakemake" / "locks"
+    if "--unlock" in cmd or not locks.is_dir() or not any(locks.iterdir()):
+        return True
+    if not Path("/proc").is_dir():
+        print("[run.py] .snakemake/locks holds a lock; if no Snakemake is running here, "
+              "run: python3 run.py report --unlock", flush=True)
+        return True
+    procs, me = _processes(), os.getpid()
+    here = str(workdir)
+    live = [p for p, (_, c, cwd) in procs.items() if p != me and cwd == here and _is_snakemake(c)]
+    if live:
+        print(f"[run.py] another Snakemake (pid {live[0]}) is working in {here}; wait for "
+              "it to finish, or stop it first", flush=True)
+        return False
+    _end_orphans(procs, here)
+    print("[run.py] removing a stale Snakemake lock (no Snakemake is running here; a "
+          "previous run was killed) and resuming", flush=True)
+    subprocess.run([*cmd, "--unlock"], env=env, check=False, stdout=subprocess.DEVNULL)
+    return True
+
+
+def _end_orphans(procs: dict, here: str) -> None:
+    """End job shells of a dead Snakemake run in ``here`` (Snakemake starts every shell
+    job with ``set -euo pipefail``) and what they started, so nothing keeps writing."""
+    orphans = {p for p, (_, c, cwd) in procs.items()
+               if cwd == here and "set -euo pipefail" in c and "-m gaitval" in c}
+    changed = True
+    while changed:                                   # and their descendants
+        new = {p for p, (pp, _, _) in procs.items() if pp in orphans} - orphans
+        changed = bool(new)
+        orphans |= new
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        for p in orphans:
+            try:
+                os.kill(p, sig)
+            except OSError:
+                pass
+        if orphans and sig == signal.SIGTERM:
+            time.sleep(2)
+    if orphans:
+        print(f"[run.py] ended {len(orphans)} job process(es) left by the killed run",
+              flush=True)
+
+
 def main(argv: list[str]) -> int:
     if not argv or argv[0] not in ("report", "test", "bench"):
         print(__doc__)
@@ -52,6 +142,8 @@ def main(argv: list[str]) -> int:
     if verb == "report":
         ensure_env("test")
         cmd = [str(BIN / "snakemake"), "--profile", "workflow/profiles/default", *rest]
+        if not clear_stale_lock(cmd, env, _workdir(rest)):
+            return 1
     elif verb == "test":
         ensure_env("test")
         cmd = [str(PY), "-m", "pytest", *rest]

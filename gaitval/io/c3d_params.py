@@ -183,6 +183,12 @@ def _assemble(groups: dict[int, str], raw: list) -> dict[tuple[str, str], Param]
                                    "section does not define")
         key = (groups[gid], name)
         p = Param(key[0], name, ptype, dims, data)
+        if key in NUMERIC and ptype == -1:
+            raise ParameterProblem(f"{p.label} must be a number but is stored as text "
+                                   "(type -1)")
+        if key in TEXT and ptype != -1:
+            raise ParameterProblem(f"{p.label} must be text but is stored as "
+                                   f"{TYPES[ptype]} (type {ptype})")
         if ptype == -1 and not dims:
             raise ParameterProblem(f"text parameter {p.label} has no dimensions")
         if key in SCALAR and not data:
@@ -191,12 +197,6 @@ def _assemble(groups: dict[int, str], raw: list) -> dict[tuple[str, str], Param]
             why = _text_problem(data.replace(b"\x00", b" "))
             if why:
                 raise ParameterProblem(f"the text of {p.label} is unreadable: {why}")
-        if key in NUMERIC and ptype == -1:
-            raise ParameterProblem(f"{p.label} must be a number but is stored as text "
-                                   "(type -1)")
-        if key in TEXT and ptype != -1:
-            raise ParameterProblem(f"{p.label} must be text but is stored as "
-                                   f"{TYPES[ptype]} (type {ptype})")
         params.setdefault(key, p)      # Nexus writes some twice (PROCESSING:BODYMASS)
     return params
 
