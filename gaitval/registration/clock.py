@@ -80,33 +80,86 @@ def to_mocap_time(t_sensor, clock_offset_s: float, clock_drift_ppm: float) -> np
     return (np.asarray(t_sensor, dtype=float) - clock_offset_s) / (1.0 + clock_drift_ppm * 1e-6)
 
 
+def _gap_mask(tj, g, gap):
+    """Grid points ``g`` that fall inside a gap (``gap[i]``: from ``tj[i]`` to ``tj[i+1]``)."""
+    k = np.searchsorted(tj, g) - 1
+    inside = (k >= 0) & (k < len(gap))
+    bad = np.zeros(len(g), dtype=bool)
+    bad[inside] = gap[k[inside]]
+    return bad
+
+
+def _uniform_1(tj, xj, g):
+    """One channel's present samples ``(tj, xj)`` linearly on the grid ``g``; NaN outside
+    and in gaps longer than 3 median sample spacings."""
+    v = np.interp(g, tj, xj, left=np.nan, right=np.nan)
+    # do not bridge gaps longer than 3 median sample spacings
+    gap = np.diff(tj) > 3 * np.median(np.diff(tj))
+    if gap.any():
+        v[_gap_mask(tj, g, gap)] = np.nan
+    return v
+
+
 def _uniform(t, x, t0, dt, n):
-    """Linear resampling of (n_samples, ch) onto t0 + k dt; NaN outside / in gaps."""
+    """Linear resampling of (n_samples, ch) onto t0 + k dt; NaN outside / in gaps.
+
+    ``t`` is (n_samples,) shared by the channels or (n_samples, ch) per channel.  The same
+    arithmetic per channel as a loop of :func:`_uniform_1`, with the sample-spacing
+    statistics computed once for channels that share their samples (shared times and the
+    same missing samples) or for all channels at once (per-channel times, none missing).
+    """
     g = t0 + dt * np.arange(n)
     out = np.full((n, x.shape[1]), np.nan)
-    for j in range(x.shape[1]):
-        ok = np.isfinite(x[:, j]) & np.isfinite(t)
-        if ok.sum() < 2:
-            continue
-        tj, xj = t[ok], x[ok, j]
-        v = np.interp(g, tj, xj, left=np.nan, right=np.nan)
-        # do not bridge gaps longer than 3 median sample spacings
+    ok = np.isfinite(x) & np.isfinite(t if t.ndim == 2 else t[:, None])
+    if t.ndim == 1 and x.shape[1] > 1 and (ok == ok[:, :1]).all():
+        mask = ok[:, 0]
+        if mask.sum() < 2:
+            return out
+        tj = t[mask]
         gap = np.diff(tj) > 3 * np.median(np.diff(tj))
-        if gap.any():
-            k = np.searchsorted(tj, g) - 1
-            inside = (k >= 0) & (k < len(gap))
-            bad = np.zeros(n, dtype=bool)
-            bad[inside] = gap[k[inside]]
-            v[bad] = np.nan
-        out[:, j] = v
+        bad = _gap_mask(tj, g, gap) if gap.any() else None
+        xs = x[mask]
+        for j in range(x.shape[1]):
+            out[:, j] = np.interp(g, tj, xs[:, j], left=np.nan, right=np.nan)
+        if bad is not None:
+            out[bad] = np.nan
+        return out
+    done = np.zeros(x.shape[1], dtype=bool)
+    if t.ndim == 2 and len(t) >= 2:
+        cols = np.flatnonzero(ok.all(axis=0))
+        if cols.size:
+            T = t[:, cols]
+            d = np.diff(T, axis=0)
+            gaps = d > 3 * np.median(d, axis=0)
+            for i, j in enumerate(cols):
+                v = np.interp(g, T[:, i], x[:, j], left=np.nan, right=np.nan)
+                if gaps[:, i].any():
+                    v[_gap_mask(T[:, i], g, gaps[:, i])] = np.nan
+                out[:, j] = v
+            done[cols] = True
+    for j in np.flatnonzero(~done):
+        okj = ok[:, j]
+        if okj.sum() < 2:
+            continue
+        tj = (t[:, j] if t.ndim == 2 else t)[okj]
+        out[:, j] = _uniform_1(tj, x[okj, j], g)
     return out
 
 
-def _xcorr(a, b, nfft):
-    """c[k] = sum_i a[i] b[i+k] summed over channels, for k = -(na-1) .. nb-1."""
-    fa = sfft.rfft(a, nfft, axis=0)
-    fb = sfft.rfft(b, nfft, axis=0)
-    full = sfft.irfft(np.sum(np.conj(fa) * fb, axis=1), nfft)
+def _xcorr(a, b, nfft, cols=None):
+    """c[k] = sum_i a[i] b[i+k] summed over channels, for k = -(na-1) .. nb-1.
+
+    ``cols``: the only channels where ``a * b`` can be non-zero (the FFTs skip the
+    others; their zero products keep their places in the sum over channels).
+    """
+    if cols is None or len(cols) == a.shape[1]:
+        prod = np.conj(sfft.rfft(a, nfft, axis=0)) * sfft.rfft(b, nfft, axis=0)
+    else:
+        prod = np.zeros((nfft // 2 + 1, a.shape[1]), dtype=complex)
+        if len(cols):
+            prod[:, cols] = np.conj(sfft.rfft(a[:, cols], nfft, axis=0)) \
+                * sfft.rfft(b[:, cols], nfft, axis=0)
+    full = sfft.irfft(np.sum(prod, axis=1), nfft)
     na, nb = a.shape[0], b.shape[0]
     return np.concatenate([full[nfft - (na - 1):], full[:nb]])
 
@@ -198,12 +251,7 @@ def _centred_grid(t: np.ndarray, x: np.ndarray, t0: float, dt: float
         1 where a channel has a sample, else 0.
     """
     n = int(np.floor((np.nanmax(t) - t0) / dt)) + 1
-    if t.ndim == 1:
-        g = _uniform(t, x, t0, dt, n)
-    else:
-        g = np.full((n, x.shape[1]), np.nan)
-        for j in range(x.shape[1]):
-            g[:, j] = _uniform(t[:, j], x[:, j:j + 1], t0, dt, n)[:, 0]
+    g = _uniform(t, x, t0, dt, n)
     w = np.isfinite(g).astype(float)
     g = np.where(w > 0, g - np.nanmean(np.where(w > 0, g, np.nan), axis=0), 0.0)
     return np.nan_to_num(g), w
@@ -217,10 +265,21 @@ def _masked_ncc(Ag, Bg, wa, wb):
     has samples and ``ov`` the number of overlapping samples (Padfield 2012).
     """
     nfft = sfft.next_fast_len(len(Ag) + len(Bg))
-    num = _xcorr(Ag, Bg, nfft)
-    ea = _xcorr(Ag * Ag, wb, nfft)
-    eb = _xcorr(wa, Bg * Bg, nfft)
-    ov = _xcorr(wa, wb, nfft)
+    # Only channels with a non-zero value (foreground, or a predicted leg) add to the
+    # correlation and the energies; the others' products are exact zeros, kept in their
+    # places so the sum over channels adds the same numbers in the same order.
+    act = np.flatnonzero((Ag != 0).any(axis=0) | (Bg != 0).any(axis=0))
+    num = _xcorr(Ag, Bg, nfft, act)
+    ea = _xcorr(Ag * Ag, wb, nfft, act)
+    eb = _xcorr(wa, Bg * Bg, nfft, act)
+    # the overlap (a count, compared with a 0.1 % margin): one FFT when every channel
+    # shares the masks of one side
+    if Ag.shape[1] > 1 and (wa == wa[:, :1]).all():
+        ov = _xcorr(wa[:, :1], wb.sum(axis=1, keepdims=True), nfft)
+    elif Bg.shape[1] > 1 and (wb == wb[:, :1]).all():
+        ov = _xcorr(wa.sum(axis=1, keepdims=True), wb[:, :1], nfft)
+    else:
+        ov = _xcorr(wa, wb, nfft)
     with np.errstate(invalid="ignore", divide="ignore"):
         ncc = num / np.sqrt(np.maximum(ea, 0) * np.maximum(eb, 0))
     return ncc, ea, eb, ov
