@@ -7,8 +7,11 @@ shared with the replay of real walks (:mod:`gaitval.simulate.replay`) from
 """
 from __future__ import annotations
 
+import concurrent.futures as cf
 import copy
 import logging
+import multiprocessing as mp
+import os
 import time
 import warnings
 from pathlib import Path
@@ -198,93 +201,108 @@ def _subject_rows(study_cfg: dict, seed: int):
     return out
 
 
-class _Laps:
-    """Logs how long each protocol took to simulate (call with the next protocol, or None)."""
-
-    def __init__(self) -> None:
-        self.t = time.perf_counter()
-        self.proto = None
-
-    def __call__(self, proto) -> None:
-        now = time.perf_counter()
-        if self.proto is not None:
-            log.info("simulated %s in %.2f s", self.proto, now - self.t)
-        self.t, self.proto = now, proto
-
-
 def _subject_trials(proto: str, c: dict, study: str, subj: dict, gp: GaitParams, rng_s,
                     attendant_gp: GaitParams) -> list:
-    """One participant's trials as ``build(rng_t) -> TrialSim``, in order.
+    """One participant's trials as ``(build, args)``, in order: ``build(rng_t, *args)`` is
+    the trial's ``TrialSim`` (module-level functions and plain arguments, so a trial can be
+    rendered in a worker process).
 
     TUG and MTST draw the fixed sensor's pose for this participant from ``rng_s`` here.
     """
     sid = subj["subject"]
     if proto == "tug":
         pose = P._pose_jitter(rng_s, c["sensor_nominal_pose"])
-        return [lambda rng, r=r: P.build_tug(rng, study, subj, gp, f"tug_{sid}_t{r}", r, pose, c)
+        return [(P.build_tug, (study, subj, gp, f"tug_{sid}_t{r}", r, pose, c))
                 for r in range(1, int(c["n_trials"]) + 1)]
     if proto == "mtst":
         pose = P._pose_jitter(rng_s, c["sensor_nominal_pose"])
-        return [lambda rng, r=r: P.build_mtst(rng, study, subj, gp, f"mtst_{sid}_t{r}", r, pose,
-                                              c, P.COLORS[(r - 1) % 3], bool(subj["stick"]),
-                                              attendant_gp)
+        return [(P.build_mtst, (study, subj, gp, f"mtst_{sid}_t{r}", r, pose, c,
+                                P.COLORS[(r - 1) % 3], bool(subj["stick"]), attendant_gp))
                 for r in range(1, int(c["n_trials"]) + 1)]
     if proto == "rollator":
-        return [lambda rng, r=r, scen=scen: P.build_rollator(
-                    rng, study, subj, gp, f"rollator_{sid}_{scen}_r{r}", r, scen, c)
+        return [(P.build_rollator, (study, subj, gp, f"rollator_{sid}_{scen}_r{r}", r, scen, c))
                 for scen in c.get("scenarios", ["straight", "obstacle"])
                 for r in range(1, int(c.get("n_repetitions", 2)) + 1)]
     return []
 
 
-def _lrs_trials(out: Path, cfg: dict, study: str, seed: int, laps: _Laps, sheet: list,
-                realism: list, poses: list, subjects: list) -> None:
-    """Simulate and write every LRS trial (TUG, MTST, rollator) of the preset.
+def _lrs_tasks(cfg: dict, study: str, seed: int, subjects: list) -> list[tuple]:
+    """Every LRS trial (TUG, MTST, rollator) of the preset as the arguments of
+    :func:`_simulate_trial`, in trial order; appends the participants to ``subjects``.
 
     Streams: participant ``si`` draws from ``_rng(seed, 2, si)`` (sensor pose, clock
     drift), trial ``idx`` (1-based over the study) from ``_rng(seed, 3, idx)`` (scene,
-    mocap variant, clock offset).
+    mocap variant, clock offset), so a trial's bytes do not depend on where it runs.
     """
     clock_cfg = cfg.get("clock", {})
-    idx = 0
     attendant_gp = GaitParams(step_length_m=0.55, step_width_m=0.12, step_time_s=0.6,
                               stance_frac=0.62, step_cv=0.03, place_sd_m=0.02,
                               shank_length_m=0.40, hip_height_m=0.85)
+    tasks = []
     for si, (proto, subj, gp) in enumerate(_subject_rows(cfg, seed)):
-        if proto != laps.proto:
-            laps(proto)
         subjects.append(subj)
         rng_s = _rng(seed, 2, si)
         builders = _subject_trials(proto, cfg[proto], study, subj, gp, rng_s, attendant_gp)
         drift = sensor_clock(rng_s, clock_cfg)["clock_drift_ppm"]
-        for build in builders:
-            idx += 1
-            rng_t = _rng(seed, 3, idx)
-            sim = build(rng_t)
-            sim.variant.update(_variant(rng_t, cfg))
-            clock = {**sensor_clock(rng_t, clock_cfg), "clock_drift_ppm": drift}
-            _render_trial(out, study, sim, subj, clock, seed, idx, realism, sheet, poses)
+        for build, bargs in builders:
+            tasks.append((len(tasks) + 1, proto, build, bargs, subj, drift))
+    return tasks
 
 
-def _add_ultrasonic(out: Path, cfg: dict, study: str, seed: int, laps: _Laps,
-                    trials: pd.DataFrame, subj_df: pd.DataFrame
-                    ) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Write the ultrasonic protocols' trials and append their sheet and subject rows."""
+def _simulate_trial(out: Path, cfg: dict, study: str, seed: int, idx: int, build, bargs,
+                    subj: dict, drift: float) -> tuple[list, list, list]:
+    """Simulate and write trial ``idx``; its (realism, sheet, pose) rows."""
+    rng_t = _rng(seed, 3, idx)
+    sim = build(rng_t, *bargs)
+    sim.variant.update(_variant(rng_t, cfg))
+    clock = {**sensor_clock(rng_t, cfg.get("clock", {})), "clock_drift_ppm": drift}
+    realism, sheet, poses = [], [], []
+    _render_trial(out, study, sim, subj, clock, seed, idx, realism, sheet, poses)
+    return realism, sheet, poses
+
+
+def _ultrasonic(out: Path, cfg: dict, study: str, seed: int):
+    """The ultrasonic protocols' (trials, subjects), or the reason they were skipped."""
     try:
         from gaitval.simulate.ultrasonic import generate_ultrasonic
     except ImportError as exc:
-        warnings.warn(f"ultrasonic protocols skipped: {exc}", stacklevel=3)
-        return trials, subj_df
-    ucfg = {**cfg["ultrasonic"], "study": study}
-    ut, us = generate_ultrasonic(out, ucfg, seed)
-    laps(None)
-    trials = pd.concat([trials, ut.reindex(columns=TRIAL_COLUMNS)], ignore_index=True)
-    subj_df = pd.concat([subj_df, us.reindex(columns=SUBJECT_COLUMNS)], ignore_index=True)
-    return trials, subj_df
+        return str(exc)
+    return generate_ultrasonic(out, {**cfg["ultrasonic"], "study": study}, seed)
 
 
-def generate_study(out_dir: Path, preset: str | dict = "default", seed: int | None = None
-                   ) -> Path:
+def _workers(n_tasks: int, workers: int | None) -> int:
+    if workers is None:
+        try:
+            workers = len(os.sched_getaffinity(0))
+        except AttributeError:                                   # not Linux
+            workers = os.cpu_count() or 1
+    return max(1, min(int(workers), n_tasks))
+
+
+class _Serial:
+    """The ``concurrent.futures`` executor interface, run in this process (1 worker)."""
+
+    def submit(self, fn, *args):
+        f = cf.Future()
+        f.set_result(fn(*args))
+        return f
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+
+def _executor(n: int):
+    if n <= 1:
+        return _Serial()
+    ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
+    return cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx)
+
+
+def generate_study(out_dir: Path, preset: str | dict = "default", seed: int | None = None,
+                   *, workers: int | None = None) -> Path:
     """Write a complete simulated study into ``out_dir``.
 
     Parameters
@@ -302,6 +320,10 @@ def generate_study(out_dir: Path, preset: str | dict = "default", seed: int | No
         the same shape.
     seed : int, optional
         Overrides the preset's ``seed``.
+    workers : int, optional
+        Processes rendering trials at once (default: the CPUs this process may use; 1
+        renders in this process).  Every trial draws from its own seeded streams, so the
+        files are byte-identical whatever the number.
 
     Returns
     -------
@@ -317,13 +339,32 @@ def generate_study(out_dir: Path, preset: str | dict = "default", seed: int | No
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     sheet, realism, poses, subjects = [], [], [], []
-    laps = _Laps()
-    _lrs_trials(out, cfg, study, seed, laps, sheet, realism, poses, subjects)
-    laps("ultrasonic" if cfg.get("ultrasonic") else None)
+    t0 = time.perf_counter()
+    tasks = _lrs_tasks(cfg, study, seed, subjects)
+    n_us = 1 if cfg.get("ultrasonic") else 0
+    with _executor(_workers(len(tasks) + n_us, workers)) as ex:
+        # the ultrasonic protocols first: one long task beside the trials
+        us = ex.submit(_ultrasonic, out, cfg, study, seed) if n_us else None
+        futures = [ex.submit(_simulate_trial, out, cfg, study, seed, idx, build, bargs,
+                             subj, drift)
+                   for idx, proto, build, bargs, subj, drift in tasks]
+        for f in futures:                                        # in trial order
+            r, sh, po = f.result()
+            realism += r
+            sheet += sh
+            poses += po
+        us = us.result() if us is not None else None
+    log.info("simulated %d LRS trials%s in %.2f s", len(tasks),
+             " and the ultrasonic protocols" if n_us else "", time.perf_counter() - t0)
     trials = pd.DataFrame(sheet, columns=TRIAL_COLUMNS)
     subj_df = pd.DataFrame(subjects, columns=SUBJECT_COLUMNS)
-    if cfg.get("ultrasonic"):
-        trials, subj_df = _add_ultrasonic(out, cfg, study, seed, laps, trials, subj_df)
+    if isinstance(us, str):
+        warnings.warn(f"ultrasonic protocols skipped: {us}", stacklevel=2)
+    elif us is not None:
+        ut, usj = us
+        trials = pd.concat([trials, ut.reindex(columns=TRIAL_COLUMNS)], ignore_index=True)
+        subj_df = pd.concat([subj_df, usj.reindex(columns=SUBJECT_COLUMNS)],
+                            ignore_index=True)
     write_csv(trials, out / "trials.csv")
     write_csv(subj_df, out / "subjects.csv")
     write_csv(pd.DataFrame(poses, columns=["trial", "x_m", "y_m", "yaw_rad", "clock_offset_s",
