@@ -1,0 +1,168 @@
+"""Build a report from nothing and print what it cost (the measure of issue 13).
+
+Usage::
+
+    .venv/bin/python benchmarks/report_end_to_end.py --study tiny            # ~1-3 min
+    .venv/bin/python benchmarks/report_end_to_end.py --study default --repeat 3
+    # the code of another checkout (e.g. a `git worktree` of an older commit):
+    PYTHONPATH=/tmp/base .venv/bin/python benchmarks/report_end_to_end.py --root /tmp/base
+
+Each repeat runs Snakemake (``--cores N``) from the checkout's Snakefile in a fresh temp
+dir (fresh data/, results/, reports/, logs/; the venv is not touched), so the simulation
+is included.  Afterwards one job of each rule is rerun twice in the same folder: once
+with its modules' import recorded (``sys.modules`` at exit) and timed, and once as a
+process that only imports those modules (``python -c 'import ...'``).  The second is the
+job's start-up + import + exit cost; times the rule's job count, summed over the rules,
+it is the share of the run's CPU that goes to interpreter start-up and imports.
+
+Prints per repeat ``wall``, ``cpu`` (user + system of all child processes) and the job
+count; then the per-rule table and the last line::
+
+    report <study>: wall <median> s, cpu <median> s, <jobs> jobs, start-up+imports <pct> % of cpu
+"""
+from __future__ import annotations
+
+import argparse
+import re
+import resource
+import shlex
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# records the modules a job imported, then runs `python -m gaitval ...` as usual
+_RECORD = ("import sys, atexit, runpy\n"
+           "def _dump(p=sys.argv.pop(1)):\n"
+           "    open(p, 'w').write('\\n'.join(m for m in list(sys.modules)))\n"
+           "atexit.register(_dump)\n"
+           "sys.argv[0] = 'gaitval'\n"
+           "runpy.run_module('gaitval', run_name='__main__', alter_sys=True)\n")
+
+
+def _cpu_children() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def _run_snakemake(root: Path, work: Path, study: str, cores: int) -> tuple[float, float, str]:
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(root / "Snakefile"),
+           "--directory", str(work), "--cores", str(cores), "--printshellcmds",
+           "--rerun-incomplete", "--config", f'run=["{study}"]']
+    c0, t0 = _cpu_children(), time.perf_counter()
+    p = subprocess.run(cmd, cwd=work, capture_output=True, text=True)
+    wall, cpu = time.perf_counter() - t0, _cpu_children() - c0
+    log = p.stdout + p.stderr
+    if p.returncode:
+        sys.exit(f"snakemake failed ({p.returncode}):\n{log[-4000:]}")
+    return wall, cpu, log
+
+
+def _job_stats(log: str) -> dict[str, int]:
+    """rule -> job count from Snakemake's 'Job stats' table."""
+    m = re.search(r"Job stats:\n(.*?)\n\n", log, re.S)
+    counts = {}
+    for line in (m.group(1).splitlines() if m else []):
+        w = line.split()
+        if len(w) == 2 and w[1].isdigit() and w[0] not in ("job", "total"):
+            counts[w[0]] = int(w[1])
+    return counts
+
+
+def _shell_commands(log: str) -> dict[str, str]:
+    """rule -> the first `python -m gaitval ...` shell command Snakemake printed for it."""
+    out, rule = {}, None
+    for line in log.splitlines():
+        m = re.match(r"\s*(?:local)?rule (\w+):", line) or re.match(r"\s*(?:local)?checkpoint (\w+):", line)
+        if m:
+            rule = m.group(1)
+            continue
+        if rule and rule not in out and " -m gaitval " in line:
+            out[rule] = line.strip()
+    return out
+
+
+def _job_argv(cmd: str) -> list[str] | None:
+    """The argv after `-m gaitval` of a rule's shell command (up to the redirection)."""
+    words = shlex.split(cmd.split(" > ")[0])
+    try:
+        i = words.index("gaitval", words.index("-m"))
+    except ValueError:
+        return None
+    return words[i + 1:]
+
+
+def _cpu_of(argv: list[str], cwd: Path) -> float:
+    c0 = _cpu_children()
+    subprocess.run(argv, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                   check=False)
+    return _cpu_children() - c0
+
+
+def _startup_of(rule_argv: list[str], work: Path, n: int = 3) -> tuple[float, float, int]:
+    """(job cpu, start-up + imports + exit cpu, modules) of one job, medians of n."""
+    mods_file = work / "_modules.txt"
+    job = statistics.median(
+        _cpu_of([sys.executable, "-c", _RECORD, str(mods_file), *rule_argv], work)
+        for _ in range(n))
+    mods = [m for m in mods_file.read_text().split("\n")
+            if m and m != "__main__" and not m.startswith("_frozen")]
+    imp = ("import importlib\n"
+           f"for m in {mods!r}:\n"
+           "    try: importlib.import_module(m)\n"
+           "    except Exception: pass\n")
+    start = statistics.median(_cpu_of([sys.executable, "-c", imp], work) for _ in range(n))
+    return job, start, len(mods)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--study", default="tiny", choices=["tiny", "default"])
+    ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--cores", type=int, default=2)
+    ap.add_argument("--root", type=Path, default=ROOT,
+                    help="checkout whose Snakefile runs (default: this one)")
+    ap.add_argument("--keep", type=Path, default=None,
+                    help="copy the last run's results/ here (to compare outputs)")
+    ap.add_argument("--no-startup", action="store_true",
+                    help="skip the per-rule start-up measurement")
+    args = ap.parse_args()
+    walls, cpus, jobs = [], [], 0
+    with tempfile.TemporaryDirectory(prefix="gaitval-e2e-") as tmp:
+        for r in range(args.repeat):
+            work = Path(tmp) / f"run{r}"
+            work.mkdir()
+            wall, cpu, log = _run_snakemake(args.root.resolve(), work, args.study, args.cores)
+            counts = _job_stats(log)
+            jobs = sum(counts.values())
+            walls.append(wall)
+            cpus.append(cpu)
+            print(f"run {r + 1}: wall {wall:.1f} s, cpu {cpu:.1f} s, {jobs} jobs", flush=True)
+        if args.keep:
+            shutil.copytree(work / "results", args.keep, dirs_exist_ok=True)
+        share = float("nan")
+        if not args.no_startup:
+            cmds = _shell_commands(log)
+            total_start = 0.0
+            print(f"{'rule':28s} {'jobs':>5s} {'job cpu':>8s} {'start-up':>9s} {'modules':>8s}")
+            for rule, n in sorted(counts.items()):
+                argv = _job_argv(cmds[rule]) if rule in cmds else None
+                if argv is None:
+                    print(f"{rule:28s} {n:5d}  (no gaitval shell command: runs in Snakemake)")
+                    continue
+                job, start, nmod = _startup_of(argv, work)
+                total_start += n * start
+                print(f"{rule:28s} {n:5d} {job:8.2f} {start:9.2f} {nmod:8d}", flush=True)
+            share = 100 * total_start / statistics.median(cpus)
+    print(f"report {args.study}: wall {statistics.median(walls):.1f} s, "
+          f"cpu {statistics.median(cpus):.1f} s, {jobs} jobs, "
+          f"start-up+imports {share:.0f} % of cpu")
+
+
+if __name__ == "__main__":
+    main()
