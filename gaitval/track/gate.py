@@ -58,13 +58,19 @@ class Gate:
     def within_radius(filter, prior, obs, r: float) -> list[tuple[int, float]]:
         """``(j, λ²)`` of the observations closer than ``r`` to the prediction (seed001
         eq. (5)); λ² only for those (the radius gates' fast path, same result as
-        :meth:`candidates` with ``admits = dist < r``)."""
-        px, py = filter.pos(prior)
+        :meth:`candidates` with ``admits = dist < r``).  A state begins ``(x, y, ...)``."""
+        px, py = prior[0], prior[1]
         r2 = r * r
-        inside = [j for j, (zx, zy) in enumerate(obs, 1)
-                  if (zx - px) * (zx - px) + (zy - py) * (zy - py) < r2]
+        inside = []
+        for j, (zx, zy) in enumerate(obs, 1):
+            dx, dy = zx - px, zy - py
+            if dx * dx + dy * dy < r2:
+                inside.append(j)
         if not inside:
-            return []
+            return inside
+        if len(inside) == 1:
+            j = inside[0]
+            return [(j, filter.mahalanobis2(prior, *obs[j - 1]))]
         return list(zip(inside, filter.lam2_all(prior, [obs[j - 1] for j in inside])))
 
 
@@ -109,7 +115,8 @@ class FixedRadiusGate(Gate):
         return dist < self.radius(ctx)              # seed001 eq. (5)
 
     def candidates(self, filter, prior, obs, ctx):
-        return self.within_radius(filter, prior, obs, self.radius(ctx))   # seed001 eq. (5)
+        return self.within_radius(filter, prior, obs,                      # seed001 eq. (5)
+                                  self.radius_leg_widths * ctx.leg_width_m)
 
 
 @GATES.register("variable_region")

@@ -31,8 +31,7 @@ class PseudoObservation(OcclusionHandler):
     """Correct an unobserved (UO) leg with its own prediction (seed 001 §2.4.3)."""
 
     def after_scan(self, state, run, k: int) -> None:
-        F = run.filter
         for leg in run.legs:
-            if not leg.real[k] and leg.z[k] is None:
+            if leg.z[k] is None:                          # UO: no real or virtual observation
                 s = leg.post[k]
-                leg.post[k] = F.correct(s, s[0], s[1])    # seed001 §2.4.3: y_k = ŷ_{k/k−1}
+                leg.post[k] = run.filter.correct(s, s[0], s[1])   # seed001 §2.4.3: y = ŷ
