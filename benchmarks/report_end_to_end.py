@@ -64,13 +64,13 @@ def _run_snakemake(root: Path, work: Path, study: str, cores: int) -> tuple[floa
 
 
 def _job_stats(log: str) -> dict[str, int]:
-    """rule -> job count from Snakemake's 'Job stats' table."""
-    m = re.search(r"Job stats:\n(.*?)\n\n", log, re.S)
-    counts = {}
-    for line in (m.group(1).splitlines() if m else []):
-        w = line.split()
-        if len(w) == 2 and w[1].isdigit() and w[0] not in ("job", "total"):
-            counts[w[0]] = int(w[1])
+    """rule -> jobs run, from the ``rule X:`` / ``checkpoint X:`` line Snakemake prints per
+    job (its 'Job stats' table is printed before a checkpoint adds the per-trial jobs)."""
+    counts: dict[str, int] = {}
+    for line in log.splitlines():
+        m = re.match(r"\s*(?:localrule|rule|localcheckpoint|checkpoint) (\w+):\s*$", line)
+        if m:
+            counts[m.group(1)] = counts.get(m.group(1), 0) + 1
     return counts
 
 
@@ -78,7 +78,7 @@ def _shell_commands(log: str) -> dict[str, str]:
     """rule -> the first `python -m gaitval ...` shell command Snakemake printed for it."""
     out, rule = {}, None
     for line in log.splitlines():
-        m = re.match(r"\s*(?:local)?rule (\w+):", line) or re.match(r"\s*(?:local)?checkpoint (\w+):", line)
+        m = re.match(r"\s*(?:localrule|rule|localcheckpoint|checkpoint) (\w+):\s*$", line)
         if m:
             rule = m.group(1)
             continue
