@@ -24,9 +24,9 @@ TARGETS = ["reports/tables/tug_table4.csv", "reports/tables/study_ingest_tiny.cs
 
 def _report(workdir: Path, data: Path, **popen) -> list[str]:
     peer = (ROOT / ".." / "shared" / "realdata" / "peer-results" / "gailo_results.parquet")
-    return [sys.executable, str(ROOT / "run.py"), "report", "--directory", str(workdir),
-            "--config", 'run=["tiny"]', f"data_dir={data}", f"peer_results={peer.resolve()}",
-            *TARGETS]
+    return [sys.executable, str(ROOT / "run.py"), "report", *TARGETS, "--directory",
+            str(workdir), "--config", 'run=["tiny"]', f"data_dir={data}",
+            f"peer_results={peer.resolve()}"]
 
 
 @pytest.mark.slow

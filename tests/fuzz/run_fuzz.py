@@ -15,6 +15,7 @@ Exit status 1 when there is any failure.
 from __future__ import annotations
 
 import argparse
+import itertools
 import multiprocessing
 import sys
 import tempfile
@@ -25,16 +26,18 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import fuzz_harness as H  # noqa: E402
 
 #: share of the mutants per kind (bags are slow to read: ~1 s each)
-SHARE = {"c3d": 0.40, "bag": 0.03, "scanlog": 0.16, "ultrasonic": 0.15,
-         "annotations": 0.13, "sheet": 0.13}
+SHARE = {"c3d": 0.25, "bag": 0.02, "scanlog": 0.19, "ultrasonic": 0.18,
+         "annotations": 0.18, "sheet": 0.18}
 
 
 def tasks(n: int, seed: int, kinds: list[str], work: str) -> list[tuple]:
     share = {k: SHARE[k] for k in kinds}
     total = sum(share.values())
-    out = []
-    for k in kinds:
-        out += [(k, seed, i, work) for i in range(round(n * share[k] / total))]
+    per_kind = [[(k, seed, i, work) for i in range(round(n * share[k] / total))]
+                for k in kinds]
+    out = []                                   # interleaved: every kind early in the run
+    for row in itertools.zip_longest(*per_kind):
+        out += [t for t in row if t is not None]
     return out
 
 

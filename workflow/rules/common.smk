@@ -1,4 +1,5 @@
 # Shared by all rule files -- config validation, paths, the trial sheet, provenance.
+import shlex
 import sys
 from pathlib import Path
 
@@ -54,7 +55,7 @@ _METHODS = getattr(getattr(workflow, "deployment_settings", None), "deployment_m
 GV = (
     "python -m gaitval"
     if any(str(m).lower().endswith("conda") for m in _METHODS)
-    else f"{sys.executable} -m gaitval"
+    else f"{shlex.quote(sys.executable)} -m gaitval"  # a checkout path with a space
 )
 # Hash of the analysis sections only: changing `run` or paths must not rerun the tables.
 CONFIG_HASH = config_hash({k: config[k] for k in ANALYSIS_SECTIONS if k in config})

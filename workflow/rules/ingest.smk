@@ -19,9 +19,9 @@ rule ingest:
     log:
         "logs/ingest/{study}/{trial}.log",
     shell:
-        "{params.gv} ingest --sheet {input.sheet} --subjects {params.subjects}"
-        " --trial {wildcards.trial} --out {params.out}"
-        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} ingest --sheet {input.sheet:q} --subjects {params.subjects:q}"
+        " --trial {wildcards.trial:q} --out {params.out:q}"
+        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 rule ingest_summary:
@@ -49,9 +49,9 @@ rule ingest_summary:
     log:
         "logs/ingest_summary/{study}.log",
     shell:
-        "{params.gv} ingest-summary {input} --study {wildcards.study} --out-stem {params.stem}"
-        " --reports-dir {params.reports} --config-hash {params.chash}"
-        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} ingest-summary {input:q} --study {wildcards.study:q} --out-stem {params.stem:q}"
+        " --reports-dir {params.reports:q} --config-hash {params.chash:q}"
+        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 REPORT_ITEM_FUNCS.append(lambda study: [f"{REPORTS}/tables/study_ingest_{study}.csv"])

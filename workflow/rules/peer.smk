@@ -23,8 +23,8 @@ rule peer_agreement:
     log:
         "logs/peer_agreement.log",
     shell:
-        "{params.gv} peer {input} --out-stem {params.stem} --reports-dir {params.reports}"
-        " --config-hash {params.chash} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} peer {input:q} --out-stem {params.stem:q} --reports-dir {params.reports:q}"
+        " --config-hash {params.chash:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 REPORT_ITEM_FUNCS.append(

@@ -36,9 +36,9 @@ rule register:
     log:
         "logs/register/{study}/{trial}.log",
     shell:
-        "{params.gv} register --ingest {params.ingest} --sheet {input.sheet}"
-        " --subjects {params.subjects} --trial {wildcards.trial} --config {input.config}"
-        " --out {params.out} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} register --ingest {params.ingest:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --config {input.config:q}"
+        " --out {params.out:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 rule registration_summary:
@@ -67,9 +67,9 @@ rule registration_summary:
     log:
         "logs/registration_summary/{study}.log",
     shell:
-        "{params.gv} registration-summary {input} --study {wildcards.study}"
-        " --out-csv {output.csv} --out-stem {params.stem} --reports-dir {params.reports}"
-        " --config-hash {params.chash} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} registration-summary {input:q} --study {wildcards.study:q}"
+        " --out-csv {output.csv:q} --out-stem {params.stem:q} --reports-dir {params.reports:q}"
+        " --config-hash {params.chash:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 REPORT_ITEM_FUNCS.append(lambda study: [f"{REPORTS}/tables/study_registration_{study}.csv"])

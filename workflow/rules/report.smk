@@ -18,5 +18,5 @@ rule report:
     log:
         "logs/report.log",
     shell:
-        "{params.gv} report --reports-dir {params.reports} --studies {params.studies}"
-        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} report --reports-dir {params.reports:q} --studies {params.studies:q}"
+        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"

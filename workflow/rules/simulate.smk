@@ -17,5 +17,5 @@ checkpoint simulate:
     log:
         "logs/simulate/{study}.log",
     shell:
-        "{params.gv} simulate --preset {input.preset} --seed {params.seed} --out {params.out}"
-        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} simulate --preset {input.preset:q} --seed {params.seed:q} --out {params.out:q}"
+        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"

@@ -51,9 +51,9 @@ rule track:
     log:
         "logs/track/{study}/{method}/{trial}.log",
     shell:
-        "{params.gv} track --sensor {input.sensor} --sheet {input.sheet}"
-        " --subjects {params.subjects} --trial {wildcards.trial} --method {wildcards.method}"
-        " --config {input.config} --out {output} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} track --sensor {input.sensor:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
+        " --config {input.config:q} --out {output:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 rule evaluate_tug:
@@ -73,9 +73,9 @@ rule evaluate_tug:
     log:
         "logs/evaluate_tug/{study}/{method}/{trial}.log",
     shell:
-        "{params.gv} evaluate-tug --track {input.track} --groundtruth {input.gt}"
-        " --registration {input.reg} --trial {wildcards.trial} --method {wildcards.method}"
-        " --config {input.config} --out {params.out} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} evaluate-tug --track {input.track:q} --groundtruth {input.gt:q}"
+        " --registration {input.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
+        " --config {input.config:q} --out {params.out:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 rule tug_tables:
@@ -114,10 +114,10 @@ rule tug_tables:
     log:
         "logs/tug_tables.log",
     shell:
-        "{params.gv} tug-tables {params.dirs} --methods {params.methods}"
-        " --tables-dir {params.tables} --figures-dir {params.figures}"
-        " --reports-dir {params.reports} --config-hash {params.chash}"
-        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} tug-tables {params.dirs:q} --methods {params.methods:q}"
+        " --tables-dir {params.tables:q} --figures-dir {params.figures:q}"
+        " --reports-dir {params.reports:q} --config-hash {params.chash:q}"
+        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 REPORT_ITEM_FUNCS.append(

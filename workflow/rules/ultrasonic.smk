@@ -29,10 +29,10 @@ rule ultrasonic_noise:
     log:
         "logs/ultrasonic_noise.log",
     shell:
-        "{params.gv} ultrasonic-noise --ingest {params.dirs} --trials {params.trials}"
-        " --config {input.config} --out {output.noise} --table-stem {params.stem}"
-        " --reports-dir {params.reports} --config-hash {params.chash}"
-        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} ultrasonic-noise --ingest {params.dirs:q} --trials {params.trials:q}"
+        " --config {input.config:q} --out {output.noise:q} --table-stem {params.stem:q}"
+        " --reports-dir {params.reports:q} --config-hash {params.chash:q}"
+        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 rule ultrasonic_track:
@@ -50,9 +50,9 @@ rule ultrasonic_track:
     log:
         "logs/ultrasonic_track/{study}/{trial}.log",
     shell:
-        "{params.gv} ultrasonic-track --ingest {params.ingest} --trial {wildcards.trial}"
-        " --config {input.config} --noise {input.noise} --out {output}"
-        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} ultrasonic-track --ingest {params.ingest:q} --trial {wildcards.trial:q}"
+        " --config {input.config:q} --noise {input.noise:q} --out {output:q}"
+        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 rule gait_parameters:
@@ -72,9 +72,9 @@ rule gait_parameters:
     log:
         "logs/gait_parameters/{study}/{trial}.log",
     shell:
-        "{params.gv} gait-parameters --track {input.track} --ingest {params.ingest}"
-        " --sheet {input.sheet} --subjects {params.subjects} --trial {wildcards.trial}"
-        " --config {input.config} --out {output} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} gait-parameters --track {input.track:q} --ingest {params.ingest:q}"
+        " --sheet {input.sheet:q} --subjects {params.subjects:q} --trial {wildcards.trial:q}"
+        " --config {input.config:q} --out {output:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 rule ultrasonic_tables:
@@ -105,9 +105,9 @@ rule ultrasonic_tables:
     log:
         "logs/ultrasonic_tables.log",
     shell:
-        "{params.gv} ultrasonic-tables {input} --tables-dir {params.tables}"
-        " --figures-dir {params.figures} --reports-dir {params.reports}"
-        " --config-hash {params.chash} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} ultrasonic-tables {input:q} --tables-dir {params.tables:q}"
+        " --figures-dir {params.figures:q} --reports-dir {params.reports:q}"
+        " --config-hash {params.chash:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 REPORT_ITEM_FUNCS.append(
