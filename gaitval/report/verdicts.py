@@ -229,6 +229,8 @@ _SPEED_ORDER = ("slow", "normal", "fast")
 
 
 def _p(p: float) -> str:
+    if not np.isfinite(p):
+        return "n/a"
     return "< 0.001" if p < 0.001 else f"{p:.3f}"
 
 
@@ -276,9 +278,11 @@ def ultrasonic_verdicts(t: dict[str, pd.DataFrame]) -> list[dict]:
     t7 = t.get("ultrasonic_table7")
     if t7 is not None:
         for r in t7.itertuples(index=False):
+            known = np.isfinite([r.H, r.H_published]).all()
             rows.append(_row(st, f"{r.symbol} normally distributed (Lilliefors)", "Table 7",
-                             f"H = {int(r.H_published)}", f"H = {int(r.H)} (p {_p(r.p)})",
-                             "same test decision", int(r.H) == int(r.H_published),
+                             f"H = {r.H_published:.0f}", f"H = {r.H:.0f} (p {_p(r.p)})"
+                             if known else "too few strides", "same test decision",
+                             int(r.H) == int(r.H_published) if known else None,
                              "ultrasonic_table7"))
     c1 = t.get("ultrasonic_tableC1")
     if c1 is not None:
