@@ -44,7 +44,7 @@ SHORT = {"tug_m1": "M1", "tug_m2": "M2", "tug_m3": "M3", "mtst_m1": "M1", "mtst_
 
 def _yn(ok) -> str:
     if ok is None or (isinstance(ok, float) and math.isnan(ok)):
-        return "n/a"
+        return "undecided"
     return "yes" if bool(ok) else "no"
 
 
@@ -290,7 +290,8 @@ def ultrasonic_verdicts(t: dict[str, pd.DataFrame]) -> list[dict]:
             rows.append(_row(st, f"{r.symbol}: no difference between subjects (ANOVA)",
                              "Table C1", f"F {r.F_published:.2f}, p {r.p_published:.3f}",
                              f"F {r.F:.2f}, p {_p(r.p)}", "same test decision at 0.05",
-                             (r.p < 0.05) == (r.p_published < 0.05), "ultrasonic_tableC1"))
+                             (r.p < 0.05) == (r.p_published < 0.05) if np.isfinite(r.p) else None,
+                             "ultrasonic_tableC1"))
     return rows
 
 
