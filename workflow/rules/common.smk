@@ -10,7 +10,9 @@ from gaitval.configcheck import (check_config, check_study_file, display_path,
 from gaitval.errors import ConfigError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash
-from gaitval.steps import ANALYSIS_SECTIONS
+from gaitval.methods import get_method, set_params
+from gaitval.steps import ANALYSIS_SECTIONS, method_definition
+from gaitval.tables.tug_evidence import method_reading
 
 
 def _config_layers():
@@ -139,6 +141,37 @@ def parent_of(name, up=0):
 def tug_methods():
     """The TUG tracker methods to run (config tug.methods)."""
     return list(config.get("tug", {}).get("methods", ["tug_m1", "tug_m2", "tug_m3"]))
+
+
+def _reading_variants():
+    """seed000 eq. (3)-(4) can be read two ways (gaitval.gait.phases): each TUG method also
+    runs under every other reading of tug.phase_readings, as <method>_<reading> = the
+    method (built-in or tracking.methods, with its tracking.overrides) with
+    phase__reading set.  They are added to tracking.methods, so the per-study config.json,
+    the track jobs and Table 2 see the definition that ran."""
+    readings = config.get("tug", {}).get("phase_readings", ["swing_first"])
+    tracking = config.setdefault("tracking", {})
+    variants = {}
+    for m in tug_methods():
+        base = set_params(get_method(method_definition(config, m)),
+                          (tracking.get("overrides") or {}).get(m))
+        own = method_reading(m, {m: base})[1]
+        for r in readings:
+            name = f"{m}_{r}"
+            if r == own or name in (tracking.get("methods") or {}):
+                continue
+            variants[name] = set_params(base, {"phase__reading": r})
+            variants[name]["label"] = f"{base.get('label', m)}, eq. (3)-(4) {r}"
+    tracking["methods"] = {**(tracking.get("methods") or {}), **variants}
+    return list(variants)
+
+
+_READING_VARIANTS = _reading_variants()
+
+
+def tug_runs():
+    """The TUG methods (tug.methods) and their reading variants (tug.phase_readings)."""
+    return tug_methods() + _READING_VARIANTS
 
 
 def pendulum_trials():

@@ -1,39 +1,6 @@
 # TUG leg tracking (seed 000): one job per (trial, method), evaluation against the
-# registered ground truth, then Tables 2-5 and the figures.
-from gaitval.methods import get_method, set_params
-from gaitval.steps import method_definition
-from gaitval.tables.tug_evidence import method_reading
-
-
-def _reading_variants():
-    """seed000 eq. (3)-(4) can be read two ways (gaitval.gait.phases): each TUG method also
-    runs under every other reading of tug.phase_readings, as <method>_<reading> = the
-    method (built-in or tracking.methods, with its tracking.overrides) with
-    phase__reading set.  They are added to tracking.methods, so the per-study config.json,
-    the track jobs and Table 2 see the definition that ran."""
-    readings = config.get("tug", {}).get("phase_readings", ["swing_first"])
-    tracking = config.setdefault("tracking", {})
-    variants = {}
-    for m in tug_methods():
-        base = set_params(get_method(method_definition(config, m)),
-                          (tracking.get("overrides") or {}).get(m))
-        own = method_reading(m, {m: base})[1]
-        for r in readings:
-            name = f"{m}_{r}"
-            if r == own or name in (tracking.get("methods") or {}):
-                continue
-            variants[name] = set_params(base, {"phase__reading": r})
-            variants[name]["label"] = f"{base.get('label', m)}, eq. (3)-(4) {r}"
-    tracking["methods"] = {**(tracking.get("methods") or {}), **variants}
-    return list(variants)
-
-
-_READING_VARIANTS = _reading_variants()
-
-
-def tug_runs():
-    """The TUG methods (tug.methods) and their reading variants (tug.phase_readings)."""
-    return tug_methods() + _READING_VARIANTS
+# registered ground truth, then Tables 2-5 and the figures.  The methods run are
+# tug_runs() (common.smk): tug.methods and their reading variants (tug.phase_readings).
 
 
 rule track:
