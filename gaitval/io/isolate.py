@@ -104,6 +104,8 @@ def _child(func, args, wfd: int) -> None:
     """Body of the child: run, pickle, write, and leave without running parent clean-ups."""
     code = 0
     try:
+        import faulthandler
+        faulthandler.disable()          # the parent reports a crash; no dump on its stderr
         try:
             out = ("ok", func(*args))
         except BaseException as exc:       # noqa: BLE001 - carried to the parent
