@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from gaitval.methods import METHOD_DEFINITIONS, METHODS, get_method
+from gaitval.stats.summary import rmse
 from gaitval.tables.render import write_table
 from gaitval.tables.tug_evidence import DEFAULT_READING, failure_evidence, method_reading
 
@@ -92,9 +93,9 @@ def _label(m: str, definitions: Mapping | None = None) -> str:
 
 
 def _rmse(e: pd.Series) -> float:
+    """The one RMSE (:func:`gaitval.stats.summary.rmse`) over the finite errors."""
     e = e.to_numpy(float)
-    e = e[np.isfinite(e)]
-    return float(np.sqrt(np.mean(e ** 2))) if len(e) else float("nan")
+    return rmse(e[np.isfinite(e)])
 
 
 def _spec(part) -> dict:
