@@ -61,6 +61,12 @@ def test_a_native_crash_or_stall_in_the_child_is_an_error_naming_the_file(func, 
     assert "[file walk.c3d, trial T1]" in str(exc.value)
 
 
+def test_a_capture_of_40000_frames_is_not_refused(tmp_path):
+    """C3D counts are unsigned: POINT:FRAMES of 40,000 is int16 -25,536 in the file."""
+    xyz = np.zeros((40000, 1, 3)) + 0.5
+    assert read_c3d(write_c3d(tmp_path / "long.c3d", ["A"], xyz, 200.0)).n_frames == 40000
+
+
 @pytest.mark.realdata
 def test_a_y_up_walk_is_turned_to_z_up_or_refused(realdata, tmp_path):
     m = read_c3d(realdata / "c3d" / "PiG_Motion-FlatFoot-Full.c3d")

@@ -116,7 +116,10 @@ def _check_layout(hdr: dict, params: Parameters, size: int, path: Path,
                               hint="re-export the file from the capture software")
 
     for (group, name), allow_zero in _FINITE:
-        for v in params.numbers(group, name) or ():
+        values = params.numbers(group, name) or []
+        if values and name in ("USED", "FRAMES"):           # counts: unsigned integers
+            values[0] = params.count(group, name)
+        for v in values:
             if not math.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
                 refuse(f"{group}:{name} is {v!r}; it must be a finite number "
                        f"{'>= 0' if allow_zero else '> 0'}")
@@ -124,7 +127,7 @@ def _check_layout(hdr: dict, params: Parameters, size: int, path: Path,
         refuse(f"the header's scale factor is {hdr['scale']!r}")
     for (group, name), want in ((("POINT", "USED"), hdr["n_points"]),
                                 (("POINT", "DATA_START"), hdr["data_start"])):
-        got = params.first(group, name)
+        got = params.count(group, name) if name == "USED" else params.first(group, name)
         if got and int(got) & 0xFFFF != want:     # 0: not filled in (c3d.org's Dance)
             refuse(f"{group}:{name} is {got:g} but the header says {want}")
     p_scale = params.first("POINT", "SCALE")
@@ -146,7 +149,7 @@ def _check_size(hdr: dict, params: Parameters, size: int, path: Path,
     header's 16-bit last-frame word is saturated); returns the larger of the two counts,
     which the reader compares with what ezc3d read."""
     n_header = hdr["last"] - hdr["first"] + 1 if hdr["last"] >= hdr["first"] else 0
-    p_frames = params.first("POINT", "FRAMES")
+    p_frames = params.count("POINT", "FRAMES")
     p_frames = 0 if p_frames is None else int(p_frames)
     # frame numbers above 65535 do not fit the header's words: ezc3d writes 65535 as the
     # last frame, other writers let them wrap; POINT:FRAMES then holds the count

@@ -225,6 +225,15 @@ class Parameters:
         vals = self.numbers(group, name)
         return vals[0] if vals else None
 
+    def count(self, group: str, name: str) -> float | None:
+        """The first value of a count (``USED``, ``FRAMES``): integers are unsigned in C3D
+        (a 40,000-frame capture stores POINT:FRAMES as int16 -25,536)."""
+        v = self.first(group, name)
+        p = self.params.get((group, name))
+        if v is not None and p is not None and p.type in (1, 2) and v < 0:
+            v += 256.0 if p.type == 1 else 65536.0
+        return v
+
 
 def float_at(b: bytes, i: int, dec: bool) -> float:
     """The 4-byte float at ``b[i]``: IEEE little-endian, or DEC (VAX F) for processor 85."""
