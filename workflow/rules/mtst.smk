@@ -71,8 +71,8 @@ rule mtst_tables:
         ),
     params:
         gv=GV,
-        dirs=lambda w, input: " ".join(str(Path(p).parent) for p in input),
-        methods=" ".join(mtst_methods()),
+        dirs=lambda w, input: [str(Path(p).parent) for p in input],
+        methods=mtst_methods(),
         config=lambda w: f"{RESULTS}/{config['run'][0]}/config.json",
         tables=parent_of("t3"),
         figures=parent_of("fig"),
@@ -83,7 +83,7 @@ rule mtst_tables:
     log:
         "logs/mtst_tables.log",
     shell:
-        "{params.gv} mtst-tables {params.dirs} --methods {params.methods}"
+        "{params.gv} mtst-tables {params.dirs:q} --methods {params.methods:q}"
         " --config {params.config} --tables-dir {params.tables}"
         " --figures-dir {params.figures} --reports-dir {params.reports}"
         " --config-hash {params.chash} > {log} 2>&1 || (cat {log} >&2; exit 1)"

@@ -12,7 +12,7 @@ rule report:
     params:
         gv=GV,
         reports=parent_of("md"),
-        studies=" ".join(config["run"]),
+        studies=list(config["run"]),
     conda:
         "../envs/gaitval.yaml"
     log:

@@ -26,9 +26,9 @@ rule rollator_train:
     log:
         "logs/rollator_train/{study}/{subject}.log",
     shell:
-        "{params.gv} rollator-train --results {params.results} --sheet {input.sheet}"
-        " --subjects {params.subjects} --subject {wildcards.subject}"
-        " --config {input.config} --out {output} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} rollator-train --results {params.results:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --subject {wildcards.subject:q}"
+        " --config {input.config:q} --out {output:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 rule rollator_track:
@@ -44,16 +44,16 @@ rule rollator_track:
     params:
         gv=GV,
         subjects=lambda w: subjects_path(w.study),
-        model=lambda w, input: f"--model {input.model}" if input.model else "",
+        model=lambda w, input: ["--model", str(input.model)] if input.model else [],
     conda:
         "../envs/gaitval.yaml"
     log:
         "logs/rollator_track/{study}/{method}/{trial}.log",
     shell:
-        "{params.gv} rollator-track --sensor {input.sensor} --sheet {input.sheet}"
-        " --subjects {params.subjects} --trial {wildcards.trial} --method {wildcards.method}"
-        " --config {input.config} {params.model} --out {output}"
-        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} rollator-track --sensor {input.sensor:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
+        " --config {input.config:q} {params.model:q} --out {output:q}"
+        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 rule rollator_evaluate:
@@ -79,10 +79,10 @@ rule rollator_evaluate:
     log:
         "logs/rollator_evaluate/{study}/{method}/{trial}.log",
     shell:
-        "{params.gv} rollator-evaluate --track {input.track} --groundtruth {input.gt}"
-        " --registration {input.reg} --ingest {params.ingest} --sheet {input.sheet}"
-        " --subjects {params.subjects} --trial {wildcards.trial} --method {wildcards.method}"
-        " --config {input.config} --out {params.out} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} rollator-evaluate --track {input.track:q} --groundtruth {input.gt:q}"
+        " --registration {input.reg:q} --ingest {params.ingest:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
+        " --config {input.config:q} --out {params.out:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 rule rollator_tables:
@@ -114,7 +114,7 @@ rule rollator_tables:
         ),
     params:
         gv=GV,
-        dirs=lambda w, input: " ".join(str(Path(p).parent) for p in input.evals),
+        dirs=lambda w, input: [str(Path(p).parent) for p in input.evals],
         kf=lambda w: rollator_cfg()["kf_method"],
         pf=lambda w: rollator_cfg()["pf_method"],
         tables=parent_of("t1"),
@@ -126,11 +126,11 @@ rule rollator_tables:
     log:
         "logs/rollator_tables.log",
     shell:
-        "{params.gv} rollator-tables {params.dirs} --kf {params.kf} --pf {params.pf}"
-        " --models {input.models} --config {input.config}"
-        " --tables-dir {params.tables} --figures-dir {params.figures}"
-        " --reports-dir {params.reports} --config-hash {params.chash}"
-        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} rollator-tables {params.dirs:q} --kf {params.kf:q} --pf {params.pf:q}"
+        " --models {input.models:q} --config {input.config:q}"
+        " --tables-dir {params.tables:q} --figures-dir {params.figures:q}"
+        " --reports-dir {params.reports:q} --config-hash {params.chash:q}"
+        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 REPORT_ITEM_FUNCS.append(

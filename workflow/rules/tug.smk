@@ -70,8 +70,8 @@ rule tug_tables:
         ),
     params:
         gv=GV,
-        dirs=lambda w, input: " ".join(str(Path(p).parent) for p in input),
-        methods=" ".join(tug_runs()),
+        dirs=lambda w, input: [str(Path(p).parent) for p in input],
+        methods=tug_runs(),
         tables=parent_of("t4"),
         figures=parent_of("fig"),
         reports=parent_of("t4", up=1),

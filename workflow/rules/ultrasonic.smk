@@ -19,8 +19,8 @@ rule ultrasonic_noise:
         ),
     params:
         gv=GV,
-        dirs=lambda w, input: " ".join(str(Path(p).parent) for p in input.ingest),
-        trials=lambda w: " ".join(t for _, t in pendulum_trials()),
+        dirs=lambda w, input: [str(Path(p).parent) for p in input.ingest],
+        trials=lambda w: [t for _, t in pendulum_trials()],
         stem=lambda w, output: output.table[: -len(".csv")],
         reports=parent_of("table", up=1),
         chash=CONFIG_HASH,
