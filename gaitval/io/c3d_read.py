@@ -127,6 +127,11 @@ def _events(c) -> tuple[pd.DataFrame, str]:
         hl = c["header"]["events"]["events_label"]
         rows = [("", str(lab).strip(), float(tt)) for tt, lab in zip(ht, hl)
                 if str(lab).strip()]
+        for k, (_, lab, _) in enumerate(rows):
+            try:
+                lab.encode("utf-8")
+            except UnicodeEncodeError:    # ezc3d passes undecodable bytes as surrogates
+                raise ValueError(f"the header's event label {k + 1} is not text") from None
         df = pd.DataFrame(rows, columns=EVENT_COLUMNS)
         source = "header" if rows else "none"
     df = df.astype({"context": object, "label": object, "t_s": np.float64})
@@ -209,7 +214,11 @@ def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "s
         raise FileFormatError(f"C3D point rate is {rate!r} (POINT:RATE, or the header's "
                               "rate); it must be a finite number > 0", path=path, trial=trial)
     ff, header_ff = _first_frame(c)
-    events, ev_source = _events(c)
+    try:
+        events, ev_source = _events(c)
+    except ValueError as exc:                 # odd EVENT:TIMES, a label that is not text
+        raise FileFormatError(f"the events cannot be read: {exc}", path=path,
+                              trial=trial) from None
     bad = np.flatnonzero(~np.isfinite(events["t_s"].to_numpy(dtype=np.float64)))
     if bad.size:
         raise FileFormatError(f"event {events['label'].iloc[bad[0]]!r} has time "
