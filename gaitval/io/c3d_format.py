@@ -130,6 +130,13 @@ def _check_layout(hdr: dict, params: Parameters, size: int, path: Path,
         got = params.count(group, name) if name == "USED" else params.first(group, name)
         if got and int(got) & 0xFFFF != want:     # 0: not filled in (c3d.org's Dance)
             refuse(f"{group}:{name} is {got:g} but the header says {want}")
+    if hdr["n_analog"]:                       # ezc3d reads these for every analog channel
+        used = params.count("ANALOG", "USED") or 0
+        for name in ("USED", "SCALE", "OFFSET", "GEN_SCALE"):
+            n = len(params.numbers("ANALOG", name) or [])
+            if n == 0 or (name in ("SCALE", "OFFSET") and n < used):
+                refuse(f"the header announces analog samples but ANALOG:{name} "
+                       f"{'is missing' if n == 0 else f'holds {n} values for {used:g} channels'}")
     p_scale = params.first("POINT", "SCALE")
     if p_scale is not None and (p_scale < 0) != (hdr["scale"] < 0):
         refuse(f"POINT:SCALE ({p_scale:g}) and the header's scale factor ({hdr['scale']:g}) "
