@@ -24,6 +24,7 @@ scanners. ICRA 2015 (the leg_tracker recordings of empty scenes, ``negative_*.ba
 """
 from __future__ import annotations
 
+import bisect
 import math
 
 import numpy as np
@@ -253,10 +254,13 @@ class Background:
     def __init__(self, arrays: list[np.ndarray], radius_m: float = 0.06, window: int = 15,
                  fraction: float = 0.5):
         self.r, self.window, self.fraction, self.n = radius_m, window, fraction, len(arrays)
-        self.cells: dict[tuple[int, int], list[tuple[int, float, float]]] = {}
+        # per grid cell: the scans (ascending, as appended) and positions of its observations
+        self.cells: dict[tuple[int, int], tuple[list[int], list[tuple[float, float]]]] = {}
         for k, obs in enumerate(arrays):
             for x, y in obs.tolist():
-                self.cells.setdefault(self._cell(x, y), []).append((k, x, y))
+                ks, xy = self.cells.setdefault(self._cell(x, y), ([], []))
+                ks.append(k)
+                xy.append((x, y))
 
     def _cell(self, x: float, y: float) -> tuple[int, int]:
         return math.floor(x / self.r), math.floor(y / self.r)
@@ -264,10 +268,17 @@ class Background:
     def occupied(self, k: int, z: np.ndarray) -> bool:
         lo, hi = max(0, k - self.window), min(self.n - 1, k + self.window)
         cx, cy = self._cell(float(z[0]), float(z[1]))
+        zx, zy = float(z[0]), float(z[1])
         scans = set()
         for dx in (-1, 0, 1):
             for dy in (-1, 0, 1):
-                for kk, x, y in self.cells.get((cx + dx, cy + dy), ()):
-                    if lo <= kk <= hi and math.hypot(x - z[0], y - z[1]) < self.r:
-                        scans.add(kk)
+                cell = self.cells.get((cx + dx, cy + dy))
+                if cell is None:
+                    continue
+                ks, xy = cell
+                # only the cell's observations of scans lo..hi (ks is ascending)
+                for q in range(bisect.bisect_left(ks, lo), bisect.bisect_right(ks, hi)):
+                    x, y = xy[q]
+                    if math.hypot(x - zx, y - zy) < self.r:
+                        scans.add(ks[q])
         return len(scans) >= self.fraction * (hi - lo + 1)
