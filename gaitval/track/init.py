@@ -213,7 +213,7 @@ class MotionCheck:
                     lost[f] += 1
                     continue
                 z = obs[got[f]]
-                if still[k] and not background.occupied(k, z):
+                if still[k] and not background.occupied_obs(k, got[f], z):
                     net[f] += z - pos[f]
                 pos[f], lost[f] = z.copy(), 0
             if got[0] is not None and got[1] is not None:
@@ -254,6 +254,7 @@ class Background:
     def __init__(self, arrays: list[np.ndarray], radius_m: float = 0.06, window: int = 15,
                  fraction: float = 0.5):
         self.r, self.window, self.fraction, self.n = radius_m, window, fraction, len(arrays)
+        self._memo: dict[tuple[int, int], bool] = {}
         # per grid cell: the scans (ascending, as appended) and positions of its observations
         self.cells: dict[tuple[int, int], tuple[list[int], list[tuple[float, float]]]] = {}
         for k, obs in enumerate(arrays):
@@ -264,6 +265,15 @@ class Background:
 
     def _cell(self, x: float, y: float) -> tuple[int, int]:
         return math.floor(x / self.r), math.floor(y / self.r)
+
+    def occupied_obs(self, k: int, j: int, z: np.ndarray) -> bool:
+        """:meth:`occupied` for observation j of scan k, remembered (several candidate pairs
+        are followed through the same scans)."""
+        key = (k, j)
+        hit = self._memo.get(key)
+        if hit is None:
+            hit = self._memo[key] = self.occupied(k, z)
+        return hit
 
     def occupied(self, k: int, z: np.ndarray) -> bool:
         lo, hi = max(0, k - self.window), min(self.n - 1, k + self.window)
