@@ -80,3 +80,12 @@ def number(meta: dict, key: str, path: Path, trial: str | None, *, what: str = "
                               f"finite {'whole ' if integer else ''}number{bounds}",
                               path=path, trial=trial)
     return int(v) if integer else v
+
+
+def column_names(table, path: Path, trial: str | None) -> list[str]:
+    """A Parquet table's column names; FileFormatError when they are not UTF-8 text."""
+    try:
+        return list(table.column_names)
+    except UnicodeDecodeError:
+        raise FileFormatError("the Parquet column names are not UTF-8 text", path=path,
+                              trial=trial) from None

@@ -39,7 +39,7 @@ import pandas as pd
 
 from gaitval.errors import FileFormatError
 from gaitval.io.atomic import atomic_path
-from gaitval.io.guard import json_meta, loader, number
+from gaitval.io.guard import column_names, json_meta, loader, number
 from gaitval.types import ScanSeries
 
 META_KEY = b"gaitval:scanlog"
@@ -151,7 +151,7 @@ def read_scanlog(path: str | Path, *, trial: str | None = None) -> ScanSeries:
     meta = json_meta(md[META_KEY], META_KEY.decode(), path, trial)
     g = _meta_fields(meta, path, trial)
     for col in ("t_s", "ranges"):
-        if col not in tab.column_names:
+        if col not in column_names(tab, path, trial):
             raise FileFormatError(f"scan log has no '{col}' column", path=path, trial=trial)
     t, raw = _columns(tab, g["n_beams"], path, trial)
     if g["unit"] == "mm":

@@ -40,7 +40,7 @@ import pandas as pd
 
 from gaitval.errors import FileFormatError, TimestampError
 from gaitval.io.atomic import atomic_path
-from gaitval.io.guard import json_meta, loader, number
+from gaitval.io.guard import column_names, json_meta, loader, number
 from gaitval.io.scanlog import check_timestamps
 from gaitval.types import UltrasonicLog
 
@@ -177,7 +177,7 @@ def read_ultrasonic(path: str | Path, *, trial: str | None = None) -> Ultrasonic
         raise FileFormatError(f"unknown quantity {quantity!r} (expected 'tof' or "
                               "'distance')", path=path, trial=trial)
     need = ["t_s", "temperature_c"] + [fmt.format(a) for a in anchors["anchor"]]
-    missing = [c for c in need if c not in tab.column_names]
+    missing = [c for c in need if c not in column_names(tab, path, trial)]
     if missing:
         raise FileFormatError(f"ultrasonic log lacks columns {missing}", path=path,
                               trial=trial)
