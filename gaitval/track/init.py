@@ -24,7 +24,6 @@ scanners. ICRA 2015 (the leg_tracker recordings of empty scenes, ``negative_*.ba
 """
 from __future__ import annotations
 
-import bisect
 import math
 
 import numpy as np
@@ -164,26 +163,39 @@ class MotionCheck:
         """The first moving pair ``(k, i, j)`` from ``first_scan`` on, or None."""
         arrays = [np.asarray(source.array(k), dtype=float).reshape(-1, 2)
                   for k in range(len(source))]
-        still = self.still_scans(arrays)
+        still = self.still_scans(arrays).tolist()
+        # plain Python floats from here on: the follow visits a few observations per scan,
+        # where numpy's per-call overhead would cost more than the arithmetic
+        pts = [a.tolist() for a in arrays]
         background = Background(arrays)
         visited: dict[int, set] = {}
-        for k in range(first_scan, len(arrays)):
-            for i, j in self._pairs(arrays[k], d_min, d_max):
+        for k in range(first_scan, len(pts)):
+            for i, j in self._pairs(pts[k], d_min, d_max):
                 if (i, j) in visited.get(k, ()):
                     continue                       # already followed from an earlier scan
-                if self._follow(arrays, still, background, k, i, j, 1.5 * d_max, visited):
+                if self._follow(pts, still, background, k, i, j, 1.5 * d_max, visited):
                     return k, i, j
         return None
 
-    def _pairs(self, obs: np.ndarray, d_min: float, d_max: float) -> list[tuple[int, int]]:
-        """The ``per_scan`` closest leg-like pairs (i < j) of one scan."""
-        if len(obs) < 2:
-            return []
-        iu, ju = np.triu_indices(len(obs), 1)
-        d = np.hypot(obs[iu, 0] - obs[ju, 0], obs[iu, 1] - obs[ju, 1])
-        ok = np.flatnonzero((d >= d_min) & (d <= d_max))
-        ok = ok[np.argsort(d[ok], kind="stable")][:self.per_scan]
-        return [(int(iu[q]), int(ju[q])) for q in ok]
+    def _pairs(self, obs: list, d_min: float, d_max: float) -> list[tuple[int, int]]:
+        """The ``per_scan`` closest leg-like pairs (i < j) of one scan (ties: lower i, j)."""
+        if len(obs) > 12:                        # a cluttered scan: all pairs at once
+            a = np.asarray(obs, dtype=float)
+            iu, ju = np.triu_indices(len(a), 1)
+            d = np.hypot(a[iu, 0] - a[ju, 0], a[iu, 1] - a[ju, 1])
+            ok = np.flatnonzero((d >= d_min) & (d <= d_max))
+            ok = ok[np.argsort(d[ok], kind="stable")][:self.per_scan]
+            return [(int(iu[q]), int(ju[q])) for q in ok]
+        hypot = math.hypot
+        cand = []
+        for i in range(len(obs)):
+            xi, yi = obs[i]
+            for j in range(i + 1, len(obs)):
+                d = hypot(xi - obs[j][0], yi - obs[j][1])
+                if d_min <= d <= d_max:
+                    cand.append((d, i, j))
+        cand.sort()
+        return [(i, j) for _, i, j in cand[:self.per_scan]]
 
     def still_scans(self, arrays: list[np.ndarray]) -> np.ndarray:
         """Per scan: True unless the scene moved (a crowded scan most of whose observations
@@ -200,95 +212,131 @@ class MotionCheck:
             still[k] = np.mean(d.min(axis=1) < self.still_radius_m) >= 0.5
         return still
 
-    def _follow(self, arrays, still, background, k0, i, j, span, visited) -> bool:
-        """Follow the pair (i, j) of scan k0; True once both legs travelled far enough."""
-        pos = [arrays[k0][i].copy(), arrays[k0][j].copy()]
-        net = [np.zeros(2), np.zeros(2)]
+    def _follow(self, pts, still, background, k0, i, j, span, visited) -> bool:
+        """Follow the pair (i, j) of scan k0; True once both legs travelled far enough.
+
+        A leg's net travel is the sum of its steps taken at still scans off the background.
+        The background test is the costly part, so a step's test is put off while the leg
+        could not have travelled ``min_travel_m`` even if every pending step counted (its
+        net so far plus the lengths of its pending steps); pending steps are then tested and
+        added in scan order, so the sums — and the answer — are those of testing each step
+        as it comes.
+        """
+        pos = [pts[k0][i], pts[k0][j]]
+        net = [[0.0, 0.0], [0.0, 0.0]]
+        pending: list[list] = [[], []]        # per leg: (k, g, z, dx, dy) not yet tested
+        reach = [0.0, 0.0]                    # per leg: Σ |pending step|
         lost = [0, 0]
-        for k in range(k0 + 1, len(arrays)):
-            obs = arrays[k]
+        hypot, min_travel = math.hypot, self.min_travel_m
+        for k in range(k0 + 1, len(pts)):
+            obs = pts[k]
             got = self._associate(obs, pos, lost, span)
             for f in (0, 1):
-                if got[f] is None:
+                g = got[f]
+                if g is None:
                     lost[f] += 1
                     continue
-                z = obs[got[f]]
-                if still[k] and not background.occupied_obs(k, got[f], z):
-                    net[f] += z - pos[f]
-                pos[f], lost[f] = z.copy(), 0
+                z, p = obs[g], pos[f]
+                if still[k]:
+                    dx, dy = z[0] - p[0], z[1] - p[1]
+                    pending[f].append((k, g, z, dx, dy))
+                    reach[f] += hypot(dx, dy)
+                pos[f], lost[f] = z, 0
             if got[0] is not None and got[1] is not None:
                 visited.setdefault(k, set()).add((min(got), max(got)))
-            if min(math.hypot(*net[0]), math.hypot(*net[1])) >= self.min_travel_m:
+            if self._travelled(0, net, pending, reach, background) and \
+                    self._travelled(1, net, pending, reach, background):
                 return True
             if max(lost) > self.max_lost_scans:
                 return False
         return False
 
+    def _travelled(self, f, net, pending, reach, background) -> bool:
+        """|net travel of leg f| ≥ min_travel_m, testing its pending steps only when the
+        bound |net| + Σ|pending| (with a margin for rounding) allows it."""
+        n = net[f]
+        if (math.hypot(n[0], n[1]) + reach[f]) * (1 + 1e-9) + 1e-12 < self.min_travel_m:
+            return False
+        steps = pending[f]
+        for (_, _, _, dx, dy), occupied in zip(steps, background.resolve(
+                [(k, g, z) for k, g, z, _, _ in steps])):
+            if not occupied:
+                n[0] += dx
+                n[1] += dy
+        pending[f].clear()
+        reach[f] = 0.0
+        return math.hypot(n[0], n[1]) >= self.min_travel_m
+
     def _associate(self, obs, pos, lost, span) -> list[int | None]:
-        """Each leg's nearest observation within its gate; a shared one goes to the nearer
-        leg, and a pair may not grow beyond ``span``."""
+        """Each leg's nearest observation within its gate (the first of equals); a shared one
+        goes to the nearer leg, and a pair may not grow beyond ``span``."""
         got: list[int | None] = [None, None]
         dist = [0.0, 0.0]
-        if not len(obs):
+        if not obs:
             return got
+        hypot = math.hypot
         for f in (0, 1):
-            d = np.hypot(obs[:, 0] - pos[f][0], obs[:, 1] - pos[f][1])
-            m = int(np.argmin(d))
-            if d[m] <= min(self.max_step_m * (1 + lost[f]), self.max_gate_m):
-                got[f], dist[f] = m, float(d[m])
+            px, py = pos[f]
+            m, dm = 0, math.inf
+            for q, (x, y) in enumerate(obs):
+                d = hypot(x - px, y - py)
+                if d < dm:
+                    m, dm = q, d
+            if dm <= min(self.max_step_m * (1 + lost[f]), self.max_gate_m):
+                got[f], dist[f] = m, dm
         if got[0] is not None and got[0] == got[1]:
             got[1 if dist[0] <= dist[1] else 0] = None
-        if got[0] is not None and got[1] is not None and \
-                math.hypot(*(obs[got[0]] - obs[got[1]])) > span:
-            got[0 if dist[0] > dist[1] else 1] = None
+        if got[0] is not None and got[1] is not None:
+            a, b = obs[got[0]], obs[got[1]]
+            if hypot(a[0] - b[0], a[1] - b[1]) > span:
+                got[0 if dist[0] > dist[1] else 1] = None
         return got
 
 
 class Background:
-    """Places observed again and again: a grid index of every observation of a trial.
+    """Places observed again and again.
 
     ``occupied(k, z)``: an observation lies within ``radius_m`` of ``z`` in at least
-    ``fraction`` of the scans ``k - window .. k + window``.
+    ``fraction`` of the scans ``k - window .. k + window``.  The scans are held as one
+    padded ``(n, J_max, 2)`` array, so a batch of questions is one numpy expression.
     """
 
     def __init__(self, arrays: list[np.ndarray], radius_m: float = 0.06, window: int = 15,
                  fraction: float = 0.5):
         self.r, self.window, self.fraction, self.n = radius_m, window, fraction, len(arrays)
         self._memo: dict[tuple[int, int], bool] = {}
-        # per grid cell: the scans (ascending, as appended) and positions of its observations
-        self.cells: dict[tuple[int, int], tuple[list[int], list[tuple[float, float]]]] = {}
-        for k, obs in enumerate(arrays):
-            for x, y in obs.tolist():
-                ks, xy = self.cells.setdefault(self._cell(x, y), ([], []))
-                ks.append(k)
-                xy.append((x, y))
+        sizes = np.array([len(a) for a in arrays], dtype=int)
+        jmax = int(sizes.max()) if len(sizes) else 0
+        self.P = np.full((self.n, max(jmax, 1), 2), 1e9)      # padding: far from everything
+        if jmax:
+            self.P[np.arange(jmax)[None, :] < sizes[:, None]] = np.concatenate(arrays)
+        self.offsets = np.arange(-window, window + 1)
 
-    def _cell(self, x: float, y: float) -> tuple[int, int]:
-        return math.floor(x / self.r), math.floor(y / self.r)
-
-    def occupied_obs(self, k: int, j: int, z: np.ndarray) -> bool:
+    def occupied_obs(self, k: int, j: int, z) -> bool:
         """:meth:`occupied` for observation j of scan k, remembered (several candidate pairs
         are followed through the same scans)."""
-        key = (k, j)
-        hit = self._memo.get(key)
-        if hit is None:
-            hit = self._memo[key] = self.occupied(k, z)
-        return hit
+        return self.resolve([(k, j, z)])[0]
 
-    def occupied(self, k: int, z: np.ndarray) -> bool:
-        lo, hi = max(0, k - self.window), min(self.n - 1, k + self.window)
-        cx, cy = self._cell(float(z[0]), float(z[1]))
-        zx, zy = float(z[0]), float(z[1])
-        scans = set()
-        for dx in (-1, 0, 1):
-            for dy in (-1, 0, 1):
-                cell = self.cells.get((cx + dx, cy + dy))
-                if cell is None:
-                    continue
-                ks, xy = cell
-                # only the cell's observations of scans lo..hi (ks is ascending)
-                for q in range(bisect.bisect_left(ks, lo), bisect.bisect_right(ks, hi)):
-                    x, y = xy[q]
-                    if math.hypot(x - zx, y - zy) < self.r:
-                        scans.add(ks[q])
-        return len(scans) >= self.fraction * (hi - lo + 1)
+    def resolve(self, queries) -> list[bool]:
+        """:meth:`occupied` for a batch of ``(k, j, z)`` (z observation j of scan k),
+        remembered by ``(k, j)``."""
+        memo = self._memo
+        todo = [(k, j, z) for k, j, z in queries if (k, j) not in memo]
+        if todo:
+            ks = np.array([q[0] for q in todo])
+            hits = self.occupied_many(ks, np.array([q[2] for q in todo], dtype=float))
+            for (k, j, _), h in zip(todo, hits.tolist()):
+                memo[(k, j)] = h
+        return [memo[(k, j)] for k, j, _ in queries]
+
+    def occupied_many(self, ks: np.ndarray, zs: np.ndarray) -> np.ndarray:
+        """:meth:`occupied` of positions ``zs`` (m, 2) at scans ``ks`` (m,)."""
+        nb = ks[:, None] + self.offsets[None, :]                   # (m, 2w+1): scan k + o
+        valid = (nb >= 0) & (nb < self.n)
+        Q = self.P[np.clip(nb, 0, self.n - 1)]                     # (m, 2w+1, J, 2)
+        d = np.hypot(Q[..., 0] - zs[:, None, None, 0], Q[..., 1] - zs[:, None, None, 1])
+        count = ((d < self.r).any(axis=2) & valid).sum(axis=1)
+        return count >= self.fraction * valid.sum(axis=1)
+
+    def occupied(self, k: int, z) -> bool:
+        return bool(self.occupied_many(np.array([k]), np.asarray(z, dtype=float)[None, :])[0])

@@ -22,10 +22,9 @@ class DetectionSeries:
     """Precomputed per-scan detections (the tracker's plain input)."""
 
     def __init__(self, xy: list[np.ndarray], patterns: list[list[str]]):
-        self._arrays = xy
         self._patterns = patterns
         # plain Python floats for the loop (numpy scalars are several times slower):
-        arrs = [np.asarray(o, dtype=float).reshape(-1, 2) for o in xy]
+        self._arrays = arrs = [np.asarray(o, dtype=float).reshape(-1, 2) for o in xy]
         flat = np.concatenate(arrs).tolist() if arrs else []
         self._lists, i = [], 0
         for o in arrs:
