@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """gaitval's two commands, for a fresh machine with only Python 3.11+.
 
-    python3 run.py report   # generate the default study (first time) and build reports/index.html
+    python3 run.py report   # generate the default study (first time), build reports/default/index.html
     python3 run.py test     # run the test suite
 
 Each creates ``.venv`` and installs gaitval into it (``pip install -e .[test]``) on first
@@ -151,7 +151,38 @@ def main(argv: list[str]) -> int:
         ensure_env("test,bench")
         cmd = [str(PY), *rest]
     print("[run.py] " + " ".join(cmd), flush=True)
-    return subprocess.call(cmd, env=env)
+    rc = subprocess.call(cmd, env=env)
+    if verb == "report" and rc == 0:
+        index = _report_index(rest)
+        if index is not None and index.is_file():
+            print(f"[run.py] report: {index}", flush=True)
+    return rc
+
+
+def _report_index(args: list[str]) -> Path | None:
+    """reports/<run>/index.html of the run the arguments ask for (workflow/rules/common.smk
+    names the folder after `run` joined by '+'); None when the arguments are not plain
+    enough to tell (a --configfile, a custom reports_dir)."""
+    import json
+    import re
+    if any(a.startswith("--configfile") for a in args):
+        return None
+    run = None
+    for a in args:
+        if a.startswith("reports_dir="):
+            return None
+        if a.startswith("run="):
+            try:
+                run = json.loads(a[4:])
+            except ValueError:
+                return None
+    if run is None:
+        m = re.search(r"^run:\s*\[([^\]]*)\]", (ROOT / "config" / "config.yaml").read_text(),
+                      re.M)
+        run = [w.strip().strip("'\"") for w in m.group(1).split(",")] if m else None
+    if not run or not all(isinstance(r, str) for r in run):
+        return None
+    return _workdir(args) / "reports" / "+".join(run) / "index.html"
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-TARGETS = ["reports/tables/tug_table4.csv", "reports/tables/study_ingest_tiny.csv"]
+TARGETS = ["reports/tiny/tables/tug_table4.csv", "reports/tiny/tables/study_ingest_tiny.csv"]
 
 
 def _report(workdir: Path, data: Path, **popen) -> list[str]:
@@ -51,10 +51,10 @@ def test_kill_9_at_a_random_point_then_report_resumes_with_identical_tables(tmp_
     assert res.returncode == 0, res.stdout[-2000:] + res.stderr[-3000:]
     if locked:
         assert "removing a stale Snakemake lock" in res.stdout
-    tables = sorted((tmp_path / "ref" / "reports" / "tables").glob("*.csv"))
+    tables = sorted((tmp_path / "ref" / "reports" / "tiny" / "tables").glob("*.csv"))
     assert tables
     for t in tables:
-        assert (work / "reports" / "tables" / t.name).read_bytes() == t.read_bytes(), t.name
+        assert (work / "reports" / "tiny" / "tables" / t.name).read_bytes() == t.read_bytes(), t.name
 
 
 def test_a_live_snakemake_keeps_its_lock(tmp_path, monkeypatch):

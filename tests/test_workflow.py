@@ -35,8 +35,9 @@ def tiny_run(tmp_path_factory):
 
 @pytest.mark.slow
 def test_dag_runs_end_to_end_and_index_has_provenance(tiny_run):
-    index = (tiny_run / "reports" / "index.md").read_text()
-    assert (tiny_run / "reports" / "index.html").is_file()
+    index = (tiny_run / "reports" / "tiny" / "index.md").read_text()
+    assert (tiny_run / "reports" / "tiny" / "index.html").is_file()
+    assert "Studies: tiny." in index
     for item in ("study_ingest_tiny", "study_registration_tiny"):
         assert f"### {item}" in index
     # every table in the index is followed by its provenance line
@@ -53,8 +54,23 @@ def test_dag_runs_end_to_end_and_index_has_provenance(tiny_run):
 def test_same_config_and_seed_give_byte_identical_tables(tiny_run, tmp_path):
     res = run_workflow(tmp_path, tiny_run / "data")
     assert res.returncode == 0, res.stderr[-4000:]
-    first = sorted((tiny_run / "reports" / "tables").glob("*.csv"))
+    first = sorted((tiny_run / "reports" / "tiny" / "tables").glob("*.csv"))
     assert first
     for p in first:
-        q = tmp_path / "reports" / "tables" / p.name
+        q = tmp_path / "reports" / "tiny" / "tables" / p.name
         assert q.read_bytes() == p.read_bytes(), p.name
+
+
+@pytest.mark.slow
+def test_switching_run_rebuilds_into_that_runs_folder(tiny_run):
+    """After the tiny report, the tiny run is up to date and a default run asks for its
+    own reports/default/ (issue 14: it used to say "Nothing to be done" and serve tiny)."""
+    same = run_workflow(tiny_run, tiny_run / "data", "-n")
+    assert same.returncode == 0 and "Nothing to be done" in same.stdout + same.stderr
+    other = subprocess.run(
+        [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(tiny_run),
+         "-n", "--config", 'run=["default"]', f"data_dir={tiny_run / 'data'}"],
+        capture_output=True, text=True, timeout=300)
+    assert other.returncode == 0, other.stderr[-3000:]
+    assert "reports/default/index.md" in other.stdout
+    assert "reports/tiny/index.md" not in other.stdout

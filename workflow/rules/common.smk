@@ -50,7 +50,13 @@ except ConfigError as exc:
 
 RESULTS = config.get("results_dir", "results")
 PRESETS = Path(workflow.basedir) / "config" / "studies"
-REPORTS = config.get("reports_dir", "reports")
+# One report folder per set of pooled studies: reports/<run-name>/ with run-name = the
+# `run` list joined by "+" (reports/tiny, reports/default, reports/tiny+replay), so a
+# table that pools the studies of `run` (tug_table4, ...) never overwrites another run's,
+# and changing `run` asks for files that do not exist yet -- Snakemake rebuilds them.
+RUN_NAME = "+".join(config["run"])
+REPORTS_ROOT = config.get("reports_dir", "reports")
+REPORTS = f"{REPORTS_ROOT}/{RUN_NAME}"
 # The library is called as `python -m gaitval` with the interpreter running Snakemake, so
 # rules work whether or not the venv's bin/ is on PATH.
 _METHODS = getattr(getattr(workflow, "deployment_settings", None), "deployment_method", ())
