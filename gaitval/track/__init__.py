@@ -10,6 +10,7 @@ from gaitval.track.associate import ASSOCIATORS  # noqa: F401
 from gaitval.track.gate import GATES  # noqa: F401
 from gaitval.track.init import INITIALISERS  # noqa: F401
 from gaitval.track import init_mtst  # noqa: F401  (registers "mtst_participant", seed 001)
+from gaitval.track import init_annotated  # noqa: F401  (registers "annotated_pair")
 from gaitval.track.kalman import FILTERS  # noqa: F401
 from gaitval.track.kinds import TRACKER_KINDS  # noqa: F401
 from gaitval.track.motion import MOTION_MODELS  # noqa: F401
