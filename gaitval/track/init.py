@@ -244,28 +244,32 @@ class MotionCheck:
                 pos[f], lost[f] = z, 0
             if got[0] is not None and got[1] is not None:
                 visited.setdefault(k, set()).add((min(got), max(got)))
-            if self._travelled(0, net, pending, reach, background) and \
-                    self._travelled(1, net, pending, reach, background):
+            if self._travelled(net, pending, reach, background):
                 return True
             if max(lost) > self.max_lost_scans:
                 return False
         return False
 
-    def _travelled(self, f, net, pending, reach, background) -> bool:
-        """|net travel of leg f| ≥ min_travel_m, testing its pending steps only when the
-        bound |net| + Σ|pending| (with a margin for rounding) allows it."""
-        n = net[f]
-        if (math.hypot(n[0], n[1]) + reach[f]) * (1 + 1e-9) + 1e-12 < self.min_travel_m:
-            return False
-        steps = pending[f]
-        for (_, _, _, dx, dy), occupied in zip(steps, background.resolve(
-                [(k, g, z) for k, g, z, _, _ in steps])):
-            if not occupied:
-                n[0] += dx
-                n[1] += dy
-        pending[f].clear()
-        reach[f] = 0.0
-        return math.hypot(n[0], n[1]) >= self.min_travel_m
+    def _travelled(self, net, pending, reach, background) -> bool:
+        """|net travel| ≥ min_travel_m for both legs.  A leg's pending steps are tested only
+        when the bounds |net| + Σ|pending| (with a margin for rounding) of both legs allow
+        it."""
+        thr = self.min_travel_m
+        for f in (0, 1):
+            if (math.hypot(*net[f]) + reach[f]) * (1 + 1e-9) + 1e-12 < thr:
+                return False
+        for f in (0, 1):
+            n, steps = net[f], pending[f]
+            for (_, _, _, dx, dy), occupied in zip(steps, background.resolve(
+                    [(k, g, z) for k, g, z, _, _ in steps])):
+                if not occupied:
+                    n[0] += dx
+                    n[1] += dy
+            steps.clear()
+            reach[f] = 0.0
+            if math.hypot(n[0], n[1]) < thr:
+                return False
+        return True
 
     def _associate(self, obs, pos, lost, span) -> list[int | None]:
         """Each leg's nearest observation within its gate (the first of equals); a shared one

@@ -34,7 +34,6 @@ Spline-Based Interpolation during Turning Motion in Walk Tests. Sensors 2015, 15
 from __future__ import annotations
 
 import math
-from collections import deque
 
 from gaitval.registry import Registry
 
@@ -57,33 +56,36 @@ class SwingAccelerationWindow:
     """g_k^f of seed000 eq. (19)–(20): the mean ‖a‖ of one leg over the steps among the
     last N_ac in which it was swinging (0 when there were none).
 
-    Kept as a running sum: :meth:`push` adds step k and drops step k − N_ac; after a
-    re-filter rewrote the history, :meth:`reset` starts again from the rewritten window.
+    Kept as a running sum over the entries pushed since the last :meth:`reset`: :meth:`push`
+    adds step k and drops step k − N_ac; after a re-filter rewrote the history,
+    :meth:`reset` starts again from the rewritten window.
     """
 
-    __slots__ = ("n_ac", "buf", "total", "count")
+    __slots__ = ("n_ac", "acc", "swing", "total", "count")
 
     def __init__(self, n_ac: int):
         self.n_ac = n_ac
-        self.buf: deque = deque()
+        self.acc: list[float] = []
+        self.swing: list[bool] = []
         self.total = 0.0
         self.count = 0
 
     def push(self, a: float, swinging: bool) -> None:
-        buf = self.buf
-        buf.append((a, swinging))
+        acc, swing = self.acc, self.swing
+        acc.append(a)
+        swing.append(swinging)
         if swinging:
             self.total += a
             self.count += 1
-        if len(buf) > self.n_ac:
-            a0, sw0 = buf.popleft()
-            if sw0:
-                self.total -= a0
-                self.count -= 1
+        i = len(acc) - 1 - self.n_ac            # the step that leaves the window
+        if i >= 0 and swing[i]:
+            self.total -= acc[i]
+            self.count -= 1
 
     def reset(self, entries: list[tuple[float, bool]]) -> None:
         """Start from ``entries`` = (‖a‖, swinging) of the window's steps, oldest first."""
-        self.buf = deque(entries)
+        self.acc = [a for a, _ in entries]
+        self.swing = [sw for _, sw in entries]
         sel = [a for a, sw in entries if sw]
         self.total, self.count = float(sum(sel)), len(sel)
 

@@ -121,6 +121,7 @@ class Tracker:
         gate, assoc, occ = self.gate, self.associator, self.occlusion
         context = gate.needs_context
         state = occ.begin(run)
+        hyp = Hypotheses(run)
         for k in range(run.k0 + 1, run.n):
             prior = run.predict(k)                                # seed000 eq. (7)–(8)
             obs, pats = source.at(k, prior)                       # detect, or take detections
@@ -128,7 +129,7 @@ class Tracker:
                                  run.gate_context(0, k) if context else None)
             cr = gate.candidates(run.filter, prior[1], obs,
                                  run.gate_context(1, k) if context else None)
-            hyp = Hypotheses(run, prior, obs)
+            hyp.reset(prior, obs)
             a, b = assoc.select(cl, cr, run.phase[k - 1], hyp.phase_of)   # seed000 eq. (9)–(10)
             run.commit(k, a, b, hyp, obs, pats)          # seed000 eq. (14)–(16), (3)–(5)
             occ.after_scan(state, run, k)                         # seed000 eq. (17)
@@ -145,16 +146,27 @@ class Hypotheses:
 
     ``corrected(f, j)``: leg f corrected with observation j (0: the prediction);
     ``phase_of(a, b)``: the phase after left ← a, right ← b (seed000 eq. (3)–(5)).
+    One object serves a whole run: :meth:`reset` starts each scan.
     """
 
     __slots__ = ("correct", "identify", "prior", "obs", "cache", "pcache")
 
-    def __init__(self, run: TrackingRun, prior, obs):
+    def __init__(self, run: TrackingRun, prior=None, obs=()):
         self.correct = run.filter.correct
         self.identify = run.phase_model.identify
-        self.prior, self.obs = prior, obs
-        self.cache = ({0: prior[0]}, {0: prior[1]})
+        self.cache: tuple[dict, dict] = ({}, {})
         self.pcache: dict = {}
+        if prior is not None:
+            self.reset(prior, obs)
+
+    def reset(self, prior, obs) -> None:
+        """Start a scan: the pair of predicted states and the scan's observations."""
+        self.prior, self.obs = prior, obs
+        c0, c1 = self.cache
+        c0.clear()
+        c1.clear()
+        c0[0], c1[0] = prior
+        self.pcache.clear()
 
     def corrected(self, f: int, j: int):
         c = self.cache[f]
@@ -218,12 +230,17 @@ class TrackingRun:
 
     def commit(self, k: int, a: int, b: int, hyp: Hypotheses, obs, pats) -> None:
         """The association (a, b): corrected states, observations used, phase, book-keeping."""
-        for leg, f, j in ((self.legs[0], 0, a), (self.legs[1], 1, b)):
-            leg.post[k] = hyp.corrected(f, j)                     # seed000 eq. (14)–(16)
-            if j:
-                leg.observed(k, obs[j - 1], pats[j - 1], j - 1)
-            else:
-                leg.unobserved(k)
+        L, R = self.legs
+        L.post[k] = hyp.corrected(0, a)                           # seed000 eq. (14)–(16)
+        R.post[k] = hyp.corrected(1, b)
+        if a:
+            L.observed(k, obs[a - 1], pats[a - 1], a - 1)
+        else:
+            L.unobserved(k)
+        if b:
+            R.observed(k, obs[b - 1], pats[b - 1], b - 1)
+        else:
+            R.unobserved(k)
         self.phase[k] = hyp.phase_of(a, b)                        # seed000 eq. (3)–(5)
         self.book(k)
 
@@ -231,12 +248,15 @@ class TrackingRun:
         """‖a_k‖ per leg into its acceleration window (seed 000 §5.5)."""
         dt, sw = self.dts[k], _SWING[self.phase[k]]
         hypot = math.hypot
-        for f in (0, 1):
-            leg = self.legs[f]
-            s1, s0 = leg.post[k], leg.post[k - 1]
-            a = leg.acc[k] = hypot(s1[2] - s0[2], s1[3] - s0[3]) / dt
-            if leg.window is not None:
-                leg.window.push(a, sw[f])
+        L, R = self.legs
+        s1, s0 = L.post[k], L.post[k - 1]
+        al = L.acc[k] = hypot(s1[2] - s0[2], s1[3] - s0[3]) / dt
+        s1, s0 = R.post[k], R.post[k - 1]
+        ar = R.acc[k] = hypot(s1[2] - s0[2], s1[3] - s0[3]) / dt
+        if L.window is not None:
+            L.window.push(al, sw[0])
+        if R.window is not None:
+            R.window.push(ar, sw[1])
 
     def replay(self, ka: int, k_now: int) -> None:
         """Filter both legs again over ka+1..k_now with the stored observations (real or
