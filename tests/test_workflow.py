@@ -74,3 +74,20 @@ def test_switching_run_rebuilds_into_that_runs_folder(tiny_run):
     assert other.returncode == 0, other.stderr[-3000:]
     assert "reports/default/index.md" in other.stdout
     assert "reports/tiny/index.md" not in other.stdout
+
+
+@pytest.mark.slow
+def test_every_tex_of_the_tiny_report_compiles(tiny_run, tmp_path):
+    """Issue 14, scope 4: each table's .tex and verdicts.tex, alone, with pdflatex."""
+    import shutil
+
+    from gaitval.tables.latex import compile_tables
+    if shutil.which("pdflatex") is None:
+        pytest.skip("pdflatex not installed (Debian: texlive-latex-base "
+                    "texlive-latex-recommended texlive-latex-extra)")
+    rd = tiny_run / "reports" / "tiny"
+    tex = sorted(rd.glob("tables/*.tex")) + [rd / "verdicts.tex"]
+    assert len(tex) > 10
+    res = compile_tables(tex, tmp_path)
+    failed = {p: err for p, (ok, err, _) in res.items() if not ok}
+    assert not failed, failed

@@ -2,8 +2,9 @@
 
 Every paper table goes through :func:`write_table`, so all three files always say the same
 thing: the CSV is the tidy source (units in column names), the Markdown carries the caption
-and notes for the report, the LaTeX is ready for a manuscript.  Floats are formatted with a
-fixed number of significant decimals so the outputs are byte-identical for the same input.
+and notes for the report, the LaTeX (:mod:`gaitval.tables.latex`, pandas' Styler with
+booktabs) is ready for a manuscript.  Floats are formatted with a fixed number of decimals
+so the outputs are byte-identical for the same input.
 """
 from __future__ import annotations
 
@@ -27,13 +28,6 @@ def _fmt(v, digits: int) -> str:
     return str(v)
 
 
-def _latex_escape(s: str) -> str:
-    for a, b in (("\\", r"\textbackslash{}"), ("&", r"\&"), ("%", r"\%"), ("_", r"\_"),
-                 ("#", r"\#"), ("$", r"\$"), ("{", r"\{"), ("}", r"\}")):
-        s = s.replace(a, b)
-    return s
-
-
 def to_markdown(df: pd.DataFrame, digits: int = 3) -> str:
     cols = [str(c) for c in df.columns]
     lines = ["| " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
@@ -41,18 +35,6 @@ def to_markdown(df: pd.DataFrame, digits: int = 3) -> str:
         lines.append("| " + " | ".join(_fmt(v, digits).replace("|", "\\|") for v in row)
                      + " |")
     return "\n".join(lines)
-
-
-def to_latex(df: pd.DataFrame, caption: str, label: str, digits: int = 3) -> str:
-    cols = [str(c) for c in df.columns]
-    spec = "l" * len(cols)
-    out = [r"\begin{table}[ht]", r"\centering", rf"\caption{{{_latex_escape(caption)}}}",
-           rf"\label{{tab:{label}}}", rf"\begin{{tabular}}{{{spec}}}", r"\hline",
-           " & ".join(_latex_escape(c) for c in cols) + r" \\", r"\hline"]
-    for row in df.itertuples(index=False):
-        out.append(" & ".join(_latex_escape(_fmt(v, digits)) for v in row) + r" \\")
-    out += [r"\hline", r"\end{tabular}", r"\end{table}", ""]
-    return "\n".join(out)
 
 
 def write_table(df: pd.DataFrame, stem: str | Path, *, caption: str,
@@ -83,7 +65,9 @@ def write_table(df: pd.DataFrame, stem: str | Path, *, caption: str,
     md = [f"**{caption}**", "", to_markdown(df, digits)]
     if notes:
         md += [""] + [f"- {n}" for n in notes]
-    tex = to_latex(df, caption + (" " + " ".join(notes) if notes else ""), stem.name, digits)
+    from gaitval.tables.latex import to_latex   # lazily: `python -m gaitval.tables.latex`
+
+    tex = to_latex(df, caption=caption, notes=notes, label=stem.name, digits=digits)
     paths = [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".tex")]
     write_text(paths[0], csv_text)
     write_text(paths[1], "\n".join(md) + "\n")
