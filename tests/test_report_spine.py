@@ -49,7 +49,9 @@ def test_index_lists_items_with_provenance_and_missing_tables(tmp_path):
     md, html = build_index(rd, study_names=["tiny"])
     text = md.read_text()
     assert "### tug_table4" in text and "Occlusion rate and RMSE" in text
-    assert f"config {h}" in text and "command: `gaitval tables tug`" in text
+    assert f"config {h}" in text and "made by step `tug_tables`" in text
+    assert "[record](provenance/tug_tables.json)" in text
+    assert "gaitval tables tug" not in text             # the command is in the record
     assert "Not produced yet: tug_table2, tug_table3, tug_table5" in text
     assert "tug_table4" in html.read_text()
     rec = json.loads((rd / "provenance" / "tug_tables.json").read_text())

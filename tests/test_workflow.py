@@ -40,8 +40,12 @@ def test_dag_runs_end_to_end_and_index_has_provenance(tiny_run):
     assert "Studies: tiny." in index
     for item in ("study_ingest_tiny", "study_registration_tiny"):
         assert f"### {item}" in index
-    # every table in the index is followed by its provenance line
-    assert index.count("_command: `gaitval") >= index.count("\n### ") - index.count("![")
+    # every table in the index is followed by its provenance line; the report's own
+    # provenance (rebuild command, config, input checksums, versions) comes once
+    assert index.count("_made by step `") >= index.count("\n### ") - index.count("![")
+    assert index.count("python3 run.py report") == 1
+    for f in ("config.yaml", "inputs.sha256", "environment.txt", "report.json"):
+        assert (tiny_run / "reports" / "tiny" / "provenance" / f).is_file(), f
     reg = pd.read_csv(tiny_run / "results" / "tiny" / "registration.csv")
     sheet = pd.read_csv(tiny_run / "data" / "tiny" / "trials.csv")
     assert sorted(reg["trial"]) == sorted(sheet["trial"])

@@ -58,10 +58,54 @@ def _caption_notes(md_path: Path) -> tuple[str, list[str]]:
 
 
 def _prov_line(rec: dict | None) -> str:
+    """One short line per item: the step that made it and its record (the step's full
+    command is in the record; the report's provenance is once, at the end)."""
     if rec is None:
         return "provenance: no record (made outside the pipeline)"
-    return (f"command: `{rec['command']}` · config {rec['config_hash'] or '-'} · "
-            f"gaitval {rec['gaitval_version']} · commit {rec['git_commit']}")
+    return (f"made by step `{rec['step']}` · config {rec['config_hash'] or '-'} · "
+            f"gaitval {rec['gaitval_version']} · commit {rec['git_commit'][:12]} · "
+            f"[record]({rec['record']})")
+
+
+def _dependency_versions(env_file: Path) -> list[str]:
+    """Exact versions of gaitval's declared dependencies, from ``environment.txt``."""
+    try:
+        from importlib.metadata import requires
+        names = {re.split(r"[ ;<>=!~\[(]", r, maxsplit=1)[0].lower().replace("_", "-")
+                 for r in requires("gaitval") or [] if "extra ==" not in r}
+    except Exception:                                 # gaitval not installed as a dist
+        names = set()
+    if not env_file.is_file():
+        return []
+    return [ln for ln in env_file.read_text().splitlines()
+            if ln.split("==")[0].lower().replace("_", "-") in names]
+
+
+def _provenance(rd: Path, rec: dict | None) -> list[str]:
+    """The report's provenance as Markdown lines (once per report)."""
+    if rec is None:
+        return ["No report provenance: this index was not built by the workflow "
+                "(no `provenance/rebuild.json` or `provenance/inputs.txt`)."]
+    out = []
+    if rec.get("command"):
+        out.append(f"Rebuild this report (from the gaitval checkout): `{rec['command']}`")
+    out.append(f"git commit `{rec['git_commit']}` · gaitval {rec['gaitval_version']} · "
+               f"Python {rec['python']} · {rec['platform']}")
+    if rec.get("config"):
+        out.append(f"Resolved configuration: [{rec['config']}]({rec['config']})"
+                   + (f" (hash {rec['config_hash']})" if rec.get("config_hash") else ""))
+    if rec.get("inputs"):
+        out.append(f"Input files: [{rec['inputs']}]({rec['inputs']}), SHA-256 of "
+                   f"{rec['n_input_files']} files ({rec['input_bytes'] / 1e6:.1f} MB); "
+                   f"check with `sha256sum -c {rec['inputs']}` in the report folder "
+                   "(absolute paths)")
+    deps = _dependency_versions(rd / rec["environment"])
+    out.append(f"Environment: [{rec['environment']}]({rec['environment']}), "
+               f"{rec['n_distributions']} distributions at exact versions"
+               + (f"; gaitval's dependencies: {', '.join(f'`{d}`' for d in deps)}"
+                  if deps else ""))
+    out.append("Each step's full command is in its record under `provenance/`.")
+    return out
 
 
 def _decimals(col: pd.Series) -> int | None:
@@ -140,7 +184,8 @@ def _md_table(header: list[str], rows: list[list[str]]) -> str:
     return "\n".join(lines)
 
 
-def collect(reports_dir: str | Path, study_names: list[str] | None = None) -> dict:
+def collect(reports_dir: str | Path, study_names: list[str] | None = None,
+            report_prov: dict | None = None) -> dict:
     """The report's content model, shared by the Markdown and the HTML."""
     rd = Path(reports_dir)
     prov = load_all(rd)
@@ -178,14 +223,16 @@ def collect(reports_dir: str | Path, study_names: list[str] | None = None) -> di
     return {"version": __version__, "studies": ", ".join(study_names or []) or "-",
             "verdict_summary": summary_lines(verdicts),
             "verdict_header": list(VERDICT_COLUMNS), "verdict_rows": vd.values.tolist(),
-            "sections": sections}
+            "sections": sections, "provenance": _provenance(rd, report_prov)}
 
 
 def render_markdown(c: dict) -> str:
     md = ["# gaitval report", "",
           f"gaitval {c['version']}. Studies: {c['studies']}.",
-          "Every item below names the command, configuration hash, package version and git "
-          "commit that produced it. Published values stand beside reproduced ones in the "
+          "Every item below names the step, configuration hash, package version and git "
+          "commit that produced it; how to rebuild the whole report, the resolved "
+          "configuration, checksums of the inputs and exact package versions are under "
+          "[Provenance](#provenance). Published values stand beside reproduced ones in the "
           "paper tables.", "", "## Verdicts: which published comparisons were reproduced", ""]
     md += [f"- {s}" for s in c["verdict_summary"]] + [""]
     rows = [[*r[:-1], f"[{r[-1]}](#{r[-1]})" if r[-1] else ""] for r in c["verdict_rows"]]
@@ -203,6 +250,7 @@ def render_markdown(c: dict) -> str:
                        f"_{it['prov']}_", ""]
         if sec["missing"]:
             md += ["_Not produced yet: " + ", ".join(sec["missing"]) + "_", ""]
+    md += ["## Provenance", ""] + [f"- {ln}" for ln in c["provenance"]] + [""]
     return "\n".join(md) + "\n"
 
 
@@ -222,8 +270,10 @@ def build_index(reports_dir: str | Path, *, study_names: list[str] | None = None
     return the first two paths."""
     from gaitval.tables.render import write_table
 
+    from gaitval.report.provenance import write_report_provenance
+
     rd = Path(reports_dir)
-    c = collect(rd, study_names)
+    c = collect(rd, study_names, write_report_provenance(rd))
     write_table(build_verdicts(rd / "tables"), rd / "verdicts",
                 caption="Published comparisons of the seed papers and whether the "
                 "reproduction goes the same way (gaitval.report.verdicts).",

@@ -1,10 +1,48 @@
-# Gather every table and figure of the studies in `run` into reports/index.{md,html}, with
-# the verdict table (reports/verdicts.*) on top.
+# Gather every table and figure of the studies in `run` into reports/<run-name>/index.{md,html}
+# with the verdict table (verdicts.*) on top, and, once per report, what a reviewer needs
+# to rerun it (provenance/: resolved config, sha256 of every input file, exact package
+# versions, git commit, the rebuild command; gaitval.report.provenance).
+from gaitval.report.provenance import (config_hash, rebuild_command, study_input_files,
+                                       write_workflow_record)
+
+
+localrules:
+    report_config,
+
+
+rule report_config:
+    input:
+        lambda w: sorted(
+            {f for s in config["run"]
+             for f in study_input_files(sheet_path(s), subjects_path(s), trials(s))}
+            | {str(Path(f).resolve()) for f in workflow.configfiles if Path(f).is_file()}
+            | {str(PRESETS / f"{study_cfg(s)['simulate']['preset']}.yaml")
+               for s in config["run"] if is_simulated(s)}
+            | ({config["peer_results"]} if config.get("peer_results")
+               and Path(config["peer_results"]).is_file() else set())
+        ),
+    output:
+        config=f"{REPORTS}/provenance/config.yaml",
+        inputs=f"{REPORTS}/provenance/inputs.txt",
+        rebuild=f"{REPORTS}/provenance/rebuild.json",
+    log:
+        f"logs/report_config/{RUN_NAME}.log",
+    params:
+        # the whole resolved config (paths and `run` too), so any change rewrites it
+        chash=config_hash(config),
+        command=rebuild_command(
+            list(getattr(workflow.config_settings, "configfiles", None) or ()),
+            dict(getattr(workflow.config_settings, "config", None) or {}),
+            Path.cwd(),
+        ),
+    run:
+        write_workflow_record(config, input, output, log[0], **params)
 
 
 rule report:
     input:
         report_items,
+        rules.report_config.output,
     output:
         md=report(f"{REPORTS}/index.md", caption="../report/index.rst", category="Report"),
         html=f"{REPORTS}/index.html",
@@ -16,7 +54,7 @@ rule report:
     conda:
         "../envs/gaitval.yaml"
     log:
-        "logs/report.log",
+        f"logs/report/{RUN_NAME}.log",
     shell:
         "{params.gv} report --reports-dir {params.reports:q} --studies {params.studies:q}"
         " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
