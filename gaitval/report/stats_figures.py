@@ -6,8 +6,9 @@
 - :func:`figure5_speed_effects` — like Figure 5: mean ± std at slow / normal / fast speed
   for reference and system, ``*`` where a paired t-test against normal speed gives
   p < 0.05 (from :func:`gaitval.tables.ultrasonic.table8`).
-- :func:`bland_altman_figure` — one Bland–Altman plot: points coloured by subject, the
-  pooled bias and limits (every stride independent, :func:`gaitval.stats.agreement`) and
+- :func:`bland_altman_figure` — one Bland–Altman plot: points coloured by subject (more
+  transparent the more there are), the paper's mean difference where it gives one (Qi et
+  al. publish no limits of agreement; the title says so), the pooled bias and limits (every stride independent, :func:`gaitval.stats.agreement`) and
   the repeated-measures ones (subjects as a random effect, :func:`gaitval.stats.loa_nested`)
   with their 95% CIs, as :mod:`gaitval.tables.ultrasonic_agreement` tabulates them.
 
@@ -127,9 +128,30 @@ def _limits(df: pd.DataFrame, ref: str, pro: str, subject: str | None) -> dict:
     return out
 
 
+def point_alpha(n: int) -> float:
+    """Marker opacity for ``n`` points: opaque for a few, down to 0.2 for thousands
+    (2,483 strides of the default study are a cloud, not a blot)."""
+    return float(np.clip(150.0 / max(n, 1), 0.2, 0.9))
+
+
+def published_bias(param: str) -> dict:
+    """What Qi et al. (2014) publish that a Bland–Altman plot of ``param`` can show: the
+    mean difference Pro − Ref of the subject averages of Tables 2–6 (normal speed).  The
+    paper gives no limits of agreement, so none are returned."""
+    from gaitval.tables._published_qi2014 import TABLES_2_6
+
+    t = TABLES_2_6.get(param)
+    if not t:
+        return {}
+    i = 10                                            # the "average" column
+    table = 2 + list(TABLES_2_6).index(param)
+    return {"bias": t["pro_mean"][i] - t["ref_mean"][i],
+            "label": f"published mean difference (Table {table} averages, Pro - Ref)"}
+
+
 def bland_altman_figure(df: pd.DataFrame, ref: str, pro: str, path: str | Path,
                         title: str = "", unit: str = "", subject: str | None = None,
-                        limits=None) -> Path:
+                        limits=None, published: dict | None = None) -> Path:
     """Bland–Altman plot: difference vs mean, pooled and repeated-measures limits.
 
     Parameters
@@ -148,6 +170,10 @@ def bland_altman_figure(df: pd.DataFrame, ref: str, pro: str, path: str | Path,
     limits : mapping, optional
         The row of :func:`gaitval.tables.ultrasonic_agreement.agreement_table` for these
         pairs (``bias``, ``loa_low`` … and the ``*_rm`` columns); computed when omitted.
+    published : mapping, optional
+        The paper's values, drawn in green dash-dot: ``bias`` and/or ``loa_low`` /
+        ``loa_high``, and a ``label`` saying where they come from.  Without published
+        limits the title says so.
 
     Notes
     -----
@@ -165,12 +191,20 @@ def bland_altman_figure(df: pd.DataFrame, ref: str, pro: str, path: str | Path,
         subs = df[subject].astype(str).to_numpy()[ok]
         order = _subject_order(subs)
         cmap = plt.get_cmap("tab10" if len(order) <= 10 else "tab20")
+        alpha = point_alpha(len(mean))
         for i, s in enumerate(order):
             sel = subs == s
-            ax.scatter(mean[sel], diff[sel], s=10, color=cmap(i % cmap.N), label=s)
+            ax.scatter(mean[sel], diff[sel], s=9, color=cmap(i % cmap.N), label=s,
+                       alpha=alpha, linewidths=0)
     else:
-        ax.scatter(mean, diff, s=10, color="k")
+        ax.scatter(mean, diff, s=9, color="k", alpha=point_alpha(len(mean)), linewidths=0)
     _pooled_lines(ax, lim)
+    pub = dict(published or {})
+    for key, style in (("bias", "-."), ("loa_low", "-."), ("loa_high", "-.")):
+        if np.isfinite(pub.get(key, np.nan)):
+            ax.axhline(pub[key], color="tab:green", ls=style, lw=1.2,
+                       label=pub.get("label", "published") if key == "bias"
+                       or "bias" not in pub else None)
     has_rm = subject is not None and np.isfinite(lim.get("loa_low_rm", np.nan))
     if has_rm:
         _repeated_lines(ax, lim, mean)
@@ -182,8 +216,13 @@ def bland_altman_figure(df: pd.DataFrame, ref: str, pro: str, path: str | Path,
     if has_rm:
         text += (f"\nrepeated measures: bias {lim['bias_rm']:.3g}, LoA "
                  f"[{lim['loa_low_rm']:.3g}, {lim['loa_high_rm']:.3g}]")
+    if not np.isfinite(pub.get("loa_low", np.nan)):
+        text += "\nno published limits of agreement"
     ax.set_title((title + "\n" if title else "") + text, fontsize=8)
-    ax.legend(fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
+    leg = ax.legend(fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.5),
+                    frameon=False)
+    for h in getattr(leg, "legend_handles", []):
+        h.set_alpha(1.0)                             # subjects legible in the legend
     fig.tight_layout()
     return save_figure(fig, path)
 
@@ -246,5 +285,6 @@ def write_ultrasonic_figures(gait_params: pd.DataFrame, out_dir: str | Path,
         paths.append(bland_altman_figure(
             sub, "reference", "system", out_dir / f"ultrasonic_bland_altman_{p}.png",
             title=f"Bland-Altman: {_label(p)}, {speed} speed", unit=PARAM_INFO[p][2],
-            subject="subject", limits=limits[limits["parameter"] == p].iloc[0]))
+            subject="subject", limits=limits[limits["parameter"] == p].iloc[0],
+            published=published_bias(p) if speed == "normal" else None))
     return paths
