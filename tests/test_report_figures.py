@@ -49,3 +49,15 @@ def test_bland_altman_draws_the_published_line_and_transparent_points(tmp_path, 
     assert "published bias (Table X)" in seen["labels"]
     assert {"S0", "S5", "repeated-measures bias"} <= set(seen["labels"])
     assert "no published limits of agreement" in seen["title"]
+
+
+def test_tug_figure_picks_a_successful_and_a_failed_trial():
+    from gaitval.report.tug_figures import main_methods, pick_trials
+    s = pd.DataFrame({"trial": ["t1", "t1", "t2", "t2", "t3", "t3", "t2"],
+                      "method": ["m1", "m2"] * 3 + ["m1_stance_first"],
+                      "success": [False, True, True, True, False, False, False]})
+    assert main_methods(s["method"]) == ["m1", "m2"]
+    assert pick_trials(s) == ("t2", "t3")            # t3: both methods failed
+    assert pick_trials(s[s["trial"] == "t2"]) == ("t2", None)   # the variant is ignored
+    assert pick_trials(s[s["trial"] == "t3"]) == (None, "t3")
+    assert pick_trials(s[s["trial"] == "t1"]) == ("t1", None)   # one trial, one row
