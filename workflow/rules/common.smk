@@ -60,11 +60,28 @@ REPORTS = f"{REPORTS_ROOT}/{RUN_NAME}"
 # The library is called as `python -m gaitval` with the interpreter running Snakemake, so
 # rules work whether or not the venv's bin/ is on PATH.
 _METHODS = getattr(getattr(workflow, "deployment_settings", None), "deployment_method", ())
+_CONDA = any(str(m).lower().endswith("conda") for m in _METHODS)
 GV = (
     "python -m gaitval"
-    if any(str(m).lower().endswith("conda") for m in _METHODS)
+    if _CONDA
     else f"{shlex.quote(sys.executable)} -m gaitval"  # a checkout path with a space
 )
+# Local runs: the rules' jobs run in a warm fork server (workflow/rules/forkserver.smk,
+# gaitval/forkserver.py) instead of each starting Python and importing numpy, pandas,
+# scipy and gaitval again.  Same verbs, same arguments, same files; one job per trial as
+# before.  Off with `--config fork_server=false` (the cluster profile does), and under
+# conda deployment; a job that finds no server runs the plain command.
+FORK_SERVER = bool(config.get("fork_server", True)) and not _CONDA
+if FORK_SERVER:
+    import os as _os
+    import tempfile as _tempfile
+
+    FORK_SOCKET = f"{_tempfile.gettempdir()}/gaitval-{_os.getuid()}/{_os.getpid()}.sock"
+    GV = (
+        f"{shlex.quote(sys.executable)} -I -S "
+        f"{shlex.quote(str(Path(workflow.basedir) / 'gaitval' / 'forkclient.py'))} "
+        f"{shlex.quote(FORK_SOCKET)} --"
+    )
 # Hash of the analysis sections only: changing `run` or paths must not rerun the tables.
 CONFIG_HASH = config_hash({k: config[k] for k in ANALYSIS_SECTIONS if k in config})
 
@@ -186,3 +203,6 @@ def pendulum_trials():
 
 def treadmill_trials():
     return [(s, t) for s in config["run"] for t in trial_ids(s, ["treadmill"])]
+
+
+include: "forkserver.smk"

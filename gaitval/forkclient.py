@@ -1,0 +1,83 @@
+"""Run one ``gaitval`` verb in the warm fork server, or start it the plain way.
+
+Usage (what the workflow's rules run when ``fork_server`` is on, see
+:mod:`gaitval.forkserver`)::
+
+    python -I -S gaitval/forkclient.py SOCKET -- VERB [ARGS...]
+
+This file is run as a script and imports only the standard library, so it starts in a few
+tens of milliseconds.  It hands its working directory, environment, argument list and its
+standard input/output/error (the job's log) to the server, which forks a child that already
+has numpy, pandas, pyarrow, scipy and gaitval imported; the child runs
+``gaitval.cli.main(args)`` — the same code a plain ``python -m gaitval VERB ARGS`` runs —
+and the client exits with its exit code.
+
+* No server at SOCKET (a cluster node, a run without the server): the client replaces
+  itself with ``python -m gaitval VERB ARGS`` — same result, the usual start-up cost.
+* The client is stopped (Snakemake cancels the job): the signal is passed on to the child,
+  and a child whose client vanished (SIGKILL) stops itself.
+"""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import struct
+import sys
+
+
+def _plain(args: list[str]) -> None:
+    os.execv(sys.executable, [sys.executable, "-m", "gaitval", *args])
+
+
+def _recv_int(sock: socket.socket) -> int | None:
+    buf = b""
+    while len(buf) < 4:
+        chunk = sock.recv(4 - len(buf))
+        if not chunk:
+            return None
+        buf += chunk
+    return struct.unpack("!i", buf)[0]
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) < 2 or argv[1] != "--":
+        sys.stderr.write("usage: forkclient.py SOCKET -- VERB [ARGS...]\n")
+        return 2
+    path, args = argv[0], argv[2:]
+    sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    try:
+        sock.connect(path)
+    except OSError:
+        sock.close()
+        _plain(args)                       # no server: the plain way (does not return)
+    body = json.dumps({"argv": args, "cwd": os.getcwd(), "env": dict(os.environ)}).encode()
+    msg = struct.pack("!I", len(body)) + body
+    sent = socket.send_fds(sock, [msg], [0, 1, 2])
+    if sent < len(msg):
+        sock.sendall(msg[sent:])
+    child = _recv_int(sock)
+    if child is None:
+        sys.stderr.write("gaitval: error: the fork server closed the connection\n")
+        return 1
+
+    def forward(signum, _frame):
+        try:
+            os.killpg(child, signum)           # the job's process group (see forkserver)
+        except ProcessLookupError:
+            pass
+        raise SystemExit(128 + signum)
+
+    for s in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
+        signal.signal(s, forward)
+    rc = _recv_int(sock)
+    if rc is None:
+        sys.stderr.write("gaitval: error: the job's process ended without an exit code "
+                         "(killed or crashed)\n")
+        return 1
+    return rc
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,110 @@
+"""The warm fork server (gaitval/forkserver.py) runs a verb exactly as the plain command does.
+
+What a user relies on: the same output, log text and exit code as ``python -m gaitval``; a
+job that finds no server still runs; a cancelled job does not keep running.
+"""
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+CLIENT = ROOT / "gaitval" / "forkclient.py"
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory):
+    sock = tmp_path_factory.mktemp("fs") / "s.sock"
+    proc = subprocess.Popen([sys.executable, "-m", "gaitval.forkserver", "--socket", str(sock),
+                             "--owner", str(os.getpid())], cwd=ROOT,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    for _ in range(600):
+        if sock.exists() or proc.poll() is not None:
+            break
+        time.sleep(0.1)
+    assert sock.exists(), f"fork server did not start: {proc.stdout.read() if proc.poll() is not None else ''}"
+    yield sock
+    proc.send_signal(signal.SIGTERM)
+    proc.wait(timeout=20)
+    assert not sock.exists(), "the server removes its socket when it stops"
+
+
+def _client(sock, *args, cwd=ROOT, **kw):
+    return subprocess.run([sys.executable, "-I", "-S", str(CLIENT), str(sock), "--", *args],
+                          cwd=cwd, capture_output=True, text=True, timeout=120, **kw)
+
+
+def _plain(*args, cwd=ROOT):
+    return subprocess.run([sys.executable, "-m", "gaitval", *args], cwd=cwd,
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_same_output_and_exit_code_as_the_plain_command(server, tmp_path):
+    bad = tmp_path / "broken.c3d"
+    bad.write_bytes(b"\x02\x50" + b"\x00" * 100)
+    for args in (["--version"], ["inspect", str(bad)], ["inspect", str(tmp_path / "none.c3d")],
+                 ["no-such-verb"]):
+        a, b = _client(server, *args), _plain(*args)
+        assert (a.returncode, a.stdout) == (b.returncode, b.stdout), args
+        assert a.stderr.replace("__main__.py", "gaitval") == \
+            b.stderr.replace("__main__.py", "gaitval"), args
+    assert _client(server, "inspect", str(bad)).returncode == 1
+
+
+def test_relative_paths_resolve_in_the_clients_folder(server, tmp_path):
+    (tmp_path / "sub").mkdir()
+    out = _client(server, "simulate", "--preset", "nonexistent-preset", "--out", "sub/x",
+                  cwd=tmp_path)
+    ref = _plain("simulate", "--preset", "nonexistent-preset", "--out", "sub/x", cwd=tmp_path)
+    assert out.returncode == ref.returncode != 0
+    assert out.stderr == ref.stderr
+
+
+def test_without_a_server_the_plain_command_runs(tmp_path):
+    r = _client(tmp_path / "no.sock", "--version")
+    assert r.returncode == 0 and r.stdout.startswith("gaitval ")
+
+
+def test_a_cancelled_job_stops(server, tmp_path):
+    """Killing the client (Snakemake cancelling the job) ends the job's process too."""
+    # a verb that takes a while: simulate the default preset (about a minute)
+    proc = subprocess.Popen([sys.executable, "-I", "-S", str(CLIENT), str(server), "--",
+                             "simulate", "--out", str(tmp_path / "study")], cwd=ROOT,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    time.sleep(3)
+    children = _children_of_server(server)
+    assert children, "the job runs in a child of the server"
+    proc.kill()                                  # SIGKILL: the client cannot pass it on
+    proc.wait()
+    deadline = time.time() + 20
+    while time.time() < deadline and any(_alive(p) for p in children):
+        time.sleep(0.2)
+    assert not any(_alive(p) for p in children)
+
+
+def _children_of_server(sock) -> list[int]:
+    procs = {}
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                args = (d / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+                ppid = int((d / "stat").read_text().rsplit(")", 1)[1].split()[1])
+            except (OSError, ValueError, IndexError):
+                continue
+            procs[int(d.name)] = (ppid, args)
+    srv = [p for p, (_pp, a) in procs.items() if "gaitval.forkserver" in a and str(sock) in a]
+    return [p for p, (pp, _a) in procs.items() if srv and pp == srv[0]]
+
+
+def _alive(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().split()[2] != "Z"
+    except FileNotFoundError:
+        return False

@@ -1,0 +1,46 @@
+# The warm fork server of local runs (gaitval/forkserver.py; FORK_SERVER in common.smk):
+# started when the run starts, stopped when it ends.  It also exits by itself when this
+# Snakemake process is gone (a killed run leaves nothing behind).  Its log:
+# logs/forkserver.log.
+import os
+import signal
+import subprocess
+
+_FORK_SERVER_PROC = []
+
+
+def _start_fork_server():
+    Path("logs").mkdir(exist_ok=True)
+    log = open("logs/forkserver.log", "w")
+    _FORK_SERVER_PROC.append(
+        subprocess.Popen(
+            [sys.executable, "-m", "gaitval.forkserver", "--socket", FORK_SOCKET,
+             "--owner", str(os.getpid())],
+            stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+            start_new_session=True,
+        )
+    )
+    # Not waited for: until its imports are done (a few seconds) jobs run the plain way.
+
+
+def _stop_fork_server():
+    for proc in _FORK_SERVER_PROC:
+        if proc.poll() is None:
+            proc.send_signal(signal.SIGTERM)
+            try:
+                proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+    _FORK_SERVER_PROC.clear()
+
+
+if FORK_SERVER:
+
+    onstart:
+        _start_fork_server()
+
+    onsuccess:
+        _stop_fork_server()
+
+    onerror:
+        _stop_fork_server()
