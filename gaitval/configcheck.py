@@ -114,8 +114,13 @@ def _problems_of(error: jsonschema.ValidationError, instance: Any, root: dict
     if v == "type":
         want = error.validator_value
         want = [want] if isinstance(want, str) else list(want)
+        hint = ""
+        if "boolean" in want and isinstance(error.instance, str) and \
+                error.instance.strip().lower() in ("true", "false", "yes", "no", "on", "off"):
+            hint = (" (on Snakemake's command line write True or False: "
+                    f"--config {where}=False)")
         return [Problem(path, f"{where} must be {' or '.join(_TYPE_NAMES[t] for t in want)}"
-                              f", got {_describe(error.instance)}")]
+                              f", got {_describe(error.instance)}{hint}")]
     if v == "enum":
         choices = [str(c) for c in error.validator_value]
         close = difflib.get_close_matches(str(error.instance), choices, n=1)

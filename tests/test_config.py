@@ -68,6 +68,14 @@ def test_top_level_typo(cfg):
     assert "unknown key groundtruh — did you mean groundtruth?" in msg
 
 
+def test_a_lowercase_false_on_the_command_line_says_how_to_write_it(cfg):
+    """Snakemake's --config parser reads False as a boolean but false as a string."""
+    cfg["fork_server"] = "false"
+    msg = error_of(cfg, [("--config", {"fork_server": "false"})])
+    assert "fork_server must be true or false, got 'false' (str)" in msg
+    assert "--config fork_server=False" in msg
+
+
 def test_nested_typo(cfg):
     cfg["groundtruth"]["lowpas_hz"] = 6
     msg = error_of(cfg)
