@@ -70,8 +70,11 @@ GV = (
 # gaitval/forkserver.py) instead of each starting Python and importing numpy, pandas,
 # scipy and gaitval again.  Same verbs, same arguments, same files; one job per trial as
 # before.  Off with `--config fork_server=false` (the cluster profile does), and under
-# conda deployment; a job that finds no server runs the plain command.
-FORK_SERVER = bool(config.get("fork_server", True)) and not _CONDA
+# conda deployment; a job that finds no server runs the plain command.  Never inside a
+# cluster job (Snakemake's --mode remote on the node, e.g. SLURM): a `--config` given on the
+# command line replaces the profile's fork_server=False, and the node has no server anyway.
+FORK_SERVER = (bool(config.get("fork_server", True)) and not _CONDA
+               and not getattr(workflow, "remote_exec", False))
 if FORK_SERVER:
     import os as _os
     import tempfile as _tempfile
