@@ -21,6 +21,7 @@ import pandas as pd
 from gaitval.config import deep_merge, section
 from gaitval.evaluate.mtst import evaluate_steps
 from gaitval.evaluate.mtst_tracking import gate_usage, tracking_vs_annotations, tracking_vs_truth
+from gaitval.evaluate.tug import align_truth
 from gaitval.gait.mtst import (FootModel, cross_steps, foot_contacts, judge_target_steps,
                                judgement_region)
 from gaitval.registration.rigid import sensor_to_field
@@ -70,6 +71,18 @@ def track_in_field(track: pd.DataFrame, pose) -> pd.DataFrame:
     out["x_m"], out["y_m"] = xy[:, 0], xy[:, 1]
     out["vx_mps"], out["vy_mps"] = v[:, 0], v[:, 1]
     return out
+
+
+def truth_in_field(track: pd.DataFrame, truth: pd.DataFrame | None, pose
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """The mocap leg point of each track row (its leg, its scan time) in the field frame;
+    NaN where the truth is invalid or outside the recording, everywhere without mocap."""
+    if truth is None:
+        nan = np.full(len(track), np.nan)
+        return nan, nan.copy()
+    fr = align_truth(track, truth)
+    xy = sensor_to_field(fr[["xs_m", "ys_m"]].to_numpy(float), *pose)
+    return xy[:, 0], xy[:, 1]
 
 
 def walking_parameters(track_f: pd.DataFrame, targets: pd.DataFrame | None, *,
@@ -122,13 +135,16 @@ def evaluate_mtst_trial(track: pd.DataFrame, *, trial: str, method: str, stick: 
     dict of DataFrame
         ``contacts`` (field frame), ``steps`` (one row per annotated contact),
         ``events`` (tracking failures, both references), ``gates`` (Table 1 cells),
-        ``track_field`` and ``summary`` (one row, :data:`SUMMARY_COLUMNS`).
+        ``track_field`` (the track in the field frame with the true leg point at each row,
+        ``x_true_m, y_true_m``, NaN without mocap; for the figure) and ``summary`` (one
+        row, :data:`SUMMARY_COLUMNS`).
     """
     s = settings(cfg)
     ev_cfg = s["evaluation"]
     track_f = track_in_field(track, pose)
     contacts = walking_parameters(track_f, targets, leg_width_m=leg_width_m,
                                   height_m=height_m, s=s)
+    track_f["x_true_m"], track_f["y_true_m"] = truth_in_field(track, truth, pose)
     events = []
     row = {"trial": trial, "method": method, "stick": bool(stick), "has_mocap": truth is not None,
            "has_annotations": annotations is not None, "has_targets": targets is not None,
@@ -161,5 +177,5 @@ def evaluate_mtst_trial(track: pd.DataFrame, *, trial: str, method: str, stick: 
     summary = pd.DataFrame([row]).reindex(columns=list(SUMMARY_COLUMNS))
     return {"contacts": contacts, "steps": steps, "events": ev_all, "gates": gates,
             "track_field": track_f[["trial", "method", "k", "t_sensor_s", "side", "x_m",
-                                    "y_m", "pattern", "swing"]],
+                                    "y_m", "pattern", "swing", "x_true_m", "y_true_m"]],
             "summary": summary}
