@@ -256,7 +256,8 @@ def mtst_evaluate_step(track_parquet, sheet, subjects, trial: str, method: str, 
 
 def mtst_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, reports_dir,
                      config_hash: str = "", methods=None, config_json=None) -> list[Path]:
-    """Seed 001 Tables 1, 3, 4 and the trial figure from the per-(trial, method) folders."""
+    """Seed 001 Tables 1, 3, 4 and the figure (a successful and a failed trial, tracked vs
+    mocap legs) from the per-(trial, method) folders."""
     from gaitval.report.mtst_figures import write_mtst_figure
     from gaitval.report.provenance import stamp
     from gaitval.tables.mtst import write_mtst_tables
@@ -276,6 +277,7 @@ def mtst_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, repor
                    ["mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed"])
     paths = write_mtst_tables(data, tables_dir, methods=methods)
     stamp("mtst_tables", paths, reports_dir, config_hash_=config_hash)
-    figs = write_mtst_figure(data, figures_dir, trial=(s or {}).get("figure_trial"))
+    figs = write_mtst_figure(data, figures_dir, trial=(s or {}).get("figure_trial"),
+                             methods=methods)
     stamp("mtst_figures", figs, reports_dir, config_hash_=config_hash)
     return paths + figs

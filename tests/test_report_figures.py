@@ -61,3 +61,76 @@ def test_tug_figure_picks_a_successful_and_a_failed_trial():
     assert pick_trials(s[s["trial"] == "t2"]) == ("t2", None)   # the variant is ignored
     assert pick_trials(s[s["trial"] == "t3"]) == (None, "t3")
     assert pick_trials(s[s["trial"] == "t1"]) == ("t1", None)   # one trial, one row
+
+
+def _mtst_summary(rows):
+    return pd.DataFrame([{"trial": t, "method": m, "has_mocap": mocap,
+                          "category_mocap": cat if mocap else "",
+                          "category_annotations": "" if mocap else cat}
+                         for t, m, cat, mocap in rows])
+
+
+def test_mtst_figure_picks_a_successful_and_a_failed_trial():
+    from gaitval.report.mtst_figures import pick_trials
+    s = _mtst_summary([("e1", "mtst_m1", "lost", True), ("e1", "mtst_proposed", "success", True),
+                       ("e2", "mtst_m1", "false_swap", True),
+                       ("e2", "mtst_proposed", "success", True),
+                       ("e3", "mtst_m1", "success", False),          # the rater's verdict
+                       ("e3", "mtst_proposed", "false_other", False)])
+    contacts = pd.DataFrame({"trial": ["e2"], "method": ["mtst_proposed"], "cross": [True]})
+    ms = ["mtst_m1", "mtst_proposed"]
+    # success: the proposed method's first success with a cross step; failure: the proposed
+    # method's own failed trial (the rater's verdict where there is no mocap)
+    assert pick_trials(s, contacts, ms) == (("e2", "mtst_proposed"), ("e3", "mtst_proposed"))
+    # the proposed method never fails: the method with the most failures, another trial
+    s2 = s[s["trial"] != "e3"]
+    assert pick_trials(s2, contacts, ms) == (("e2", "mtst_proposed"), ("e1", "mtst_m1"))
+    # one trial: the same trial, the method that failed on it
+    s3 = s[s["trial"] == "e1"]
+    assert pick_trials(s3, contacts.iloc[:0], ms) == (("e1", "mtst_proposed"), ("e1", "mtst_m1"))
+    ok = _mtst_summary([("e1", "mtst_proposed", "success", True)])
+    assert pick_trials(ok, contacts, ms) == (("e1", "mtst_proposed"), None)
+    bad = _mtst_summary([("e1", "mtst_proposed", "lost", True)])
+    assert pick_trials(bad, contacts, ms) == (None, ("e1", "mtst_proposed"))
+
+
+def test_mtst_figure_draws_both_rows_with_the_truth(tmp_path, monkeypatch):
+    import gaitval.report.mtst_figures as mf
+    s = _mtst_summary([("e1", "mtst_proposed", "success", True),
+                       ("e2", "mtst_proposed", "lost", True)])
+    k = np.arange(20)
+    tf = pd.concat([pd.DataFrame({"trial": t, "method": "mtst_proposed", "k": k,
+                                  "t_sensor_s": k * 0.05, "side": side,
+                                  "x_m": k * 0.3, "y_m": y, "pattern": "FS", "swing": False,
+                                  "x_true_m": k * 0.3, "y_true_m": y + 0.01})
+                    for t in ("e1", "e2") for side, y in (("L", 0.1), ("R", -0.1))])
+    contacts = pd.DataFrame({"trial": ["e1"], "method": ["mtst_proposed"], "side": ["L"],
+                             "x_m": [1.0], "y_m": [0.1], "target": ["T1"], "cross": [False]})
+    titles, widths = [], []
+    orig = mf._trial_panel
+
+    def spy(ax, *a):
+        orig(ax, *a)
+        titles.append(ax.get_title())
+        widths.append(sorted({ln.get_linewidth() for ln in ax.get_lines()}))
+    monkeypatch.setattr(mf, "_trial_panel", spy)
+    paths = mf.write_mtst_figure({"summary": s, "track_field": tf, "contacts": contacts},
+                                 tmp_path)
+    assert paths == [tmp_path / "mtst_trial.png"] and paths[0].stat().st_size > 0
+    assert titles == ["e1, mtst_proposed: success (mocap)",
+                      "e2, mtst_proposed: FAILED: lost (mocap)"]
+    assert all(max(w) > 2 * min(w) for w in widths)           # truth thick, tracked thin
+
+
+def test_mtst_truth_in_field_is_the_mocap_leg_in_the_field_frame():
+    from gaitval.evaluate.mtst_trial import truth_in_field
+    track = pd.DataFrame({"t_sensor_s": [0.0, 0.05, 0.05], "side": ["L", "L", "R"],
+                          "x_m": [1.0, 1.1, 1.2], "y_m": [0.0, 0.0, 0.2]})
+    truth = pd.DataFrame({"t_sensor_s": [0.0, 0.1, 0.0, 0.1], "side": ["L", "L", "R", "R"],
+                          "xs_m": [1.0, 1.2, 1.0, 1.2], "ys_m": [0.0, 0.0, 0.3, 0.3],
+                          "valid": [True, True, False, False]})
+    x, y = truth_in_field(track, truth, (5.0, 1.0, np.pi / 2))   # field = R(90°) p + t
+    np.testing.assert_allclose(x[:2], [5.0, 5.0], atol=1e-12)
+    np.testing.assert_allclose(y[:2], [2.0, 2.1], atol=1e-12)
+    assert np.isnan(x[2]) and np.isnan(y[2])                    # invalid truth
+    assert np.isnan(truth_in_field(track, None, (0, 0, 0))[0]).all()
