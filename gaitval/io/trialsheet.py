@@ -258,6 +258,9 @@ def _row_problems(r, sheet: Path, subj, sub_path: Path, check_files: bool,
         problems.append(TrialSheetError(f"{where}, column {col!r}: {problem}", path=sheet,
                                         trial=r.trial, hint=hint))
 
+    if not r.mocap_file and not (r.annotation_file or r.annotation_topic):
+        add("mocap_file", "is required but empty (a trial without motion capture needs hand "
+            "annotations: annotation_file or annotation_topic)")
     if subj is not None and r.subject not in subj.attrs.get("all_ids", subj.index):
         add("subject", f"{r.subject!r} is not in the subject table {sub_path}")
     for col in ("mocap_file", "sensor_file", "annotation_file"):
