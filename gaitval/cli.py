@@ -396,6 +396,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_ultrasonic_verbs(sub)
     _add_mtst_verbs(sub)
     _add_rollator_verbs(sub)
+    from gaitval.steps_legbench import add_legbench_verbs
+    add_legbench_verbs(sub)              # annotated recordings without mocap (issue 18)
 
     s = sub.add_parser("report", help="write reports/index.md and index.html")
     s.add_argument("--reports-dir", default="reports")

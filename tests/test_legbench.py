@@ -177,3 +177,25 @@ def test_annotated_pair_starts_on_the_annotated_person_not_the_closest_pair():
     assert far.find(src, 0.1) is None                           # nobody within 0.75 m
     with pytest.raises(ConfigError, match="annotated scan"):
         INITIALISERS.build({"name": "annotated_pair"})
+
+
+# -- the steps on the real bag -----------------------------------------------------------------
+@pytest.mark.realdata
+def test_track_and_evaluate_the_outdoor_bag_from_its_first_annotation(outdoor, tmp_path):
+    from gaitval.steps_legbench import legbench_evaluate_step, legbench_track_step
+    path, (ann, _) = outdoor
+    topics = {"annotation_topic": "/ground_truth_people_tracks", "scan_topic": "/scan_base2"}
+    legbench_track_step(path, "tug_m1", tmp_path / "track.parquet", init="annotation",
+                        annotations=path, **topics)
+    s = legbench_evaluate_step(tmp_path / "track.parquet", path, tmp_path / "a",
+                               **topics).iloc[0]
+    assert (s["n_scans"], s["gt"], s["annotated_scans"]) == (7170, 6179, 6179)
+    # the track starts on the first annotated scan, on the annotated person
+    assert s["k_init"] == int(ann["k"].min()) and s["init_offset_m"] < 0.75
+    assert s["mota"] == pytest.approx(1 - (s["fn"] + s["fp"] + s["idsw"]) / s["gt"])
+    frames = pd.read_parquet(tmp_path / "a" / "frames.parquet")
+    assert (frames["event"] == "MISS").sum() == s["fn"]
+    # same inputs, same bytes
+    legbench_evaluate_step(tmp_path / "track.parquet", path, tmp_path / "b", **topics)
+    for f in ("summary.parquet", "frames.parquet"):
+        assert (tmp_path / "a" / f).read_bytes() == (tmp_path / "b" / f).read_bytes()

@@ -1,0 +1,303 @@
+"""Annotated recordings without mocap (issue 18): track, score with CLEAR-MOT, tabulate.
+
+File-level steps behind the verbs ``gaitval legbench-track``, ``legbench-evaluate`` and
+``legbench-tables`` (rules in ``workflow/rules/legbench.smk``; docs/legbench.md).  They
+take file paths and topics, not a trial sheet, so the same two commands score a tracker
+on anybody's annotated bag (README):
+
+    gaitval legbench-track --sensor my.bag --scan-topic /scan --annotations my.bag \\
+        --annotation-topic /ground_truth_people_tracks --method tug_m1 --init annotation \\
+        --out track.parquet
+    gaitval legbench-evaluate --track track.parquet --annotations my.bag \\
+        --annotation-topic /ground_truth_people_tracks --scan-topic /scan --out eval/
+
+Initialisation (``--init``)
+    ``own``: the method's own initialiser (TUG ``closest_pair``, MTST ``mtst_participant``
+    without a lane, rollator ``facing_pair``).  ``annotation``: ``annotated_pair``
+    (:mod:`gaitval.track.init_annotated`) at the trial's first annotated scan — issue 18
+    scope 2, "initialisation from the annotation at the first annotated time".  For a
+    raw-scan tracker (``rollator_pf``) the override goes to ``kind__init``.
+Scan rate
+    Every scan is tracked at the recording's own rate (the MTST steps' 0.05 s resampling
+    of seed 001 is not applied: the leg_tracker bags run at 10 Hz, slower than 20 Hz).
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from gaitval.errors import ConfigError, GaitvalError
+from gaitval.io.atomic import write_parquet
+from gaitval.steps import load_json, method_definition
+
+INITS = ("own", "annotation")
+SUMMARY_FILE, FRAMES_FILE = "summary.parquet", "frames.parquet"
+
+
+def read_scans(path, scan_topic: str | None, trial: str | None):
+    """A ROS bag's LaserScan topic or a gaitval scan log."""
+    from gaitval.io.rosbag import is_rosbag, read_rosbag_scans
+    from gaitval.io.scanlog import read_scanlog
+    if is_rosbag(path):
+        return read_rosbag_scans(path, scan_topic, trial=trial)
+    return read_scanlog(path, trial=trial)
+
+
+def read_positions(path, annotation_topic: str | None, scan_topic: str | None,
+                   scan_t: np.ndarray | None, trial: str | None) -> tuple[pd.DataFrame, dict]:
+    """Annotated positions with their scan index ``k`` (bag topic or position CSV)."""
+    from gaitval.evaluate.clearmot import assign_scans
+    from gaitval.io.annotations_bag import read_bag_annotations, read_position_csv
+    from gaitval.io.rosbag import is_rosbag
+    if is_rosbag(path):
+        return read_bag_annotations(path, annotation_topic, scan_topic, trial=trial)
+    pos = read_position_csv(path, trial=trial)
+    if scan_t is None:
+        raise GaitvalError("a position CSV needs the scan times to find each annotation's "
+                           "scan", path=path, trial=trial)
+    return assign_scans(pos, scan_t), {"topic": "", "frame_source": "position CSV",
+                                       "frame": ",".join(sorted(set(pos["frame"])))}
+
+
+def with_init(method_def, init: str, positions: pd.DataFrame) -> dict:
+    """The method definition with its initialiser chosen by ``init`` (module notes)."""
+    from gaitval.methods import get_method
+    m = get_method(method_def)
+    if init == "own":
+        return m
+    if init != "annotation":
+        raise ConfigError(f"unknown legbench init {init!r}", hint=f"one of {', '.join(INITS)}")
+    if positions.empty:
+        raise GaitvalError("init 'annotation' needs at least one annotated position")
+    first = positions.sort_values(["k", "id"], kind="stable").iloc[0]
+    spec = {"name": "annotated_pair", "k": int(first["k"]), "x_m": float(first["x_m"]),
+            "y_m": float(first["y_m"])}
+    kind = m.get("kind")
+    raw_scan = isinstance(kind, dict) and kind.get("name", "detect_then_track") != \
+        "detect_then_track"
+    holder = m["kind"] if raw_scan else m           # a raw-scan tracker's init is its own
+    base = holder.get("init") if isinstance(holder.get("init"), dict) else {}
+    holder["init"] = {**{k: base[k] for k in ("max_pair_m", "min_leg_widths") if k in base},
+                      **spec}
+    return m
+
+
+def legbench_track_step(sensor, method: str, out_parquet, *, init: str = "own",
+                        scan_topic: str | None = None, annotations=None,
+                        annotation_topic: str | None = None, leg_width_m: float = 0.10,
+                        config_json=None, trial: str | None = None) -> pd.DataFrame:
+    """Track one annotated recording with one method and initialisation; write the
+    per-scan two-leg track (:data:`gaitval.track.TRACK_COLUMNS`, sensor frame, sensor
+    clock) with ``method``, ``init``, ``k_init`` and ``restarts`` in the Parquet metadata."""
+    from gaitval.methods import build_method
+
+    cfg = load_json(config_json) if config_json else {}
+    trial = trial or Path(sensor).name
+    scans = read_scans(sensor, scan_topic, trial)
+    mdef = method_definition(cfg, method)
+    overrides = dict(((cfg.get("tracking") or {}).get("overrides") or {}).get(method) or {})
+    if init == "annotation":
+        if annotations is None:
+            raise GaitvalError("init 'annotation' needs --annotations", trial=trial)
+        positions, _ = read_positions(annotations, annotation_topic, scan_topic, scans.t,
+                                      trial)
+    else:
+        positions = pd.DataFrame()
+    try:
+        res = build_method(with_init(mdef, init, positions), overrides).track(
+            scans, float(leg_width_m))
+    except GaitvalError as exc:
+        raise exc.with_context(path=sensor, trial=trial) from None
+    track = res.to_frame()
+    k_init = getattr(res, "k_init", None)
+    meta = {"gaitval_legbench": json.dumps({
+        "method": method, "init": init, "trial": trial,
+        "k_init": None if k_init is None or k_init < 0 else int(k_init),
+        "restarts": [int(k) for k in (getattr(res, "restarts", None) or [])],
+        "source": str(scans.source), "leg_width_m": float(leg_width_m)}, sort_keys=True)}
+    write_parquet(track, out_parquet, metadata=meta)
+    return track
+
+
+def read_track(path) -> tuple[pd.DataFrame, dict]:
+    """A legbench track and its metadata."""
+    import pyarrow.parquet as pq
+    from gaitval.errors import FileFormatError
+    try:
+        table = pq.read_table(path)
+        raw = (table.schema.metadata or {}).get(b"gaitval_legbench")
+        if raw is None:
+            raise FileFormatError("not a legbench track (no gaitval_legbench metadata)",
+                                  path=path, hint="make it with `gaitval legbench-track`")
+        return table.to_pandas(), json.loads(raw)
+    except (OSError, ValueError) as exc:
+        raise FileFormatError(f"cannot read the track: {exc}", path=path) from None
+
+
+def legbench_evaluate_step(track_parquet, annotations, out_dir, *,
+                           annotation_topic: str | None = None, scan_topic: str | None = None,
+                           match_m: float = 0.75, min_false_s: float = 0.5,
+                           trial: str | None = None) -> pd.DataFrame:
+    """CLEAR-MOT and false leg tracks of one track against the annotations.
+
+    Writes ``summary.parquet`` (one row: trial, method, init, the CLEAR-MOT counts and
+    rates, false leg tracks, the initial person's offset from the annotation) and
+    ``frames.parquet`` (per scan: annotated and tracked person, the CLEAR-MOT event).
+    """
+    from gaitval.evaluate.clearmot import clear_mot, false_leg_tracks, person_hypotheses
+
+    track, meta = read_track(track_parquet)
+    trial = trial or meta.get("trial")
+    t = track.loc[track["side"] == "L", "t_sensor_s"].to_numpy(float)
+    n = len(t)
+    x = np.vstack([track.loc[track["side"] == s, "x_m"].to_numpy(float) for s in "LR"])
+    y = np.vstack([track.loc[track["side"] == s, "y_m"].to_numpy(float) for s in "LR"])
+    positions, ameta = read_positions(annotations, annotation_topic, scan_topic, t, trial)
+    if len(positions) and positions["k"].max() >= n:
+        raise GaitvalError(f"annotations refer to scan {int(positions['k'].max())} but the "
+                           f"track has {n} scans: not the same recording or scan topic",
+                           path=annotations, trial=trial)
+    hyp = person_hypotheses(x, y, meta.get("restarts") or [])
+    summary, events = clear_mot(positions, hyp, n, match_m=match_m)
+    legs = false_leg_tracks(x, y, t, positions, match_m=match_m, min_false_s=min_false_s)
+    k0 = meta.get("k_init")
+    offset = float("nan")
+    if k0 is not None:
+        g = positions[positions["k"] == k0]
+        h = hyp[hyp["k"] == k0]
+        if len(g) and len(h):
+            offset = float(np.min(np.hypot(g["x_m"].to_numpy() - h["x_m"].iloc[0],
+                                           g["y_m"].to_numpy() - h["y_m"].iloc[0])))
+    window = _window_fraction(meta["method"], positions)
+    row = {"trial": trial, "method": meta["method"], "init": meta["init"],
+           "k_init": -1 if k0 is None else int(k0),
+           "t_init_s": float(t[k0] - t[0]) if k0 is not None else float("nan"),
+           "init_offset_m": offset, **summary, **legs,
+           "tracked_fraction": float(len(hyp) / n) if n else float("nan"),
+           "annotated_scans": int(positions["k"].nunique()), "n_scans": int(n),
+           "annotations_in_window": window,
+           "match_m": float(match_m), "annotation_frame": str(ameta.get("frame", "")),
+           "annotation_frame_source": str(ameta.get("frame_source", ""))}
+    out = Path(out_dir)
+    summary_df = pd.DataFrame([row])
+    write_parquet(summary_df, out / SUMMARY_FILE)
+    write_parquet(_frames(t, positions, hyp, events), out / FRAMES_FILE)
+    return summary_df
+
+
+def _window_fraction(method: str, positions: pd.DataFrame) -> float:
+    """Fraction of the annotated positions inside the method's fixed detection window
+    (seed 002's ``rollator_window``: the only detector that looks at part of the scan);
+    NaN for a detector that sees the whole scan or a method gaitval does not know."""
+    from gaitval.methods import METHODS
+    m = METHODS.get(method) or {}
+    det = m.get("detector")
+    if det is None and isinstance(m.get("kind"), dict):
+        det = m["kind"].get("detector")               # a raw-scan tracker's own detector
+    if not isinstance(det, dict) or "window_x_m" not in det or positions.empty:
+        return float("nan")
+    (x0, x1), (y0, y1) = det["window_x_m"], det["window_y_m"]
+    x, y = positions["x_m"].to_numpy(float), positions["y_m"].to_numpy(float)
+    return float(np.mean((x >= x0) & (x <= x1) & (y >= y0) & (y <= y1)))
+
+
+def _frames(t, positions, hyp, events) -> pd.DataFrame:
+    """Per scan: the (first) annotated person, the person hypothesis, the event."""
+    n = len(t)
+    f = pd.DataFrame({"k": np.arange(n, dtype=np.int64), "t_s": t - t[0]})
+    g = positions.drop_duplicates("k").set_index("k")
+    f["gt_x_m"] = g["x_m"].reindex(f["k"]).to_numpy(float)
+    f["gt_y_m"] = g["y_m"].reindex(f["k"]).to_numpy(float)
+    h = hyp.drop_duplicates("k").set_index("k")
+    f["hyp_x_m"] = h["x_m"].reindex(f["k"]).to_numpy(float)
+    f["hyp_y_m"] = h["y_m"].reindex(f["k"]).to_numpy(float)
+    f["hyp_id"] = h["hyp_id"].reindex(f["k"]).fillna(-1).astype(np.int64).to_numpy()
+    order = {"SWITCH": 0, "MISS": 1, "FP": 2, "MATCH": 3}
+    ev = events[events["type"].isin(list(order))].copy()
+    ev["rank"] = ev["type"].map(order)
+    first = ev.sort_values(["k", "rank"], kind="stable").drop_duplicates("k").set_index("k")
+    f["event"] = first["type"].reindex(f["k"]).fillna("").astype(str).to_numpy()
+    return f
+
+
+def legbench_tables_step(inputs, tables_dir, figures_dir, reports_dir, config_hash: str = "",
+                         *, methods=None, inits=None) -> pd.DataFrame:
+    """The CLEAR-MOT table and the figure of every evaluated (trial, method, init)."""
+    from gaitval.report.legbench_figures import write_legbench_figure
+    from gaitval.report.provenance import stamp
+    from gaitval.tables.legbench import write_legbench_table
+
+    summaries, frames = [], {}
+    for d in map(Path, inputs):
+        s = pd.read_parquet(d / SUMMARY_FILE)
+        summaries.append(s)
+        r = s.iloc[0]
+        frames[(r["trial"], r["method"], r["init"])] = pd.read_parquet(d / FRAMES_FILE)
+    summary = pd.concat(summaries, ignore_index=True)
+    paths = write_legbench_table(summary, Path(tables_dir) / "legbench_clearmot",
+                                 methods=methods, inits=inits)
+    fig = write_legbench_figure(frames, summary, Path(figures_dir) / "legbench_tracks.png",
+                                methods=methods, inits=inits)
+    stamp("legbench_tables", [*paths, fig], reports_dir, config_hash_=config_hash)
+    return summary
+
+
+def add_legbench_verbs(sub) -> None:
+    """``legbench-track``, ``legbench-evaluate``, ``legbench-tables`` (for gaitval.cli)."""
+    def run(a) -> int:
+        if a.verb == "legbench-track":
+            legbench_track_step(a.sensor, a.method, a.out, init=a.init,
+                                scan_topic=a.scan_topic, annotations=a.annotations,
+                                annotation_topic=a.annotation_topic,
+                                leg_width_m=a.leg_width_m, config_json=a.config,
+                                trial=a.trial)
+        elif a.verb == "legbench-evaluate":
+            s = legbench_evaluate_step(a.track, a.annotations, a.out,
+                                       annotation_topic=a.annotation_topic,
+                                       scan_topic=a.scan_topic, match_m=a.match_m,
+                                       min_false_s=a.min_false_s, trial=a.trial)
+            cols = ["method", "init", "mota", "motp_m", "idsw", "idf1", "fn", "fp", "gt",
+                    "false_leg_tracks_per_min"]
+            print(s[cols].to_string(index=False))
+        else:
+            legbench_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir,
+                                 a.config_hash, methods=a.methods, inits=a.inits)
+        return 0
+
+    s = sub.add_parser("legbench-track", help="track an annotated recording (bag or scan "
+                                              "log, no mocap) with one method")
+    s.add_argument("--sensor", required=True, help="ROS bag or *.scan.parquet")
+    s.add_argument("--scan-topic", help="LaserScan topic (bags with several)")
+    s.add_argument("--method", required=True)
+    s.add_argument("--init", choices=INITS, default="own",
+                   help="own: the method's initialiser; annotation: the first annotation")
+    s.add_argument("--annotations", help="bag with the annotation topic, or *.positions.csv")
+    s.add_argument("--annotation-topic")
+    s.add_argument("--leg-width-m", type=float, default=0.10)
+    s.add_argument("--config", help="a study's config.json (tracking section)")
+    s.add_argument("--trial")
+    s.add_argument("--out", required=True)
+    s.set_defaults(func=run)
+    s = sub.add_parser("legbench-evaluate", help="CLEAR-MOT (0.75 m) and false leg tracks "
+                                                 "of a legbench track")
+    s.add_argument("--track", required=True)
+    s.add_argument("--annotations", required=True)
+    s.add_argument("--annotation-topic")
+    s.add_argument("--scan-topic")
+    s.add_argument("--match-m", type=float, default=0.75)
+    s.add_argument("--min-false-s", type=float, default=0.5)
+    s.add_argument("--trial")
+    s.add_argument("--out", required=True)
+    s.set_defaults(func=run)
+    s = sub.add_parser("legbench-tables", help="CLEAR-MOT table and figure of legbench runs")
+    s.add_argument("inputs", nargs="+", help="legbench-evaluate output folders")
+    s.add_argument("--methods", nargs="+", default=None)
+    s.add_argument("--inits", nargs="+", default=None)
+    s.add_argument("--tables-dir", required=True)
+    s.add_argument("--figures-dir", required=True)
+    s.add_argument("--reports-dir", default="reports")
+    s.add_argument("--config-hash", default="")
+    s.set_defaults(func=run)

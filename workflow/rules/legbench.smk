@@ -1,0 +1,172 @@
+# Annotated recordings without mocap (issue 18; docs/legbench.md): every trial of protocol
+# `legbench` is tracked with each legbench.methods x legbench.inits, scored with CLEAR-MOT
+# (py-motmetrics, legbench.match_m) against its hand annotations, and tabulated.
+# Input functions first (snakemake --lint), then the rules.
+import json
+
+from gaitval.io.trialsheet import load_subjects
+
+LEGBENCH_WC = {"study": "[^/]+", "method": "[^/]+", "init": "own|annotation", "trial": "[^/]+"}
+# the legbench section is not one of steps.ANALYSIS_SECTIONS: its own provenance hash
+LEGBENCH_HASH = config_hash(
+    {**{k: config[k] for k in ANALYSIS_SECTIONS if k in config},
+     "legbench": config.get("legbench", {})}
+)
+
+
+def legbench_cfg():
+    lb = dict(config.get("legbench") or {})
+    lb.setdefault("methods", ["tug_m1", "tug_m2", "tug_m3"])
+    lb.setdefault("inits", ["own", "annotation"])
+    lb.setdefault("match_m", 0.75)
+    lb.setdefault("min_false_s", 0.5)
+    return lb
+
+
+def legbench_trials(study):
+    return trial_ids(study, ["legbench"])
+
+
+def legbench_annotations(study, trial):
+    """The annotation source of a trial: its annotation_file, else its bag (topic)."""
+    row = trial_row(study, trial)
+    return row["annotation_path"] or row["sensor_path"]
+
+
+def legbench_args(w):
+    """Topics of the trial (command-line options; empty when the sheet gives none)."""
+    row = trial_row(w.study, w.trial)
+    args = []
+    if row["sensor_topic"]:
+        args += ["--scan-topic", row["sensor_topic"]]
+    if row["annotation_topic"]:
+        args += ["--annotation-topic", row["annotation_topic"]]
+    return args
+
+
+def legbench_leg_width(w):
+    subj = load_subjects(subjects_path(w.study)).loc[trial_row(w.study, w.trial)["subject"]]
+    return float(subj["leg_width_m"])
+
+
+def legbench_eval_dirs(study):
+    lb = legbench_cfg()
+    return [
+        f"{RESULTS}/{study}/legbench_eval/{m}/{i}/{t}"
+        for t in legbench_trials(study)
+        for m in lb["methods"]
+        for i in lb["inits"]
+    ]
+
+
+def _without_mocap_items(func):
+    """The ingest and registration tables need mocap: for a study whose trials are all
+    legbench (annotations, no mocap) they are left out of the report."""
+
+    def items(study):
+        got = func(study)
+        if legbench_trials(study) and set(trials(study)["protocol"]) == {"legbench"}:
+            got = [i for i in got if not Path(i).name.startswith(MOCAP_TABLES)]
+        return got
+
+    return items
+
+
+MOCAP_TABLES = ("study_ingest_", "study_registration_")
+# ingest.smk and register.smk list those tables for every study in `run`
+REPORT_ITEM_FUNCS[:] = [_without_mocap_items(f) for f in REPORT_ITEM_FUNCS]
+
+
+rule legbench_track:
+    input:
+        sensor=lambda w: trial_row(w.study, w.trial)["sensor_path"],
+        annotations=lambda w: legbench_annotations(w.study, w.trial),
+        config=f"{RESULTS}/{{study}}/config.json",
+    output:
+        f"{RESULTS}/{{study}}/legbench/{{method}}/{{init}}/{{trial}}/track.parquet",
+    wildcard_constraints:
+        **LEGBENCH_WC,
+    params:
+        gv=GV,
+        topics=legbench_args,
+        leg_width=legbench_leg_width,
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/legbench_track/{study}/{method}/{init}/{trial}.log",
+    shell:
+        "{params.gv} legbench-track --sensor {input.sensor:q} --annotations {input.annotations:q}"
+        " {params.topics:q} --method {wildcards.method:q} --init {wildcards.init:q}"
+        " --leg-width-m {params.leg_width} --config {input.config:q}"
+        " --trial {wildcards.trial:q} --out {output:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+
+
+rule legbench_evaluate:
+    input:
+        track=f"{RESULTS}/{{study}}/legbench/{{method}}/{{init}}/{{trial}}/track.parquet",
+        annotations=lambda w: legbench_annotations(w.study, w.trial),
+    output:
+        summary=f"{RESULTS}/{{study}}/legbench_eval/{{method}}/{{init}}/{{trial}}/summary.parquet",
+        frames=f"{RESULTS}/{{study}}/legbench_eval/{{method}}/{{init}}/{{trial}}/frames.parquet",
+    wildcard_constraints:
+        **LEGBENCH_WC,
+    params:
+        gv=GV,
+        topics=legbench_args,
+        out=parent_of("summary"),
+        match_m=legbench_cfg()["match_m"],
+        min_false_s=legbench_cfg()["min_false_s"],
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/legbench_evaluate/{study}/{method}/{init}/{trial}.log",
+    shell:
+        "{params.gv} legbench-evaluate --track {input.track:q} --annotations {input.annotations:q}"
+        " {params.topics:q} --match-m {params.match_m} --min-false-s {params.min_false_s}"
+        " --trial {wildcards.trial:q} --out {params.out:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+
+
+rule legbench_tables:
+    input:
+        lambda w: [
+            f"{d}/summary.parquet" for study in config["run"] for d in legbench_eval_dirs(study)
+        ],
+    output:
+        table=report(
+            f"{REPORTS}/tables/legbench_clearmot.csv",
+            caption="../report/legbench.rst",
+            category="Annotated recordings",
+        ),
+        md=f"{REPORTS}/tables/legbench_clearmot.md",
+        fig=report(
+            f"{REPORTS}/figures/legbench_tracks.png",
+            caption="../report/legbench.rst",
+            category="Annotated recordings",
+        ),
+    params:
+        gv=GV,
+        dirs=lambda w, input: [str(Path(p).parent) for p in input],
+        methods=legbench_cfg()["methods"],
+        inits=legbench_cfg()["inits"],
+        tables=parent_of("table"),
+        figures=parent_of("fig"),
+        reports=parent_of("table", up=1),
+        chash=LEGBENCH_HASH,
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/legbench_tables.log",
+    shell:
+        "{params.gv} legbench-tables {params.dirs:q} --methods {params.methods:q}"
+        " --inits {params.inits:q} --tables-dir {params.tables:q}"
+        " --figures-dir {params.figures:q} --reports-dir {params.reports:q}"
+        " --config-hash {params.chash:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+
+
+REPORT_ITEM_FUNCS.append(
+    lambda study: (
+        [f"{REPORTS}/tables/legbench_clearmot.csv", f"{REPORTS}/figures/legbench_tracks.png"]
+        if legbench_trials(study)
+        else []
+    )
+)
