@@ -2,7 +2,9 @@
 
 One row per method, two panels (x forward, y left of the laser, m): the hand-annotated
 person (black), and the tracker's person (leg midpoint) for each initialisation; scans
-the CLEAR-MOT counted as a miss are marked below the curves.  The figure is drawn for
+the CLEAR-MOT counted as a miss are marked below the curves.  The axes show the laser's
+reach (x -1..6 m, y -3..3 m): a tracker that lost the legs and keeps predicting runs far
+outside it (off-scale).  The figure is drawn for
 the first trial (trials sorted by name).
 """
 from __future__ import annotations
@@ -47,11 +49,13 @@ def write_legbench_figure(frames: dict, summary: pd.DataFrame, path, methods=Non
                 ax.plot(f["t_s"].to_numpy()[miss], np.full(miss.sum(), lo - 0.3 - off), "|",
                         color=COLOURS.get(i, "tab:green"), ms=3)
             first = False
+        for col, lim in enumerate(((-1.0, 6.0), (-3.0, 3.0))):
+            axes[row, col].set_ylim(*lim)     # the laser's reach (5.6 m); beyond: off-scale
         axes[row, 0].set_ylabel(f"{m}\nx (m)")
         axes[row, 1].set_ylabel("y (m)")
         axes[row, 1].legend(loc="upper right", fontsize=6, markerscale=4)
     for ax in axes[-1]:
         ax.set_xlabel("time from the first scan (s)")
     fig.suptitle(f"{trial}: tracked (leg midpoint) vs annotated person; ticks below: "
-                 "misses", fontsize=9)
+                 "misses; estimates beyond the laser's reach are off-scale", fontsize=9)
     return save_figure(fig, path)
