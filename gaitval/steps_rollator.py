@@ -187,7 +187,8 @@ def rollator_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, r
                          config_hash: str = "", kf_method: str = "rollator_kf",
                          pf_method: str = "rollator_pf", models: list[str | Path] = (),
                          config_json=None) -> list[Path]:
-    """Seed 002 Tables I and II and the turning-trial figure from the evaluations."""
+    """Seed 002 Tables I and II and the figure (a successful and a failed trial,
+    :mod:`gaitval.report.rollator_figures`) from the evaluations."""
     from gaitval.report.provenance import stamp
     from gaitval.report.rollator_figures import write_rollator_figure
     from gaitval.tables.rollator import write_rollator_tables

@@ -134,3 +134,60 @@ def test_mtst_truth_in_field_is_the_mocap_leg_in_the_field_frame():
     np.testing.assert_allclose(y[:2], [2.0, 2.1], atol=1e-12)
     assert np.isnan(x[2]) and np.isnan(y[2])                    # invalid truth
     assert np.isnan(truth_in_field(track, None, (0, 0, 0))[0]).all()
+
+
+def _rollator_frames(spec, n=10):
+    """Evaluation frames (both trackers) of trials ``{trial: (scenario, errors, restarts)}``
+    for the KF; the PF never errs."""
+    rows = []
+    for trial, (scenario, n_err, n_rs) in spec.items():
+        for tracker in ("kf", "pf"):
+            k = np.arange(n)
+            kf = tracker == "kf"
+            d = {"trial": trial, "tracker": tracker, "scan": k, "t_sensor_s": k * 0.028,
+                 "status": "evaluated", "error": kf & (k < n_err),
+                 "restart": kf & (k >= n - n_rs), "subject": "P01", "scenario": scenario}
+            for side, y in (("L", 0.1), ("R", -0.1)):
+                d.update({f"x_true_m_{side}": -0.6 + 0 * k, f"y_true_m_{side}": y + 0 * k,
+                          f"x_m_{side}": -0.6 + 0.01 * k, f"y_m_{side}": y + 0 * k})
+            rows.append(pd.DataFrame(d))
+    return pd.concat(rows, ignore_index=True)
+
+
+def test_rollator_figure_picks_a_successful_and_a_failed_trial():
+    from gaitval.report.rollator_figures import pick_trials, trial_outcomes
+    f = _rollator_frames({"r_obst": ("obstacle", 0, 0), "r_str": ("straight", 0, 0),
+                          "r_err": ("straight", 3, 0), "r_rs": ("obstacle", 0, 1)})
+    o = trial_outcomes(f, "kf").set_index("trial")
+    assert o.loc["r_err", "error_pct"] == 30.0 and o.loc["r_rs", "restarts"] == 1
+    assert list(o["failed"]) == [True, False, True, False]     # r_err, r_obst, r_rs, r_str
+    # success: no KF error frame nor re-initialisation, a straight (turning) trial first;
+    # failure: the most KF error frames
+    assert pick_trials(f, "kf") == ("r_str", "r_err")
+    assert pick_trials(f, "kf", trial="r_rs") == ("r_str", "r_rs")   # figure_trial, failed
+    assert pick_trials(f, "kf", trial="r_obst") == ("r_obst", "r_err")
+    assert pick_trials(f[f["trial"] == "r_str"], "kf") == ("r_str", None)
+    bad = f[f["trial"].isin(["r_err", "r_rs"])]
+    assert pick_trials(bad, "kf") == ("r_rs", "r_err")      # every trial failed: best, worst
+    assert pick_trials(f[f["trial"] == "r_err"], "kf") == (None, "r_err")
+
+
+def test_rollator_figure_draws_both_trials(tmp_path, monkeypatch):
+    from gaitval.report import rollator_figures as rf
+    f = _rollator_frames({"r_str": ("straight", 0, 0), "r_err": ("straight", 3, 1)})
+    seen = {}
+    orig = rf.save_figure
+
+    def spy(fig, path):
+        seen["titles"] = [ax.get_title() for ax in fig.axes]
+        seen["suptitle"] = fig._suptitle.get_text()
+        return orig(fig, path)
+    monkeypatch.setattr(rf, "save_figure", spy)
+    paths = rf.write_rollator_figure(f, tmp_path, kf="kf", pf="pf")
+    assert paths == [tmp_path / "rollator_turning_trial.png"] and paths[0].stat().st_size
+    assert len(seen["titles"]) == 8
+    assert seen["titles"][0].startswith("r_str: success: KF 0.0 % error frames, "
+                                        "0 re-initialisations; PF 0.0 %")
+    assert seen["titles"][4].startswith("r_err: FAILED: KF 30.0 % error frames, "
+                                        "1 re-initialisation;")
+    assert seen["suptitle"].startswith("a successful and a failed trial")
