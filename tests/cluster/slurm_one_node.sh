@@ -10,15 +10,24 @@
 #   apt-get install -y slurm-wlm munge
 # Everything (slurm.conf, munge key and socket, state, spool, logs, pid files) lives in
 # $GAITVAL_SLURM_DIR (default /tmp/gaitval-slurm); the system's /etc/slurm, /etc/munge and
-# any running munged/slurmd are left alone.  No slurmdbd: AccountingStorageType=none, so
-# `sacct` answers from slurmctld's memory (jobs younger than MinJobAge) and every finished
-# job is also written to $GAITVAL_SLURM_DIR/jobcomp.log (JobCompType=jobcomp/filetxt).
+# any running munged/slurmd are left alone.  Every finished job is written to
+# $GAITVAL_SLURM_DIR/jobcomp.log (JobCompType=jobcomp/filetxt).
+#
+# Accounting: by default none (no slurmdbd), so `sacct` answers "Slurm accounting storage
+# is disabled" and Snakemake must poll with squeue (--slurm-status-command squeue).  With
+# GAITVAL_SLURM_DBD=1 the script also starts a MariaDB server and slurmdbd in the same
+# folder (apt-get install -y slurmdbd mariadb-server), registers the cluster, an account
+# `gaitval` and root in it: then sacct works as on a real cluster (job count, MaxRSS,
+# Elapsed per job) and the executor can check `slurm_account`.
 set -euo pipefail
 
 DIR=${GAITVAL_SLURM_DIR:-/tmp/gaitval-slurm}
 CTLD_PORT=${GAITVAL_SLURMCTLD_PORT:-16817}
 SLURMD_PORT=${GAITVAL_SLURMD_PORT:-16818}
 CPUS=${GAITVAL_SLURM_CPUS:-$(nproc)}
+DBD=${GAITVAL_SLURM_DBD:-0}
+DBD_PORT=${GAITVAL_SLURMDBD_PORT:-16819}
+DB_PORT=${GAITVAL_SLURM_MARIADB_PORT:-16306}
 
 write_conf() {
     mkdir -p "$DIR"/state "$DIR"/spool "$DIR"/munge "$DIR"/log
@@ -28,6 +37,14 @@ write_conf() {
     avail_mb=$(awk '/MemAvailable/ {print int($2/1024)}' /proc/meminfo)
     local real_mb=$((avail_mb - 2048))
     [ "$real_mb" -gt 1024 ] || real_mb=1024
+    local ACCOUNTING="AccountingStorageType=accounting_storage/none"
+    if [ "$DBD" = 1 ]; then
+        ACCOUNTING="AccountingStorageType=accounting_storage/slurmdbd
+AccountingStorageHost=localhost
+AccountingStoragePort=$DBD_PORT
+# the munge socket for talking to slurmdbd (AuthInfo covers slurmctld/slurmd only)
+AccountingStoragePass=$DIR/munge/munge.socket"
+    fi
     cat > "$DIR/slurm.conf" <<EOF
 # Written by tests/cluster/slurm_one_node.sh -- a one-node test cluster on loopback.
 ClusterName=gaitval-test
@@ -54,11 +71,14 @@ SlurmctldLogFile=$DIR/log/slurmctld.log
 SlurmdLogFile=$DIR/log/slurmd.log
 SlurmctldDebug=info
 SlurmdDebug=info
-# No slurmdbd: no accounting database; sacct then asks slurmctld, which forgets a job
-# MinJobAge seconds after it ended -- long enough for Snakemake's status checks.
-AccountingStorageType=accounting_storage/none
+$ACCOUNTING
+# a finished job stays visible to squeue for MinJobAge seconds -- long enough for
+# Snakemake's status checks when there is no accounting database
 JobAcctGatherType=jobacct_gather/linux
 JobAcctGatherFrequency=5
+# no cgroups here: jobacct_gather polls each step's memory and kills a step over its --mem,
+# so a too small mem_mb in the profile fails the test as it would on a real cluster
+JobAcctGatherParams=OverMemoryKill
 JobCompType=jobcomp/filetxt
 JobCompLoc=$DIR/jobcomp.log
 MinJobAge=3600
@@ -67,6 +87,47 @@ TmpFS=/tmp
 NodeName=localhost NodeAddr=127.0.0.1 CPUs=$CPUS RealMemory=$real_mb State=UNKNOWN
 PartitionName=debug Nodes=localhost Default=YES MaxTime=INFINITE State=UP
 EOF
+}
+
+start_dbd() {  # MariaDB + slurmdbd in $DIR; the cluster, account `gaitval`, root in it
+    command -v slurmdbd >/dev/null && command -v mariadbd >/dev/null \
+        || { echo "GAITVAL_SLURM_DBD=1 needs: apt-get install -y slurmdbd mariadb-server" >&2; exit 2; }
+    local db="$DIR/mysql"
+    mkdir -p "$db"
+    if [ ! -d "$db/data/mysql" ]; then
+        mariadb-install-db --no-defaults --datadir="$db/data" --user=root \
+            --auth-root-authentication-method=normal --skip-test-db > "$DIR/log/mariadb-install.log" 2>&1
+    fi
+    setsid mariadbd --no-defaults --datadir="$db/data" --socket="$db/mysqld.sock" \
+        --port="$DB_PORT" --bind-address=127.0.0.1 --user=root --pid-file="$db/mariadbd.pid" \
+        --log-error="$DIR/log/mariadbd.log" --innodb-buffer-pool-size=64M \
+        < /dev/null > /dev/null 2>&1 &
+    for _ in $(seq 1 60); do
+        mariadb-admin --no-defaults --socket="$db/mysqld.sock" -u root ping >/dev/null 2>&1 && break
+        sleep 1
+    done
+    mariadb --no-defaults --socket="$db/mysqld.sock" -u root -e "
+        CREATE USER IF NOT EXISTS 'slurm'@'localhost' IDENTIFIED BY 'slurm';
+        CREATE USER IF NOT EXISTS 'slurm'@'127.0.0.1' IDENTIFIED BY 'slurm';
+        GRANT ALL ON slurm_acct_db.* TO 'slurm'@'localhost';
+        GRANT ALL ON slurm_acct_db.* TO 'slurm'@'127.0.0.1';"
+    # slurmdbd reads slurmdbd.conf beside $SLURM_CONF (mode 600, owned by SlurmUser)
+    printf '%s\n' "AuthType=auth/munge" "AuthInfo=socket=$DIR/munge/munge.socket" \
+        "DbdHost=localhost" "DbdPort=$DBD_PORT" "SlurmUser=root" \
+        "LogFile=$DIR/log/slurmdbd.log" "PidFile=$DIR/slurmdbd.pid" \
+        "StorageType=accounting_storage/mysql" "StorageHost=127.0.0.1" \
+        "StoragePort=$DB_PORT" "StorageUser=slurm" "StoragePass=slurm" \
+        "StorageLoc=slurm_acct_db" > "$DIR/slurmdbd.conf"
+    chmod 600 "$DIR/slurmdbd.conf"
+    slurmdbd
+    for _ in $(seq 1 60); do
+        sacctmgr -n list cluster >/dev/null 2>&1 && break
+        sleep 1
+    done
+    sacctmgr -i add cluster gaitval-test >/dev/null
+    sacctmgr -i add account gaitval Description=gaitval-test Organization=gaitval >/dev/null
+    sacctmgr -i add user root Account=gaitval >/dev/null
+    echo "slurmdbd up (MariaDB on 127.0.0.1:$DB_PORT): account gaitval, user root"
 }
 
 pid_alive() { [ -f "$1" ] && kill -0 "$(cat "$1")" 2>/dev/null; }
@@ -93,6 +154,7 @@ start() {
         --pid-file="$DIR/munge/munged.pid" --log-file="$DIR/log/munged.log" \
         --seed-file="$DIR/munge/munged.seed"
     export SLURM_CONF="$DIR/slurm.conf"
+    if [ "$DBD" = 1 ]; then start_dbd; fi
     # -c: a clean start (no jobs/state carried over from an earlier test)
     slurmctld -c -f "$DIR/slurm.conf"
     slurmd -f "$DIR/slurm.conf" -N localhost
@@ -123,6 +185,8 @@ stop_one() {  # pid file, name
 stop() {
     stop_one "$DIR/slurmd.pid" slurmd
     stop_one "$DIR/slurmctld.pid" slurmctld
+    stop_one "$DIR/slurmdbd.pid" slurmdbd
+    stop_one "$DIR/mysql/mariadbd.pid" mariadbd
     stop_one "$DIR/munge/munged.pid" munged
 }
 
