@@ -69,17 +69,21 @@ GV = (
 # Local runs: the rules' jobs run in a warm fork server (workflow/rules/forkserver.smk,
 # gaitval/forkserver.py) instead of each starting Python and importing numpy, pandas,
 # scipy and gaitval again.  Same verbs, same arguments, same files; one job per trial as
-# before.  Off with `--config fork_server=false` (the cluster profile does), and under
-# conda deployment; a job that finds no server runs the plain command.  Never inside a
-# cluster job (Snakemake's --mode remote on the node, e.g. SLURM): a `--config` given on the
-# command line replaces the profile's fork_server=False, and the node has no server anyway.
-FORK_SERVER = (bool(config.get("fork_server", True)) and not _CONDA
-               and not getattr(workflow, "remote_exec", False))
-if FORK_SERVER:
+# before.  Every rule calls gaitval through the small client (gaitval/forkclient.py); where
+# no server listens -- `fork_server: false`, a cluster executor, a job on a compute node --
+# the client runs the plain `python -m gaitval`.  So GV, a parameter of every rule, is one
+# string whatever the mode and from run to run (the socket path depends only on the working
+# directory): switching the server on or off, a new run, or a cluster job that records its
+# own params reruns nothing.  The server is started only by a local, non-dry run
+# (forkserver.smk).  Under conda deployment the plain command is used.
+FORK_SERVER = bool(config.get("fork_server", True)) and not _CONDA
+if not _CONDA:
+    import hashlib as _hashlib
     import os as _os
     import tempfile as _tempfile
 
-    FORK_SOCKET = f"{_tempfile.gettempdir()}/gaitval-{_os.getuid()}/{_os.getpid()}.sock"
+    _WORKDIR_KEY = _hashlib.sha256(str(Path.cwd().resolve()).encode()).hexdigest()[:16]
+    FORK_SOCKET = f"{_tempfile.gettempdir()}/gaitval-{_os.getuid()}/{_WORKDIR_KEY}.sock"
     GV = (
         f"{shlex.quote(sys.executable)} -I -S "
         f"{shlex.quote(str(Path(workflow.basedir) / 'gaitval' / 'forkclient.py'))} "

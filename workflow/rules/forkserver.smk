@@ -37,7 +37,10 @@ def _stop_fork_server():
 if FORK_SERVER:
 
     onstart:
-        _start_fork_server()
+        # only the Snakemake process that runs the jobs here (not a cluster executor's,
+        # whose jobs run elsewhere, nor a job's own Snakemake on a node)
+        if workflow.local_exec and not workflow.remote_exec:
+            _start_fork_server()
 
     onsuccess:
         _stop_fork_server()
