@@ -15,6 +15,11 @@ process that only imports those modules (``python -c 'import ...'``).  The secon
 job's start-up + import + exit cost; times the rule's job count, summed over the rules,
 it is the share of the run's CPU that goes to interpreter start-up and imports.
 
+With the fork server (the default for local runs, ``gaitval/forkserver.py``) a job's
+start-up is the small client (``python -I -S gaitval/forkclient.py``, standard library
+only) plus the fork; the server's imports are paid once per run and counted once.
+``--no-fork-server`` runs the plain one-process-per-job shape for comparison.
+
 Prints per repeat ``wall``, ``cpu`` (user + system of all child processes) and the job
 count; then the per-rule table and the last line::
 
@@ -50,10 +55,13 @@ def _cpu_children() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def _run_snakemake(root: Path, work: Path, study: str, cores: int) -> tuple[float, float, str]:
+def _run_snakemake(root: Path, work: Path, study: str, cores: int, fork_server: bool = True
+                   ) -> tuple[float, float, str]:
     cmd = [sys.executable, "-m", "snakemake", "-s", str(root / "Snakefile"),
            "--directory", str(work), "--cores", str(cores), "--printshellcmds",
            "--rerun-incomplete", "--config", f'run=["{study}"]']
+    if not fork_server:
+        cmd.append("fork_server=False")
     c0, t0 = _cpu_children(), time.perf_counter()
     p = subprocess.run(cmd, cwd=work, capture_output=True, text=True)
     wall, cpu = time.perf_counter() - t0, _cpu_children() - c0
@@ -82,7 +90,7 @@ def _shell_commands(log: str) -> dict[str, str]:
         if m:
             rule = m.group(1)
             continue
-        if rule and rule not in out and " -m gaitval " in line:
+        if rule and rule not in out and (" -m gaitval " in line or "forkclient.py" in line):
             out[rule] = line.strip()
     return out
 
@@ -90,6 +98,8 @@ def _shell_commands(log: str) -> dict[str, str]:
 def _job_argv(cmd: str) -> list[str] | None:
     """The argv after `-m gaitval` of a rule's shell command (up to the redirection)."""
     words = shlex.split(cmd.split(" > ")[0])
+    if any(w.endswith("forkclient.py") for w in words) and "--" in words:
+        return words[words.index("--") + 1:]
     try:
         i = words.index("gaitval", words.index("-m"))
     except ValueError:
@@ -129,6 +139,8 @@ def main() -> None:
                     help="checkout whose Snakefile runs (default: this one)")
     ap.add_argument("--keep", type=Path, default=None,
                     help="copy the last run's results/ here (to compare outputs)")
+    ap.add_argument("--no-fork-server", action="store_true",
+                    help="one plain Python process per job (fork_server=False)")
     ap.add_argument("--no-startup", action="store_true",
                     help="skip the per-rule start-up measurement")
     args = ap.parse_args()
@@ -137,7 +149,8 @@ def main() -> None:
         for r in range(args.repeat):
             work = Path(tmp) / f"run{r}"
             work.mkdir()
-            wall, cpu, log = _run_snakemake(args.root.resolve(), work, args.study, args.cores)
+            wall, cpu, log = _run_snakemake(args.root.resolve(), work, args.study, args.cores,
+                                            fork_server=not args.no_fork_server)
             counts = _job_stats(log)
             jobs = sum(counts.values())
             walls.append(wall)
@@ -148,7 +161,18 @@ def main() -> None:
         share = float("nan")
         if not args.no_startup:
             cmds = _shell_commands(log)
+            forked = "forkclient.py" in log
             total_start = 0.0
+            if forked:
+                client = statistics.median(_cpu_of(
+                    [sys.executable, "-I", "-S", "-c",
+                     "import json, os, signal, socket, struct, sys"], work) for _ in range(5))
+                server = statistics.median(_cpu_of(
+                    [sys.executable, "-c", "from gaitval.forkserver import preload; preload()"],
+                    work) for _ in range(3))
+                total_start += server
+                print(f"fork server: imports once {server:.2f} cpu-s; per job the client "
+                      f"{client:.3f} cpu-s (instead of the plain start-up column)")
             print(f"{'rule':28s} {'jobs':>5s} {'job cpu':>8s} {'start-up':>9s} {'modules':>8s}")
             for rule, n in sorted(counts.items()):
                 argv = _job_argv(cmds[rule]) if rule in cmds else None
@@ -156,7 +180,7 @@ def main() -> None:
                     print(f"{rule:28s} {n:5d}  (no gaitval shell command: runs in Snakemake)")
                     continue
                 job, start, nmod = _startup_of(argv, work)
-                total_start += n * start
+                total_start += n * (client if forked else start)
                 print(f"{rule:28s} {n:5d} {job:8.2f} {start:9.2f} {nmod:8d}", flush=True)
             share = 100 * total_start / statistics.median(cpus)
     print(f"report {args.study}: wall {statistics.median(walls):.1f} s, "
