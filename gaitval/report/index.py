@@ -37,6 +37,7 @@ SECTION_TITLES = {
     "mtst": "Multi-target stepping task (Yorozu et al., Sensors 2015, seed 001)",
     "rollator": "Robotic rollator, KF vs PF (Chalvatzaki et al., 2017, seed 002)",
     "ultrasonic": "Ultrasonic foot tracking (Qi et al., Sensors 2014, seed 003)",
+    "legbench": "Annotated recordings without mocap: CLEAR-MOT (Leigh et al., ICRA 2015)",
     "peer": "Worked example: agreement statistics on a peer's published data",
 }
 
