@@ -13,7 +13,7 @@
 #   GAITVAL_SLURM_DBD=1 tests/cluster/run_tiny_on_slurm.sh [OUT]
 # Reuse an existing local reference run (folder with results/ and reports/):
 #   LOCAL_REF=/path tests/cluster/run_tiny_on_slurm.sh [OUT]
-# Needs root (slurmd launches the jobs).  Takes ~15-25 min on 2 busy cores.
+# Needs root (slurmd launches the jobs).  Takes ~35 min on 2 busy cores (docs/cluster.md).
 set -euo pipefail
 
 REPO=$(cd "$(dirname "$0")/../.." && pwd)
