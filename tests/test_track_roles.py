@@ -62,6 +62,10 @@ def test_every_registered_part_drives_the_tracker(role, name):
     reports the hidden scans as UO and returns a full-length result."""
     t, xy, pats, truth = _walk()
     spec = {"name": name, **CONTRACT_PARAMS.get((role, name), {})}
+    if (role, name) == ("init", "annotated_pair"):
+        # the rater's annotation: the person (midpoint of the legs) at the first scan
+        mid = (truth[0, 0] + truth[1, 0]) / 2
+        spec.update(k=0, x_m=float(mid[0]), y_m=float(mid[1]))
     tr = Tracker(**{role: spec}, dt_s=DT, sides="as_initialised")
     res = tr.run(t, xy, pats, 0.1)
     assert res.k_init == 0 and res.x.shape == (2, len(t))
@@ -74,7 +78,10 @@ def test_every_registered_part_drives_the_tracker(role, name):
 @pytest.mark.parametrize("name", ROLE_REGISTRIES["init"].names())
 def test_initialiser_contract(name):
     from gaitval.track.observations import DetectionSeries
-    init = ROLE_REGISTRIES["init"].build(name)
+    # annotated_pair starts where the rater clicked: the pair's midpoint, from scan 0 on
+    spec = {"name": name, **({"k": 0, "x_m": 1.0, "y_m": 0.175}
+                             if name == "annotated_pair" else {})}
+    init = ROLE_REGISTRIES["init"].build(spec)
     empty = DetectionSeries([np.zeros((0, 2))] * 5, [[]] * 5)
     assert init.find(empty, 0.1) is None                     # nobody there: no track
     xy = [np.zeros((0, 2)), np.array([[1.0, 0.3], [1.0, 0.05]])]
