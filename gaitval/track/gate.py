@@ -42,6 +42,11 @@ class Gate:
 
     needs_context = True
 
+    def for_leg_width(self, leg_width_m: float) -> "Gate":
+        """The gate for one run (one subject's w_l); a gate that needs only w_l from the
+        context returns a bound copy with ``needs_context = False`` (faster)."""
+        return self
+
     def admits(self, lam2: float, dist: float, ctx: GateContext | None) -> bool:
         raise NotImplementedError
 
@@ -117,6 +122,24 @@ class FixedRadiusGate(Gate):
     def candidates(self, filter, prior, obs, ctx):
         return self.within_radius(filter, prior, obs,                      # seed001 eq. (5)
                                   self.radius_leg_widths * ctx.leg_width_m)
+
+    def for_leg_width(self, leg_width_m):
+        return _BoundRadius(self.radius_leg_widths * leg_width_m)
+
+
+class _BoundRadius(Gate):
+    """:class:`FixedRadiusGate` for one subject: r_val computed once, no context."""
+
+    needs_context = False
+
+    def __init__(self, r: float):
+        self.r = r
+
+    def admits(self, lam2, dist, ctx):
+        return dist < self.r                        # seed001 eq. (5)
+
+    def candidates(self, filter, prior, obs, ctx):
+        return self.within_radius(filter, prior, obs, self.r)             # seed001 eq. (5)
 
 
 @GATES.register("variable_region")

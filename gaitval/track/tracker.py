@@ -118,7 +118,7 @@ class Tracker:
         if start is None:                                       # no subject found
             return empty_result(t)
         run = TrackingRun(self, t, source, leg_width_m, start)
-        gate, assoc, occ = self.gate, self.associator, self.occlusion
+        gate, assoc, occ = self.gate.for_leg_width(leg_width_m), self.associator, self.occlusion
         context = gate.needs_context
         state = occ.begin(run)
         hyp = Hypotheses(run)
