@@ -66,18 +66,29 @@ class ClosestPair(Initialiser):
             obs = source.array(k)
             if len(obs) < 2:
                 continue
-            best = None
-            for i in range(len(obs)):
-                for j in range(i + 1, len(obs)):
-                    d = math.hypot(*(obs[i] - obs[j]))
-                    if d_min <= d <= self.max_pair_m and (best is None or d < best[0]):
-                        best = (d, i, j)
+            best = min(leg_pairs(obs, d_min, self.max_pair_m), key=lambda p: p[2],
+                       default=None)                       # the closest (first of equals)
             if best is not None:
-                _, i, j = best
-                ai = math.atan2(obs[i][1], obs[i][0])
-                aj = math.atan2(obs[j][1], obs[j][0])
-                return (k, i, j) if ai >= aj else (k, j, i)   # left = larger bearing
+                return left_first(k, obs, best[0], best[1])
         return None
+
+
+def leg_pairs(obs, d_min: float, d_max: float):
+    """``(i, j, d)`` of every pair i < j of one scan's observations ``d_min``..``d_max``
+    apart (a pair of legs; nearer than ~0.7 w_l is one leg seen twice)."""
+    for i in range(len(obs)):
+        for j in range(i + 1, len(obs)):
+            d = math.hypot(*(obs[i] - obs[j]))
+            if d_min <= d <= d_max:
+                yield i, j, d
+
+
+def left_first(k: int, obs, i: int, j: int) -> tuple[int, int, int]:
+    """``(k, left, right)`` for the pair (i, j): the observation at the larger bearing is
+    the left leg (the tracker may decide the sides again from the walking direction)."""
+    ai = math.atan2(obs[i][1], obs[i][0])
+    aj = math.atan2(obs[j][1], obs[j][0])
+    return (k, i, j) if ai >= aj else (k, j, i)
 
 
 @INITIALISERS.register("closest_pair")

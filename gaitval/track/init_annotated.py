@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 
 from gaitval.errors import ConfigError
-from gaitval.track.init import INITIALISERS, Initialiser
+from gaitval.track.init import INITIALISERS, Initialiser, left_first, leg_pairs
 
 
 @INITIALISERS.register("annotated_pair")
@@ -72,19 +72,13 @@ class AnnotatedPair(Initialiser):
         d_min = self.min_leg_widths * leg_width_m
         for k in range(self.k, min(len(source), self.k + self.search_scans + 1)):
             obs = source.array(k)
-            best = None
-            for i in range(len(obs)):
-                for j in range(i + 1, len(obs)):
-                    d = math.hypot(*(obs[i] - obs[j]))
-                    if not d_min <= d <= self.max_pair_m:
-                        continue
-                    off = math.hypot(0.5 * (obs[i][0] + obs[j][0]) - self.x,
-                                     0.5 * (obs[i][1] + obs[j][1]) - self.y)
-                    if off <= self.max_offset_m and (best is None or (off, d) < best[0]):
-                        best = ((off, d), i, j)
+            near = []
+            for i, j, d in leg_pairs(obs, d_min, self.max_pair_m):
+                off = math.hypot(0.5 * (obs[i][0] + obs[j][0]) - self.x,
+                                 0.5 * (obs[i][1] + obs[j][1]) - self.y)
+                if off <= self.max_offset_m:
+                    near.append(((off, d), i, j))
+            best = min(near, key=lambda c: c[0], default=None)   # nearest (first of equals)
             if best is not None:
-                _, i, j = best
-                ai = math.atan2(obs[i][1], obs[i][0])
-                aj = math.atan2(obs[j][1], obs[j][0])
-                return (k, i, j) if ai >= aj else (k, j, i)      # left = larger bearing
+                return left_first(k, obs, best[1], best[2])
         return None

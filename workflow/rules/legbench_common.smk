@@ -1,0 +1,74 @@
+# Input functions of legbench.smk (annotated recordings without mocap, issue 18).
+import json
+
+from gaitval.io.trialsheet import load_subjects
+
+LEGBENCH_WC = {"study": "[^/]+", "method": "[^/]+", "init": "own|annotation", "trial": "[^/]+"}
+# the legbench section is not one of steps.ANALYSIS_SECTIONS: its own provenance hash
+LEGBENCH_HASH = config_hash(
+    {**{k: config[k] for k in ANALYSIS_SECTIONS if k in config},
+     "legbench": config.get("legbench", {})}
+)
+
+
+def legbench_cfg():
+    lb = dict(config.get("legbench") or {})
+    lb.setdefault("methods", ["tug_m1", "tug_m2", "tug_m3"])
+    lb.setdefault("inits", ["own", "annotation"])
+    lb.setdefault("match_m", 0.75)
+    lb.setdefault("min_false_s", 0.5)
+    return lb
+
+
+def legbench_trials(study):
+    return trial_ids(study, ["legbench"])
+
+
+def legbench_annotations(study, trial):
+    """The annotation source of a trial: its annotation_file, else its bag (topic)."""
+    row = trial_row(study, trial)
+    return row["annotation_path"] or row["sensor_path"]
+
+
+def legbench_args(w):
+    """Topics of the trial (command-line options; empty when the sheet gives none)."""
+    row = trial_row(w.study, w.trial)
+    args = []
+    if row["sensor_topic"]:
+        args += ["--scan-topic", row["sensor_topic"]]
+    if row["annotation_topic"]:
+        args += ["--annotation-topic", row["annotation_topic"]]
+    return args
+
+
+def legbench_leg_width(w):
+    subj = load_subjects(subjects_path(w.study)).loc[trial_row(w.study, w.trial)["subject"]]
+    return float(subj["leg_width_m"])
+
+
+def legbench_eval_dirs(study):
+    lb = legbench_cfg()
+    return [
+        f"{RESULTS}/{study}/legbench_eval/{m}/{i}/{t}"
+        for t in legbench_trials(study)
+        for m in lb["methods"]
+        for i in lb["inits"]
+    ]
+
+
+def _without_mocap_items(func):
+    """The ingest and registration tables need mocap: for a study whose trials are all
+    legbench (annotations, no mocap) they are left out of the report."""
+
+    def items(study):
+        got = func(study)
+        if legbench_trials(study) and set(trials(study)["protocol"]) == {"legbench"}:
+            got = [i for i in got if not Path(i).name.startswith(MOCAP_TABLES)]
+        return got
+
+    return items
+
+
+MOCAP_TABLES = ("study_ingest_", "study_registration_")
+# ingest.smk and register.smk list those tables for every study in `run`
+REPORT_ITEM_FUNCS[:] = [_without_mocap_items(f) for f in REPORT_ITEM_FUNCS]
