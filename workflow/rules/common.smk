@@ -145,6 +145,16 @@ def trial_row(study, trial):
     return trials(study).loc[trial]
 
 
+def has_mocap(study, trial):
+    """Whether a trial has a mocap file (a trial with annotations only has none)."""
+    return bool(trial_row(study, trial)["mocap_path"])
+
+
+def mocap_trial_ids(study):
+    """The trials of a study with mocap: the ones ingest and register take (issue 11)."""
+    return [t for t in trial_ids(study) if has_mocap(study, t)]
+
+
 def ingest_inputs(wildcards):
     """Raw files of one trial (the sheet too, so editing it reruns the trial)."""
     row = trial_row(wildcards.study, wildcards.trial)

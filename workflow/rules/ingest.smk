@@ -29,7 +29,7 @@ rule ingest_summary:
         lambda w: expand(
             f"{RESULTS}/{{study}}/ingest/{{trial}}/ingest.json",
             study=w.study,
-            trial=trial_ids(w.study),
+            trial=mocap_trial_ids(w.study),
         ),
     output:
         csv=report(
@@ -54,4 +54,9 @@ rule ingest_summary:
         " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
-REPORT_ITEM_FUNCS.append(lambda study: [f"{REPORTS}/tables/study_ingest_{study}.csv"])
+# Ingest reads mocap: a study whose trials all have annotations only has no ingest table.
+REPORT_ITEM_FUNCS.append(
+    lambda study: (
+        [f"{REPORTS}/tables/study_ingest_{study}.csv"] if mocap_trial_ids(study) else []
+    )
+)

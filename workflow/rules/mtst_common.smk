@@ -11,20 +11,16 @@ def mtst_methods():
     )
 
 
-def mtst_has_mocap(study, trial):
-    return bool(trial_row(study, trial)["mocap_path"])
-
-
 def mtst_sensor(wildcards):
     """The ingested scan log, or the raw one for a trial without mocap."""
-    if mtst_has_mocap(wildcards.study, wildcards.trial):
+    if has_mocap(wildcards.study, wildcards.trial):
         return f"{RESULTS}/{wildcards.study}/ingest/{wildcards.trial}/sensor.parquet"
     return trial_row(wildcards.study, wildcards.trial)["sensor_path"]
 
 
 def mtst_registration(wildcards):
     """registration.json and groundtruth.parquet when the trial has mocap."""
-    if not mtst_has_mocap(wildcards.study, wildcards.trial):
+    if not has_mocap(wildcards.study, wildcards.trial):
         return {}
     reg = f"{RESULTS}/{wildcards.study}/register/{wildcards.trial}"
     return {

@@ -46,7 +46,7 @@ rule registration_summary:
         lambda w: expand(
             f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
             study=w.study,
-            trial=trial_ids(w.study),
+            trial=mocap_trial_ids(w.study),
         ),
     output:
         csv=f"{RESULTS}/{{study}}/registration.csv",
@@ -72,4 +72,9 @@ rule registration_summary:
         " --config-hash {params.chash:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
-REPORT_ITEM_FUNCS.append(lambda study: [f"{REPORTS}/tables/study_registration_{study}.csv"])
+# Registration needs mocap: likewise absent for a study without any.
+REPORT_ITEM_FUNCS.append(
+    lambda study: (
+        [f"{REPORTS}/tables/study_registration_{study}.csv"] if mocap_trial_ids(study) else []
+    )
+)
