@@ -4,7 +4,9 @@ Both files are rendered from one content model (:func:`collect`): the verdict ta
 (:mod:`gaitval.report.verdicts`), then every table under ``reports/tables`` and figure under
 ``reports/figures`` grouped by protocol, each table with its caption, its notes (parsed from
 the table's ``.md``), its file links and the provenance record of the step that made it
-(:mod:`gaitval.report.provenance`), and, for honesty, the paper tables not produced yet.
+(:mod:`gaitval.report.provenance`), and, for honesty, the paper tables not produced yet
+(in the sections of the protocols the run produced anything for; the verdict table says
+which papers were not run).
 The Markdown is written directly; the HTML through the jinja2 template
 ``templates/index.html.j2``, with each ``*_published`` column placed right after the
 reproduced column it belongs to and numbers printed at the precision the paper prints.
@@ -216,8 +218,10 @@ def collect(reports_dir: str | Path, study_names: list[str] | None = None,
                 rel = str(p.relative_to(rd))
                 items.append({"kind": "figure", "stem": p.stem, "src": rel,
                               "prov": _prov_line(prov.get(rel))})
+        # a protocol without any item was not in the run's studies (an MTST study
+        # without mocap has no TUG trials): its section is absent, not "not produced"
         miss = [t for t in EXPECTED_TABLES.get(sec, []) if t not in present]
-        if items or miss:
+        if items:
             sections.append({"key": sec, "title": SECTION_TITLES[sec], "items": items,
                              "missing": miss})
     vd = verdicts.astype(str)

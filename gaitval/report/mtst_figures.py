@@ -116,8 +116,11 @@ def plot_mtst_trial(data: dict[str, pd.DataFrame], trial, path: str | Path,
                        bbox_to_anchor=(0.0, -0.25))
     what = ("a successful and a failed trial" if len(rows) == 2 else
             f"trial {rows[0][0]}")
-    fig.suptitle(f"MTST, {what}: tracked legs (thin) vs mocap (thick), foot contacts "
-                 "(dots), assigned targets (bold outline)", fontsize=10)
+    mocap = "has_mocap" in summary and summary["has_mocap"].astype(bool).any()
+    legs = ("tracked legs (thin) vs mocap (thick)" if mocap else
+            "tracked legs (mocap truth: not available)")
+    fig.suptitle(f"MTST, {what}: {legs}, foot contacts (dots), assigned targets "
+                 "(bold outline)", fontsize=10)
     fig.tight_layout()
     return save_figure(fig, path)
 

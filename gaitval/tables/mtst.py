@@ -152,6 +152,22 @@ def table4(summary: pd.DataFrame, method: str = "mtst_proposed") -> pd.DataFrame
     return out
 
 
+def mocap_notes(summary: pd.DataFrame) -> list[str]:
+    """A note when some or all evaluated trials have no mocap (issue 11: a study with
+    rater annotations only); none when every trial has mocap."""
+    if summary.empty:
+        return []
+    has = summary.drop_duplicates("trial").set_index("trial")["has_mocap"].astype(bool)
+    if has.all():
+        return []
+    if not has.any():
+        return ["mocap truth: not available (no trial has mocap): every row is against the "
+                "rater annotations ('rater events'); a trial counts as tracked by its rater "
+                "verdict."]
+    return [f"mocap truth: available for {int(has.sum())} of {len(has)} trials; the 'mocap' "
+            "rows count those only, the 'rater events' rows every trial with annotations."]
+
+
 def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
                       methods: list[str]) -> list[Path]:
     """Write ``mtst_table1``, ``mtst_table3``, ``mtst_table4`` (csv, md, tex) from the
@@ -179,11 +195,13 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
         "and the tracking success rate; published values beside. Reference 'mocap': the "
         "track against the mocap leg points (stands in for the paper's video check); "
         "'rater events': from the rater's contacts only (what a study without mocap "
-        "has)."), notes=table3_notes(t3, data.get("events"), data.get("track_field")))
+        "has)."), notes=mocap_notes(summary)
+        + table3_notes(t3, data.get("events"), data.get("track_field")))
     paths += write_table(t4, td / "mtst_table4", digits=1, caption=(
         "Seed 001 Table 4: target-step judgement and cross-step detection against the "
         "rater annotations on the trials the proposed method tracked successfully; "
         "success = (N - non-judgements or non-detections) / N, error rate = "
         "misjudgements / steps or false detections / detected cross steps; published "
-        "values beside."), notes=table4_notes(t4, table4_trials(summary)))
+        "values beside."), notes=mocap_notes(summary)
+        + table4_notes(t4, table4_trials(summary)))
     return paths
