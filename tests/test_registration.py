@@ -480,11 +480,6 @@ def _pole_visible(scans, pole_s):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason=(
-    "open finding: since the gait-initiation change of the twin (commit 000cd61, issue 10) "
-    "the marker-derived leg point of tiny tug_Y01_t2 is ~7 mm (max 45 mm) from the "
-    "simulator's true leg centre (was < 2 mm); registration itself still passes. strict: "
-    "this xfail fails as soon as the twin is consistent again, so it cannot be forgotten"))
 def test_tiny_study_lrs_acceptance(tiny):
     from gaitval.groundtruth import ground_truth, leg_points
     from gaitval.io.c3d import read_c3d

@@ -34,7 +34,8 @@ from gaitval.registration.moving import is_moving, rollator_labels
 from gaitval.types import MocapTrial, ScanSeries, UltrasonicLog
 
 #: Marker names (after the side letter) the leg points may use, besides the tibia cluster.
-LEG_MARKERS = ("FEO", "TIO", "KJC", "AJC", "KNE", "KNEin", "ANK", "ANKin", "ASI")
+LEG_MARKERS = ("FEO", "TIO", "KJC", "AJC", "KNE", "KNEin", "ANK", "ANKin", "ASI", "HEE",
+               "TOE")
 
 
 @dataclass
@@ -142,10 +143,12 @@ def leg_points(mocap: MocapTrial, h: float, subject: dict | None = None,
     valid = np.zeros((n, 2), dtype=bool)
     sources = {}
     for j, s in enumerate(C.SIDES):
+        r = 0.5 * float(c["marker_diameter_m"])
         knee, sources[(s, "knee")] = joint_centre(mocap, s, "knee", subject, markers=markers,
-                                                  trial=trial)
+                                                  trial=trial, marker_radius_m=r)
         ankle, sources[(s, "ankle")] = joint_centre(mocap, s, "ankle", subject,
-                                                    markers=markers, trial=trial)
+                                                    markers=markers, trial=trial,
+                                                    marker_radius_m=r)
         if cylinder:
             xyz[:, j], valid[:, j] = _cylinder_point(mocap, markers, s, knee, ankle, h, c,
                                                      trial)
