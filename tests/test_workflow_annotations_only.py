@@ -124,6 +124,7 @@ def test_mtst_tables_carry_rater_values_for_every_method(annot_run):
 @pytest.mark.slow
 def test_no_ingest_or_register_job_and_no_mocap_parts(annot_run):
     work, log = annot_run
+    assert log.count("rule mtst_track:") == len(METHODS)     # the log names every job
     for rule in ("ingest", "register", "ingest_summary", "registration_summary", "track",
                  "rollator_track", "ultrasonic_noise"):
         assert f"rule {rule}:" not in log, rule
