@@ -44,6 +44,22 @@ def test_no_swinging_shin_moves_backwards(physics):
     assert (rows["value"] == 0).all() and rows["passed"].astype(bool).all()
 
 
+def test_first_swing_from_standing_in_every_protocol(tiny, physics):
+    """One gait-initiation model for every protocol (issue 10): each trial's first swing
+    from standing moves forward and lasts a steady swing, (1 - stance_frac) 2 T -- MTST
+    included, whose first swing used to last 0.9 T (1.36 x its median swing in tiny)."""
+    from gaitval.simulate.swings import first_swing, lrs_trials
+    rows = physics[physics["check"] == "first_swing_backward"]
+    assert set(rows["protocol"]) == {"tug", "mtst", "rollator"}
+    assert (rows["value"] == 0).all() and rows["passed"].astype(bool).all()
+    for trial in lrs_trials(tiny)["trial"]:
+        fwd_min, ratio = first_swing(tiny, trial)
+        assert fwd_min > SWING_BACKWARD_MPS, trial
+        # the median swing mixes straight, turning (1.15 T) and target steps, and the
+        # first step's own T varies by the step CV: not exactly 1
+        assert 0.85 <= ratio <= 1.1, (trial, ratio)
+
+
 def test_tug_path_is_out_and_back_around_the_marker(physics):
     p = physics.set_index("check")
     assert p.loc["tug_marker_clearance", "value"] > 0          # around the cone, not through

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from gaitval.simulate.footsteps import first_swing_s
 from gaitval.simulate.kinematics import (GaitParams, StepPlan, make_path, plan_from_footholds,
                                          plan_steps)
 from gaitval.simulate.scene import ID_POLE, Walker
@@ -69,13 +70,17 @@ def plan_mtst(rng, gp: GaitParams, targets: pd.DataFrame, color: str, t0: float
     arises from the geometry.  Placement scatter is ``place_sd_m`` around the aim, plus
     for target steps 2 cm and 10 % of the distance between the target and the foothold
     the walker would have chosen without it (endpoint error grows with the correction).
+    The first step from standing follows the gait-initiation model of every protocol: its
+    swing lasts a steady swing (:func:`~gaitval.simulate.footsteps.first_swing_s`) and, as
+    a swing shorter than a stride, is a scaled copy of the steady one
+    (:func:`~gaitval.simulate.kinematics.swing_scale`).
     """
     tg = targets[targets["color"] == color].sort_values("x_m").reset_index(drop=True)
     sides = [0, 1]
     xy = [np.array([-0.35, gp.step_width_m / 2]), np.array([-0.35, -gp.step_width_m / 2])]
     hd = [0.0, 0.0]
     lab = ["walk", "walk"]
-    times = []
+    times, step_T = [], []          # contact increments; drawn step times (lift-offs)
     which: dict[int, str] = {}
     side = int(rng.integers(0, 2))
     x = -0.35
@@ -90,7 +95,10 @@ def plan_mtst(rng, gp: GaitParams, targets: pd.DataFrame, color: str, t0: float
         xy.append(p)
         hd.append(float(0.04 * rng.standard_normal()))
         lab.append(label)
-        times.append(T * (0.9 if first else 1.0))
+        # gait initiation as in every protocol (footsteps.first_swing_s, docs/simulator.md):
+        # the first swing from standing lasts a steady swing, (1 - stance_frac) 2 T
+        times.append(first_swing_s(gp, T) if first else T)
+        step_T.append(T)
         side = 1 - side
         x = float(aim[0])
 
@@ -135,7 +143,7 @@ def plan_mtst(rng, gp: GaitParams, targets: pd.DataFrame, color: str, t0: float
     add((x, own_side()), "walk")
     plan = plan_from_footholds(np.array(sides), t0 + np.concatenate([[-np.inf, -np.inf],
                                np.cumsum(times)]), np.array(xy), np.array(hd),
-                               np.array(lab, dtype=object), np.array(times), gp, t0)
+                               np.array(lab, dtype=object), np.array(step_T), gp, t0)
     return plan, which
 
 

@@ -15,6 +15,9 @@ swing_shin_backward       per protocol: swings whose shin point (at sensor heigh
                           than :data:`SWING_BACKWARD_MPS`; reference 0 (a swinging shank is
                           carried forward by the thigh; the real C3D walks measured the same
                           way never go backwards); pass: no such swing
+first_swing_backward      the same for each trial's first swing from standing (gait
+                          initiation; the note gives its duration ÷ the trial's median
+                          swing, 1 by the model); pass: no such swing
 shin_swing_peak           peak swing speed / walking speed of the study's walkers on steady
                           straight walks vs the three real C3D walks
                           (:mod:`gaitval.simulate.shin`); pass: within ±15 %
@@ -64,6 +67,7 @@ import pandas as pd
 from scipy import stats
 
 from gaitval.io.atomic import write_csv
+from gaitval.simulate.swings import first_swing, lrs_trials, swing_minima
 
 # --------------------------------------------------------------------------------------
 # Tolerances and references: stated before any value of these checks was computed.
@@ -125,43 +129,6 @@ def poisson_ci(k: int, level: float = 0.95) -> tuple[float, float]:
     return float(lo), float(stats.chi2.ppf(1 - a, 2 * k + 2) / 2)
 
 
-# --------------------------------------------------------------------------------------
-# Reading a study back
-# --------------------------------------------------------------------------------------
-def _swings(ev: pd.DataFrame, side: str) -> list[tuple[float, float]]:
-    """(foot off, next contact) of one side from a truth ``events.csv``."""
-    offs = np.sort(ev.loc[(ev["event"] == "foot_off") & (ev["side"] == side), "t_s"].to_numpy())
-    cons = np.sort(ev.loc[(ev["event"] == "foot_contact") & (ev["side"] == side),
-                          "t_s"].to_numpy())
-    out = []
-    for to in offs:
-        nxt = cons[cons > to]
-        if len(nxt):
-            out.append((float(to), float(nxt[0])))
-    return out
-
-
-def _lrs_trials(study_dir: Path) -> pd.DataFrame:
-    tr = pd.read_csv(study_dir / "trials.csv")
-    tr = tr[tr["sensor_kind"] == "lrs"]
-    return tr[[(study_dir / "truth" / t / "legs.parquet").is_file() for t in tr["trial"]]]
-
-
-def swing_minima(study_dir: Path, trial: str) -> np.ndarray:
-    """Per complete swing of a trial: the lowest forward speed of the shin point (m/s)."""
-    from gaitval.simulate.shin import point_profile
-
-    d = study_dir / "truth" / trial
-    legs, ev = pd.read_parquet(d / "legs.parquet"), pd.read_csv(d / "events.csv")
-    out = []
-    for side, g in legs.groupby("side", sort=True):
-        t = g["t_s"].to_numpy(float)
-        rate = 1.0 / float(np.median(np.diff(t)))
-        prof = point_profile(t, g[["x_m", "y_m"]].to_numpy(float), _swings(ev, side), rate)
-        out.append(prof["fwd_min"])
-    return np.concatenate(out) if out else np.array([])
-
-
 def _swing_rows(study_dir: Path, trials: pd.DataFrame, real: dict | None) -> list[dict]:
     rows = []
     ref = real["swing_fwd_min_mps"] if real else np.nan
@@ -174,6 +141,16 @@ def _swing_rows(study_dir: Path, trials: pd.DataFrame, real: dict | None) -> lis
                          f"{ref:.2f} m/s", group=GROUP_OF.get(proto, ""),
                          note=f"{len(mins)} swings; lowest forward speed "
                               f"{np.min(mins) if len(mins) else np.nan:.2f} m/s"))
+        first = np.array([first_swing(study_dir, t) for t in g["trial"]])
+        rows.append(_row("first_swing_backward", proto,
+                         int(np.sum(first[:, 0] < SWING_BACKWARD_MPS)), 0, 0, 0, "swings",
+                         f"no first swing below {SWING_BACKWARD_MPS} m/s forward",
+                         "gait initiation (docs/simulator.md): hip and knee lead the first "
+                         "step, the thigh carries the knee forward", group=GROUP_OF.get(proto, ""),
+                         note=f"{len(first)} first swings from standing; lowest forward speed "
+                              f"{first[:, 0].min():.2f} m/s; duration "
+                              f"{first[:, 1].min():.2f}-{first[:, 1].max():.2f} x the trial's "
+                              "median swing"))
     return rows
 
 
@@ -391,7 +368,7 @@ def physics_table(study_dir: str | Path, walkers: list | None = None,
         realdata = Path(__file__).resolve().parents[3] / "shared" / "realdata" / "c3d"
     realdata = Path(realdata)
     shin_rows, real = _shin_rows(walkers, realdata if realdata.is_dir() else None)
-    lrs = _lrs_trials(d)
+    lrs = lrs_trials(d)
     rows = _swing_rows(d, lrs, real) + shin_rows + _step_rows(d, lrs)
     tug = lrs[lrs["protocol"] == "tug"]
     if len(tug):
