@@ -10,7 +10,7 @@ For each side ``S`` (``L``/``R``) and each joint the first available source is u
    joint width from the subject table (``knee_width_m`` / ``ankle_width_m``) plus the
    marker's radius, horizontally: Plug-in Gait's offset of the joint centre from its
    lateral marker, ``(joint width + marker diameter) / 2`` (CGM1 / VCM "chord"; the
-   caller passes ``groundtruth.marker_diameter_m`` / 2, 14 mm markers by default).  The
+   caller passes half of :data:`MARKER_DIAMETER_M`, PiG's default 14 mm markers).  The
    medial direction is, per frame, perpendicular to this side's foot long axis (heel ->
    toe, horizontal; with one foot marker missing, the other one and the malleolus marker,
    :func:`_foot_heading`): the knee and ankle flexion axes turn with the shank and the
@@ -36,6 +36,12 @@ import numpy as np
 from gaitval.config import as_float
 from gaitval.errors import MarkerError
 from gaitval.types import MocapTrial
+
+#: Diameter of the lateral knee and ankle markers (m): Plug-in Gait's default
+#: ``MarkerDiameter`` (14 mm), also the twin's markers (``simulate/markers.py``).  The
+#: seed papers do not state theirs.  Not a config key yet (the config schema lives in
+#: workflow/); a lab with other markers passes ``marker_radius_m`` to :func:`joint_centre`.
+MARKER_DIAMETER_M = 0.014
 
 #: Shortest horizontal heel-to-toe distance (m) that defines a foot heading.
 MIN_FOOT_AXIS_M = 0.03
@@ -140,7 +146,7 @@ def joint_centre(mocap: MocapTrial, side: str, joint: str, subject: dict | None 
     marker_radius_m : float
         Radius of the lateral marker (its centre is this far outside the skin), added to
         half the joint width by the lateral-offset source; :func:`~gaitval.groundtruth.
-        legs.leg_points` passes half of ``groundtruth.marker_diameter_m``.
+        legs.leg_points` passes half of :data:`MARKER_DIAMETER_M`.
 
     Returns
     -------

@@ -27,7 +27,7 @@ from gaitval import consts as C
 from gaitval.config import as_float
 from gaitval.errors import MarkerError, RegistrationError
 from gaitval.groundtruth.gaps import fill_short_gaps
-from gaitval.groundtruth.joints import joint_centre, source_label
+from gaitval.groundtruth.joints import MARKER_DIAMETER_M, joint_centre, source_label
 from gaitval.groundtruth.settings import gt_cfg
 from gaitval.groundtruth.shank import cylinder_at_height, fit_cylinder_cluster, point_at_height
 from gaitval.registration.moving import is_moving, rollator_labels
@@ -143,7 +143,7 @@ def leg_points(mocap: MocapTrial, h: float, subject: dict | None = None,
     valid = np.zeros((n, 2), dtype=bool)
     sources = {}
     for j, s in enumerate(C.SIDES):
-        r = 0.5 * float(c["marker_diameter_m"])
+        r = 0.5 * MARKER_DIAMETER_M
         knee, sources[(s, "knee")] = joint_centre(mocap, s, "knee", subject, markers=markers,
                                                   trial=trial, marker_radius_m=r)
         ankle, sources[(s, "ankle")] = joint_centre(mocap, s, "ankle", subject,

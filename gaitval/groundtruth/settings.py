@@ -16,9 +16,6 @@ DEFAULTS = {
     "filter_positions": False,
     "leg_point": "auto",            # auto | axis | cylinder
     "cylinder_marker_offset_m": 0.009,
-    # lateral knee/ankle markers (lateral-offset joint centres): Plug-in Gait's
-    # MarkerDiameter, 14 mm by default
-    "marker_diameter_m": 0.014,
     "tibia_markers": ["TB1", "TB2", "TB3", "TB4"],   # prefixed with L/R
     "tx_marker": "TX",
     "anchor_markers": ["ANC1", "ANC2", "ANC3", "ANC4"],
