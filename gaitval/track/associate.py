@@ -80,6 +80,12 @@ class Associator:
             return [(j, math.sqrt(lam2)) for j, lam2 in cand]
         return cand
 
+    def obvious(self, cand_l, cand_r) -> tuple[int, int]:
+        """:func:`_GNN_FAST` on the gate's ``(j, λ²)`` (the cost of the one candidate per
+        leg computed on the spot; (-1, -1) when the full ranking is needed)."""
+        return _GNN_FAST(self.d_max, cand_l, cand_r,
+                         math.sqrt if self.cost == "mahalanobis" else None)
+
     def select(self, cand_l: list[tuple[int, float]], cand_r: list[tuple[int, float]],
                prev_phase: int, phase_of: Callable[[int, int], int]) -> tuple[int, int]:
         raise NotImplementedError
@@ -100,11 +106,13 @@ def ranked_associations(cand_l, cand_r, d_max: float) -> list[tuple[float, int, 
     return out
 
 
-def _GNN_FAST(d_max, cand_l, cand_r) -> tuple[int, int]:
+def _GNN_FAST(d_max, cand_l, cand_r, cost=None) -> tuple[int, int]:
     """The least-cost association when it is obvious, else (-1, -1).
 
-    With at most one gated observation per leg, different ones, and every λ < d_max,
+    With at most one gated observation per leg, different ones, and every cost < d_max,
     taking them costs less than any alternative (same result as the full ranking).
+    ``cost`` turns a candidate's gate value into its cost (None: it is the cost already),
+    so the gate's ``(j, λ²)`` can be tested without building the cost lists.
     """
     if len(cand_l) > 1 or len(cand_r) > 1:
         return -1, -1
@@ -112,7 +120,10 @@ def _GNN_FAST(d_max, cand_l, cand_r) -> tuple[int, int]:
     b = cand_r[0][0] if cand_r else 0
     if a and a == b:
         return -1, -1
-    if (cand_l and cand_l[0][1] >= d_max) or (cand_r and cand_r[0][1] >= d_max):
+    if cost is None:
+        if (cand_l and cand_l[0][1] >= d_max) or (cand_r and cand_r[0][1] >= d_max):
+            return -1, -1
+    elif (cand_l and cost(cand_l[0][1]) >= d_max) or (cand_r and cost(cand_r[0][1]) >= d_max):
         return -1, -1
     return a, b
 
@@ -122,10 +133,10 @@ class GNNAssociator(Associator):
     """Global nearest neighbour: least total cost (seed 000 Method 1, seed 001)."""
 
     def select(self, cand_l, cand_r, prev_phase, phase_of):
-        cand_l, cand_r = self.distances(cand_l), self.distances(cand_r)
-        a, b = _GNN_FAST(self.d_max, cand_l, cand_r)
+        a, b = self.obvious(cand_l, cand_r)
         if a >= 0:
             return a, b
+        cand_l, cand_r = self.distances(cand_l), self.distances(cand_r)
         _, a, b = ranked_associations(cand_l, cand_r, self.d_max)[0]
         return a, b
 
@@ -135,11 +146,11 @@ class GaitPhaseAssociator(Associator):
     """Least-cost association with a likely gait-phase change (seed 000 §5.2)."""
 
     def select(self, cand_l, cand_r, prev_phase, phase_of):
-        cand_l, cand_r = self.distances(cand_l), self.distances(cand_r)
         unlikely = UNLIKELY_TRANSITIONS.get(prev_phase, _NO_PHASES)
-        a, b = _GNN_FAST(self.d_max, cand_l, cand_r)
+        a, b = self.obvious(cand_l, cand_r)
         if a >= 0 and phase_of(a, b) not in unlikely:
             return a, b                      # the cheapest association is likely: done
+        cand_l, cand_r = self.distances(cand_l), self.distances(cand_r)
         ranked = ranked_associations(cand_l, cand_r, self.d_max)
         for _, a, b in ranked:
             if phase_of(a, b) not in unlikely:

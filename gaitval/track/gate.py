@@ -98,9 +98,7 @@ class ChiSquareGate(Gate):
         return lam2 < self.g                        # seed000 eq. (13)
 
     def candidates(self, filter, prior, obs, ctx):
-        g = self.g
-        return [(j, lam2) for j, lam2 in enumerate(filter.lam2_all(prior, obs), 1)
-                if lam2 < g]                        # seed000 eq. (13)
+        return filter.gated(prior, obs, self.g)     # seed000 eq. (13)
 
 
 @GATES.register("fixed_radius")

@@ -172,12 +172,12 @@ class MotionCheck:
     def moving_pair(self, source, d_min: float, d_max: float, first_scan: int = 0
                     ) -> tuple[int, int, int] | None:
         """The first moving pair ``(k, i, j)`` from ``first_scan`` on, or None."""
-        arrays = [np.asarray(source.array(k), dtype=float).reshape(-1, 2)
-                  for k in range(len(source))]
+        arrays = [source.array(k) for k in range(len(source))]        # (J, 2) float each
         still = self.still_scans(arrays).tolist()
         # plain Python floats from here on: the follow visits a few observations per scan,
         # where numpy's per-call overhead would cost more than the arithmetic
-        pts = [a.tolist() for a in arrays]
+        lists = getattr(source, "lists", None)
+        pts = lists() if lists is not None else [a.tolist() for a in arrays]
         background = Background(arrays)
         visited: dict[int, set] = {}
         for k in range(first_scan, len(pts)):

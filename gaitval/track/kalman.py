@@ -106,6 +106,11 @@ class LegFilter:
         m2 = self.mahalanobis2
         return [m2(s, zx, zy) for zx, zy in obs]
 
+    def gated(self, s, obs, g: float) -> list[tuple[int, float]]:
+        """``(j, λ²)`` (j = 1..J) of the observations with λ² < g (seed000 eq. (11), (13)):
+        the χ² gate's work in one call per leg and scan."""
+        return [(j, lam2) for j, lam2 in enumerate(self.lam2_all(s, obs), 1) if lam2 < g]
+
     def noise(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(Q_a, R, P0)``: acceleration-noise covariance (2×2, the Q of B Q Bᵀ), the
         measurement covariance (2×2) and the initial covariance (4×4) this filter uses."""
@@ -192,6 +197,20 @@ class AxisKalmanFilter(LegFilter):
             ex = zx - px
             ey = zy - py
             out.append((ex * ex + ey * ey) / sv)     # seed000 eq. (11)
+        return out
+
+    def gated(self, s, obs, g):
+        px, py = s[0], s[1]
+        sv = s[4] + self.r_sd_m ** 2                 # seed000 eq. (12), per axis
+        out = []
+        j = 0
+        for zx, zy in obs:
+            j += 1
+            ex = zx - px
+            ey = zy - py
+            lam2 = (ex * ex + ey * ey) / sv          # seed000 eq. (11)
+            if lam2 < g:                             # seed000 eq. (13)
+                out.append((j, lam2))
         return out
 
     def innovation_cov(self, s):

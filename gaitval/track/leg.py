@@ -82,7 +82,11 @@ class LegTrack:
 
     def fill(self, res: "TrackResult", f: int, k0: int) -> None:
         """Write scans k0.. of this leg into row f of ``res``."""
-        pv = np.array([p[:4] for p in self.post[k0:]], dtype=float).reshape(-1, 4)
+        post = self.post[k0:]
+        try:                                  # states of floats only: one conversion
+            pv = np.array(post, dtype=float)[:, :4]
+        except ValueError:                    # a state holding arrays (e.g. a matrix P)
+            pv = np.array([p[:4] for p in post], dtype=float).reshape(-1, 4)
         res.x[f, k0:], res.y[f, k0:] = pv[:, 0], pv[:, 1]
         res.vx[f, k0:], res.vy[f, k0:] = pv[:, 2], pv[:, 3]
         res.observed[f, k0:] = self.real[k0:]

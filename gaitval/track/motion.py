@@ -61,7 +61,7 @@ class SwingAccelerationWindow:
     :meth:`reset` starts again from the rewritten window.
     """
 
-    __slots__ = ("n_ac", "acc", "swing", "total", "count")
+    __slots__ = ("n_ac", "acc", "swing", "total", "count", "mean")
 
     def __init__(self, n_ac: int):
         self.n_ac = n_ac
@@ -69,6 +69,7 @@ class SwingAccelerationWindow:
         self.swing: list[bool] = []
         self.total = 0.0
         self.count = 0
+        self.mean = 0.0          # = value(), kept current so the per-scan read is a load
 
     def push(self, a: float, swinging: bool) -> None:
         acc, swing = self.acc, self.swing
@@ -81,16 +82,18 @@ class SwingAccelerationWindow:
         if i >= 0 and swing[i]:
             self.total -= acc[i]
             self.count -= 1
+        self.mean = self.total / self.count if self.count > 0 else 0.0
 
-    def reset(self, entries: list[tuple[float, bool]]) -> None:
-        """Start from ``entries`` = (‖a‖, swinging) of the window's steps, oldest first."""
-        self.acc = [a for a, _ in entries]
-        self.swing = [sw for _, sw in entries]
-        sel = [a for a, sw in entries if sw]
+    def reset(self, acc: list[float], swing: list[bool]) -> None:
+        """Start from the window's steps, oldest first: ``acc`` their ‖a‖, ``swing`` whether
+        the leg was swinging (the lists are taken over, not copied)."""
+        self.acc, self.swing = acc, swing
+        sel = [a for a, sw in zip(acc, swing) if sw]
         self.total, self.count = float(sum(sel)), len(sel)
+        self.mean = self.total / self.count if self.count > 0 else 0.0
 
     def value(self) -> float:
-        return self.total / self.count if self.count > 0 else 0.0
+        return self.mean
 
 
 class MotionModel:

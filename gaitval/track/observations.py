@@ -23,13 +23,18 @@ class DetectionSeries:
 
     def __init__(self, xy: list[np.ndarray], patterns: list[list[str]]):
         self._patterns = patterns
-        # plain Python floats for the loop (numpy scalars are several times slower):
-        self._arrays = arrs = [np.asarray(o, dtype=float).reshape(-1, 2) for o in xy]
-        flat = np.concatenate(arrs).tolist() if arrs else []
-        self._lists, i = [], 0
+        arrs = [np.asarray(o, dtype=float) for o in xy]
+        arrs = [o if o.ndim == 2 and o.shape[1:] == (2,) else o.reshape(-1, 2) for o in arrs]
+        # one (N, 2) array; per scan a view of it, and plain Python floats for the loop
+        # (numpy scalars are several times slower)
+        allxy = np.concatenate(arrs) if arrs else np.zeros((0, 2))
+        flat = allxy.tolist()
+        self._arrays, self._lists, i = [], [], 0
         for o in arrs:
-            self._lists.append(flat[i:i + len(o)])
-            i += len(o)
+            j = i + len(o)
+            self._arrays.append(allxy[i:j])
+            self._lists.append(flat[i:j])
+            i = j
 
     def __len__(self) -> int:
         return len(self._arrays)
@@ -39,6 +44,10 @@ class DetectionSeries:
 
     def at(self, k: int, prior):
         return self._lists[k], self._patterns[k]
+
+    def lists(self) -> list[list[list[float]]]:
+        """Every scan's observations as lists of ``[x, y]`` floats (``array(k).tolist()``)."""
+        return self._lists
 
 
 class WindowedDetections:

@@ -166,15 +166,12 @@ class CatmullRomInterpolation(OcclusionHandler):
         return _Pending(last_real=[run.k0, run.k0], due=[], next_due=run.n)
 
     def after_scan(self, st, run, k):
-        for f in (0, 1):
-            if run.legs[f].real[k]:
-                last = st.last_real[f]
-                if last < k - 1:                   # leg f reappears after k−1−last UO scans
-                    d = self.delay(k - last - 1)
-                    if d is not None:
-                        st.due.append((k + d, f, last, k))
-                        st.next_due = min(st.next_due, k + d)
-                st.last_real[f] = k
+        last_real = st.last_real
+        for f, leg in enumerate(run.legs):
+            if leg.real[k]:
+                if last_real[f] < k - 1:          # leg f reappears after k−1−last UO scans
+                    self._reappeared(st, f, last_real[f], k)
+                last_real[f] = k
         if st.due and k >= st.next_due:
             now = [p for p in st.due if p[0] <= k]
             st.due = [p for p in st.due if p[0] > k]
@@ -182,6 +179,12 @@ class CatmullRomInterpolation(OcclusionHandler):
                 self.refilter(run, f, ka, m, k)
             run.resync(k)
             st.next_due = min((p[0] for p in st.due), default=run.n)
+
+    def _reappeared(self, st, f: int, last: int, k: int) -> None:
+        d = self.delay(k - last - 1)
+        if d is not None:
+            st.due.append((k + d, f, last, k))
+            st.next_due = min(st.next_due, k + d)
 
     def finish(self, st, run):
         for _, f, ka, m in sorted(st.due, key=lambda p: (p[2], p[1])):

@@ -13,6 +13,8 @@ Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (seed 001), eq. (9)–(10).
 """
 from __future__ import annotations
 
+import functools
+
 from gaitval.gait.phases import (check_reading, gait_phase_of_states,
                                  gait_phase_of_states_stance_first)
 from gaitval.registry import Registry
@@ -54,6 +56,9 @@ class SpeedThresholdPhases(PhaseModel):
         self.reading = check_reading(reading)
         self._of_states = (gait_phase_of_states_stance_first if reading == "stance_first"
                            else gait_phase_of_states)
+        # identify(l, r) without a Python frame of its own (called several times a scan)
+        self.identify = functools.partial(self._of_states, v_st_th=self.v_st_th,
+                                          v_sw_th=self.v_sw_th)   # seed000 eq. (3)–(5)
 
-    def identify(self, l, r):
+    def identify(self, l, r):  # noqa: F811 -- the instance's partial (above) replaces it
         return self._of_states(l, r, self.v_st_th, self.v_sw_th)   # seed000 eq. (3)–(5)

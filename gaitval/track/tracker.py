@@ -218,8 +218,8 @@ class TrackingRun:
         L, R = self.legs
         sl, sr = L.post[k - 1], R.post[k - 1]
         ul, ur = self.motion.inputs(self.phase[k - 1], (sl[2], sl[3]), (sr[2], sr[3]),
-                                    L.window.value() if L.window is not None else 0.0,
-                                    R.window.value() if R.window is not None else 0.0, dt)
+                                    L.window.mean if L.window is not None else 0.0,
+                                    R.window.mean if R.window is not None else 0.0, dt)
         return predict(sl, dt, ul[0], ul[1]), predict(sr, dt, ur[0], ur[1])
 
     def gate_context(self, f: int, k: int) -> GateContext:
@@ -261,22 +261,24 @@ class TrackingRun:
     def replay(self, ka: int, k_now: int) -> None:
         """Filter both legs again over ka+1..k_now with the stored observations (real or
         virtual) and associations (seed 000 §5.4)."""
-        F = self.filter
+        correct, identify = self.filter.correct, self.phase_model.identify
+        predict, book, phase = self.predict, self.book, self.phase
         L, R = self.legs
         for k in range(ka + 1, k_now + 1):
-            for leg, s in zip(self.legs, self.predict(k)):
-                z = leg.z[k]
-                leg.post[k] = F.correct(s, z[0], z[1]) if z is not None else s
-            self.phase[k] = self.phase_model.identify(L.post[k], R.post[k])  # seed000 eq. (3)–(5)
-            self.book(k)
+            sl, sr = predict(k)
+            z = L.z[k]
+            sl = L.post[k] = correct(sl, z[0], z[1]) if z is not None else sl
+            z = R.z[k]
+            sr = R.post[k] = correct(sr, z[0], z[1]) if z is not None else sr
+            phase[k] = identify(sl, sr)                           # seed000 eq. (3)–(5)
+            book(k)
 
     def resync(self, k: int) -> None:
         """Rebuild the acceleration windows from the (rewritten) history up to k."""
         for f, leg in enumerate(self.legs):
             if leg.window is not None:
                 lo = max(self.k0 + 1, k - leg.window.n_ac + 1)
-                swings = [_SWING[p][f] for p in self.phase[lo:k + 1]]
-                leg.window.reset(list(zip(leg.acc[lo:k + 1], swings)))
+                leg.window.reset(leg.acc[lo:k + 1], [_SWING[p][f] for p in self.phase[lo:k + 1]])
 
     def restart(self, k: int, obs, pats, il: int, ir: int) -> None:
         """Re-initialise both legs at scan k on observations ``il`` (left) and ``ir``
