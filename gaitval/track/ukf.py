@@ -45,7 +45,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
-from scipy.linalg.lapack import dposv as _posv, dpotrf as _potrf
 
 from gaitval.errors import ConfigError, TimestampError
 from gaitval.io.ultrasonic import anchor_positions, log_distances
@@ -238,6 +237,11 @@ class _Model:
     """The constant pieces of one run: weights (eq. 12–13), noises, eq. (5) and the gate."""
 
     def __init__(self, anchors, W_sigma, V, alpha, beta, kappa, gate_sigma, max_reject):
+        # LAPACK's Cholesky and SPD solve, imported here: importing the tracker roles (the
+        # workflow does at parse time) should not pay for scipy.linalg
+        from scipy.linalg.lapack import dposv, dpotrf
+
+        self.potrf, self.posv = dpotrf, dposv
         self.anchors = anchors
         self.Wm, Wc, lam = ukf_weights(N_STATE, alpha, beta, kappa)
         self.Wc_col = Wc[:, None]
@@ -282,10 +286,10 @@ def _sigma_statistics(mdl: _Model, x: np.ndarray, P: np.ndarray):
     Returns ``P`` (symmetrised if its Cholesky factor failed), ``ybar`` (eq. 9) and
     ``Pyy``, ``Pxy`` (eq. 10).
     """
-    B, info = _potrf(mdl.scale * P, lower=1)              # seed003 eq. (7)
+    B, info = mdl.potrf(mdl.scale * P, lower=1)              # seed003 eq. (7)
     if info != 0:
         P = 0.5 * (P + P.T) + 1e-12 * mdl.I6
-        B, info = _potrf(mdl.scale * P, lower=1)
+        B, info = mdl.potrf(mdl.scale * P, lower=1)
     dX = mdl.S @ B.T
     diff = (x[:3] + dX[:, :3])[:, None, :] - mdl.anchors
     Ysig = np.sqrt((diff * diff).sum(axis=2))        # Y_i = h(chi_i), seed003 eq. (6)
@@ -327,13 +331,13 @@ def _update(mdl: _Model, x, P, dk, n_ok: int, res: ToaUkfResult, k: int):
         res.used[k, bad] = False
         n_ok -= bad.size
     if n_ok == len(dk):
-        _, KT, info = _posv(Pyy, Pxy.T)                  # K = Pxy Pyy^-1, seed003 eq. (10)
+        _, KT, info = mdl.posv(Pyy, Pxy.T)                  # K = Pxy Pyy^-1, seed003 eq. (10)
         x = x + nu @ KT                                  # seed003 eq. (11)
         P = P - KT.T @ Pxy.T                             # P - K Pyy K^T, seed003 eq. (11)
     elif n_ok > 0:
         s = np.flatnonzero(res.used[k])
         Pxy_s = Pxy[:, s]
-        _, KT, info = _posv(Pyy[np.ix_(s, s)], Pxy_s.T)
+        _, KT, info = mdl.posv(Pyy[np.ix_(s, s)], Pxy_s.T)
         x = x + nu[s] @ KT
         P = P - KT.T @ Pxy_s.T
     P += P.T
