@@ -54,21 +54,3 @@ def legbench_eval_dirs(study):
         for m in lb["methods"]
         for i in lb["inits"]
     ]
-
-
-def _without_mocap_items(func):
-    """The ingest and registration tables need mocap: for a study whose trials are all
-    legbench (annotations, no mocap) they are left out of the report."""
-
-    def items(study):
-        got = func(study)
-        if legbench_trials(study) and set(trials(study)["protocol"]) == {"legbench"}:
-            got = [i for i in got if not Path(i).name.startswith(MOCAP_TABLES)]
-        return got
-
-    return items
-
-
-MOCAP_TABLES = ("study_ingest_", "study_registration_")
-# ingest.smk and register.smk list those tables for every study in `run`
-REPORT_ITEM_FUNCS[:] = [_without_mocap_items(f) for f in REPORT_ITEM_FUNCS]
