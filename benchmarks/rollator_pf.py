@@ -47,8 +47,7 @@ sys.path.insert(0, str(ROOT))
 
 from gaitval.io.scanlog import read_scanlog  # noqa: E402
 from gaitval.track.pf import ParticleFilterTracker, _Scan  # noqa: E402
-from gaitval.track.pf_likelihood import (PFArrays, likelihood, near_points,  # noqa: E402
-                                         sample_velocities)
+from gaitval.track.pf_likelihood import PFArrays, likelihood, sample_velocities  # noqa: E402
 from gaitval.track.pf_model import default_pf_model  # noqa: E402
 
 
@@ -131,8 +130,7 @@ def stonesoup_filters(P: PFArrays, p0, N: int, rng, t0):
             X, Y = state1.metadata["points"]
             px = np.asarray(state2.state_vector[0], float).ravel()
             py = np.asarray(state2.state_vector[1], float).ravel()
-            Xn, Yn = near_points(P, X, Y, px, py)
-            lik, _ = likelihood(P, px, py, Xn, Yn, self.other[0], self.other[1])
+            lik, _ = likelihood(P, px, py, X, Y, self.other[0], self.other[1])
             with np.errstate(divide="ignore"):
                 return np.log(lik)
 

@@ -28,7 +28,11 @@ E. Estimate: the weighted mean (position and velocity) of the particles with
    ω ≥ 0.8·max ω.
 
 All random draws come from one ``numpy.random.Generator`` seeded with ``seed``: the same
-seed and input give the same track, bit for bit.
+seed and input give the same track, bit for bit.  The draws are made here, in numpy; the
+per-scan arithmetic (B–E) is compiled with numba (:mod:`gaitval.track.pf_kernels`, imported
+at the first :meth:`ParticleFilterTracker.track`, so that importing this module — every
+tracking job does — does not import numba) and gives the numbers of the numpy version it
+replaced, bit for bit.
 
 Output columns as every tracker's: ``observed`` (and pattern ``SL``) when some particle of
 the leg had laser points in its window, else ``UO``; ``phase`` from seed 000's speed
@@ -53,8 +57,7 @@ from gaitval.track.init import INITIALISERS
 from gaitval.track.kinds import TRACKER_KINDS, RawScanTracker
 from gaitval.track.leg import TrackResult, empty_result
 from gaitval.track.observations import WindowedDetections
-from gaitval.track.pf_likelihood import (PFArrays, effective_size, likelihood, near_points,
-                                         sample_velocities, systematic_resample)
+from gaitval.track.pf_likelihood import PFArrays, draw_mixture, sample_velocities
 from gaitval.track.pf_model import default_pf_model
 from gaitval.track.phase import PHASE_MODELS
 from gaitval.track.tracker import step_durations
@@ -147,53 +150,27 @@ class ParticleFilterTracker(RawScanTracker):
         return self._result(res, est, seen, k0)
 
     def step(self, P: PFArrays, rng, pts: _Scan, k: int, prev: np.ndarray, dt: float):
-        """One scan for both legs: B (propagate), C (weigh), D (resample-move), E."""
+        """One scan for both legs: B (propagate), C (weigh), D (resample-move), E.
+
+        The draws come from ``rng`` here, in numpy, in the order B (component uniforms,
+        normals), D (one systematic-resampling uniform per leg, the walk's normals, the MH
+        uniforms); the arithmetic is the compiled kernels of :mod:`gaitval.track.pf_kernels`.
+        """
+        from gaitval.track import pf_kernels as K
+
         N = self.n_particles
-        v = sample_velocities(P, rng, N)                              # §III.B
-        pos = prev[:, None, :2] + v * dt                              # p = p̂_{k−1} + v Δt
+        u, z = draw_mixture(rng, N)                                   # §III.B draws
         X, Y = pts.X[k], pts.Y[k]
-        lik, cnt = self._weigh(P, pos, prev, X, Y, (0, 1))            # §III.C
-        w = _normalise(lik)
-        need = np.flatnonzero(effective_size(w) < self.resample_fraction * N)   # §III.D
-        if need.size:
-            v, lik, w = self._resample_move(P, rng, prev, dt, v, lik, w, need, X, Y)
-            pos = prev[:, None, :2] + v * dt
-        best = w >= self.best_fraction * w.max(axis=1, keepdims=True)           # §III.E
-        ws = np.where(best, w, 0.0)
-        ws /= ws.sum(axis=1, keepdims=True)
-        out = np.concatenate([np.einsum("ln,lnj->lj", ws, pos),
-                              np.einsum("ln,lnj->lj", ws, v)], axis=1)
-        return out, cnt.max(axis=1) > 0
-
-    @staticmethod
-    def _weigh(P, pos, prev, X, Y, legs):
-        """Likelihoods and contour counts of the particles of ``legs`` (rows of ``pos``);
-        β against the other leg's estimate at k−1."""
-        lik = np.zeros(pos.shape[:2])
-        cnt = np.zeros(pos.shape[:2], dtype=np.intp)
-        for i, f in enumerate(legs):
-            px, py = pos[i, :, 0], pos[i, :, 1]
-            Xn, Yn = near_points(P, X, Y, px, py)
-            lik[i], cnt[i] = likelihood(P, px, py, Xn, Yn, prev[1 - f, 0], prev[1 - f, 1])
-        return lik, cnt
-
-    def _resample_move(self, P, rng, prev, dt, v, lik, w, need, X, Y):
-        """§III.D for the legs in ``need``: systematic resampling, random walk on the
-        velocity, Metropolis–Hastings accept/reject with min(1, ω*/ω)."""
-        N = self.n_particles
-        idx = systematic_resample(w[need], rng.random(need.size))
-        v, lik, w = v.copy(), lik.copy(), w.copy()
-        v[need] = np.take_along_axis(v[need], idx[..., None], axis=1)
-        lik[need] = np.take_along_axis(lik[need], idx, axis=1)
-        v_new = v[need] + rng.standard_normal((need.size, N, 2)) * P.walk_sd
-        pos_new = prev[need, None, :2] + v_new * dt
-        lik_new, _ = self._weigh(P, pos_new, prev, X, Y, need)
-        u = rng.random((need.size, N))
-        accept = (lik[need] <= 0.0) | (u * lik[need] < lik_new)       # u < ω*/ω (MH)
-        v[need] = np.where(accept[..., None], v_new, v[need])
-        lik[need] = np.where(accept, lik_new, lik[need])
-        w[need] = _normalise(lik[need])
-        return v, lik, w
+        vx, vy, px, py, lik, w, seen, need = K.propagate_weigh(       # §III.B–C, N_eff
+            prev, dt, u, z, X, Y, P.kernel, self.resample_fraction)
+        legs = np.flatnonzero(need)
+        if legs.size:                                                 # §III.D
+            u_res = rng.random(legs.size)
+            z_walk = rng.standard_normal((legs.size, N, 2))
+            u_mh = rng.random((legs.size, N))
+            K.resample_move(prev, dt, vx, vy, px, py, lik, w, legs, u_res, z_walk, u_mh,
+                            X, Y, P.kernel)
+        return K.estimate(vx, vy, px, py, w, self.best_fraction), seen   # §III.E
 
     def _result(self, res: TrackResult, est: np.ndarray, seen: np.ndarray, k0: int):
         res.k_init = k0
@@ -205,9 +182,3 @@ class ParticleFilterTracker(RawScanTracker):
         res.phase[k0:] = [phase.identify(tuple(e[0]), tuple(e[1])) for e in est[k0:]]
         return res
 
-
-def _normalise(lik: np.ndarray) -> np.ndarray:
-    """Weights per row summing to 1; a row of zeros (no information) becomes uniform."""
-    s = lik.sum(axis=1, keepdims=True)
-    ok = s > 0.0
-    return np.where(ok, lik / np.where(ok, s, 1.0), 1.0 / lik.shape[1])

@@ -1,10 +1,10 @@
-"""The particle filter's arithmetic, vectorised over particles (seed 002 §III).
+"""The particle filter's model arrays, draws and likelihood (seed 002 §III).
 
 :class:`PFArrays` turns a model (:mod:`gaitval.track.pf_model`) into the arrays the
-per-scan steps use; :func:`sample_velocities` draws from the Gaussian mixtures (§III.A–B);
+per-scan steps use (and the tuple the compiled kernels of :mod:`gaitval.track.pf_kernels`
+take); :func:`sample_velocities` draws from the Gaussian mixtures (§III.A–B);
 :func:`likelihood` weighs one leg's particles against the scan's points near them
-(§III.C, vectorised over particles × points); :func:`effective_size` and
-:func:`systematic_resample` serve §III.D.
+(§III.C, the compiled kernel).  numba is imported only when a likelihood is computed.
 
 Notes
 -----
@@ -38,7 +38,9 @@ class PFArrays:
     factors of the covariances; hx, hy : window half-sizes; mu, inv_sd, norm, pi : (4,)
     per region R1..R4; abc, pi_code : the same per pair code (see :func:`likelihood`);
     count_pdf : (T,); gamma_a, gamma_scale, gamma_lognorm : β's constants; walk_sd : (2,)
-    m/s.
+    m/s; kernel : the tuple (w, chol, mean, hx, hy, abc, pi_code, count_pdf, gamma_a,
+    gamma_scale, gamma_lognorm, walk_sd) the kernels of :mod:`gaitval.track.pf_kernels`
+    take.
     """
 
     def __init__(self, model: dict):
@@ -67,14 +69,18 @@ class PFArrays:
         self.gamma_a, self.gamma_scale = float(ga["a"]), float(ga["scale"])
         self.gamma_lognorm = gammaln(self.gamma_a) + self.gamma_a * math.log(self.gamma_scale)
         self.walk_sd = np.asarray(model["walk_sd_mps"], dtype=float)
+        c = np.ascontiguousarray
+        self.kernel = (c(self.w), c(self.chol), c(self.mean), self.hx, self.hy, c(self.abc),
+                       c(self.pi_code), c(self.count_pdf), self.gamma_a, self.gamma_scale,
+                       float(self.gamma_lognorm), c(self.walk_sd))
 
 
 def sample_velocities(P: PFArrays, rng: np.random.Generator, n: int,
                       zero_mean: bool = False) -> np.ndarray:
     """(2, n, 2) velocities drawn from each leg's 2-component mixture (seed002 §III.B);
     ``zero_mean``: the same mixture centred on zero (§III.A)."""
-    second = rng.random((2, n, 1)) >= P.w[:, None, :1]               # component per draw
-    z = rng.standard_normal((2, n, 2))
+    u, z = draw_mixture(rng, n)
+    second = u >= P.w[:, None, :1]                                   # component per draw
     L, m = P.chol, P.mean                                            # (2, 2, 2, 2), (2, 2, 2)
     # v = m_c + L_c z with L_c lower triangular (c = the draw's component)
     vx = z[..., :1] * np.where(second, L[:, None, 1:, 0, 0], L[:, None, :1, 0, 0])
@@ -86,36 +92,27 @@ def sample_velocities(P: PFArrays, rng: np.random.Generator, n: int,
     return v
 
 
-def gamma_pdf(P: PFArrays, d: np.ndarray) -> np.ndarray:
-    """β: Gamma(a, scale) density at d (= ``scipy.stats.gamma(a, scale=s).pdf``)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lp = (P.gamma_a - 1.0) * np.log(d) - d / P.gamma_scale - P.gamma_lognorm
-    return np.where(d > 0, np.exp(lp), 0.0)
-
-
-def near_points(P: PFArrays, X: np.ndarray, Y: np.ndarray, px: np.ndarray, py: np.ndarray):
-    """The points (of X, Y) that can be in the lower half-window of some particle:
-    x in [min px − h_x, max px), y in [min py − h_y, max py + h_y]."""
-    with np.errstate(invalid="ignore"):
-        keep = ((X >= px.min() - P.hx) & (X < px.max()) & (Y >= py.min() - P.hy)
-                & (Y <= py.max() + P.hy))
-    return X[keep], Y[keep]
+def draw_mixture(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The draws of :func:`sample_velocities`, in its order: (2, n, 1) uniforms (the
+    component) and (2, n, 2) standard normals."""
+    return rng.random((2, n, 1)), rng.standard_normal((2, n, 2))
 
 
 def likelihood(P: PFArrays, px: np.ndarray, py: np.ndarray, X: np.ndarray, Y: np.ndarray,
                ox: float, oy: float) -> tuple[np.ndarray, np.ndarray]:
-    """Observation likelihood of one leg's K particles against a scan's points.
+    """Observation likelihood of one leg's K particles against a scan's points (seed002
+    §III.C), by the compiled kernel :func:`gaitval.track.pf_kernels.leg_likelihood`.
 
     Parameters
     ----------
     P : PFArrays
     px, py : (K,) particle positions, sensor frame.
-    X, Y : (M,) the scan's points (those of :func:`near_points` suffice).
-    ox, oy : float or (K,) the other leg's estimate (for β).
+    X, Y : (M,) the scan's points (NaN: no return).
+    ox, oy : float, the other leg's estimate (for β).
 
     Returns
     -------
-    weights : (K,) unnormalised p(y|x) (seed002 §III.C, module notes)
+    weights : (K,) unnormalised p(y|x) (module notes)
     counts : (K,) contour points (points in R1..R4 of the particle's window)
 
     Notes
@@ -125,39 +122,14 @@ def likelihood(P: PFArrays, px: np.ndarray, py: np.ndarray, X: np.ndarray, Y: np
     |v| < u; code = inner + 2·[v ≥ 0] (0: R1, 1: R2, 2: R4, 3: R3).  The normal density is
     evaluated as exp(A d² + B d + C) with A = −1/(2σ²), B = μ/σ² and
     C = −μ²/(2σ²) + ln(1/(σ√2π)), which is N(d | μ, σ) term for term, with one table
-    look-up per pair.
+    look-up per pair.  Only the points that can lie in some particle's window are visited
+    (x in [min px − h_x, max px), y in [min py − h_y, max py + h_y]).
     """
-    K, M = len(px), len(X)
-    u = np.subtract.outer(px, X)
-    v = np.subtract.outer(py, Y)
-    av = np.abs(v)
-    idx = np.flatnonzero((u > 0.0) & (u <= P.hx) & (av <= P.hy))    # window ∩ lower half
-    uu, vv = u.ravel()[idx], v.ravel()[idx]
-    code = (av.ravel()[idx] < uu).astype(np.intp)
-    code += 2 * (vv >= 0.0)
-    d2 = uu * uu + vv * vv
-    co = P.abc[code]                                                   # (n, 3): A, B, C
-    dens = np.exp(co[:, 0] * d2 + co[:, 1] * np.sqrt(d2) + co[:, 2])  # N(d | μ_Rm, Σ_Rm)
-    key = (idx // M) * 4 + code if M else idx
-    sums = np.bincount(key, weights=dens, minlength=4 * K).reshape(K, 4)
-    cnts = np.bincount(key, minlength=4 * K).reshape(K, 4)
-    region_term = (sums / np.maximum(cnts, 1)) @ P.pi_code            # Σ_m π_Rm · N(...)
-    n = cnts.sum(axis=1)
-    lam = P.count_pdf[np.minimum(n, len(P.count_pdf) - 1)]            # λ_i
-    beta = gamma_pdf(P, np.hypot(px - ox, py - oy))                    # β_i
-    return beta * lam * region_term, n                                # seed002 §III.C
+    from gaitval.track.pf_kernels import leg_likelihood
 
-
-def effective_size(w: np.ndarray) -> np.ndarray:
-    """N_eff = 1 / Σ ω̂² per row of normalised weights (seed002 §III.D)."""
-    return 1.0 / np.sum(w * w, axis=-1)
-
-
-def systematic_resample(w: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """Indices (rows × N) drawn by systematic resampling of normalised weights ``w`` (rows,
-    N), with one uniform ``u`` per row (Arulampalam et al. 2002, Algorithm 2)."""
-    n = w.shape[-1]
-    c = np.cumsum(w, axis=-1)
-    c[..., -1] = 1.0
-    pos = (np.arange(n)[None, :] + u[:, None]) / n
-    return np.stack([np.searchsorted(c[i], pos[i]) for i in range(len(w))])
+    px, py = np.ascontiguousarray(px, dtype=float), np.ascontiguousarray(py, dtype=float)
+    lik, cnt = np.empty(px.size), np.empty(px.size, dtype=np.intp)
+    leg_likelihood(px, py, np.ascontiguousarray(X, dtype=float),
+                   np.ascontiguousarray(Y, dtype=float), float(ox), float(oy), P.kernel,
+                   lik, cnt)
+    return lik, cnt
