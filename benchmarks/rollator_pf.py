@@ -1,22 +1,30 @@
 """Frames per second of gaitval's seed 002 particle filter vs the laser and vs Stone Soup.
 
 gaitval's ``rollator_pf`` (two filters of N = 500 particles, seed 002 §III) runs over one
-rollator trial's scans; the time per frame covers both legs' full step: GMM propagation
-from the previous estimate (§III.B), the laser-point likelihood (§III.C), the resample-move
-when N_eff < N/2 (§III.D) and the best-80 % estimate (§III.E).  The figures:
+rollator trial's scans; the time per frame covers both legs' full step
+(:meth:`~gaitval.track.pf.ParticleFilterTracker.step`): the numpy draws and the compiled
+kernels (:mod:`gaitval.track.pf_kernels`) of the GMM propagation from the previous estimate
+(§III.B), the laser-point likelihood (§III.C), the resample-move when N_eff < N/2 (§III.D)
+and the best-80 % estimate (§III.E).  The figures:
 
+* the one-off cost per process, paid once by a ``rollator_track`` job before its first
+  scan and not part of the frames/s: importing numba with the kernels module, and the first
+  step, which loads the compiled kernels from numba's cache (``__pycache__`` beside
+  ``pf_kernels.py``; compiles them instead when there is no usable cache — the line says
+  which);
 * frames/s against the UBG-04LX-F01's scan rate (the trial's median period, ≈ 37 Hz):
   "× real time per leg pair" (the bar of issue 12 is ≥ 50×);
 * frames/s of Stone Soup's ``ParticlePredictor`` + ``ParticleUpdater`` (with
   ``ESSResampler(SystematicResampler)`` at N/2) doing the same prediction and update: a
   transition model drawing the velocities from the same mixtures from the previous
-  estimate, and a measurement model whose log-likelihood is the same gaitval function,
-  with the scan's points as the detection.  Stone Soup does no MH move here, so the
-  comparison favours it.
+  estimate, and a measurement model whose log-likelihood is the same (compiled) gaitval
+  function, with the scan's points as the detection.  Stone Soup does no MH move here, so
+  the comparison favours it.
 
 Both run on the same scans with the same model.  Times are CPU seconds (``process_time``)
 of the median of ``--repeat`` runs over ``--frames`` frames; wall time is printed too (on a
-shared machine it is inflated by other processes).
+shared machine it is inflated by other processes, and CPU time somewhat too: two processes
+on the cores of one machine slow each other's caches).
 
 Usage::
 
@@ -168,6 +176,29 @@ def run_stonesoup(P, scans, k0, p0, frames: int, dt: float, N: int):
             leg[3].other = list(est[1 - f])
 
 
+def one_off_cost(tracker, P, scans, k0, p0, dt):
+    """What a process pays once before its first PF step: importing numba and
+    :mod:`gaitval.track.pf_kernels` (which imports numba), and the first step, which loads
+    the compiled kernels from numba's cache (or compiles them when there is no cache).
+
+    Returns ``(import_cpu, import_wall, first_cpu, first_wall, how)`` in seconds; ``how``:
+    "loaded from the cache" or "compiled (no usable cache)".
+    """
+    if "numba" in sys.modules:
+        raise RuntimeError("numba was imported before the one-off cost was measured")
+    c, w = time.process_time(), time.perf_counter()
+    from gaitval.track import pf_kernels
+    imp = (time.process_time() - c, time.perf_counter() - w)
+    pts = _Scan(scans)
+    prev = np.concatenate([p0, np.zeros((2, 2))], axis=1)
+    c, w = time.process_time(), time.perf_counter()
+    tracker.step(P, np.random.default_rng(0), pts, k0 + 1, prev, dt)
+    first = (time.process_time() - c, time.perf_counter() - w)
+    kernels = [getattr(pf_kernels, n) for n in ("propagate_weigh", "estimate")]
+    hits = all(sum(f.stats.cache_hits.values()) > 0 for f in kernels)
+    return (*imp, *first, "loaded from the cache" if hits else "compiled (no usable cache)")
+
+
 def timed(fn, repeat: int):
     cpu, wall = [], []
     for _ in range(repeat):
@@ -203,6 +234,9 @@ def main(argv=None) -> int:
     print(f"trial {row['trial']} ({study}): {frames} frames from scan {k0}, N = {N} "
           f"particles per leg; model: {source}")
     print(f"laser: {1 / dt:.1f} scans/s (median period {dt * 1000:.1f} ms)")
+    ic, iw, fc, fw, how = one_off_cost(tracker, P, scans, k0, p0, dt)
+    print(f"one-off per process: import numba + gaitval.track.pf_kernels {ic:.2f} s CPU "
+          f"({iw:.2f} s wall); first step, kernels {how}: {fc:.2f} s CPU ({fw:.2f} s wall)")
     g_cpu, g_wall = timed(lambda: run_gaitval(tracker, P, scans, k0, p0, frames, dt),
                           a.repeat)
     s_cpu, s_wall = timed(lambda: run_stonesoup(P, scans, k0, p0, frames, dt, N),

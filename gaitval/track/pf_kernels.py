@@ -3,7 +3,8 @@
 Imported only by the PF (lazily, from :mod:`gaitval.track.pf` and
 :func:`gaitval.track.pf_likelihood.likelihood`), so that no other job pays numba's import.
 Every kernel is ``@njit(cache=True)`` without ``fastmath``: IEEE arithmetic, no
-reassociation and no fused multiply-add, and the compiled machine code is cached beside this
+reassociation and no contraction into fused multiply-adds (the only ones are the explicit
+``llvm.fma`` of :func:`libc_exp`), and the compiled machine code is cached beside this
 file (``__pycache__``, or ``NUMBA_CACHE_DIR``), so a process pays numba's import and the
 loading of the cached kernels once, not a compilation (docs/rollator.md, "Speed").
 
@@ -12,8 +13,11 @@ bit for bit:
 
 * random draws are not made here: :mod:`gaitval.track.pf` draws them with the
   ``numpy.random.Generator`` in the same order and shapes as before and passes them in;
-* ``exp``, ``log``, ``sqrt`` and ``hypot`` are the C library's, as numpy's are for float64
-  on x86-64 without AVX-512 (numpy's AVX-512 ``exp``/``log`` may differ in the last bit);
+* ``log``, ``sqrt``, ``hypot`` and β's ``exp`` are the C library's, as numpy's are for
+  float64 on x86-64 without AVX-512 (numpy's AVX-512 ``exp``/``log`` may differ in the last
+  bit); the pair densities' ``exp`` is the C library's algorithm inlined
+  (:func:`libc_exp`, bit-equal to glibc's x86-64 ``exp``; other C libraries may round a
+  last bit differently, and so would numpy there);
 * sums keep numpy's order: the region sums add the pairs particle-major, point ascending
   (``np.bincount``); row sums are numpy's pairwise summation (:func:`pairwise_sum`); the
   weighted means add sequentially from 0 (``np.einsum``); the four-region dot product is
@@ -238,7 +242,6 @@ def leg_likelihood(px, py, X, Y, ox, oy, model, lik, cnt):
     for i in range(px.size):
         _pair_exponents(px[i], py[i], Xn, Yn, hx, hy, abc, x, code, ki, r)
         s0 = s1 = s2 = s3 = 0.0                                       # Σ densities per code
-        n0 = n1 = n2 = n3 = 0.0                                       # points per code
         for j in range(M):                                            # point ascending
             ax = abs(x[j])
             if ax < 512.0 and ax >= 5.551115123125783e-17:            # libc_exp, 2nd half
@@ -256,14 +259,16 @@ def leg_likelihood(px, py, X, Y, ox, oy, model, lik, cnt):
             s1 += dens * one[c, 1]
             s2 += dens * one[c, 2]
             s3 += dens * one[c, 3]
-            n0 += one[c, 0]
-            n1 += one[c, 1]
-            n2 += one[c, 2]
-            n3 += one[c, 3]
+        n0 = n1 = n2 = n3 = 0                                         # points per code
+        for j in range(M):
+            n0 += code[j] == 0
+            n1 += code[j] == 1
+            n2 += code[j] == 2
+            n3 += code[j] == 3
         m0, m1 = s0 / max(n0, 1.0), s1 / max(n1, 1.0)                 # mean per region
         m2, m3 = s2 / max(n2, 1.0), s3 / max(n3, 1.0)
         region = (m0 * pi[0] + m2 * pi[2]) + (m1 * pi[1] + m3 * pi[3])   # Σ_m π_Rm N(...)
-        n = int(n0 + n1 + n2 + n3)
+        n = n0 + n1 + n2 + n3
         lam = count_pdf[min(n, top)]                                  # λ_i
         d = math.hypot(px[i] - ox, py[i] - oy)
         beta = 0.0                                                    # β_i: Gamma pdf
