@@ -24,7 +24,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.special import gammaln
 
 from gaitval.track.pf_model import SIDES, check_model
 
@@ -67,6 +66,8 @@ class PFArrays:
         self.count_pdf = np.asarray(model["count_pdf"], dtype=float)
         ga = model["gamma"]
         self.gamma_a, self.gamma_scale = float(ga["a"]), float(ga["scale"])
+        from scipy.special import gammaln   # here: importing gaitval.track need not load it
+
         self.gamma_lognorm = gammaln(self.gamma_a) + self.gamma_a * math.log(self.gamma_scale)
         self.walk_sd = np.asarray(model["walk_sd_mps"], dtype=float)
         c = np.ascontiguousarray
