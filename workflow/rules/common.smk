@@ -110,11 +110,20 @@ def is_simulated(study):
     return "simulate" in study_cfg(study)
 
 
+_SHEET_PATHS = {}
+
+
 def sheet_path(study):
-    """Trial sheet path; for a simulated study, wait for the `simulate` checkpoint."""
-    if is_simulated(study):
-        return checkpoints.simulate.get(study=study).output.sheet
-    return study_cfg(study)["trial_sheet"]
+    """Trial sheet path; for a simulated study, wait for the `simulate` checkpoint.  Once
+    known it is remembered: input functions ask for it thousands of times per DAG."""
+    path = _SHEET_PATHS.get(study)
+    if path is None:
+        if is_simulated(study):
+            path = checkpoints.simulate.get(study=study).output.sheet   # raises until done
+        else:
+            path = study_cfg(study)["trial_sheet"]
+        _SHEET_PATHS[study] = path
+    return path
 
 
 def subjects_path(study):
@@ -141,8 +150,16 @@ def trial_ids(study, protocols=None):
     return sorted(df.index)
 
 
+_ROWS = {}
+
+
 def trial_row(study, trial):
-    return trials(study).loc[trial]
+    """One trial's row of the validated sheet, as a dict (column -> value)."""
+    path = sheet_path(study)
+    rows = _ROWS.get(path)
+    if rows is None:
+        rows = _ROWS[path] = trials(study).to_dict("index")
+    return rows[trial]
 
 
 def has_mocap(study, trial):

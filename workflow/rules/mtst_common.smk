@@ -29,15 +29,27 @@ def mtst_registration(wildcards):
     }
 
 
+_TARGET_PATTERNS = {}
+
+
+def mtst_target_pattern(study):
+    """mtst.targets of the study's study.yaml, else of the config (read once per study)."""
+    if study not in _TARGET_PATTERNS:
+        sheet = Path(sheet_path(study))
+        pattern = (config.get("mtst") or {}).get("targets")
+        cal = sheet.parent / "study.yaml"
+        if cal.is_file():
+            pattern = ((yaml.safe_load(cal.read_text()) or {}).get("mtst") or {}).get(
+                "targets", pattern
+            )
+        _TARGET_PATTERNS[study] = pattern
+    return _TARGET_PATTERNS[study]
+
+
 def mtst_targets_file(wildcards):
     """The trial's target layout (mtst.targets of study.yaml or the config), when it exists."""
     sheet = Path(sheet_path(wildcards.study))
-    pattern = (config.get("mtst") or {}).get("targets")
-    cal = sheet.parent / "study.yaml"
-    if cal.is_file():
-        pattern = ((yaml.safe_load(cal.read_text()) or {}).get("mtst") or {}).get(
-            "targets", pattern
-        )
+    pattern = mtst_target_pattern(wildcards.study)
     if not pattern:
         return []
     path = sheet.parent / str(pattern).replace("{trial}", wildcards.trial)
