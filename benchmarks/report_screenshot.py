@@ -34,7 +34,10 @@ def main(argv=None) -> int:
     if exe is None:
         print("chromium not found: apt-get install -y chromium", file=sys.stderr)
         return 2
-    _, html = build_index(a.reports_dir, study_names=a.studies)
+    # the report folder is named after its run (reports/<study>+<study>): re-rendering the
+    # index without the studies would overwrite its "Studies:" line with "-"
+    studies = a.studies if a.studies is not None else Path(a.reports_dir).name.split("+")
+    _, html = build_index(a.reports_dir, study_names=studies)
     a.out.parent.mkdir(parents=True, exist_ok=True)
     subprocess.run([exe, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
                     f"--screenshot={a.out.resolve()}",
