@@ -60,5 +60,5 @@ class SpeedThresholdPhases(PhaseModel):
         self.identify = functools.partial(self._of_states, v_st_th=self.v_st_th,
                                           v_sw_th=self.v_sw_th)   # seed000 eq. (3)–(5)
 
-    def identify(self, l, r):  # noqa: F811 -- the instance's partial (above) replaces it
+    def identify(self, l, r):  # the role's method; each instance binds a partial of it (above)
         return self._of_states(l, r, self.v_st_th, self.v_sw_th)   # seed000 eq. (3)–(5)

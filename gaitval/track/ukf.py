@@ -286,7 +286,7 @@ def _sigma_statistics(mdl: _Model, x: np.ndarray, P: np.ndarray):
     Returns ``P`` (symmetrised if its Cholesky factor failed), ``ybar`` (eq. 9) and
     ``Pyy``, ``Pxy`` (eq. 10).
     """
-    B, info = mdl.potrf(mdl.scale * P, lower=1)              # seed003 eq. (7)
+    B, info = mdl.potrf(mdl.scale * P, lower=1)           # seed003 eq. (7)
     if info != 0:
         P = 0.5 * (P + P.T) + 1e-12 * mdl.I6
         B, info = mdl.potrf(mdl.scale * P, lower=1)
@@ -331,7 +331,7 @@ def _update(mdl: _Model, x, P, dk, n_ok: int, res: ToaUkfResult, k: int):
         res.used[k, bad] = False
         n_ok -= bad.size
     if n_ok == len(dk):
-        _, KT, info = mdl.posv(Pyy, Pxy.T)                  # K = Pxy Pyy^-1, seed003 eq. (10)
+        _, KT, info = mdl.posv(Pyy, Pxy.T)               # K = Pxy Pyy^-1, seed003 eq. (10)
         x = x + nu @ KT                                  # seed003 eq. (11)
         P = P - KT.T @ Pxy.T                             # P - K Pyy K^T, seed003 eq. (11)
     elif n_ok > 0:
