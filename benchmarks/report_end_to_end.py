@@ -50,6 +50,33 @@ _RECORD = ("import sys, atexit, runpy\n"
            "runpy.run_module('gaitval', run_name='__main__', alter_sys=True)\n")
 
 
+# runs Snakemake in this process and prints its own CPU (not its jobs') at exit
+_SNAKEMAKE_SELF = ("import atexit, os, runpy, sys\n"
+                   "atexit.register(lambda: print('snakemake itself: cpu %.2f s' % "
+                   "(os.times().user + os.times().system), file=sys.stderr))\n"
+                   "sys.argv[0] = 'snakemake'\n"
+                   "runpy.run_module('snakemake', run_name='__main__', alter_sys=True)\n")
+
+
+def _forked_jobs(log: Path) -> dict[str, list[float]]:
+    """verb -> [jobs, cpu s] of the jobs the fork server ran (its log: one line with each
+    job's command when it starts, one with its exit, wall and CPU from wait4 when it ends)."""
+    verb, out = {}, {}
+    if not log.is_file():
+        return out
+    for line in log.read_text().splitlines():
+        m = re.match(r"job (\d+): gaitval (\S+)", line)
+        if m:
+            verb[m[1]] = m[2]
+            continue
+        m = re.match(r"job (\d+): exit (-?\d+), wall ([\d.]+) s, cpu ([\d.]+) s", line)
+        if m:
+            acc = out.setdefault(verb.get(m[1], "?"), [0, 0.0])
+            acc[0] += 1
+            acc[1] += float(m[4])
+    return out
+
+
 def _cpu_children() -> float:
     r = resource.getrusage(resource.RUSAGE_CHILDREN)
     return r.ru_utime + r.ru_stime
@@ -57,7 +84,7 @@ def _cpu_children() -> float:
 
 def _run_snakemake(root: Path, work: Path, study: str, cores: int, fork_server: bool = True
                    ) -> tuple[float, float, str]:
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(root / "Snakefile"),
+    cmd = [sys.executable, "-c", _SNAKEMAKE_SELF, "-s", str(root / "Snakefile"),
            "--directory", str(work), "--cores", str(cores), "--printshellcmds",
            "--rerun-incomplete", "--config", f'run=["{study}"]']
     if not fork_server:
@@ -130,6 +157,18 @@ def _startup_of(rule_argv: list[str], work: Path, n: int = 3) -> tuple[float, fl
     return job, start, len(mods)
 
 
+def _print_breakdown(log: str, server_log: Path, cpu: float) -> None:
+    """Where the run's CPU went: Snakemake itself, each verb's forked jobs, the rest."""
+    m = re.search(r"snakemake itself: cpu ([\d.]+) s", log)
+    own = float(m[1]) if m else float("nan")
+    forked = _forked_jobs(server_log)
+    jobs_cpu = sum(c for _n, c in forked.values())
+    print(f"  snakemake itself {own:.1f} s; forked jobs {jobs_cpu:.1f} s; the rest (fork "
+          f"server imports, job shells and clients, plain jobs) {cpu - own - jobs_cpu:.1f} s")
+    for verb, (n, c) in sorted(forked.items(), key=lambda kv: -kv[1][1]):
+        print(f"    {verb:26s} {n:5d} jobs {c:8.1f} cpu-s ({c / n:.2f} per job)")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--study", default="tiny", choices=["tiny", "default"])
@@ -156,6 +195,7 @@ def main() -> None:
             walls.append(wall)
             cpus.append(cpu)
             print(f"run {r + 1}: wall {wall:.1f} s, cpu {cpu:.1f} s, {jobs} jobs", flush=True)
+            _print_breakdown(log, work / "logs" / "forkserver.log", cpu)
         if args.keep:
             shutil.copytree(work / "results", args.keep, dirs_exist_ok=True)
         share = float("nan")

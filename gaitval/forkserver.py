@@ -28,6 +28,7 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib
 import json
 import os
@@ -82,13 +83,16 @@ def _request(conn: socket.socket) -> tuple[dict, list[int]]:
     return json.loads(buf[4:4 + n].decode()), fds
 
 
+_ANSWERED = threading.Event()
+
+
 def _watch(conn: socket.socket) -> None:
     """In the child: the client went away before the answer → stop the job."""
     try:
         gone = conn.recv(1) == b""
     except OSError:
         gone = True
-    if gone:                                   # the job and whatever it started
+    if gone and not _ANSWERED.is_set():        # the job and whatever it started
         try:
             os.killpg(0, signal.SIGKILL)
         finally:
@@ -104,6 +108,7 @@ def _run_job(conn: socket.socket) -> None:
             signal.signal(s, signal.SIG_DFL)
         signal.signal(signal.SIGINT, signal.default_int_handler)
         req, fds = _request(conn)
+        print(f"job {os.getpid()}: gaitval {' '.join(req['argv'])}", flush=True)   # server log
         for i, fd in enumerate(fds[:3]):
             os.dup2(fd, i)
             os.close(fd)
@@ -134,6 +139,7 @@ def _run_job(conn: socket.socket) -> None:
                 stream.flush()
             except Exception:
                 pass
+    _ANSWERED.set()                            # the client may now close: not a cancel
     try:
         conn.sendall(struct.pack("!i", int(rc or 0)))
     finally:
@@ -148,6 +154,22 @@ def _alive(pid: int) -> bool:
     except PermissionError:
         return True
     return True
+
+
+def _reap(jobs: dict[int, float]) -> None:
+    """Collect finished jobs; log each one's wall and CPU seconds (user + system)."""
+    while jobs:
+        try:
+            pid, status, ru = os.wait4(-1, os.WNOHANG)
+        except ChildProcessError:
+            return
+        if pid == 0:
+            return
+        t0 = jobs.pop(pid, None)
+        if t0 is not None:
+            print(f"job {pid}: exit {os.waitstatus_to_exitcode(status)}, "
+                  f"wall {time.perf_counter() - t0:.3f} s, "
+                  f"cpu {ru.ru_utime + ru.ru_stime:.3f} s", flush=True)
 
 
 def serve(path: str, owner: int | None) -> int:
@@ -166,13 +188,10 @@ def serve(path: str, owner: int | None) -> int:
     srv.listen(64)
     srv.settimeout(0.5)
     print(f"gaitval fork server: pid {os.getpid()} on {path}", flush=True)
+    jobs: dict[int, float] = {}
     try:
         while not stop and (owner is None or _alive(owner)):
-            try:
-                while os.waitpid(-1, os.WNOHANG)[0] > 0:     # reap finished jobs
-                    pass
-            except ChildProcessError:
-                pass
+            _reap(jobs)
             try:
                 conn, _ = srv.accept()
             except (socket.timeout, InterruptedError):
@@ -180,9 +199,11 @@ def serve(path: str, owner: int | None) -> int:
             conn.settimeout(None)
             sys.stdout.flush()
             sys.stderr.flush()
-            if os.fork() == 0:
+            pid = os.fork()
+            if pid == 0:
                 srv.close()
                 _run_job(conn)
+            jobs[pid] = time.perf_counter()
             conn.close()
     finally:
         srv.close()
@@ -202,6 +223,8 @@ def main(argv: list[str] | None = None) -> int:
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
     failed = preload()
+    gc.freeze()          # the preloaded objects: the children's collections skip them and so
+    #                      leave their pages shared instead of copying them on the first gc
     print(f"gaitval fork server: imports took {time.perf_counter() - t0:.2f} s"
           + (f"; not importable (jobs needing them will say so): {', '.join(failed)}"
              if failed else ""), flush=True)
