@@ -45,7 +45,8 @@ import traceback
 THIRD_PARTY = ("numpy", "pandas", "pyarrow", "pyarrow.parquet", "pyarrow.csv", "scipy.signal",
                "scipy.stats", "scipy.optimize", "scipy.interpolate", "scipy.linalg",
                "scipy.spatial", "matplotlib.pyplot", "ezc3d", "jinja2", "yaml",
-               "sklearn.cluster", "sklearn.mixture", "motmetrics", "rosbags.highlevel")
+               "sklearn.cluster", "sklearn.mixture", "motmetrics", "rosbags.highlevel",
+               "jsonschema")
 SKIP = {"gaitval.__main__", "gaitval.forkserver", "gaitval.forkclient"}
 
 
@@ -67,6 +68,12 @@ def preload() -> list[str]:
             importlib.import_module(mod.name)
         except Exception:
             failed.append(mod.name)
+    try:                                       # parsed once here instead of in every job
+        from gaitval.io.trialsheet import load_schema
+        for name in ("trials", "subjects"):
+            load_schema(name)
+    except Exception:
+        failed.append("workflow/schemas")
     return failed
 
 

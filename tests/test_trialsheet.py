@@ -64,3 +64,24 @@ def test_subject_table_errors(tmp_path):
         load_trial_sheet(make_study(tmp_path, subjects=SUBJECTS.replace("0.10,0.10", "wide,0.10")))
     with pytest.raises(TrialSheetError, match="leg_width_m"):
         load_trial_sheet(make_study(tmp_path, subjects="subject,group\nS01,young\n"))
+
+
+def test_one_trial_job_checks_its_own_row_not_the_others(tmp_path):
+    """A per-trial job (steps.trial_and_subject) validates its trial's row, its subject's
+    row and the headers: a bad cell in another trial's row is the whole-sheet check's
+    problem, a bad cell in its own row stops it with the row and column named."""
+    from gaitval.steps import trial_and_subject
+
+    other = ROW.replace("tug_S01_1", "tug_S01_2").replace(",0.27,", ",tall,")
+    sheet = make_study(tmp_path, rows=ROW + other)
+    with pytest.raises(TrialSheetError, match="row 3"):
+        load_trial_sheet(sheet)
+    row, subj = trial_and_subject(sheet, tmp_path / "subjects.csv", "tug_S01_1")
+    assert row["sensor_height_m"] == pytest.approx(0.27)
+    assert subj["leg_width_m"] == pytest.approx(0.10)
+    with pytest.raises(TrialSheetError, match=r"row 3 \(trial 'tug_S01_2'\), column "
+                                              r"'sensor_height_m'"):
+        trial_and_subject(sheet, tmp_path / "subjects.csv", "tug_S01_2")
+    with pytest.raises(TrialSheetError, match="unknown column 'protocl'"):
+        trial_and_subject(make_study(tmp_path, header=HEADER.replace("protocol", "protocl")),
+                          tmp_path / "subjects.csv", "tug_S01_1")
