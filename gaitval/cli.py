@@ -55,8 +55,9 @@ def cmd_simulate(a) -> int:
 
 def cmd_ingest(a) -> int:
     from gaitval.io.ingest import ingest_trial
-    from gaitval.io.trialsheet import load_trial_sheet
-    df = load_trial_sheet(a.sheet, a.subjects)
+    from gaitval.io.trialsheet import raise_all, sheet_problems
+    df, problems = sheet_problems(a.sheet, a.subjects, only=a.trial)   # this trial's row
+    raise_all(problems)
     if a.trial not in df.index:
         raise GaitvalError(f"trial {a.trial!r} is not in the trial sheet", path=a.sheet)
     s = ingest_trial(df.loc[a.trial].to_dict(), a.out)

@@ -45,7 +45,7 @@ def detect_vertical(xyz: np.ndarray) -> tuple[str | None, float]:
     seen = np.isfinite(x[:, :, 0])
     ok = seen.mean(axis=0) >= 0.2
     with _quiet():
-        lo, hi = np.nanpercentile(x, 5, axis=0), np.nanpercentile(x, 95, axis=0)
+        lo, hi = nanpercentile(x, 5, axis=0), nanpercentile(x, 95, axis=0)
         travel = hi - lo                                      # (n_markers, 3)
         reach = np.where(ok, np.nanmax(np.nan_to_num(travel, nan=0.0), axis=1), 0.0)
     moving = reach > 0.05
@@ -60,7 +60,7 @@ def detect_vertical(xyz: np.ndarray) -> tuple[str | None, float]:
         return None, 0.0
     with _quiet():
         b = body[frames]
-        spread = np.nanmedian(np.nanpercentile(b, 90, axis=1) - np.nanpercentile(b, 10, axis=1),
+        spread = np.nanmedian(nanpercentile(b, 90, axis=1) - nanpercentile(b, 10, axis=1),
                               axis=0)                         # A, per axis
         move = np.nanmedian(travel[moving], axis=0)           # B, per axis
     score = spread / (move + 0.05)
@@ -74,6 +74,22 @@ def detect_vertical(xyz: np.ndarray) -> tuple[str | None, float]:
     if abs(level) < 0.1:
         return None, ratio
     return ("+" if level > 0 else "-") + AXES[a], ratio
+
+
+def nanpercentile(a: np.ndarray, q: float, axis: int) -> np.ndarray:
+    """``np.nanpercentile(a, q, axis=axis)`` (linear method), the same values (a zero may
+    come out as -0.0 where numpy gives 0.0), without numpy's 1-D call per slice when there are NaNs (2,800 slices of a C3D file:
+    0.5 s): the slices are sorted once (NaN last) and those with the same number of finite
+    values go through one vectorised ``np.percentile`` — the same order statistics and
+    interpolation per slice.  All-NaN slices give NaN."""
+    moved = np.moveaxis(np.asarray(a, float), axis, 0)
+    flat = np.sort(moved.reshape(moved.shape[0], -1), axis=0)
+    count = np.isfinite(flat).sum(axis=0)
+    out = np.full(flat.shape[1], np.nan)
+    for n in np.unique(count[count > 0]):
+        cols = np.flatnonzero(count == n)
+        out[cols] = np.percentile(flat[:n, cols], q, axis=0)
+    return out.reshape(moved.shape[1:])
 
 
 def to_z_up(xyz: np.ndarray, up: str) -> np.ndarray:
