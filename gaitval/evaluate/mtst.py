@@ -182,18 +182,22 @@ def judge_steps(ann: pd.DataFrame, t_ann: np.ndarray, contacts: pd.DataFrame, to
     fc = a[a["event"] == "foot_contact"].sort_values("t_ann_s", kind="stable")
     fc = fc.reset_index(drop=True)
     match, other = match_contacts(contacts, fc, tol)
+    side_a, t_a = a["side"].to_numpy(object), a["t_ann_s"].to_numpy(float)
+    is_step = (a["event"] == "target_step").to_numpy(bool)
+    is_cross = (a["event"] == "cross_step").to_numpy(bool)
+    hit, target = (a["value"] == "hit").to_numpy(bool), a["target"].to_numpy(object)
+    c_target, c_cross = contacts["target"].to_numpy(object), contacts["cross"].to_numpy()
     rows = []
-    for i, r in fc.iterrows():
-        same = a[(a["side"] == r["side"]) & (np.abs(a["t_ann_s"] - r["t_ann_s"]) < 1e-6)]
-        tsteps = same[same["event"] == "target_step"]
-        ref_on = bool((tsteps["value"] == "hit").any())
-        ref_target = str(tsteps["target"].iloc[0]) if len(tsteps) else ""
+    for i, (side, t) in enumerate(zip(fc["side"].to_numpy(object), fc["t_ann_s"].to_numpy(float))):
+        same = (side_a == side) & (np.abs(t_a - t) < 1e-6)     # this contact's annotations
+        steps = same & is_step
+        ref_on = bool(hit[steps].any())
+        ref_target = str(target[steps][0]) if steps.any() else ""
         j = int(match[i])
-        sys_target = str(contacts["target"].iloc[j]) if j >= 0 else ""
+        sys_target = str(c_target[j]) if j >= 0 else ""
         sys_on = sys_target != ""
-        rows.append([r["side"], float(r["t_ann_s"]), ref_target, ref_on,
-                     bool((same["event"] == "cross_step").any()), j, int(other[i]),
-                     sys_target, bool(contacts["cross"].iloc[j]) if j >= 0 else False,
+        rows.append([side, float(t), ref_target, ref_on, bool(is_cross[same].any()), j,
+                     int(other[i]), sys_target, bool(c_cross[j]) if j >= 0 else False,
                      ref_on and not sys_on, sys_on and (not ref_on or sys_target != ref_target),
                      False, False])
     _cross_episodes(rows)

@@ -220,6 +220,13 @@ def judge_target_steps(xy: np.ndarray, targets: pd.DataFrame, region, heading
     return out
 
 
+def _leg_samples(g: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One leg's track as (scan index k ascending, (n, 2) positions, swing flags)."""
+    g = g.sort_values("k", kind="stable")
+    return (g["k"].to_numpy(), g[["x_m", "y_m"]].to_numpy(float),
+            g["swing"].astype(bool).to_numpy())
+
+
 def cross_steps(contacts: pd.DataFrame, track: pd.DataFrame, heading, w_c: float,
                 y_towards: str = "support_side") -> np.ndarray:
     """Cross-step flag of each contact (eq. (11), orientation in the module notes).
@@ -252,22 +259,24 @@ def cross_steps(contacts: pd.DataFrame, track: pd.DataFrame, heading, w_c: float
     left = np.array([-u[1], u[0]])
     c = contacts.reset_index(drop=True)
     flags = np.zeros(len(c), bool)
-    pos = {s: g.set_index("k")[["x_m", "y_m", "swing"]] for s, g in track.groupby("side")}
-    for i, r in c.iterrows():
-        same = c[(c["side"] == r["side"]) & (c["k"] < r["k"])]
-        if same.empty:
+    side, k, xy = c["side"].to_numpy(object), c["k"].to_numpy(), c[["x_m", "y_m"]].to_numpy(float)
+    pos = {s: _leg_samples(g) for s, g in track.groupby("side")}
+    for i in range(len(c)):
+        same = np.flatnonzero((side == side[i]) & (k < k[i]))
+        if not len(same):
             continue
-        prev = same.iloc[-1]
-        other = c[(c["side"] != r["side"]) & (c["k"] > prev["k"]) & (c["k"] <= r["k"])]
-        if other.empty:
+        prev = same[-1]
+        other = np.flatnonzero((side != side[i]) & (k > k[prev]) & (k <= k[i]))
+        if not len(other):
             continue
-        y_dir = left if r["side"] == "R" else -left          # y′ towards the supporting leg
+        y_dir = left if side[i] == "R" else -left          # y′ towards the supporting leg
         if y_towards == "swing_side":
             y_dir = -y_dir
-        origin = prev[["x_m", "y_m"]].to_numpy(float)
-        y_st = float((other.iloc[-1][["x_m", "y_m"]].to_numpy(float) - origin) @ y_dir)
-        g = pos[r["side"]].loc[int(prev["k"]) + 1:int(r["k"])]
-        sw = g[g["swing"].astype(bool)][["x_m", "y_m"]].to_numpy(float)
+        origin = xy[prev]
+        y_st = float((xy[other[-1]] - origin) @ y_dir)
+        ks, leg_xy, swing = pos[side[i]]
+        lo, hi = np.searchsorted(ks, int(k[prev]) + 1), np.searchsorted(ks, int(k[i]), "right")
+        sw = leg_xy[lo:hi][swing[lo:hi]]
         y_sw = (sw - origin) @ y_dir if len(sw) else np.zeros(0)
         flags[i] = bool(y_st < w_c and np.any(y_sw < -w_c))    # seed001 eq. (11)
     return flags
