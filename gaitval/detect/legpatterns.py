@@ -124,10 +124,22 @@ def classify_segment(nearer_left: bool, nearer_right: bool, width: float,
     return None                                        # {F, B, B, F}: a gap
 
 
+def _median(x: np.ndarray) -> float:
+    """``float(np.median(x))`` of a short 1-D array, the same value without numpy's
+    per-call overhead (~0.1 ms; 3,500 calls per MTST trial): the middle value, or the two
+    middle ones added and halved as ``np.mean`` does; NaN when any value is NaN."""
+    v = sorted(x.tolist())
+    n = len(v)
+    if n == 0 or any(e != e for e in v):
+        return math.nan
+    m = n // 2
+    return float(v[m]) if n % 2 else (v[m - 1] + v[m]) / 2.0
+
+
 def _centre(r: np.ndarray, a: np.ndarray, rho: float) -> tuple[float, float]:
     """SL/FS_O centre of a segment with ranges ``r`` and angles ``a``."""
     bearing = 0.5 * (a[0] + a[-1])
-    rc = float(np.median(r)) + _SQRT3_2 * rho
+    rc = _median(r) + _SQRT3_2 * rho
     return rc * math.cos(bearing), rc * math.sin(bearing)
 
 
@@ -140,7 +152,7 @@ def _fs_u_centre(r, a, rho, width, occluder_high: bool) -> tuple[float, float]:
     sgn = 1.0 if occluder_high else -1.0              # higher index = counter-clockwise
     el = (-er[1] * sgn, er[0] * sgn)
     u = max(0.0, 1.0 - width / (2.0 * rho))
-    depth = float(np.median(r)) - r[i_out] + rho * math.sqrt(max(0.0, 1.0 - u * u))
+    depth = _median(r) - r[i_out] + rho * math.sqrt(max(0.0, 1.0 - u * u))
     return (bx + rho * el[0] + depth * er[0], by + rho * el[1] + depth * er[1])
 
 
@@ -165,8 +177,8 @@ def see_through_occluders(masked: np.ndarray, raw: np.ndarray, angles: np.ndarra
         # the occluder's edge)
         lo = masked[max(0, i0 - 3):i0]
         hi = masked[i1:i1 + 3]
-        left = float(np.median(lo[np.isfinite(lo)]))
-        right = float(np.median(hi[np.isfinite(hi)]))
+        left = _median(lo[np.isfinite(lo)])
+        right = _median(hi[np.isfinite(hi)])
         if abs(left - right) >= half:
             continue
         occ = raw[i0:i1]
