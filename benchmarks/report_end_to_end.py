@@ -6,6 +6,10 @@ Usage::
     .venv/bin/python benchmarks/report_end_to_end.py --study default --repeat 3
     # the code of another checkout (e.g. a `git worktree` of an older commit):
     PYTHONPATH=/tmp/base .venv/bin/python benchmarks/report_end_to_end.py --root /tmp/base
+    # keep the run's folder, then time a rerun with nothing changed in it:
+    .venv/bin/python benchmarks/report_end_to_end.py --study default --workdir /tmp/e2e
+    cd /tmp/e2e/run0 && time /path/to/.venv/bin/snakemake -s /path/to/Snakefile \
+        --cores 2 --config 'run=["default"]' -n
 
 Each repeat runs Snakemake (``--cores N``) from the checkout's Snakefile in a fresh temp
 dir (fresh data/, results/, reports/, logs/; the venv is not touched), so the simulation
@@ -178,15 +182,21 @@ def main() -> None:
                     help="checkout whose Snakefile runs (default: this one)")
     ap.add_argument("--keep", type=Path, default=None,
                     help="copy the last run's results/ here (to compare outputs)")
+    ap.add_argument("--workdir", type=Path, default=None,
+                    help="run in this new folder and keep it (data/, results/, reports/, "
+                         "logs/: e.g. to time a rerun with nothing changed afterwards)")
     ap.add_argument("--no-fork-server", action="store_true",
                     help="one plain Python process per job (fork_server=False)")
     ap.add_argument("--no-startup", action="store_true",
                     help="skip the per-rule start-up measurement")
     args = ap.parse_args()
     walls, cpus, jobs = [], [], 0
+    if args.workdir is not None:
+        args.workdir.mkdir(parents=True)               # refuses an existing folder
     with tempfile.TemporaryDirectory(prefix="gaitval-e2e-") as tmp:
         for r in range(args.repeat):
-            work = Path(tmp) / f"run{r}"
+            base = args.workdir.resolve() if args.workdir is not None else Path(tmp)
+            work = base / f"run{r}"
             work.mkdir()
             wall, cpu, log = _run_snakemake(args.root.resolve(), work, args.study, args.cores,
                                             fork_server=not args.no_fork_server)
