@@ -94,15 +94,18 @@ class Associator:
 def ranked_associations(cand_l, cand_r, d_max: float) -> list[tuple[float, int, int]]:
     """All joint associations as ``(c_{a,b}, a, b)``, cheapest first (seed000 eq. (9)–(10)).
     """
-    opts_l = [(0, d_max)] + list(cand_l)
-    opts_r = [(0, d_max)] + list(cand_r)
-    out = []
-    for a, da in opts_l:
-        for b, db in opts_r:
-            if a != 0 and a == b:
-                continue
-            out.append((da + db, a, b))                 # seed000 eq. (9)
-    out.sort(key=lambda c: c[0])                        # stable: ties keep (a, b) order
+    out = [(d_max + d_max, 0, 0)]
+    add = out.append
+    for b, db in cand_r:
+        add((d_max + db, 0, b))                         # seed000 eq. (9), a = 0
+    for a, da in cand_l:
+        add((da + d_max, a, 0))
+        for b, db in cand_r:
+            if b != a:
+                add((da + db, a, b))                    # seed000 eq. (9)
+    # ties in c: a, then b, ascending -- the enumeration order, since the candidates come
+    # in ascending j; plain tuple order does that without a Python key function
+    out.sort()
     return out
 
 
