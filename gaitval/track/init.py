@@ -353,10 +353,26 @@ class Background:
         """:meth:`occupied` of positions ``zs`` (m, 2) at scans ``ks`` (m,)."""
         nb = ks[:, None] + self.offsets[None, :]                   # (m, 2w+1): scan k + o
         valid = (nb >= 0) & (nb < self.n)
-        Q = self.P[np.clip(nb, 0, self.n - 1)]                     # (m, 2w+1, J, 2)
-        d = np.hypot(Q[..., 0] - zs[:, None, None, 0], Q[..., 1] - zs[:, None, None, 1])
-        count = ((d < self.r).any(axis=2) & valid).sum(axis=1)
+        Q = self.P.take(np.clip(nb, 0, self.n - 1), axis=0)        # (m, 2w+1, J, 2)
+        near = hypot_below(Q[..., 0] - zs[:, None, None, 0], Q[..., 1] - zs[:, None, None, 1],
+                           self.r)
+        count = (near.any(axis=2) & valid).sum(axis=1)
         return count >= self.fraction * valid.sum(axis=1)
 
     def occupied(self, k: int, z) -> bool:
         return bool(self.occupied_many(np.array([k]), np.asarray(z, dtype=float)[None, :])[0])
+
+
+def hypot_below(dx: np.ndarray, dy: np.ndarray, r: float) -> np.ndarray:
+    """``np.hypot(dx, dy) < r``, elementwise, with the same result but cheaper: dx² + dy² is
+    compared with r², and ``np.hypot`` (a libm call per element) is evaluated only where
+    dx² + dy² lies within a relative 1e-9 of r² (rounding cannot decide there)."""
+    d2 = dx * dx
+    d2 += dy * dy
+    r2 = r * r
+    lo, hi = r2 * (1.0 - 1e-9), r2 * (1.0 + 1e-9)
+    near = d2 < lo
+    edge = (d2 >= lo) & (d2 <= hi)
+    if edge.any():
+        near[edge] = np.hypot(dx[edge], dy[edge]) < r
+    return near
