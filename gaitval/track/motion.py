@@ -73,6 +73,7 @@ class SwingAccelerationWindow:
 
     def push(self, a: float, swinging: bool) -> None:
         steps = self.steps
+        changed = swinging
         if swinging:
             steps.append(a)
             self.total += a
@@ -85,7 +86,9 @@ class SwingAccelerationWindow:
             if old is not None:
                 self.total -= old
                 self.count -= 1
-        self.mean = self.total / self.count if self.count > 0 else 0.0
+                changed = True
+        if changed:                              # else the mean is what it was
+            self.mean = self.total / self.count if self.count > 0 else 0.0
 
     def reset(self, acc: list[float], swing: list[bool]) -> None:
         """Start from the window's steps, oldest first: ``acc`` their ‖a‖, ``swing`` whether
