@@ -490,3 +490,16 @@ def test_regression_snapshot():
                     "GAITVAL_UPDATE_SNAPSHOTS=1 and commit it")
     want = json.loads(SNAPSHOT.read_text())
     assert got == want
+
+
+def test_hypot_below_is_np_hypot_compared_even_at_the_edge():
+    from gaitval.track.init import hypot_below
+    rng = np.random.default_rng(7)
+    r = 0.06
+    t = rng.uniform(0, 2 * np.pi, 20000)
+    rr = r * (1 + rng.integers(-4, 5, t.size) * np.finfo(float).eps)    # within ulps of r
+    dx = np.concatenate([rng.normal(0, 0.05, 20000), rr * np.cos(t), [np.nan, np.inf, 1e9]])
+    dy = np.concatenate([rng.normal(0, 0.05, 20000), rr * np.sin(t), [0.0, np.nan, 1e9]])
+    expected = np.hypot(dx, dy) < r
+    assert 0 < expected.sum() < expected.size
+    assert np.array_equal(hypot_below(dx, dy, r), expected)

@@ -81,10 +81,27 @@ class Associator:
         return cand
 
     def obvious(self, cand_l, cand_r) -> tuple[int, int]:
-        """:func:`_GNN_FAST` on the gate's ``(j, λ²)`` (the cost of the one candidate per
-        leg computed on the spot; (-1, -1) when the full ranking is needed)."""
-        return _GNN_FAST(self.d_max, cand_l, cand_r,
-                         math.sqrt if self.cost == "mahalanobis" else None)
+        """The least-cost association when it is obvious, else (-1, -1).
+
+        With at most one gated observation per leg, different ones, and each one's cost
+        below d_max, taking them costs less than any alternative (the same result as the
+        full ranking).  Tested on the gate's ``(j, λ²)``, each cost computed on the spot.
+        """
+        if len(cand_l) > 1 or len(cand_r) > 1:
+            return -1, -1
+        a = cand_l[0][0] if cand_l else 0
+        b = cand_r[0][0] if cand_r else 0
+        if a and a == b:
+            return -1, -1
+        d_max = self.d_max
+        if self.cost == "mahalanobis":
+            sqrt = math.sqrt
+            if ((cand_l and sqrt(cand_l[0][1]) >= d_max)            # d = λ, seed000 eq. (10)
+                    or (cand_r and sqrt(cand_r[0][1]) >= d_max)):
+                return -1, -1
+        elif (cand_l and cand_l[0][1] >= d_max) or (cand_r and cand_r[0][1] >= d_max):
+            return -1, -1
+        return a, b
 
     def select(self, cand_l: list[tuple[int, float]], cand_r: list[tuple[int, float]],
                prev_phase: int, phase_of: Callable[[int, int], int]) -> tuple[int, int]:
@@ -94,38 +111,19 @@ class Associator:
 def ranked_associations(cand_l, cand_r, d_max: float) -> list[tuple[float, int, int]]:
     """All joint associations as ``(c_{a,b}, a, b)``, cheapest first (seed000 eq. (9)–(10)).
     """
-    opts_l = [(0, d_max)] + list(cand_l)
-    opts_r = [(0, d_max)] + list(cand_r)
-    out = []
-    for a, da in opts_l:
-        for b, db in opts_r:
-            if a != 0 and a == b:
-                continue
-            out.append((da + db, a, b))                 # seed000 eq. (9)
-    out.sort(key=lambda c: c[0])                        # stable: ties keep (a, b) order
+    out = [(d_max + d_max, 0, 0)]
+    add = out.append
+    for b, db in cand_r:
+        add((d_max + db, 0, b))                         # seed000 eq. (9), a = 0
+    for a, da in cand_l:
+        add((da + d_max, a, 0))
+        for b, db in cand_r:
+            if b != a:
+                add((da + db, a, b))                    # seed000 eq. (9)
+    # ties in c: a, then b, ascending -- the enumeration order, since the candidates come
+    # in ascending j; plain tuple order does that without a Python key function
+    out.sort()
     return out
-
-
-def _GNN_FAST(d_max, cand_l, cand_r, cost=None) -> tuple[int, int]:
-    """The least-cost association when it is obvious, else (-1, -1).
-
-    With at most one gated observation per leg, different ones, and every cost < d_max,
-    taking them costs less than any alternative (same result as the full ranking).
-    ``cost`` turns a candidate's gate value into its cost (None: it is the cost already),
-    so the gate's ``(j, λ²)`` can be tested without building the cost lists.
-    """
-    if len(cand_l) > 1 or len(cand_r) > 1:
-        return -1, -1
-    a = cand_l[0][0] if cand_l else 0
-    b = cand_r[0][0] if cand_r else 0
-    if a and a == b:
-        return -1, -1
-    if cost is None:
-        if (cand_l and cand_l[0][1] >= d_max) or (cand_r and cand_r[0][1] >= d_max):
-            return -1, -1
-    elif (cand_l and cost(cand_l[0][1]) >= d_max) or (cand_r and cost(cand_r[0][1]) >= d_max):
-        return -1, -1
-    return a, b
 
 
 @ASSOCIATORS.register("gnn")

@@ -179,10 +179,10 @@ class MotionCheck:
         lists = getattr(source, "lists", None)
         pts = lists() if lists is not None else [a.tolist() for a in arrays]
         background = Background(arrays)
-        visited: dict[int, set] = {}
+        visited: set[tuple[int, int, int]] = set()          # (k, i, j) followed already
         for k in range(first_scan, len(pts)):
             for i, j in self._pairs(pts[k], d_min, d_max):
-                if (i, j) in visited.get(k, ()):
+                if (k, i, j) in visited:
                     continue                       # already followed from an earlier scan
                 if self._follow(pts, still, background, k, i, j, 1.5 * d_max, visited):
                     return k, i, j
@@ -235,13 +235,15 @@ class MotionCheck:
         """
         pos = [pts[k0][i], pts[k0][j]]
         net = [[0.0, 0.0], [0.0, 0.0]]
+        net_len = [0.0, 0.0]                  # per leg: |net|
         pending: list[list] = [[], []]        # per leg: (k, g, z, dx, dy) not yet tested
         reach = [0.0, 0.0]                    # per leg: Σ |pending step|
         lost = [0, 0]
-        hypot, min_travel = math.hypot, self.min_travel_m
+        hypot, thr, max_lost = math.hypot, self.min_travel_m, self.max_lost_scans
+        associate, travelled = self._associate, self._travelled
         for k in range(k0 + 1, len(pts)):
             obs = pts[k]
-            got = self._associate(obs, pos, lost, span)
+            got = associate(obs, pos, lost, span)
             for f in (0, 1):
                 g = got[f]
                 if g is None:
@@ -253,22 +255,23 @@ class MotionCheck:
                     pending[f].append((k, g, z, dx, dy))
                     reach[f] += hypot(dx, dy)
                 pos[f], lost[f] = z, 0
-            if got[0] is not None and got[1] is not None:
-                visited.setdefault(k, set()).add((min(got), max(got)))
-            if self._travelled(net, pending, reach, background):
+            g0, g1 = got
+            if g0 is not None and g1 is not None:
+                visited.add((k, g0, g1) if g0 < g1 else (k, g1, g0))
+            # the bound |net| + Σ|pending| of both legs (with a margin for rounding) must
+            # reach min_travel_m before the pending steps are worth testing
+            if (not (net_len[0] + reach[0]) * (1 + 1e-9) + 1e-12 < thr
+                    and not (net_len[1] + reach[1]) * (1 + 1e-9) + 1e-12 < thr
+                    and travelled(net, net_len, pending, reach, background)):
                 return True
-            if max(lost) > self.max_lost_scans:
+            if lost[0] > max_lost or lost[1] > max_lost:
                 return False
         return False
 
-    def _travelled(self, net, pending, reach, background) -> bool:
-        """|net travel| ≥ min_travel_m for both legs.  A leg's pending steps are tested only
-        when the bounds |net| + Σ|pending| (with a margin for rounding) of both legs allow
-        it."""
+    def _travelled(self, net, net_len, pending, reach, background) -> bool:
+        """|net travel| ≥ min_travel_m for both legs, testing the pending steps of each leg
+        in scan order (the caller has checked the bounds)."""
         thr = self.min_travel_m
-        for f in (0, 1):
-            if (math.hypot(*net[f]) + reach[f]) * (1 + 1e-9) + 1e-12 < thr:
-                return False
         for f in (0, 1):
             n, steps = net[f], pending[f]
             for (_, _, _, dx, dy), occupied in zip(steps, background.resolve(
@@ -278,7 +281,8 @@ class MotionCheck:
                     n[1] += dy
             steps.clear()
             reach[f] = 0.0
-            if math.hypot(n[0], n[1]) < thr:
+            net_len[f] = math.hypot(n[0], n[1])
+            if net_len[f] < thr:
                 return False
         return True
 
@@ -289,7 +293,7 @@ class MotionCheck:
         dist = [0.0, 0.0]
         if not obs:
             return got
-        hypot = math.hypot
+        hypot, step, gate_max = math.hypot, self.max_step_m, self.max_gate_m
         for f in (0, 1):
             px, py = pos[f]
             m, dm = 0, math.inf
@@ -297,7 +301,8 @@ class MotionCheck:
                 d = hypot(x - px, y - py)
                 if d < dm:
                     m, dm = q, d
-            if dm <= min(self.max_step_m * (1 + lost[f]), self.max_gate_m):
+            gate = step * (1 + lost[f])
+            if dm <= (gate if gate < gate_max else gate_max):
                 got[f], dist[f] = m, dm
         if got[0] is not None and got[0] == got[1]:
             got[1 if dist[0] <= dist[1] else 0] = None
@@ -348,10 +353,26 @@ class Background:
         """:meth:`occupied` of positions ``zs`` (m, 2) at scans ``ks`` (m,)."""
         nb = ks[:, None] + self.offsets[None, :]                   # (m, 2w+1): scan k + o
         valid = (nb >= 0) & (nb < self.n)
-        Q = self.P[np.clip(nb, 0, self.n - 1)]                     # (m, 2w+1, J, 2)
-        d = np.hypot(Q[..., 0] - zs[:, None, None, 0], Q[..., 1] - zs[:, None, None, 1])
-        count = ((d < self.r).any(axis=2) & valid).sum(axis=1)
+        Q = self.P.take(np.clip(nb, 0, self.n - 1), axis=0)        # (m, 2w+1, J, 2)
+        near = hypot_below(Q[..., 0] - zs[:, None, None, 0], Q[..., 1] - zs[:, None, None, 1],
+                           self.r)
+        count = (near.any(axis=2) & valid).sum(axis=1)
         return count >= self.fraction * valid.sum(axis=1)
 
     def occupied(self, k: int, z) -> bool:
         return bool(self.occupied_many(np.array([k]), np.asarray(z, dtype=float)[None, :])[0])
+
+
+def hypot_below(dx: np.ndarray, dy: np.ndarray, r: float) -> np.ndarray:
+    """``np.hypot(dx, dy) < r``, elementwise, with the same result but cheaper: dx² + dy² is
+    compared with r², and ``np.hypot`` (a libm call per element) is evaluated only where
+    dx² + dy² lies within a relative 1e-9 of r² (rounding cannot decide there)."""
+    d2 = dx * dx
+    d2 += dy * dy
+    r2 = r * r
+    lo, hi = r2 * (1.0 - 1e-9), r2 * (1.0 + 1e-9)
+    near = d2 < lo
+    edge = (d2 >= lo) & (d2 <= hi)
+    if edge.any():
+        near[edge] = np.hypot(dx[edge], dy[edge]) < r
+    return near

@@ -82,8 +82,12 @@ class LegFilter:
             return self
         out = copy.copy(self)
         out.r_sd_m = k * leg_width_m
-        out._cache = {}
+        out._noise_changed()
         return out
+
+    def _noise_changed(self) -> None:
+        """Recompute what a filter keeps derived from its noise parameters."""
+        self._cache = {}
 
     def init(self, x: float, y: float, vx: float = 0.0, vy: float = 0.0):
         raise NotImplementedError
@@ -146,7 +150,11 @@ class AxisKalmanFilter(LegFilter):
                  r_sd_leg_widths: float | None = None):
         super().__init__(q_accel_sd_mps2, r_sd_m, p0_pos_sd_m, p0_vel_sd_mps)
         self.r_sd_leg_widths = r_sd_leg_widths
-        self._cache: dict[float, tuple] = {}
+        self._noise_changed()
+
+    def _noise_changed(self):
+        self._cache: dict[float, tuple] = {}     # per Δt, see _consts
+        self._r2 = self.r_sd_m ** 2               # r², the per-axis R
 
     def init(self, x, y, vx=0.0, vy=0.0):
         return (float(x), float(y), float(vx), float(vy),
@@ -171,7 +179,7 @@ class AxisKalmanFilter(LegFilter):
 
     def correct(self, s, zx, zy):
         x, y, vx, vy, a, b, c = s
-        sv = a + self.r_sd_m ** 2            # seed000 eq. (12): S = C P Cᵀ + R (per axis)
+        sv = a + self._r2            # seed000 eq. (12): S = C P Cᵀ + R (per axis)
         k0 = a / sv                          # seed000 eq. (15): K = P Cᵀ S⁻¹
         k1 = b / sv
         ex = zx - x
@@ -187,11 +195,11 @@ class AxisKalmanFilter(LegFilter):
     def mahalanobis2(self, s, zx, zy):
         ex = zx - s[0]
         ey = zy - s[1]
-        return (ex * ex + ey * ey) / (s[4] + self.r_sd_m ** 2)   # seed000 eq. (11)
+        return (ex * ex + ey * ey) / (s[4] + self._r2)   # seed000 eq. (11)
 
     def lam2_all(self, s, obs):
         px, py = s[0], s[1]
-        sv = s[4] + self.r_sd_m ** 2                 # seed000 eq. (12), per axis
+        sv = s[4] + self._r2                 # seed000 eq. (12), per axis
         out = []
         for zx, zy in obs:
             ex = zx - px
@@ -201,7 +209,7 @@ class AxisKalmanFilter(LegFilter):
 
     def gated(self, s, obs, g):
         px, py = s[0], s[1]
-        sv = s[4] + self.r_sd_m ** 2                 # seed000 eq. (12), per axis
+        sv = s[4] + self._r2                 # seed000 eq. (12), per axis
         out = []
         j = 0
         for zx, zy in obs:
@@ -214,7 +222,7 @@ class AxisKalmanFilter(LegFilter):
         return out
 
     def innovation_cov(self, s):
-        v = s[4] + self.r_sd_m ** 2
+        v = s[4] + self._r2
         return np.array([[v, 0.0], [0.0, v]])
 
 

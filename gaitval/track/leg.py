@@ -83,12 +83,12 @@ class LegTrack:
     def fill(self, res: "TrackResult", f: int, k0: int) -> None:
         """Write scans k0.. of this leg into row f of ``res``."""
         post = self.post[k0:]
-        try:                                  # states of floats only: one conversion
-            pv = np.array(post, dtype=float)[:, :4]
-        except ValueError:                    # a state holding arrays (e.g. a matrix P)
-            pv = np.array([p[:4] for p in post], dtype=float).reshape(-1, 4)
-        res.x[f, k0:], res.y[f, k0:] = pv[:, 0], pv[:, 1]
-        res.vx[f, k0:], res.vy[f, k0:] = pv[:, 2], pv[:, 3]
+        # a state begins with x, y, vx, vy as Python floats: lists of floats convert several
+        # times faster than numpy's shape discovery over the list of state tuples
+        res.x[f, k0:] = [s[0] for s in post]
+        res.y[f, k0:] = [s[1] for s in post]
+        res.vx[f, k0:] = [s[2] for s in post]
+        res.vy[f, k0:] = [s[3] for s in post]
         res.observed[f, k0:] = self.real[k0:]
         res.interpolated[f, k0:] = self.interpolated[k0:]
         res.obs_index[f, k0:] = self.obs_index[k0:]

@@ -58,36 +58,42 @@ class SwingAccelerationWindow:
 
     Kept as a running sum over the entries pushed since the last :meth:`reset`: :meth:`push`
     adds step k and drops step k − N_ac; after a re-filter rewrote the history,
-    :meth:`reset` starts again from the rewritten window.
+    :meth:`reset` starts again from the rewritten window.  ``steps`` holds one entry per
+    step, ‖a‖ when the leg was swinging and None when not.
     """
 
-    __slots__ = ("n_ac", "acc", "swing", "total", "count", "mean")
+    __slots__ = ("n_ac", "steps", "total", "count", "mean")
 
     def __init__(self, n_ac: int):
         self.n_ac = n_ac
-        self.acc: list[float] = []
-        self.swing: list[bool] = []
+        self.steps: list[float | None] = []
         self.total = 0.0
         self.count = 0
         self.mean = 0.0          # = value(), kept current so the per-scan read is a load
 
     def push(self, a: float, swinging: bool) -> None:
-        acc, swing = self.acc, self.swing
-        acc.append(a)
-        swing.append(swinging)
+        steps = self.steps
+        changed = swinging
         if swinging:
+            steps.append(a)
             self.total += a
             self.count += 1
-        i = len(acc) - 1 - self.n_ac            # the step that leaves the window
-        if i >= 0 and swing[i]:
-            self.total -= acc[i]
-            self.count -= 1
-        self.mean = self.total / self.count if self.count > 0 else 0.0
+        else:
+            steps.append(None)
+        i = len(steps) - 1 - self.n_ac          # the step that leaves the window
+        if i >= 0:
+            old = steps[i]
+            if old is not None:
+                self.total -= old
+                self.count -= 1
+                changed = True
+        if changed:                              # else the mean is what it was
+            self.mean = self.total / self.count if self.count > 0 else 0.0
 
     def reset(self, acc: list[float], swing: list[bool]) -> None:
         """Start from the window's steps, oldest first: ``acc`` their ‖a‖, ``swing`` whether
-        the leg was swinging (the lists are taken over, not copied)."""
-        self.acc, self.swing = acc, swing
+        the leg was swinging."""
+        self.steps = [a if sw else None for a, sw in zip(acc, swing)]
         sel = [a for a, sw in zip(acc, swing) if sw]
         self.total, self.count = float(sum(sel)), len(sel)
         self.mean = self.total / self.count if self.count > 0 else 0.0

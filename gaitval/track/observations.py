@@ -24,17 +24,10 @@ class DetectionSeries:
     def __init__(self, xy: list[np.ndarray], patterns: list[list[str]]):
         self._patterns = patterns
         arrs = [np.asarray(o, dtype=float) for o in xy]
-        arrs = [o if o.ndim == 2 and o.shape[1:] == (2,) else o.reshape(-1, 2) for o in arrs]
-        # one (N, 2) array; per scan a view of it, and plain Python floats for the loop
-        # (numpy scalars are several times slower)
-        allxy = np.concatenate(arrs) if arrs else np.zeros((0, 2))
-        flat = allxy.tolist()
-        self._arrays, self._lists, i = [], [], 0
-        for o in arrs:
-            j = i + len(o)
-            self._arrays.append(allxy[i:j])
-            self._lists.append(flat[i:j])
-            i = j
+        self._arrays = [o if o.ndim == 2 and o.shape[1:] == (2,) else o.reshape(-1, 2)
+                        for o in arrs]
+        # and plain Python floats for the loop (numpy scalars are several times slower)
+        self._lists = [o.tolist() for o in self._arrays]
 
     def __len__(self) -> int:
         return len(self._arrays)

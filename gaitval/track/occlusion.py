@@ -167,12 +167,16 @@ class CatmullRomInterpolation(OcclusionHandler):
 
     def after_scan(self, st, run, k):
         last_real = st.last_real
-        for f, leg in enumerate(run.legs):
-            if leg.real[k]:
-                if last_real[f] < k - 1:          # leg f reappears after k−1−last UO scans
-                    self._reappeared(st, f, last_real[f], k)
-                last_real[f] = k
-        if st.due and k >= st.next_due:
+        L, R = run.legs
+        if L.real[k]:
+            if last_real[0] < k - 1:              # leg reappears after k−1−last UO scans
+                self._reappeared(st, 0, last_real[0], k)
+            last_real[0] = k
+        if R.real[k]:
+            if last_real[1] < k - 1:
+                self._reappeared(st, 1, last_real[1], k)
+            last_real[1] = k
+        if k >= st.next_due:                      # (next_due = n while nothing is due)
             now = [p for p in st.due if p[0] <= k]
             st.due = [p for p in st.due if p[0] > k]
             for _, f, ka, m in sorted(now, key=lambda p: (p[2], p[1])):

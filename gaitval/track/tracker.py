@@ -46,6 +46,7 @@ from gaitval.track.occlusion import OCCLUSION_HANDLERS
 from gaitval.track.phase import PHASE_MODELS
 
 _SWING = tuple(SWINGING[i] for i in range(6))
+_SWING_OF = tuple(tuple(sw[f] for sw in _SWING) for f in (0, 1))   # [leg][phase]
 
 
 def step_durations(t: np.ndarray, dt_s: float | None) -> tuple[float, np.ndarray]:
@@ -179,9 +180,23 @@ class Hypotheses:
     def phase_of(self, a: int, b: int) -> int:
         ph = self.pcache.get((a, b))
         if ph is None:
-            ph = self.pcache[(a, b)] = self.identify(self.corrected(0, a),
-                                                     self.corrected(1, b))
+            # corrected(0, a), corrected(1, b) written out: this runs several times a scan
+            c0, c1 = self.cache
+            sl = c0.get(a)
+            if sl is None:
+                o = self.obs[a - 1]
+                sl = c0[a] = self.correct(self.prior[0], o[0], o[1])  # seed000 eq. (14)–(16)
+            sr = c1.get(b)
+            if sr is None:
+                o = self.obs[b - 1]
+                sr = c1[b] = self.correct(self.prior[1], o[0], o[1])
+            ph = self.pcache[(a, b)] = self.identify(sl, sr)       # seed000 eq. (3)–(5)
         return ph
+
+    def outcome(self, a: int, b: int):
+        """``(left state, right state, phase)`` after left ← a, right ← b."""
+        ph = self.phase_of(a, b)
+        return self.cache[0][a], self.cache[1][b], ph
 
 
 class TrackingRun:
@@ -231,8 +246,8 @@ class TrackingRun:
     def commit(self, k: int, a: int, b: int, hyp: Hypotheses, obs, pats) -> None:
         """The association (a, b): corrected states, observations used, phase, book-keeping."""
         L, R = self.legs
-        L.post[k] = hyp.corrected(0, a)                           # seed000 eq. (14)–(16)
-        R.post[k] = hyp.corrected(1, b)
+        # seed000 eq. (14)–(16) (corrected states) and eq. (3)–(5) (the phase they are in)
+        L.post[k], R.post[k], self.phase[k] = hyp.outcome(a, b)
         if a:
             L.observed(k, obs[a - 1], pats[a - 1], a - 1)
         else:
@@ -241,7 +256,6 @@ class TrackingRun:
             R.observed(k, obs[b - 1], pats[b - 1], b - 1)
         else:
             R.unobserved(k)
-        self.phase[k] = hyp.phase_of(a, b)                        # seed000 eq. (3)–(5)
         self.book(k)
 
     def book(self, k: int) -> None:
@@ -275,10 +289,10 @@ class TrackingRun:
 
     def resync(self, k: int) -> None:
         """Rebuild the acceleration windows from the (rewritten) history up to k."""
-        for f, leg in enumerate(self.legs):
+        for leg, swing in zip(self.legs, _SWING_OF):
             if leg.window is not None:
                 lo = max(self.k0 + 1, k - leg.window.n_ac + 1)
-                leg.window.reset(leg.acc[lo:k + 1], [_SWING[p][f] for p in self.phase[lo:k + 1]])
+                leg.window.reset(leg.acc[lo:k + 1], [swing[p] for p in self.phase[lo:k + 1]])
 
     def restart(self, k: int, obs, pats, il: int, ir: int) -> None:
         """Re-initialise both legs at scan k on observations ``il`` (left) and ``ir``
