@@ -101,6 +101,35 @@ def test_likelihood_borders_regions_and_no_points(model):
     assert w[0] == 0.0                                                # on the other leg: β 0
 
 
+def _sums(P, px, py, X, Y, exact):
+    near = K.near_points(X, Y, px, py, P.hx, P.hy)
+    s, n = np.zeros((4, px.size)), np.zeros((4, px.size), np.int64)
+    f = K._region_sums_exact if exact else K._region_sums
+    return f(px, py, X, Y, near, P.hx, P.hy, P.abc, s, n), s, n
+
+
+def test_vectorised_region_sums_equal_the_pair_by_pair_sums(model):
+    """The particle-inner, vectorised region sums (libc_exp's formula inlined) against the
+    pair-by-pair loop with libc_exp: bit for bit; and an exponent beyond the formula's
+    range (σ = 0.1 mm: exponents ≪ −512) makes the vectorised sums report it, and the
+    likelihood, taking the pair-by-pair path, still equals the §III.C formula (to 1e-9:
+    A d² + B d + C cancels terms ≈ 10⁵ at so small a σ)."""
+    rng = np.random.default_rng(6)
+    P = PFArrays(model)
+    X, Y = 0.40 + rng.normal(0, 0.05, 80), rng.normal(0, 0.05, 80)
+    px, py = 0.45 + rng.normal(0, 0.03, 300), rng.normal(0, 0.03, 300)
+    ok, s, n = _sums(P, px, py, X, Y, exact=False)
+    _, s_ref, n_ref = _sums(P, px, py, X, Y, exact=True)
+    assert ok and np.array_equal(s, s_ref) and np.array_equal(n, n_ref) and n.sum() > 1000
+    sharp = dict(model, regions=dict(model["regions"], sd_m=[1e-4] * 4))
+    P = PFArrays(sharp)
+    assert not _sums(P, px, py, X, Y, exact=False)[0]                 # out of range: seen
+    w, cnt = likelihood(P, px, py, X, Y, 0.45, 0.2)
+    w_ref, n_ref = reference_likelihood(sharp, px, py, X, Y, 0.45, 0.2)
+    assert np.array_equal(cnt, n_ref) and (cnt > 0).sum() > 100 and (w > 0).sum() > 10
+    np.testing.assert_allclose(w, w_ref, rtol=1e-9, atol=1e-300)      # 1e-300: subnormals
+
+
 @pytest.mark.skipif(not (platform.system() == "Linux" and platform.machine() == "x86_64"
                          and platform.libc_ver()[0] == "glibc"),
                     reason="libc_exp reproduces glibc's x86-64 exp; other C libraries differ")

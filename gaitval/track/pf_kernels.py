@@ -4,7 +4,7 @@ Imported only by the PF (lazily, from :mod:`gaitval.track.pf` and
 :func:`gaitval.track.pf_likelihood.likelihood`), so that no other job pays numba's import.
 Every kernel is ``@njit(cache=True)`` without ``fastmath``: IEEE arithmetic, no
 reassociation and no contraction into fused multiply-adds (the only ones are the explicit
-``llvm.fma`` of :func:`libc_exp`), and the compiled machine code is cached beside this
+``llvm.fma`` of ``libc_exp``), and the compiled machine code is cached beside this
 file (``__pycache__``, or ``NUMBA_CACHE_DIR``), so a process pays numba's import and the
 loading of the cached kernels once, not a compilation (docs/rollator.md, "Speed").
 
@@ -13,111 +13,30 @@ bit for bit:
 
 * random draws are not made here: :mod:`gaitval.track.pf` draws them with the
   ``numpy.random.Generator`` in the same order and shapes as before and passes them in;
-* ``log``, ``sqrt``, ``hypot`` and β's ``exp`` are the C library's, as numpy's are for
-  float64 on x86-64 without AVX-512 (numpy's AVX-512 ``exp``/``log`` may differ in the last
-  bit); the pair densities' ``exp`` is the C library's algorithm inlined
-  (:func:`libc_exp`, bit-equal to glibc's x86-64 ``exp``; other C libraries may round a
-  last bit differently, and so would numpy there);
-* sums keep numpy's order: the region sums add the pairs particle-major, point ascending
-  (``np.bincount``); row sums are numpy's pairwise summation (:func:`pairwise_sum`); the
-  weighted means add sequentially from 0 (``np.einsum``); the four-region dot product is
-  (R1 + R4) + (R2 + R3) in pair-code order 0, 2, 1, 3 — the order OpenBLAS's x86-64 ``dgemv``
-  used for ``means @ pi`` (a fixed order here, on every machine).
+* ``log``, ``sqrt`` and ``hypot`` are the C library's, as numpy's are for float64 on x86-64
+  without AVX-512 (numpy's AVX-512 ``exp``/``log`` may differ in the last bit); ``exp`` is
+  the C library's algorithm inlined (:func:`gaitval.track.pf_exp.libc_exp`, bit-equal to
+  glibc's x86-64 ``exp``; other C libraries may round a last bit differently, and so would
+  numpy there), vectorised over the particles in the region sums;
+* sums keep numpy's order: each region sum adds its pairs point ascending (the order of
+  ``np.bincount``'s particle-major pass, here point-major for all particles at once); row
+  sums are numpy's pairwise summation (:func:`pairwise_sum`); the weighted means add
+  sequentially from 0 (``np.einsum``); the four-region dot product is (R1 + R4) + (R2 + R3)
+  in pair-code order 0, 2, 1, 3 — the order OpenBLAS's x86-64 ``dgemv`` used for
+  ``means @ pi`` (a fixed order here, on every machine).
 """
 from __future__ import annotations
 
 import math
-import struct
-from fractions import Fraction
 
 import numpy as np
-from llvmlite import ir
-from numba import njit, types
-from numba.core import cgutils
-from numba.extending import intrinsic
+from numba import njit
+
+from gaitval.track.pf_exp import (_C2, _C3, _C4, _C5, _EXP_TAB, _INVLN2N, _NEGLN2HIN,
+                                  _NEGLN2LON, _SHIFT, _bits, _double, _fma, libc_exp)
 
 #: numpy's block size of pairwise summation (numpy/_core/src/umath/loops_utils.h.src)
 _PW_BLOCK = 128
-
-
-# -- exp: the C library's algorithm, inlined ---------------------------------------------------
-@intrinsic
-def _fma(typingctx, a, b, c):
-    """IEEE fused multiply-add a·b + c, one rounding (``llvm.fma.f64``)."""
-    def codegen(context, builder, signature, args):
-        d = ir.DoubleType()
-        fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(d, [d, d, d]),
-                                            "llvm.fma.f64")
-        return builder.call(fn, args)
-    return types.float64(types.float64, types.float64, types.float64), codegen
-
-
-@intrinsic
-def _bits(typingctx, a):
-    """The bits of a float64 as uint64."""
-    def codegen(context, builder, signature, args):
-        return builder.bitcast(args[0], ir.IntType(64))
-    return types.uint64(types.float64), codegen
-
-
-@intrinsic
-def _double(typingctx, a):
-    """A uint64's bits as float64."""
-    def codegen(context, builder, signature, args):
-        return builder.bitcast(args[0], ir.DoubleType())
-    return types.float64(types.uint64), codegen
-
-
-def _exp_table() -> np.ndarray:
-    """2^(i/128) = H_i·(1 + T_i), i < 128: [bits(T_i), bits(H_i) − (i << 45)] per i, H_i the
-    nearest double, T_i the nearest double to the relative rest (the table of glibc's and
-    musl's exp, ``__exp_data.tab``; computed here from a 200-bit 2^(1/128))."""
-    P = 200
-    base = 1 << (1 + 128 * P)
-    for _ in range(7):
-        base = math.isqrt(base)                       # 2^(1/128)·2^P, error < 2^-190
-    bits = lambda d: struct.unpack("<Q", struct.pack("<d", d))[0]   # noqa: E731
-    tab, acc = np.empty(256, np.uint64), 1 << P
-    for i in range(128):
-        t = Fraction(acc, 1 << P)
-        H = float(t)
-        tab[2 * i] = bits(float((t - Fraction(H)) / Fraction(H)))
-        tab[2 * i + 1] = (bits(H) - (i << 45)) % 2 ** 64
-        acc = acc * base >> P
-    return tab
-
-
-_EXP_TAB = _exp_table()
-_INVLN2N = float.fromhex("0x1.71547652b82fep0") * 128      # N/ln2, N = 128
-_NEGLN2HIN = -float.fromhex("0x1.62e42fefa0000p-8")         # −ln2/N, high part
-_NEGLN2LON = -float.fromhex("0x1.cf79abc9e3b3ap-47")        # −ln2/N, low part
-_SHIFT = float.fromhex("0x1.8p52")
-_C2, _C3, _C4, _C5 = (float.fromhex(h) for h in (
-    "0x1.ffffffffffdbdp-2", "0x1.555555555543cp-3", "0x1.55555cf172b91p-5",
-    "0x1.1111167a4d017p-7"))
-
-
-@njit(cache=True)
-def libc_exp(x):
-    """exp(x), bit for bit the value of glibc ≥ 2.28's ``exp`` on x86-64 with FMA (the one
-    ``np.exp`` and ``math.exp`` call here): ARM's optimized-routines algorithm, x = k ln2/128
-    + r, 2^(k/128) from the table, exp(r) − 1 by a degree-5 polynomial, with glibc's fused
-    multiply-adds.  Inlined, about twice as fast as the library call; |x| outside
-    [2^-54, 512) and NaN go to the library (``math.exp``).  tests/test_pf_kernel.py checks it
-    against ``np.exp``."""
-    ax = abs(x)
-    if not (ax < 512.0 and ax >= 5.551115123125783e-17):       # 2^-54 ≤ |x| < 512
-        return math.exp(x)
-    kd = _INVLN2N * x + _SHIFT
-    ki = _bits(kd)
-    kd -= _SHIFT
-    r = _fma(kd, _NEGLN2LON, _fma(kd, _NEGLN2HIN, x))
-    i = (ki & np.uint64(127)) << np.uint64(1)
-    tail = _double(_EXP_TAB[i])
-    scale = _double(_EXP_TAB[i + np.uint64(1)] + (ki << np.uint64(45)))
-    r2 = r * r
-    tmp = _fma(r2 * r2, _fma(r, _C5, _C4), _fma(r2, _fma(r, _C3, _C2), tail + r))
-    return _fma(scale, tmp, scale)
 
 
 @njit(cache=True)
@@ -186,37 +105,81 @@ def near_points(X, Y, px, py, hx, hy):
     return keep[:m]
 
 
-#: row k: which region sum a pair of code k adds to (row 4: a pair outside the window)
-_ONE_HOT = np.vstack([np.eye(4), np.zeros((1, 4))])
+@njit(cache=True, inline="always")
+def _pair_exponent(pxi, pyi, xj, yj, hx, hy, A, B, C):
+    """Pair (particle, point): the pair code (4: outside the window's near half) and the
+    exponent of the pair's normal density (−1 outside); ``A, B, C``: the coefficients
+    per code (``abc``'s columns, as 4-tuples).  Branch-free (vectorises)."""
+    u = pxi - xj
+    v = pyi - yj
+    av = abs(v)
+    inside = (u > 0.0) & (u <= hx) & (av <= hy)                     # window ∩ lower half
+    inner, left = av < u, v >= 0.0                                    # seed002 §III.C R_m
+    a = (A[3] if inner else A[2]) if left else (A[1] if inner else A[0])
+    b = (B[3] if inner else B[2]) if left else (B[1] if inner else B[0])
+    c = (C[3] if inner else C[2]) if left else (C[1] if inner else C[0])
+    d2 = u * u + v * v
+    x = a * d2 + b * math.sqrt(d2) + c                                # ln N(d | μ_Rm, Σ_Rm)
+    return ((inner + 2 * left) if inside else 4), (x if inside else -1.0)
 
 
 @njit(cache=True, inline="always")
-def _pair_exponents(pxi, pyi, Xn, Yn, hx, hy, abc, x, code, ki, r):
-    """For particle (pxi, pyi) and each point j: ``code[j]`` the pair code (4: outside the
-    window's near half), ``x[j]`` the exponent of the pair's normal density (−1 outside), and
-    the first, table-free half of :func:`libc_exp` of it (``ki``, ``r``).
-    Branch-free, so that it vectorises."""
-    A0, A1, A2, A3 = abc[0, 0], abc[1, 0], abc[2, 0], abc[3, 0]
-    B0, B1, B2, B3 = abc[0, 1], abc[1, 1], abc[2, 1], abc[3, 1]
-    C0, C1, C2, C3 = abc[0, 2], abc[1, 2], abc[2, 2], abc[3, 2]
-    for j in range(Xn.size):
-        u = pxi - Xn[j]
-        v = pyi - Yn[j]
-        av = abs(v)
-        inside = (u > 0.0) & (u <= hx) & (av <= hy)                 # window ∩ lower half
-        inner, left = av < u, v >= 0.0                                # seed002 §III.C R_m
-        A = (A3 if inner else A2) if left else (A1 if inner else A0)
-        B = (B3 if inner else B2) if left else (B1 if inner else B0)
-        C = (C3 if inner else C2) if left else (C1 if inner else C0)
-        d2 = u * u + v * v
-        e = A * d2 + B * math.sqrt(d2) + C                            # ln N(d | μ_Rm, Σ_Rm)
-        e = e if inside else -1.0
-        x[j] = e
-        code[j] = (inner + 2 * left) if inside else 4
-        kd = _INVLN2N * e + _SHIFT                                    # libc_exp, first half
-        ki[j] = _bits(kd)
-        kd -= _SHIFT
-        r[j] = _fma(kd, _NEGLN2LON, _fma(kd, _NEGLN2HIN, e))
+def _columns(abc):
+    """``abc``'s three columns as 4-tuples of scalars."""
+    return ((abc[0, 0], abc[1, 0], abc[2, 0], abc[3, 0]),
+            (abc[0, 1], abc[1, 1], abc[2, 1], abc[3, 1]),
+            (abc[0, 2], abc[1, 2], abc[2, 2], abc[3, 2]))
+
+
+@njit(cache=True)
+def _region_sums(px, py, X, Y, near, hx, hy, abc, s, n):
+    """Σ of the pair densities (``s``, (4, N)) and pair counts (``n``) per particle and
+    code, the points ``near`` ascending: the point loop outer, the particle loop inner (it
+    vectorises, :func:`libc_exp`'s formula with its table look-ups inlined).  Returns False
+    (sums unusable) when an exponent lies outside the formula's range 2^-54 ≤ |x| < 512."""
+    tab = _EXP_TAB
+    A, B, C = _columns(abc)
+    s0, s1, s2, s3 = s[0], s[1], s[2], s[3]
+    n0, n1, n2, n3 = n[0], n[1], n[2], n[3]
+    ok = True
+    for j in near:                                                    # point ascending
+        xj, yj = X[j], Y[j]
+        for i in range(px.size):
+            c, x = _pair_exponent(px[i], py[i], xj, yj, hx, hy, A, B, C)
+            ax = abs(x)
+            ok &= (ax < 512.0) & (ax >= 5.551115123125783e-17)
+            kd = _INVLN2N * x + _SHIFT                                # libc_exp, inlined
+            ki = _bits(kd)
+            kd -= _SHIFT
+            r = _fma(kd, _NEGLN2LON, _fma(kd, _NEGLN2HIN, x))
+            t = (ki & np.uint64(127)) << np.uint64(1)
+            scale = _double(tab[t + np.uint64(1)] + (ki << np.uint64(45)))
+            rr = r * r
+            tmp = _fma(rr * rr, _fma(r, _C5, _C4), _fma(rr, _fma(r, _C3, _C2),
+                                                         _double(tab[t]) + r))
+            dens = _fma(scale, tmp, scale)                            # N(d | μ_Rm, Σ_Rm)
+            s0[i] += dens if c == 0 else 0.0
+            s1[i] += dens if c == 1 else 0.0
+            s2[i] += dens if c == 2 else 0.0
+            s3[i] += dens if c == 3 else 0.0
+            n0[i] += c == 0
+            n1[i] += c == 1
+            n2[i] += c == 2
+            n3[i] += c == 3
+    return ok
+
+
+@njit(cache=True)
+def _region_sums_exact(px, py, X, Y, near, hx, hy, abc, s, n):
+    """:func:`_region_sums` pair by pair with :func:`libc_exp` (the library's ``exp``
+    outside the formula's range): same order, any exponent."""
+    A, B, C = _columns(abc)
+    for j in near:
+        for i in range(px.size):
+            c, x = _pair_exponent(px[i], py[i], X[j], Y[j], hx, hy, A, B, C)
+            if c < 4:
+                s[c, i] += libc_exp(x)
+                n[c, i] += 1
 
 
 @njit(cache=True)
@@ -227,53 +190,30 @@ def leg_likelihood(px, py, X, Y, ox, oy, model, lik, cnt):
     ``model``: :attr:`gaitval.track.pf_likelihood.PFArrays.kernel`.  A pair (particle i,
     point j) with u = px_i − X_j, v = py_i − Y_j is in the window's near half when
     0 < u ≤ h_x and |v| ≤ h_y; its pair code is [|v| < u] + 2·[v ≥ 0] (R1, R2, R4, R3).
-    Each region's densities are added point ascending from 0; a pair outside the window or
-    in another region adds +0.0 (exact: the sums are ≥ +0 and every density is finite,
-    its exponent being ≤ ln(1/(σ√2π)) since A < 0).
+    Each region's densities are added point ascending from 0, one running sum per particle
+    and region; the loop over the points is the outer one and the particles are the inner,
+    vectorised one, so every sum adds the same terms in the same order as a particle-major
+    loop (numpy's ``np.bincount``).  A pair outside the window or in another region adds
+    nothing (as adding +0.0 to a sum ≥ +0: the same number).
     """
     _, _, _, hx, hy, abc, pi, count_pdf, g_a, g_scale, g_lognorm, _ = model
     near = near_points(X, Y, px, py, hx, hy)
-    Xn, Yn = X[near], Y[near]
-    M = Xn.size
-    x, r = np.empty(M), np.empty(M)
-    code, ki = np.empty(M, np.intp), np.empty(M, np.uint64)
-    one, tab = _ONE_HOT, _EXP_TAB
+    N = px.size
+    s, cn = np.zeros((4, N)), np.zeros((4, N), np.int64)            # Σ dens, points per code
+    if not _region_sums(px, py, X, Y, near, hx, hy, abc, s, cn):
+        s[:], cn[:] = 0.0, 0                                          # rare: pair by pair
+        _region_sums_exact(px, py, X, Y, near, hx, hy, abc, s, cn)
     top = count_pdf.size - 1
-    for i in range(px.size):
-        _pair_exponents(px[i], py[i], Xn, Yn, hx, hy, abc, x, code, ki, r)
-        s0 = s1 = s2 = s3 = 0.0                                       # Σ densities per code
-        for j in range(M):                                            # point ascending
-            ax = abs(x[j])
-            if ax < 512.0 and ax >= 5.551115123125783e-17:            # libc_exp, 2nd half
-                t = (ki[j] & np.uint64(127)) << np.uint64(1)
-                scale = _double(tab[t + np.uint64(1)] + (ki[j] << np.uint64(45)))
-                rj = r[j]
-                rr = rj * rj
-                tmp = _fma(rr * rr, _fma(rj, _C5, _C4), _fma(rr, _fma(rj, _C3, _C2),
-                                                             _double(tab[t]) + rj))
-                dens = _fma(scale, tmp, scale)                        # N(d | μ_Rm, Σ_Rm)
-            else:
-                dens = math.exp(x[j])
-            c = code[j]
-            s0 += dens * one[c, 0]
-            s1 += dens * one[c, 1]
-            s2 += dens * one[c, 2]
-            s3 += dens * one[c, 3]
-        n0 = n1 = n2 = n3 = 0                                         # points per code
-        for j in range(M):
-            n0 += code[j] == 0
-            n1 += code[j] == 1
-            n2 += code[j] == 2
-            n3 += code[j] == 3
-        m0, m1 = s0 / max(n0, 1.0), s1 / max(n1, 1.0)                 # mean per region
-        m2, m3 = s2 / max(n2, 1.0), s3 / max(n3, 1.0)
+    for i in range(N):
+        m0, m1 = s[0, i] / max(cn[0, i], 1.0), s[1, i] / max(cn[1, i], 1.0)   # mean per
+        m2, m3 = s[2, i] / max(cn[2, i], 1.0), s[3, i] / max(cn[3, i], 1.0)   # region
         region = (m0 * pi[0] + m2 * pi[2]) + (m1 * pi[1] + m3 * pi[3])   # Σ_m π_Rm N(...)
-        n = n0 + n1 + n2 + n3
+        n = cn[0, i] + cn[1, i] + cn[2, i] + cn[3, i]
         lam = count_pdf[min(n, top)]                                  # λ_i
         d = math.hypot(px[i] - ox, py[i] - oy)
         beta = 0.0                                                    # β_i: Gamma pdf
         if d > 0.0:
-            beta = math.exp((g_a - 1.0) * math.log(d) - d / g_scale - g_lognorm)
+            beta = libc_exp((g_a - 1.0) * math.log(d) - d / g_scale - g_lognorm)
         lik[i] = beta * lam * region                                  # seed002 §III.C
         cnt[i] = n
 
@@ -396,3 +336,4 @@ def estimate(vx, vy, px, py, w, best_fraction):
             a3 += ws[n] * vy[f, n]
         out[f, 0], out[f, 1], out[f, 2], out[f, 3] = a0, a1, a2, a3
     return out
+
