@@ -13,8 +13,6 @@ import logging
 import sys
 from pathlib import Path
 
-from gaitval.errors import GaitvalError
-
 
 # -- verbs --------------------------------------------------------------------------------
 def cmd_inspect(a) -> int:
@@ -55,12 +53,8 @@ def cmd_simulate(a) -> int:
 
 def cmd_ingest(a) -> int:
     from gaitval.io.ingest import ingest_trial
-    from gaitval.io.trialsheet import raise_all, sheet_problems
-    df, problems = sheet_problems(a.sheet, a.subjects, only=a.trial)   # this trial's row
-    raise_all(problems)
-    if a.trial not in df.index:
-        raise GaitvalError(f"trial {a.trial!r} is not in the trial sheet", path=a.sheet)
-    s = ingest_trial(df.loc[a.trial].to_dict(), a.out)
+    from gaitval.io.trialsheet import load_trial_row
+    s = ingest_trial(load_trial_row(a.sheet, a.subjects, a.trial), a.out)
     print(json.dumps(s, sort_keys=True, default=str))
     return 0
 

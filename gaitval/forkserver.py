@@ -17,8 +17,9 @@ temporary directory, so only the same user can submit jobs.
 
 Protocol (Unix stream socket): the client sends a 4-byte length and a JSON object
 ``{"argv", "cwd", "env"}`` with its stdin/stdout/stderr attached (SCM_RIGHTS); the server
-forks; the child (leader of its own process group) answers its pid (4 bytes), runs the verb with those descriptors, working
-directory and environment, and answers the exit code (4 bytes).  A child whose client
+forks; the child (leader of its own process group) answers its pid (4 bytes), runs the
+verb with those descriptors, working directory and environment, and answers the exit
+code (4 bytes).  A child whose client
 disconnects before the end (the job was cancelled) exits at once.
 
 Usage::

@@ -23,7 +23,7 @@ from gaitval import consts as C
 from gaitval.config import deep_merge
 from gaitval.errors import GaitvalError
 from gaitval.io.atomic import write_csv, write_parquet, write_text
-from gaitval.io.trialsheet import load_subjects, raise_all, sheet_problems
+from gaitval.io.trialsheet import load_subjects, load_trial_row
 
 #: Config sections that parameterise the analysis (copied into the per-study config).
 ANALYSIS_SECTIONS = ("registration", "groundtruth", "rollator", "tracking", "tug",
@@ -67,14 +67,8 @@ def _clean(v):
 
 
 def trial_and_subject(sheet, subjects, trial: str) -> tuple[dict, dict]:
-    """One trial's validated row and its subject's, as dicts.  Only their rows (and the
-    headers) are validated: the whole sheet is the workflow's and ``gaitval validate``'s
-    check, and would cost every per-trial job ~0.3 s on a sheet of 100s of rows."""
-    df, problems = sheet_problems(sheet, subjects, check_files=False, only=trial)
-    raise_all(problems)
-    if trial not in df.index:
-        raise GaitvalError(f"trial {trial!r} is not in the trial sheet", path=sheet)
-    row = df.loc[trial].to_dict()
+    """One trial's validated row and its subject's, as dicts (only their rows checked)."""
+    row = load_trial_row(sheet, subjects, trial, check_files=False)
     subj = load_subjects(subjects, only=row["subject"]).loc[row["subject"]].to_dict()
     return row, subj
 

@@ -85,3 +85,12 @@ def test_one_trial_job_checks_its_own_row_not_the_others(tmp_path):
     with pytest.raises(TrialSheetError, match="unknown column 'protocl'"):
         trial_and_subject(make_study(tmp_path, header=HEADER.replace("protocol", "protocl")),
                           tmp_path / "subjects.csv", "tug_S01_1")
+
+
+def test_one_trial_row_names_a_missing_trial(tmp_path):
+    from gaitval.io.trialsheet import load_trial_row
+
+    sheet = make_study(tmp_path)
+    assert load_trial_row(sheet, None, "tug_S01_1")["subject"] == "S01"
+    with pytest.raises(TrialSheetError, match="'tug_S01_9' is not in the trial sheet"):
+        load_trial_row(sheet, None, "tug_S01_9")

@@ -77,11 +77,11 @@ def detect_vertical(xyz: np.ndarray) -> tuple[str | None, float]:
 
 
 def nanpercentile(a: np.ndarray, q: float, axis: int) -> np.ndarray:
-    """``np.nanpercentile(a, q, axis=axis)`` (linear method), the same values (a zero may
-    come out as -0.0 where numpy gives 0.0), without numpy's 1-D call per slice when there are NaNs (2,800 slices of a C3D file:
-    0.5 s): the slices are sorted once (NaN last) and those with the same number of finite
-    values go through one vectorised ``np.percentile`` — the same order statistics and
-    interpolation per slice.  All-NaN slices give NaN."""
+    """``np.nanpercentile(a, q, axis=axis)`` (linear method): the same values (a zero may
+    come out as -0.0 where numpy gives 0.0) without numpy's 1-D call per slice when there
+    are NaNs (2,800 slices of a C3D file: 0.5 s).  The slices are sorted once (NaN last) and
+    those with the same number of finite values go through one vectorised ``np.percentile``
+    — the same order statistics and interpolation per slice.  All-NaN slices give NaN."""
     moved = np.moveaxis(np.asarray(a, float), axis, 0)
     flat = np.sort(moved.reshape(moved.shape[0], -1), axis=0)
     count = np.isfinite(flat).sum(axis=0)

@@ -354,3 +354,24 @@ def load_trial_sheet(path: str | Path, subjects: str | Path | None = None, *,
                                   allow_outside_paths=allow_outside_paths)
     raise_all(problems)
     return df
+
+
+def load_trial_row(path: str | Path, subjects: str | Path | None, trial: str, *,
+                   check_files: bool = True) -> dict:
+    """One trial's validated row, as a dict (the columns of :func:`load_trial_sheet`).
+
+    Only that row, its subject's row and the two headers are validated: the whole sheet
+    is checked once by ``gaitval validate`` and at the workflow's start, and checking its
+    100s of rows again would cost every per-trial job ~0.3 s.
+
+    Raises
+    ------
+    TrialSheetError
+        A problem of the row, its subject or a header; or the trial is not in the sheet.
+    """
+    df, problems = sheet_problems(path, subjects, check_files=check_files, only=trial)
+    raise_all(problems)
+    if trial not in df.index:
+        raise TrialSheetError(f"trial {trial!r} is not in the trial sheet", path=path,
+                              trial=trial)
+    return df.loc[trial].to_dict()

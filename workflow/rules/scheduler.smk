@@ -39,7 +39,9 @@ if _JobScheduler is not None and hasattr(_JobScheduler, "update_input_sizes") an
 # 44.7 % of its busy samples in these timers, after the first fix).  Here a round starts a
 # timer only when none is pending: still a round within the timespan whenever one is asked
 # for (what the rate limit and the queue-input wait need), never a pile of them.
-if _JobScheduler is not None and hasattr(_JobScheduler, "_schedule_reevalutation"):
+if _JobScheduler is not None and hasattr(_JobScheduler, "_schedule_reevalutation") and not getattr(
+    _JobScheduler._schedule_reevalutation, "_gaitval_one_timer", False
+):
     import threading as _threading
 
     def _schedule_one_reevaluation(self, delay):
@@ -57,5 +59,6 @@ if _JobScheduler is not None and hasattr(_JobScheduler, "_schedule_reevalutation
             self._gaitval_timer.daemon = True
             self._gaitval_timer.start()
 
+    _schedule_one_reevaluation._gaitval_one_timer = True
     _GV_TIMER_LOCK = _threading.Lock()
     _JobScheduler._schedule_reevalutation = _schedule_one_reevaluation
