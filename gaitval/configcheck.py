@@ -51,7 +51,7 @@ def _load_schema(path: str) -> dict:
                           hint="gaitval checks configs against the repository's "
                                "workflow/schemas/config.schema.yaml")
     with open(p, encoding="utf-8") as fh:
-        return yaml.safe_load(fh)
+        return yaml.load(fh, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # libyaml
 
 
 def load_schema(path: str | Path | None = None) -> dict:

@@ -30,13 +30,35 @@ ANALYSIS_SECTIONS = ("registration", "groundtruth", "rollator", "tracking", "tug
                      "ultrasonic", "evaluation", "mtst")
 
 
-def study_config(config: dict, sheet: str | Path, out: str | Path) -> dict:
+STUDY_VIEW = "study"
+
+
+def method_view(cfg: dict, view: str) -> dict:
+    """``cfg`` as the per-trial jobs of one method read it: ``tracking.methods`` and
+    ``tracking.overrides`` reduced to method ``view``'s entries, or to none for
+    ``view == STUDY_VIEW`` (the jobs without a method: registration, ultrasonic, ...).
+    Every other key is kept.  A job looks up no other method's definition (it calls
+    :func:`method_definition` with its own method), so its results depend on this view
+    only; the workflow reruns a method's jobs when its view changes, not on any change of
+    another method (``workflow/rules/register.smk``, rule ``config_view``)."""
+    out = dict(cfg)
+    tracking = dict(out.get("tracking") or {})
+    for key in ("methods", "overrides"):
+        entries = tracking.get(key) or {}
+        tracking[key] = {view: entries[view]} if view in entries else {}
+    out["tracking"] = tracking
+    return out
+
+
+def study_config(config: dict, sheet: str | Path, out: str | Path,
+                 view: str | None = None) -> dict:
     """Write the effective analysis config of one study (JSON) and return it.
 
     The workflow config's :data:`ANALYSIS_SECTIONS` are the base; ``study.yaml`` beside the
     trial sheet, when present, overrides them (the study's calibration); it is checked
     against the config schema first, so a typo in it stops with the file and key named
-    (:func:`gaitval.configcheck.check_study_file`).
+    (:func:`gaitval.configcheck.check_study_file`).  With ``view`` (a method name or
+    :data:`STUDY_VIEW`), only that view of it is written (:func:`method_view`).
     """
     from gaitval.configcheck import check_study_file
 
@@ -48,6 +70,8 @@ def study_config(config: dict, sheet: str | Path, out: str | Path) -> dict:
         check_study_file(study, cal)
         cfg = deep_merge(cfg, {k: v for k, v in study.items() if k in ANALYSIS_SECTIONS})
         cfg["calibration_file"] = str(cal)
+    if view is not None:
+        cfg = method_view(cfg, view)
     write_text(out, json.dumps(cfg, indent=1, sort_keys=True) + "\n")
     return cfg
 

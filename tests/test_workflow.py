@@ -80,6 +80,40 @@ def test_switching_run_rebuilds_into_that_runs_folder(tiny_run):
     assert "reports/tiny/index.md" not in other.stdout
 
 
+def _planned(res: subprocess.CompletedProcess) -> dict[str, int]:
+    """Job counts of a dry run's first "Job stats" table."""
+    text = res.stdout + res.stderr
+    rows = text.split("Job stats:", 1)[1].split("total", 1)[0].splitlines()
+    out = {}
+    for row in rows:
+        parts = row.split()
+        if len(parts) == 2 and parts[1].isdigit():
+            out[parts[0]] = int(parts[1])
+    return out
+
+
+@pytest.mark.slow
+def test_one_methods_parameter_reruns_only_that_methods_trials(tiny_run):
+    """Issue 13: after the tiny report, a new value of one TUG method's parameter plans
+    that method's tracks and evaluations (and its eq. (3)-(4) reading variant's, which
+    inherits the override), the pooled tables and the report -- no registration, no
+    other method's track, no ultrasonic noise identification or track."""
+    res = run_workflow(tiny_run, tiny_run / "data",   # a --config item, then the dry run
+                       'tracking={"overrides": {"tug_m1": {"occlusion__max_n": 7}}}', "-n")
+    assert res.returncode == 0, res.stderr[-3000:]
+    planned = _planned(res)
+    n_tug = len(list((tiny_run / "results" / "tiny" / "track" / "tug_m1").glob("*.parquet")))
+    assert n_tug > 0
+    assert planned["track"] == planned["evaluate_tug"] == 2 * n_tug    # tug_m1 + variant
+    assert planned["config_view"] == 2
+    for rule in ("register", "ingest", "mtst_track", "rollator_track", "ultrasonic_noise",
+                 "ultrasonic_track", "gait_parameters", "rollator_train"):
+        assert rule not in planned, (rule, planned)
+    assert planned.get("tug_tables") == 1
+    out = res.stdout + res.stderr
+    assert "track/tug_m2/" not in out and "track/tug_m1/" in out
+
+
 @pytest.mark.slow
 def test_every_tex_of_the_tiny_report_compiles(tiny_run, tmp_path):
     """Issue 14, scope 4: each table's .tex and verdicts.tex, alone, with pdflatex."""

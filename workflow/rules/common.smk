@@ -1,4 +1,5 @@
 # Shared by all rule files -- config validation, paths, the trial sheet, provenance.
+import json
 import shlex
 import sys
 from pathlib import Path
@@ -11,7 +12,7 @@ from gaitval.errors import ConfigError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash
 from gaitval.methods import get_method, set_params
-from gaitval.steps import ANALYSIS_SECTIONS, method_definition
+from gaitval.steps import ANALYSIS_SECTIONS, STUDY_VIEW, method_definition, method_view
 from gaitval.tables.tug_evidence import method_reading
 
 
@@ -91,6 +92,30 @@ if not _CONDA:
     )
 # Hash of the analysis sections only: changing `run` or paths must not rerun the tables.
 CONFIG_HASH = config_hash({k: config[k] for k in ANALYSIS_SECTIONS if k in config})
+
+
+
+def analysis_sections_json(view=None):
+    """The analysis sections as canonical JSON (sorted keys), or one view of them
+    (gaitval.steps.method_view): the params of rules study_config and config_view."""
+    sections = {k: config[k] for k in ANALYSIS_SECTIONS if k in config}
+    if view is not None:
+        sections = method_view(sections, view)
+    return json.dumps(sections, sort_keys=True, default=str)
+
+
+def study_configs(wildcards):
+    """Input function: results/<study>/config.json of every study in `run` (what the pooled
+    tables read; the per-trial jobs read their views, config_view_file)."""
+    return [f"{RESULTS}/{study}/config.json" for study in config["run"]]
+
+
+def config_view_file(wildcards):
+    """Input function: the config view a per-trial job reads (made by rule config_view); its
+    {method}'s, or the study view for a job without a method."""
+    view = getattr(wildcards, "method", None) or STUDY_VIEW
+    return f"{RESULTS}/{wildcards.study}/config_views/{view}.json"
+
 
 # Rule files add functions study -> [report items] here; rule `report` collects them.
 REPORT_ITEM_FUNCS = []

@@ -9,7 +9,7 @@ rule legbench_track:
     input:
         sensor=lambda w: trial_row(w.study, w.trial)["sensor_path"],
         annotations=lambda w: legbench_annotations(w.study, w.trial),
-        config=f"{RESULTS}/{{study}}/config.json",
+        config=config_view_file,
     output:
         f"{RESULTS}/{{study}}/legbench/{{method}}/{{init}}/{{trial}}/track.parquet",
     wildcard_constraints:

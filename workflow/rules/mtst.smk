@@ -55,7 +55,8 @@ rule mtst_evaluate:
 
 rule mtst_tables:
     input:
-        mtst_summaries,
+        evals=mtst_summaries,
+        configs=study_configs,
     output:
         t3=report(
             f"{REPORTS}/tables/mtst_table3.csv",
@@ -71,9 +72,9 @@ rule mtst_tables:
         ),
     params:
         gv=GV,
-        dirs=lambda w, input: [str(Path(p).parent) for p in input],
+        dirs=lambda w, input: [str(Path(p).parent) for p in input.evals],
         methods=mtst_methods(),
-        config=lambda w: f"{RESULTS}/{config['run'][0]}/config.json",
+        config=lambda w, input: input.configs[0],
         tables=parent_of("t3"),
         figures=parent_of("fig"),
         reports=parent_of("t3", up=1),

@@ -59,7 +59,7 @@ def mtst_targets_file(wildcards):
 def mtst_track_inputs(wildcards):
     files = {
         "sensor": mtst_sensor(wildcards),
-        "config": f"{RESULTS}/{wildcards.study}/config.json",
+        "config": config_view_file(wildcards),
         "sheet": sheet_path(wildcards.study),
     }
     reg = mtst_registration(wildcards)
@@ -71,7 +71,7 @@ def mtst_track_inputs(wildcards):
 def mtst_eval_inputs(wildcards):
     files = {
         "track": f"{RESULTS}/{wildcards.study}/mtst_track/{wildcards.method}/{wildcards.trial}.parquet",
-        "config": f"{RESULTS}/{wildcards.study}/config.json",
+        "config": config_view_file(wildcards),
         "sheet": sheet_path(wildcards.study),
         "targets": mtst_targets_file(wildcards),
         **mtst_registration(wildcards),

@@ -8,20 +8,44 @@ rule study_config:
     output:
         f"{RESULTS}/{{study}}/config.json",
     params:
-        sections=lambda w: {k: config[k] for k in ANALYSIS_SECTIONS if k in config},
+        # canonical JSON (sorted keys): the same config given in another key order (e.g.
+        # a section passed with --config) is no change
+        sections=lambda w: analysis_sections_json(),
     log:
         "logs/study_config/{study}.log",
     run:
         from gaitval.steps import study_config
 
-        study_config(params.sections, input.sheet, output[0])
+        study_config(json.loads(params.sections), input.sheet, output[0])
+
+
+# The config as the per-trial jobs of one method read it (gaitval.steps.method_view): every
+# per-trial job takes its view (config_view_file, common.smk) instead of config.json, so a
+# change of one method's parameter reruns that method's tracking and evaluation (and the
+# pooled tables, which read config.json), not every trial's registration and every other
+# method.  view = a method name, or "study" for the jobs without a method.
+rule config_view:
+    input:
+        sheet=lambda w: sheet_path(w.study),
+    output:
+        f"{RESULTS}/{{study}}/config_views/{{view}}.json",
+    wildcard_constraints:
+        view=r"[A-Za-z0-9_.\-]+",
+    params:
+        sections=lambda w: analysis_sections_json(w.view),
+    log:
+        "logs/config_view/{study}/{view}.log",
+    run:
+        from gaitval.steps import study_config
+
+        study_config(json.loads(params.sections), input.sheet, output[0], view=wildcards.view)
 
 
 rule register:
     input:
         mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
         sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
-        config=f"{RESULTS}/{{study}}/config.json",
+        config=config_view_file,
         sheet=lambda w: sheet_path(w.study),
     output:
         record=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",

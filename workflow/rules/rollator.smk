@@ -11,7 +11,7 @@ include: "rollator_common.smk"
 rule rollator_train:
     input:
         others=rollator_training_inputs,
-        config=f"{RESULTS}/{{study}}/config.json",
+        config=config_view_file,
         sheet=lambda w: sheet_path(w.study),
     output:
         f"{RESULTS}/{{study}}/rollator/model/{{subject}}.json",
@@ -34,7 +34,7 @@ rule rollator_train:
 rule rollator_track:
     input:
         sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
-        config=f"{RESULTS}/{{study}}/config.json",
+        config=config_view_file,
         sheet=lambda w: sheet_path(w.study),
         model=rollator_model,
     output:
@@ -62,7 +62,7 @@ rule rollator_evaluate:
         gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
         reg=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
         mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
-        config=f"{RESULTS}/{{study}}/config.json",
+        config=config_view_file,
         sheet=lambda w: sheet_path(w.study),
     output:
         summary=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}/summary.parquet",

@@ -6,7 +6,7 @@
 rule track:
     input:
         sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
-        config=f"{RESULTS}/{{study}}/config.json",
+        config=config_view_file,
         sheet=lambda w: sheet_path(w.study),
     output:
         f"{RESULTS}/{{study}}/track/{{method}}/{{trial}}.parquet",
@@ -28,7 +28,7 @@ rule evaluate_tug:
         track=f"{RESULTS}/{{study}}/track/{{method}}/{{trial}}.parquet",
         gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
         reg=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
-        config=f"{RESULTS}/{{study}}/config.json",
+        config=config_view_file,
     output:
         summary=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/summary.parquet",
         frames=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/frames.parquet",
@@ -47,12 +47,13 @@ rule evaluate_tug:
 
 rule tug_tables:
     input:
-        lambda w: [
+        evals=lambda w: [
             f"{RESULTS}/{study}/evaluate/{method}/{trial}/summary.parquet"
             for study in config["run"]
             for method in tug_runs()
             for trial in trial_ids(study, ["tug"])
         ],
+        configs=study_configs,        # Table 2 reads each study's methods from them
     output:
         t4=report(
             f"{REPORTS}/tables/tug_table4.csv",
@@ -70,7 +71,7 @@ rule tug_tables:
         ),
     params:
         gv=GV,
-        dirs=lambda w, input: [str(Path(p).parent) for p in input],
+        dirs=lambda w, input: [str(Path(p).parent) for p in input.evals],
         methods=tug_runs(),
         tables=parent_of("t4"),
         figures=parent_of("fig"),
