@@ -39,6 +39,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import fft as sfft
 
+from gaitval.registration.occupancy import predicted_occupancy
+
 #: Defaults of the ``registration:`` config keys used here.
 DEFAULTS = {
     "sync_max_lag_s": 5.0,
@@ -309,34 +311,6 @@ def beam_times(sensor) -> np.ndarray:
     meta = sensor.meta or {}
     inc = float(meta.get("time_increment_s") or 0.0)
     return sensor.t[:, None] + inc * np.arange(sensor.n_beams)[None, :]
-
-
-def predicted_occupancy(legs_s: np.ndarray, angles: np.ndarray, radius_m: float) -> np.ndarray:
-    """Which beams hit a leg, from leg centres in the sensor frame.
-
-    Parameters
-    ----------
-    legs_s : ndarray (n, n_legs, 2)
-        Leg centres in the sensor frame (metres); NaN = unknown.
-    angles : ndarray (n_beams,)
-    radius_m : float
-        Leg radius (half the subject's leg width).
-
-    Returns
-    -------
-    ndarray (n, n_beams) of 0/1 floats; NaN for frames where any leg is unknown.
-    A beam with unit vector u hits a circle of centre c when ``c.u > 0`` and
-    ``|c x u| < radius``.
-    """
-    u = np.stack([np.cos(angles), np.sin(angles)], axis=-1)           # (nb, 2)
-    cx, cy = legs_s[..., 0], legs_s[..., 1]
-    along = cx[..., None] * u[:, 0] + cy[..., None] * u[:, 1]          # (n, L, nb)
-    perp = np.abs(cx[..., None] * u[:, 1] - cy[..., None] * u[:, 0])
-    with np.errstate(invalid="ignore"):
-        hit = ((along > 0) & (perp < radius_m)).any(axis=1).astype(float)
-    unknown = ~np.all(np.isfinite(legs_s), axis=(1, 2))
-    hit[unknown] = np.nan
-    return hit
 
 
 def _bin(x: np.ndarray, k: int) -> np.ndarray:

@@ -59,9 +59,31 @@ def pole_cfg(cfg: dict | None) -> dict:
     return out
 
 
+def nanmedian0(a: np.ndarray) -> np.ndarray:
+    """``np.nanmedian(a, axis=0)`` of a 2-D float array, the same values, ~3x faster: one
+    sort (NaN last), then the middle value, or the mean of the two middle values as numpy
+    computes it ((low + high) / 2); NaN where a column has no number."""
+    s = np.sort(a, axis=0)
+    n = (~np.isnan(a)).sum(axis=0)
+    cols = np.arange(a.shape[1])
+    hi = s[np.maximum(n // 2, 0).clip(max=len(a) - 1), cols]
+    lo = s[np.maximum((n - 1) // 2, 0), cols]
+    with np.errstate(invalid="ignore"):
+        med = np.where(n % 2 == 1, hi, (lo + hi) / 2.0)
+    med[n == 0] = np.nan
+    return med
+
+
+_BACKGROUND: dict = {}
+
+
 def static_background(sensor: ScanSeries, cfg: dict | None = None
                       ) -> tuple[np.ndarray, np.ndarray]:
     """Per-beam median range and static fraction over the calibration window.
+
+    Registration asks for it up to three times per trial with the same window (pole
+    detection, pole registration, the clock's background): the last result is kept per
+    scan series and window, and copies are returned.
 
     Returns
     -------
@@ -71,6 +93,15 @@ def static_background(sensor: ScanSeries, cfg: dict | None = None
         Fraction of scans within ``pole_static_tol_m`` of the median.
     """
     c = pole_cfg(cfg)
+    key = (id(sensor), c["pole_window_s"], c["pole_max_scans"], c["pole_static_tol_m"])
+    hit = _BACKGROUND.get(key)
+    if hit is None or hit[0] is not sensor:
+        _BACKGROUND.clear()                                  # one scan series at a time
+        hit = _BACKGROUND[key] = (sensor, *_static_background(sensor, c))
+    return hit[1].copy(), hit[2].copy()
+
+
+def _static_background(sensor: ScanSeries, c: dict) -> tuple[np.ndarray, np.ndarray]:
     r = sensor.ranges
     idx = np.arange(sensor.n_scans)
     if c["pole_window_s"] is not None:
@@ -82,7 +113,7 @@ def static_background(sensor: ScanSeries, cfg: dict | None = None
     with np.errstate(all="ignore"):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            med = np.nanmedian(sub, axis=0)
+            med = nanmedian0(sub)
         static = np.mean(np.abs(sub - med) <= c["pole_static_tol_m"], axis=0)
     med[valid_frac < 0.5] = np.nan
     return med, static
