@@ -49,7 +49,7 @@ def figure_a1_histograms(gait_params: pd.DataFrame, path: str | Path,
     """Histograms of the differences system − reference per parameter (Figure A1-like)."""
     df = check_gait_params(gait_params)
     df = df[df["speed"] == speed]
-    params = [p for p in SUMMARY_PARAMETERS if p in set(df["parameter"])]
+    params = [p for p in SUMMARY_PARAMETERS if p in set(df["parameter"].unique())]
     fig, axes = _grid(max(len(params), 1))
     for ax, p in zip(axes, params):
         sub = df[df["parameter"] == p]
@@ -69,7 +69,7 @@ def figure_b1_boxplots(gait_params: pd.DataFrame, path: str | Path, speed: str =
     """Per-subject boxplots of each parameter (Figure B1-like)."""
     df = check_gait_params(gait_params)
     df = df[df["speed"] == speed]
-    params = [p for p in SUMMARY_PARAMETERS if p in set(df["parameter"])]
+    params = [p for p in SUMMARY_PARAMETERS if p in set(df["parameter"].unique())]
     fig, axes = _grid(max(len(params), 1), width=5.0)
     for ax, p in zip(axes, params):
         sub = df[df["parameter"] == p]
@@ -92,7 +92,7 @@ def figure5_speed_effects(table8_df: pd.DataFrame, path: str | Path) -> Path:
     table8_df : DataFrame
         Output of :func:`gaitval.tables.ultrasonic.table8`.
     """
-    params = [p for p in PARAMETERS if p in set(table8_df["parameter"])]
+    params = [p for p in PARAMETERS if p in set(table8_df["parameter"].unique())]
     fig, axes = _grid(max(len(params), 1), width=3.6)
     x = np.arange(len(SPEEDS))
     for ax, p in zip(axes, params):

@@ -61,12 +61,12 @@ def check_gait_params(df: pd.DataFrame) -> pd.DataFrame:
     if missing:
         raise GaitvalError(f"gait parameter table lacks column(s) {missing}",
                            hint=f"expected columns {list(GAIT_PARAM_COLUMNS)}")
-    bad = sorted(set(df["parameter"].astype(str)) - set(PARAMETERS))
+    bad = sorted(set(df["parameter"].astype(str).unique()) - set(PARAMETERS))
     if bad:
         raise GaitvalError(f"gait parameter table: unknown parameter(s) {bad}",
                            hint=f"use {list(PARAMETERS)}")
     speeds = df["speed"].astype(str)
-    bad = sorted(set(speeds[df["speed"].notna()]) - set(SPEEDS))
+    bad = sorted(set(speeds[df["speed"].notna()].unique()) - set(SPEEDS))
     if bad:
         raise GaitvalError(f"gait parameter table: unknown speed(s) {bad}",
                            hint=f"use {list(SPEEDS)}")

@@ -103,7 +103,7 @@ def table8(gait_params: pd.DataFrame, alpha: float = 0.05) -> pd.DataFrame:
     t-tests; gaitval pairs by subject (every subject walked at every speed).
     """
     df = check_gait_params(gait_params)
-    present = [p for p in PARAMETERS if p in set(df["parameter"])]
+    present = [p for p in PARAMETERS if p in set(df["parameter"].unique())]
     ps = _per_subject(df[df["parameter"].isin(present)])
     rows = []
     for param in present:
