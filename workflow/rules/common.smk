@@ -117,6 +117,14 @@ def config_view_file(wildcards):
     return f"{RESULTS}/{wildcards.study}/config_views/{view}.json"
 
 
+# PRIORITIES.  Snakemake starts ready jobs by priority (default 0), not by how much waits
+# on them.  The default report's critical path (benchmarks/report_end_to_end.py, the run's
+# Snakemake log) was the ultrasonic chain: the noise identification (one ~30 CPU-s job)
+# started only when every other trial was done, then its 30 tracks, gait parameters and
+# tables ran alone for ~90 s; the rollator PF likewise waited for its trained models.  So:
+# ultrasonic_noise and rollator_train 100, ultrasonic_track and gait_parameters 50,
+# ingest and register (everything's inputs) 20.  Order only: same jobs, same files.
+
 # Rule files add functions study -> [report items] here; rule `report` collects them.
 REPORT_ITEM_FUNCS = []
 

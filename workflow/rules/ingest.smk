@@ -10,6 +10,7 @@ rule ingest:
         sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
         annotations=f"{RESULTS}/{{study}}/ingest/{{trial}}/annotations.csv",
         summary=f"{RESULTS}/{{study}}/ingest/{{trial}}/ingest.json",
+    priority: 20  # critical path first (PRIORITIES in common.smk)
     params:
         gv=GV,
         subjects=lambda w: subjects_path(w.study),

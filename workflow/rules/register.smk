@@ -50,6 +50,7 @@ rule register:
     output:
         record=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
         gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
+    priority: 20  # critical path first (PRIORITIES in common.smk)
     params:
         gv=GV,
         subjects=lambda w: subjects_path(w.study),

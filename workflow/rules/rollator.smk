@@ -17,6 +17,7 @@ rule rollator_train:
         f"{RESULTS}/{{study}}/rollator/model/{{subject}}.json",
     wildcard_constraints:
         **ROLLATOR_WC,
+    priority: 100  # critical path first (PRIORITIES in common.smk)
     params:
         gv=GV,
         subjects=lambda w: subjects_path(w.study),

@@ -19,6 +19,7 @@ rule ultrasonic_noise:
             caption="../report/ultrasonic.rst",
             category="Ultrasonic",
         ),
+    priority: 100  # critical path first (PRIORITIES in common.smk)
     params:
         gv=GV,
         dirs=lambda w, input: [str(Path(p).parent) for p in input.ingest],
@@ -47,6 +48,7 @@ rule ultrasonic_track:
         noise=f"{RESULTS}/ultrasonic_noise.json",
     output:
         f"{RESULTS}/{{study}}/ultrasonic/track/{{trial}}.parquet",
+    priority: 50  # critical path first (PRIORITIES in common.smk)
     params:
         gv=GV,
         ingest=lambda w, input: str(Path(input.sensor).parent),
@@ -68,6 +70,7 @@ rule gait_parameters:
         sheet=lambda w: sheet_path(w.study),
     output:
         f"{RESULTS}/{{study}}/ultrasonic/gait/{{trial}}.parquet",
+    priority: 50  # critical path first (PRIORITIES in common.smk)
     params:
         gv=GV,
         subjects=lambda w: subjects_path(w.study),
