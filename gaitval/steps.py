@@ -247,7 +247,9 @@ def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, report
     """Gather per-trial TUG evaluations into seed 000 Tables 2-5 and the figures.
 
     Table 2 shows the method definitions actually run: ``tracking.methods`` and
-    ``tracking.overrides`` of each study's ``config.json`` (``configs``; default
+    ``tracking.overrides`` of each study's ``config.json`` or of its method views
+    ``results/<study>/config_views/<method>.json`` (``configs``, which the workflow gives:
+    the views, so that another study section's change does not rerun these tables; default
     ``results/<study>/config.json`` above the ``evaluate/<method>/<trial>`` folders).  A
     method run with different parameters in different studies gets one set of rows per
     study, labelled ``<method> (<study>)``.
@@ -277,7 +279,18 @@ def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, report
         configs = [Path(d).parents[2] / "config.json" for d in eval_dirs
                    if len(Path(d).parents) > 2]
     found = sorted({Path(c) for c in configs if Path(c).is_file()})
-    cfgs = {c.parent.name: load_json(c) for c in found} or {"": {}}
+    cfgs: dict[str, dict] = {}
+    for c in found:                      # a study's config.json, or its views merged
+        study = c.parent.parent.name if c.parent.name == "config_views" else c.parent.name
+        cfg = load_json(c)
+        if study not in cfgs:
+            cfgs[study] = cfg
+            continue
+        tracking = cfgs[study].setdefault("tracking", {})
+        for key in ("methods", "overrides"):
+            tracking[key] = {**(tracking.get(key) or {}),
+                             **((cfg.get("tracking") or {}).get(key) or {})}
+    cfgs = cfgs or {"": {}}
     used: dict[str, dict] = {}
     for m in methods:
         runs = {study: set_params(get_method(method_definition(cfg, m)),

@@ -305,9 +305,9 @@ def table2_of(monkeypatch, tmp_path):
     monkeypatch.setattr(tables, "write_tug_tables", spy)
     monkeypatch.setattr(figures, "write_tug_figures", lambda *a, **k: [])
 
-    def run(dirs, methods):
+    def run(dirs, methods, configs=None):
         tug_tables_step(dirs, tmp_path / "t", tmp_path / "f", tmp_path / "r",
-                        methods=methods)
+                        methods=methods, configs=configs)
         return tables.tug_table2(seen["methods"])
     return run
 
@@ -355,3 +355,28 @@ def test_table2_studies_that_ran_a_method_differently(tmp_path, table2_of):
     t2 = table2_of(dirs, ["tug_m1", "tug_m3"])
     assert list(dict.fromkeys(t2.method)) == ["tug_m1", "tug_m3 (a)", "tug_m3 (b)"]
     assert g_of(t2, "tug_m3 (a)") == "9.21" and g_of(t2, "tug_m3 (b)") == "13.82"
+
+
+def test_table2_from_the_method_views_is_the_table_from_config_json(tmp_path, table2_of):
+    """The workflow hands tug_tables each study's method views (config_views/<method>.json,
+    one method's definition and override each), not config.json, so that another section's
+    change does not rerun the table (issue 13): Table 2 is the same, studies still apart."""
+    from gaitval.steps import method_view
+
+    a = {"registration": {"sync_bin_deg": 0.5},
+         "tracking": {"methods": {"my_m3": my_m3()},
+                      "overrides": {"my_m3": {"gate__g": 5.99}, "tug_m3": {"occlusion__n_bo": 5}}}}
+    b = {"tracking": {"methods": {"my_m3": my_m3()}, "overrides": {}}}
+    names = ["tug_m3", "my_m3"]
+    res = tmp_path / "res"
+    dirs = study_results(res, "a", a, names) + study_results(res, "b", b, names)
+    whole = table2_of(dirs, names)
+    views = []
+    for study, cfg in (("a", a), ("b", b)):
+        (res / study / "config_views").mkdir()
+        for m in names:
+            views.append(res / study / "config_views" / f"{m}.json")
+            views[-1].write_text(json.dumps(method_view(cfg, m)))
+    from_views = table2_of(dirs, names, configs=views)
+    assert from_views.equals(whole)
+    assert {"tug_m3 (a)", "tug_m3 (b)", "my_m3 (a)", "my_m3 (b)"} <= set(from_views.method)

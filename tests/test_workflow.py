@@ -96,8 +96,9 @@ def _planned(res: subprocess.CompletedProcess) -> dict[str, int]:
 def test_one_methods_parameter_reruns_only_that_methods_trials(tiny_run):
     """Issue 13: after the tiny report, a new value of one TUG method's parameter plans
     that method's tracks and evaluations (and its eq. (3)-(4) reading variant's, which
-    inherits the override), the pooled tables and the report -- no registration, no
-    other method's track, no ultrasonic noise identification or track."""
+    inherits the override), the TUG tables and the report -- no registration, no
+    other method's track, no ultrasonic noise identification or track, no other study
+    section's tables or summaries."""
     res = run_workflow(tiny_run, tiny_run / "data",   # a --config item, then the dry run
                        'tracking={"overrides": {"tug_m1": {"occlusion__max_n": 7}}}', "-n")
     assert res.returncode == 0, res.stderr[-3000:]
@@ -107,7 +108,9 @@ def test_one_methods_parameter_reruns_only_that_methods_trials(tiny_run):
     assert planned["track"] == planned["evaluate_tug"] == 2 * n_tug    # tug_m1 + variant
     assert planned["config_view"] == 2
     for rule in ("register", "ingest", "mtst_track", "rollator_track", "ultrasonic_noise",
-                 "ultrasonic_track", "gait_parameters", "rollator_train"):
+                 "ultrasonic_track", "gait_parameters", "rollator_train", "mtst_tables",
+                 "rollator_tables", "ultrasonic_tables", "ingest_summary",
+                 "registration_summary"):
         assert rule not in planned, (rule, planned)
     assert planned.get("tug_tables") == 1
     out = res.stdout + res.stderr

@@ -105,9 +105,35 @@ def analysis_sections_json(view=None):
 
 
 def study_configs(wildcards):
-    """Input function: results/<study>/config.json of every study in `run` (what the pooled
-    tables read; the per-trial jobs read their views, config_view_file)."""
+    """Input function: results/<study>/config.json of every study in `run` (the whole
+    analysis config, for a step run by hand; the jobs read their views: config_view_file,
+    study_views)."""
     return [f"{RESULTS}/{study}/config.json" for study in config["run"]]
+
+
+def config_hash_when_run(wildcards, input):
+    """Param function: CONFIG_HASH, the provenance stamp of a pooled table.  A param that
+    takes `input` is evaluated when the job runs and is not one of Snakemake's params rerun
+    triggers, so a table reruns when its inputs (evaluations, config views) change, not on
+    every change of the configuration; the hash it stamps is the configuration's when the
+    table was last built (docs/report.md)."""
+    return CONFIG_HASH
+
+
+def study_views(views):
+    """Input function: results/<study>/config_views/<view>.json of every study in `run`, for
+    each of `views` (method names or STUDY_VIEW): what the pooled tables read, so that a
+    change of one method's parameters reruns the tables of that method's study section and
+    not the others (issue 13)."""
+
+    def views_of_every_study(wildcards):
+        return [
+            f"{RESULTS}/{study}/config_views/{view}.json"
+            for study in config["run"]
+            for view in views
+        ]
+
+    return views_of_every_study
 
 
 def config_view_file(wildcards):

@@ -44,7 +44,7 @@ rule ingest_summary:
         gv=GV,
         stem=lambda w, output: output.csv[: -len(".csv")],
         reports=parent_of("csv", up=1),
-        chash=CONFIG_HASH,
+        chash=config_hash_when_run,
     conda:
         "../envs/gaitval.yaml"
     log:

@@ -56,7 +56,7 @@ rule mtst_evaluate:
 rule mtst_tables:
     input:
         evals=mtst_summaries,
-        configs=study_configs,
+        configs=study_views([STUDY_VIEW]),  # the mtst: section
     output:
         t3=report(
             f"{REPORTS}/tables/mtst_table3.csv",
@@ -78,7 +78,7 @@ rule mtst_tables:
         tables=parent_of("t3"),
         figures=parent_of("fig"),
         reports=parent_of("t3", up=1),
-        chash=CONFIG_HASH,
+        chash=config_hash_when_run,
     conda:
         "../envs/gaitval.yaml"
     log:

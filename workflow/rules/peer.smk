@@ -17,7 +17,7 @@ rule peer_agreement:
         gv=GV,
         stem=lambda w, output: output.csv[: -len(".csv")],
         reports=parent_of("csv", up=1),
-        chash=CONFIG_HASH,
+        chash=config_hash_when_run,
     conda:
         "../envs/gaitval.yaml"
     log:

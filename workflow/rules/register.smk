@@ -21,9 +21,10 @@ rule study_config:
 
 # The config as the per-trial jobs of one method read it (gaitval.steps.method_view): every
 # per-trial job takes its view (config_view_file, common.smk) instead of config.json, so a
-# change of one method's parameter reruns that method's tracking and evaluation (and the
-# pooled tables, which read config.json), not every trial's registration and every other
-# method.  view = a method name, or "study" for the jobs without a method.
+# change of one method's parameter reruns that method's tracking and evaluation and the
+# tables of its study section (the pooled tables read the views too: study_views), not
+# every trial's registration, every other method and the other tables.  view = a method
+# name, or "study" for the jobs without a method.
 rule config_view:
     input:
         sheet=lambda w: sheet_path(w.study),
@@ -86,7 +87,7 @@ rule registration_summary:
         gv=GV,
         stem=lambda w, output: output.table[: -len(".csv")],
         reports=parent_of("table", up=1),
-        chash=CONFIG_HASH,
+        chash=config_hash_when_run,
     conda:
         "../envs/gaitval.yaml"
     log:

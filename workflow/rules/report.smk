@@ -43,6 +43,7 @@ rule report:
     input:
         report_items,
         rules.report_config.output,
+        study_configs,  # results/<study>/config.json, for running a step by hand (docs/formats.md)
     output:
         md=report(f"{REPORTS}/index.md", caption="../report/index.rst", category="Report"),
         html=f"{REPORTS}/index.html",

@@ -99,7 +99,7 @@ rule rollator_tables:
             for study in config["run"]
             for subject in rollator_subjects(study)
         ],
-        config=lambda w: f"{RESULTS}/{config['run'][0]}/config.json",
+        config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/{STUDY_VIEW}.json",
     output:
         t1=report(
             f"{REPORTS}/tables/rollator_table1.csv",
@@ -121,7 +121,7 @@ rule rollator_tables:
         tables=parent_of("t1"),
         figures=parent_of("fig"),
         reports=parent_of("t1", up=1),
-        chash=CONFIG_HASH,
+        chash=config_hash_when_run,
     conda:
         "../envs/gaitval.yaml"
     log:

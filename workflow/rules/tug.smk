@@ -53,7 +53,7 @@ rule tug_tables:
             for method in tug_runs()
             for trial in trial_ids(study, ["tug"])
         ],
-        configs=study_configs,        # Table 2 reads each study's methods from them
+        configs=study_views(tug_runs()),  # Table 2: each study's method definitions
     output:
         t4=report(
             f"{REPORTS}/tables/tug_table4.csv",
@@ -76,7 +76,7 @@ rule tug_tables:
         tables=parent_of("t4"),
         figures=parent_of("fig"),
         reports=parent_of("t4", up=1),
-        chash=CONFIG_HASH,
+        chash=config_hash_when_run,
     conda:
         "../envs/gaitval.yaml"
     log:

@@ -29,7 +29,7 @@ rule ultrasonic_noise:
         # Table 1's provenance: the config hash of the run that made it.  A function of
         # `input`, so Snakemake does not rerun the job when only the hash changed (its
         # "derived" params are not compared); the config it reads is its input above.
-        chash=lambda w, input: CONFIG_HASH,
+        chash=config_hash_when_run,
     conda:
         "../envs/gaitval.yaml"
     log:
@@ -107,7 +107,7 @@ rule ultrasonic_tables:
         tables=parent_of("t2"),
         figures=parent_of("fig"),
         reports=parent_of("t2", up=1),
-        chash=CONFIG_HASH,
+        chash=config_hash_when_run,
     conda:
         "../envs/gaitval.yaml"
     log:
