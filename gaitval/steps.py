@@ -21,7 +21,7 @@ import yaml
 
 from gaitval import consts as C
 from gaitval.config import deep_merge
-from gaitval.errors import GaitvalError
+from gaitval.errors import ConfigError, GaitvalError
 from gaitval.io.atomic import write_csv, write_parquet, write_text
 from gaitval.io.trialsheet import load_subjects, load_trial_row
 
@@ -32,16 +32,30 @@ ANALYSIS_SECTIONS = ("registration", "groundtruth", "rollator", "tracking", "tug
 
 STUDY_VIEW = "study"
 
+#: the sections of one protocol family's own settings: a job of one family reads its own
+#: and the shared sections (registration, groundtruth, tracking, evaluation), never another
+#: family's (a view's scope, :func:`method_view`)
+SCOPES = ("tug", "mtst", "rollator", "ultrasonic")
+ALL_SCOPE = "all"
+#: trial-sheet protocol -> scope of its jobs' views (another protocol: ALL_SCOPE)
+PROTOCOL_SCOPE = {"tug": "tug", "mtst": "mtst", "rollator": "rollator",
+                  "treadmill": "ultrasonic", "pendulum": "ultrasonic"}
 
-def method_view(cfg: dict, view: str) -> dict:
-    """``cfg`` as the per-trial jobs of one method read it: ``tracking.methods`` and
-    ``tracking.overrides`` reduced to method ``view``'s entries, or to none for
-    ``view == STUDY_VIEW`` (the jobs without a method: registration, ultrasonic, ...).
-    Every other key is kept.  A job looks up no other method's definition (it calls
-    :func:`method_definition` with its own method), so its results depend on this view
-    only; the workflow reruns a method's jobs when its view changes, not on any change of
-    another method (``workflow/rules/register.smk``, rule ``config_view``)."""
-    out = dict(cfg)
+
+def method_view(cfg: dict, view: str, scope: str = ALL_SCOPE) -> dict:
+    """``cfg`` as the jobs of one method and protocol family read it: ``tracking.methods``
+    and ``tracking.overrides`` reduced to method ``view``'s entries, or to none for
+    ``view == STUDY_VIEW`` (the jobs without a method: registration, ultrasonic, ...), and,
+    for a ``scope`` in :data:`SCOPES`, the other families' sections left out (``all``: none
+    left out).  Every other key is kept.  A job looks up no other method's definition (it
+    calls :func:`method_definition` with its own method) and no other family's section, so
+    its results depend on this view only; the workflow reruns a method's jobs when its view
+    changes, not on any change of another method or family (``workflow/rules/register.smk``,
+    rule ``config_view``)."""
+    if scope != ALL_SCOPE and scope not in SCOPES:
+        raise ConfigError(f"unknown config view scope {scope!r} (one of {SCOPES + (ALL_SCOPE,)})")
+    out = {k: v for k, v in cfg.items()
+           if scope == ALL_SCOPE or k not in SCOPES or k == scope}
     tracking = dict(out.get("tracking") or {})
     for key in ("methods", "overrides"):
         entries = tracking.get(key) or {}
@@ -51,14 +65,15 @@ def method_view(cfg: dict, view: str) -> dict:
 
 
 def study_config(config: dict, sheet: str | Path, out: str | Path,
-                 view: str | None = None) -> dict:
+                 view: str | None = None, scope: str = ALL_SCOPE) -> dict:
     """Write the effective analysis config of one study (JSON) and return it.
 
     The workflow config's :data:`ANALYSIS_SECTIONS` are the base; ``study.yaml`` beside the
     trial sheet, when present, overrides them (the study's calibration); it is checked
     against the config schema first, so a typo in it stops with the file and key named
     (:func:`gaitval.configcheck.check_study_file`).  With ``view`` (a method name or
-    :data:`STUDY_VIEW`), only that view of it is written (:func:`method_view`).
+    :data:`STUDY_VIEW`), only that view of it, in ``scope``, is written
+    (:func:`method_view`).
     """
     from gaitval.configcheck import check_study_file
 
@@ -71,7 +86,7 @@ def study_config(config: dict, sheet: str | Path, out: str | Path,
         cfg = deep_merge(cfg, {k: v for k, v in study.items() if k in ANALYSIS_SECTIONS})
         cfg["calibration_file"] = str(cal)
     if view is not None:
-        cfg = method_view(cfg, view)
+        cfg = method_view(cfg, view, scope)
     write_text(out, json.dumps(cfg, indent=1, sort_keys=True) + "\n")
     return cfg
 
@@ -281,7 +296,8 @@ def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, report
     found = sorted({Path(c) for c in configs if Path(c).is_file()})
     cfgs: dict[str, dict] = {}
     for c in found:                      # a study's config.json, or its views merged
-        study = c.parent.parent.name if c.parent.name == "config_views" else c.parent.name
+        views = [p for p in c.parents if p.name == "config_views"]   # <study>/config_views/
+        study = views[0].parent.name if views else c.parent.name
         cfg = load_json(c)
         if study not in cfgs:
             cfgs[study] = cfg

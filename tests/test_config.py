@@ -358,7 +358,7 @@ def test_table2_studies_that_ran_a_method_differently(tmp_path, table2_of):
 
 
 def test_table2_from_the_method_views_is_the_table_from_config_json(tmp_path, table2_of):
-    """The workflow hands tug_tables each study's method views (config_views/<method>.json,
+    """The workflow hands tug_tables each study's method views (config_views/tug/<method>.json,
     one method's definition and override each), not config.json, so that another section's
     change does not rerun the table (issue 13): Table 2 is the same, studies still apart."""
     from gaitval.steps import method_view
@@ -373,10 +373,10 @@ def test_table2_from_the_method_views_is_the_table_from_config_json(tmp_path, ta
     whole = table2_of(dirs, names)
     views = []
     for study, cfg in (("a", a), ("b", b)):
-        (res / study / "config_views").mkdir()
+        (res / study / "config_views" / "tug").mkdir(parents=True)
         for m in names:
-            views.append(res / study / "config_views" / f"{m}.json")
-            views[-1].write_text(json.dumps(method_view(cfg, m)))
+            views.append(res / study / "config_views" / "tug" / f"{m}.json")
+            views[-1].write_text(json.dumps(method_view(cfg, m, "tug")))
     from_views = table2_of(dirs, names, configs=views)
     assert from_views.equals(whole)
     assert {"tug_m3 (a)", "tug_m3 (b)", "my_m3 (a)", "my_m3 (b)"} <= set(from_views.method)

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from gaitval.steps import STUDY_VIEW, method_definition, method_view, study_config
 
 
@@ -47,3 +49,24 @@ def test_study_config_writes_the_view_after_merging_study_yaml(tmp_path):
     # study.yaml wins for this study, and the view still holds this method's entries only
     assert cfg["tracking"]["overrides"] == {"custom": {"gate__g": 5.0}}
     assert cfg["calibration_file"] == str(tmp_path / "study.yaml")
+
+
+def test_a_scoped_view_leaves_out_the_other_protocol_families_sections():
+    """Scope 'rollator' (the views of the rollator trials' jobs) keeps the rollator: section
+    and the shared ones, not tug:/mtst:/ultrasonic:, so a new rollator.pf_seed changes no
+    TUG, MTST or ultrasonic job's view (issue 13)."""
+    from gaitval.errors import ConfigError
+    from gaitval.steps import PROTOCOL_SCOPE, SCOPES
+
+    cfg = {**CFG, "rollator": {"pf_seed": 2017}, "tug": {"a": 1}, "mtst": {"b": 2},
+           "ultrasonic": {"c": 3}, "evaluation": {"tug": {}}}
+    v = method_view(cfg, STUDY_VIEW, "rollator")
+    assert set(v) == {"registration", "tracking", "rollator", "evaluation"}
+    assert set(method_view(cfg, "custom", "all")) == set(cfg)
+    other = {**cfg, "rollator": {"pf_seed": 2018}}
+    for scope in ("tug", "mtst", "ultrasonic"):
+        assert method_view(other, "custom", scope) == method_view(cfg, "custom", scope)
+    assert method_view(other, STUDY_VIEW, "rollator") != v
+    assert set(PROTOCOL_SCOPE.values()) == set(SCOPES)
+    with pytest.raises(ConfigError, match="walking"):
+        method_view(cfg, STUDY_VIEW, "walking")

@@ -118,6 +118,31 @@ def test_one_methods_parameter_reruns_only_that_methods_trials(tiny_run):
 
 
 @pytest.mark.slow
+def test_a_rollator_setting_reruns_only_the_rollator_trials(tiny_run, tmp_path):
+    """Issue 13: a new rollator.pf_seed (a section of one protocol family) plans the
+    rollator trials' jobs and tables only: the TUG, MTST and ultrasonic jobs read views
+    without the rollator: section (config_views/<scope>/)."""
+    import pandas as pd
+
+    overlay = tmp_path / "seed.yaml"
+    overlay.write_text("rollator:\n  pf_seed: 2018\n")
+    res = run_workflow(tiny_run, tiny_run / "data", "--configfile",
+                       str(ROOT / "config" / "config.yaml"), str(overlay), "-n")
+    assert res.returncode == 0, res.stderr[-3000:]
+    planned = _planned(res)
+    sheet = pd.read_csv(tiny_run / "data" / "tiny" / "trials.csv")
+    n_rollator = int((sheet["protocol"] == "rollator").sum())
+    assert n_rollator > 0
+    assert planned["rollator_track"] == 2 * n_rollator            # KF and PF
+    assert planned["rollator_tables"] == 1
+    assert planned.get("register", 0) <= n_rollator             # its view holds rollator:
+    for rule in ("track", "evaluate_tug", "mtst_track", "mtst_evaluate", "ultrasonic_noise",
+                 "ultrasonic_track", "gait_parameters", "tug_tables", "mtst_tables",
+                 "ultrasonic_tables", "ingest"):
+        assert rule not in planned, (rule, planned)
+
+
+@pytest.mark.slow
 def test_every_tex_of_the_tiny_report_compiles(tiny_run, tmp_path):
     """Issue 14, scope 4: each table's .tex and verdicts.tex, alone, with pdflatex."""
     import shutil

@@ -12,7 +12,8 @@ from gaitval.errors import ConfigError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash
 from gaitval.methods import get_method, set_params
-from gaitval.steps import ANALYSIS_SECTIONS, STUDY_VIEW, method_definition, method_view
+from gaitval.steps import (ALL_SCOPE, ANALYSIS_SECTIONS, PROTOCOL_SCOPE, SCOPES, STUDY_VIEW,
+                           method_definition, method_view)
 from gaitval.tables.tug_evidence import method_reading
 
 
@@ -95,12 +96,12 @@ CONFIG_HASH = config_hash({k: config[k] for k in ANALYSIS_SECTIONS if k in confi
 
 
 
-def analysis_sections_json(view=None):
+def analysis_sections_json(view=None, scope=ALL_SCOPE):
     """The analysis sections as canonical JSON (sorted keys), or one view of them
     (gaitval.steps.method_view): the params of rules study_config and config_view."""
     sections = {k: config[k] for k in ANALYSIS_SECTIONS if k in config}
     if view is not None:
-        sections = method_view(sections, view)
+        sections = method_view(sections, view, scope)
     return json.dumps(sections, sort_keys=True, default=str)
 
 
@@ -120,15 +121,15 @@ def config_hash_when_run(wildcards, input):
     return CONFIG_HASH
 
 
-def study_views(views):
-    """Input function: results/<study>/config_views/<view>.json of every study in `run`, for
-    each of `views` (method names or STUDY_VIEW): what the pooled tables read, so that a
-    change of one method's parameters reruns the tables of that method's study section and
-    not the others (issue 13)."""
+def study_views(views, scope):
+    """Input function: results/<study>/config_views/<scope>/<view>.json of every study in
+    `run`, for each of `views` (method names or STUDY_VIEW): what the pooled tables read, so
+    that a change of one method's parameters, or of another protocol family's section,
+    does not rerun them (issue 13)."""
 
     def views_of_every_study(wildcards):
         return [
-            f"{RESULTS}/{study}/config_views/{view}.json"
+            f"{RESULTS}/{study}/config_views/{scope}/{view}.json"
             for study in config["run"]
             for view in views
         ]
@@ -136,11 +137,24 @@ def study_views(views):
     return views_of_every_study
 
 
-def config_view_file(wildcards):
-    """Input function: the config view a per-trial job reads (made by rule config_view); its
-    {method}'s, or the study view for a job without a method."""
+def config_view_file(wildcards, scope=None):
+    """Input function: the config view a job reads (made by the config_view rule), its
+    {method}'s, or the study view for a job without a method, in the scope of its trial's
+    protocol (gaitval.steps.PROTOCOL_SCOPE) unless `scope` is given."""
     view = getattr(wildcards, "method", None) or STUDY_VIEW
-    return f"{RESULTS}/{wildcards.study}/config_views/{view}.json"
+    if scope is None:
+        protocol = trial_row(wildcards.study, wildcards.trial)["protocol"]
+        scope = PROTOCOL_SCOPE.get(protocol, ALL_SCOPE)
+    return f"{RESULTS}/{wildcards.study}/config_views/{scope}/{view}.json"
+
+
+def config_view_in(scope):
+    """Input function: config_view_file in a given scope (jobs without a trial)."""
+
+    def view_in_scope(wildcards):
+        return config_view_file(wildcards, scope)
+
+    return view_in_scope
 
 
 # PRIORITIES.  Snakemake starts ready jobs by priority (default 0), not by how much waits

@@ -56,7 +56,7 @@ rule mtst_evaluate:
 rule mtst_tables:
     input:
         evals=mtst_summaries,
-        configs=study_views([STUDY_VIEW]),  # the mtst: section
+        configs=study_views([STUDY_VIEW], "mtst"),  # the mtst: section
     output:
         t3=report(
             f"{REPORTS}/tables/mtst_table3.csv",

@@ -24,22 +24,27 @@ rule study_config:
 # change of one method's parameter reruns that method's tracking and evaluation and the
 # tables of its study section (the pooled tables read the views too: study_views), not
 # every trial's registration, every other method and the other tables.  view = a method
-# name, or "study" for the jobs without a method.
+# name, or "study" for the jobs without a method; scope = the protocol family whose section
+# it keeps (tug, mtst, rollator, ultrasonic; the others' left out), or "all".
 rule config_view:
     input:
         sheet=lambda w: sheet_path(w.study),
     output:
-        f"{RESULTS}/{{study}}/config_views/{{view}}.json",
+        f"{RESULTS}/{{study}}/config_views/{{scope}}/{{view}}.json",
     wildcard_constraints:
+        scope="|".join((*SCOPES, ALL_SCOPE)),
         view=r"[A-Za-z0-9_.\-]+",
     params:
-        sections=lambda w: analysis_sections_json(w.view),
+        sections=lambda w: analysis_sections_json(w.view, w.scope),
     log:
-        "logs/config_view/{study}/{view}.log",
+        "logs/config_view/{study}/{scope}/{view}.log",
     run:
         from gaitval.steps import study_config
 
-        study_config(json.loads(params.sections), input.sheet, output[0], view=wildcards.view)
+        study_config(
+            json.loads(params.sections), input.sheet, output[0], view=wildcards.view,
+            scope=wildcards.scope,
+        )
 
 
 rule register:

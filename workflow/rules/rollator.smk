@@ -11,7 +11,7 @@ include: "rollator_common.smk"
 rule rollator_train:
     input:
         others=rollator_training_inputs,
-        config=config_view_file,
+        config=config_view_in("rollator"),
         sheet=lambda w: sheet_path(w.study),
     output:
         f"{RESULTS}/{{study}}/rollator/model/{{subject}}.json",
@@ -99,7 +99,7 @@ rule rollator_tables:
             for study in config["run"]
             for subject in rollator_subjects(study)
         ],
-        config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/{STUDY_VIEW}.json",
+        config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/rollator/{STUDY_VIEW}.json",
     output:
         t1=report(
             f"{REPORTS}/tables/rollator_table1.csv",

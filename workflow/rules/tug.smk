@@ -53,7 +53,7 @@ rule tug_tables:
             for method in tug_runs()
             for trial in trial_ids(study, ["tug"])
         ],
-        configs=study_views(tug_runs()),  # Table 2: each study's method definitions
+        configs=study_views(tug_runs(), "tug"),  # Table 2: each study's method definitions
     output:
         t4=report(
             f"{REPORTS}/tables/tug_table4.csv",

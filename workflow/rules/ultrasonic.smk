@@ -11,7 +11,7 @@ rule ultrasonic_noise:
         ],
         # the study view (no method's definition): a tracker parameter changed elsewhere
         # does not rerun the noise identification and every ultrasonic track after it
-        config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/{STUDY_VIEW}.json",
+        config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/ultrasonic/{STUDY_VIEW}.json",
     output:
         noise=f"{RESULTS}/ultrasonic_noise.json",
         table=report(
