@@ -122,7 +122,7 @@ def cmd_evaluate_tug(a) -> int:
 def cmd_tug_tables(a) -> int:
     from gaitval.steps import tug_tables_step
     tug_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir, a.config_hash,
-                    methods=a.methods)
+                    methods=a.methods, configs=a.configs)
     return 0
 
 
@@ -254,6 +254,10 @@ def _add_lrs_verbs(sub) -> None:
     s.add_argument("--figures-dir", required=True)
     s.add_argument("--reports-dir", default="reports")
     s.add_argument("--config-hash", default="")
+    s.add_argument("--configs", nargs="+", default=None,
+                   help="each study's config.json or its method views (config_views/tug/"
+                        "<method>.json) for Table 2; default: the config.json above each "
+                        "evaluation folder")
     s.set_defaults(func=cmd_tug_tables)
 
 

@@ -380,3 +380,19 @@ def test_table2_from_the_method_views_is_the_table_from_config_json(tmp_path, ta
     from_views = table2_of(dirs, names, configs=views)
     assert from_views.equals(whole)
     assert {"tug_m3 (a)", "tug_m3 (b)", "my_m3 (a)", "my_m3 (b)"} <= set(from_views.method)
+
+
+def test_tug_tables_verb_hands_the_configs_it_is_given_to_the_step(monkeypatch):
+    """The workflow gives `gaitval tug-tables` the method views with --configs: a run that
+    asks for the TUG tables only has no config.json to fall back on (test_resume)."""
+    import gaitval.steps as steps
+    from gaitval.cli import main
+
+    seen = {}
+    monkeypatch.setattr(steps, "tug_tables_step",
+                        lambda *a, **k: seen.update(k) or [])
+    assert main(["tug-tables", "e1", "--tables-dir", "t", "--figures-dir", "f",
+                 "--configs", "v/tug_m1.json", "v/tug_m2.json"]) == 0
+    assert seen["configs"] == ["v/tug_m1.json", "v/tug_m2.json"]
+    assert main(["tug-tables", "e1", "--tables-dir", "t", "--figures-dir", "f"]) == 0
+    assert seen["configs"] is None                                # config.json convention

@@ -85,7 +85,7 @@ rule tug_tables:
         "{params.gv} tug-tables {params.dirs:q} --methods {params.methods:q}"
         " --tables-dir {params.tables:q} --figures-dir {params.figures:q}"
         " --reports-dir {params.reports:q} --config-hash {params.chash:q}"
-        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+        " --configs {input.configs:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 REPORT_ITEM_FUNCS.append(
