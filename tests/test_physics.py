@@ -36,6 +36,19 @@ def test_simulate_writes_the_physics_table(physics):
         "forward", "turning", "return"}
 
 
+def test_physics_rows_are_the_same_with_the_swing_statistics_on_a_pool(tiny):
+    """generate_study maps the per-trial swing statistics over its worker processes
+    (issue 13); the table is the serial one, row for row."""
+    import concurrent.futures as cf
+    import multiprocessing as mp
+
+    serial = physics_table(tiny)
+    with cf.ProcessPoolExecutor(2, mp_context=mp.get_context("fork")) as ex:
+        pooled = physics_table(tiny, map_fn=ex.map)
+    pd.testing.assert_frame_equal(pooled, serial)
+    assert (serial["check"] == "swing_shin_backward").any()
+
+
 def test_no_swinging_shin_moves_backwards(physics):
     """Issue 10: the swing shin's forward speed stays >= 0 (within noise) in every swing,
     gait initiation from the chair included, in every protocol."""

@@ -67,7 +67,7 @@ import pandas as pd
 from scipy import stats
 
 from gaitval.io.atomic import write_csv
-from gaitval.simulate.swings import first_swing, lrs_trials, swing_minima
+from gaitval.simulate.swings import lrs_trials, swing_stats
 
 # --------------------------------------------------------------------------------------
 # Tolerances and references: stated before any value of these checks was computed.
@@ -129,11 +129,14 @@ def poisson_ci(k: int, level: float = 0.95) -> tuple[float, float]:
     return float(lo), float(stats.chi2.ppf(1 - a, 2 * k + 2) / 2)
 
 
-def _swing_rows(study_dir: Path, trials: pd.DataFrame, real: dict | None) -> list[dict]:
+def _swing_rows(study_dir: Path, trials: pd.DataFrame, real: dict | None,
+                map_fn=map) -> list[dict]:
     rows = []
     ref = real["swing_fwd_min_mps"] if real else np.nan
+    names = list(trials["trial"])                 # one task per trial, results in order
+    stats = dict(zip(names, map_fn(swing_stats, [study_dir] * len(names), names)))
     for proto, g in trials.groupby("protocol", sort=True):
-        mins = np.concatenate([swing_minima(study_dir, t) for t in g["trial"]])
+        mins = np.concatenate([stats[t][0] for t in g["trial"]])
         n_back = int(np.sum(mins < SWING_BACKWARD_MPS))
         rows.append(_row("swing_shin_backward", proto, n_back, 0, 0, 0, "swings",
                          f"no swing below {SWING_BACKWARD_MPS} m/s forward",
@@ -141,7 +144,7 @@ def _swing_rows(study_dir: Path, trials: pd.DataFrame, real: dict | None) -> lis
                          f"{ref:.2f} m/s", group=GROUP_OF.get(proto, ""),
                          note=f"{len(mins)} swings; lowest forward speed "
                               f"{np.min(mins) if len(mins) else np.nan:.2f} m/s"))
-        first = np.array([first_swing(study_dir, t) for t in g["trial"]])
+        first = np.array([stats[t][1] for t in g["trial"]])
         rows.append(_row("first_swing_backward", proto,
                          int(np.sum(first[:, 0] < SWING_BACKWARD_MPS)), 0, 0, 0, "swings",
                          f"no first swing below {SWING_BACKWARD_MPS} m/s forward",
@@ -344,7 +347,7 @@ def _treadmill_rows(study_dir: Path) -> list[dict]:
 
 
 def physics_table(study_dir: str | Path, walkers: list | None = None,
-                  realdata: str | Path | None = None) -> pd.DataFrame:
+                  realdata: str | Path | None = None, map_fn=map) -> pd.DataFrame:
     """All checks of one simulated study (rows as in the module table).
 
     Parameters
@@ -357,6 +360,9 @@ def physics_table(study_dir: str | Path, walkers: list | None = None,
     realdata : path, optional
         Folder of the real C3D walks (default ``../shared/realdata/c3d`` beside the
         checkout); the shin rows show "not checked" when it is absent.
+    map_fn : callable
+        ``map``-like (results in order) for the per-trial swing statistics, e.g. a process
+        pool's ``map`` (:func:`gaitval.simulate.generate_study` passes its own); same rows.
 
     Returns
     -------
@@ -369,7 +375,7 @@ def physics_table(study_dir: str | Path, walkers: list | None = None,
     realdata = Path(realdata)
     shin_rows, real = _shin_rows(walkers, realdata if realdata.is_dir() else None)
     lrs = lrs_trials(d)
-    rows = _swing_rows(d, lrs, real) + shin_rows + _step_rows(d, lrs)
+    rows = _swing_rows(d, lrs, real, map_fn) + shin_rows + _step_rows(d, lrs)
     tug = lrs[lrs["protocol"] == "tug"]
     if len(tug):
         rows += _tug_phase_rows(d, tug) + _tug_path_rows(d, tug)
@@ -381,8 +387,8 @@ def physics_table(study_dir: str | Path, walkers: list | None = None,
 
 
 def write_physics(study_dir: str | Path, walkers: list | None = None,
-                  realdata: str | Path | None = None) -> Path:
+                  realdata: str | Path | None = None, map_fn=map) -> Path:
     """Write ``<study_dir>/physics.csv`` (:func:`physics_table`) and return its path."""
     out = Path(study_dir) / "physics.csv"
-    write_csv(physics_table(study_dir, walkers, realdata), out, float_format="%.6g")
+    write_csv(physics_table(study_dir, walkers, realdata, map_fn), out, float_format="%.6g")
     return out

@@ -287,6 +287,9 @@ class _Serial:
         f.set_result(fn(*args))
         return f
 
+    def map(self, fn, *iterables):
+        return map(fn, *iterables)
+
     def __enter__(self):
         return self
 
@@ -372,8 +375,11 @@ def generate_study(out_dir: Path, preset: str | dict = "default", seed: int | No
               out / "truth" / "sensor_pose.csv", float_format="%.9g")
     if realism:
         write_csv(summarise_realism(realism), out / "realism.csv", float_format="%.6g")
-    # the physical checks of the twin (gaitval.simulate.physics): data/<study>/physics.csv
-    write_physics(out, walkers=[(p, s["group"], gp) for p, s, gp in _subject_rows(cfg, seed)])
+    # the physical checks of the twin (gaitval.simulate.physics): data/<study>/physics.csv;
+    # the per-trial swing statistics read back across the same workers (same rows)
+    walkers = [(p, s["group"], gp) for p, s, gp in _subject_rows(cfg, seed)]
+    with _executor(_workers(len(tasks), workers)) as ex:
+        write_physics(out, walkers=walkers, map_fn=ex.map)
     mount = cfg.get("rollator", {}).get("sensor_mount",
                                         {"x_m": -0.22, "y_m": 0.0, "yaw_rad": float(np.pi)})
     calibration = {

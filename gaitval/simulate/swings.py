@@ -32,10 +32,30 @@ def lrs_trials(study_dir: Path) -> pd.DataFrame:
 
 def swing_minima(study_dir: Path, trial: str) -> np.ndarray:
     """Per complete swing of a trial: the lowest forward speed of the shin point (m/s)."""
+    return _minima(*_truth(study_dir, trial))
+
+
+def first_swing(study_dir: Path, trial: str) -> tuple[float, float]:
+    """The first swing from standing (the trial's earliest lift-off): the lowest forward
+    speed of its shin point (m/s) and its duration ÷ the trial's median swing."""
+    return _first(*_truth(study_dir, trial))
+
+
+def swing_stats(study_dir: Path, trial: str) -> tuple[np.ndarray, tuple[float, float]]:
+    """(:func:`swing_minima`, :func:`first_swing`) of a trial, its truth read once: one
+    task per trial of the physical checks (the simulation's worker pool maps it)."""
+    legs, ev = _truth(study_dir, trial)
+    return _minima(legs, ev), _first(legs, ev)
+
+
+def _truth(study_dir: Path, trial: str) -> tuple[pd.DataFrame, pd.DataFrame]:
+    d = Path(study_dir) / "truth" / trial
+    return pd.read_parquet(d / "legs.parquet"), pd.read_csv(d / "events.csv")
+
+
+def _minima(legs: pd.DataFrame, ev: pd.DataFrame) -> np.ndarray:
     from gaitval.simulate.shin import point_profile
 
-    d = study_dir / "truth" / trial
-    legs, ev = pd.read_parquet(d / "legs.parquet"), pd.read_csv(d / "events.csv")
     out = []
     for side, g in legs.groupby("side", sort=True):
         t = g["t_s"].to_numpy(float)
@@ -45,13 +65,9 @@ def swing_minima(study_dir: Path, trial: str) -> np.ndarray:
     return np.concatenate(out) if out else np.array([])
 
 
-def first_swing(study_dir: Path, trial: str) -> tuple[float, float]:
-    """The first swing from standing (the trial's earliest lift-off): the lowest forward
-    speed of its shin point (m/s) and its duration ÷ the trial's median swing."""
+def _first(legs: pd.DataFrame, ev: pd.DataFrame) -> tuple[float, float]:
     from gaitval.simulate.shin import point_profile
 
-    d = study_dir / "truth" / trial
-    legs, ev = pd.read_parquet(d / "legs.parquet"), pd.read_csv(d / "events.csv")
     sw = {s: swings(ev, s) for s in ("L", "R")}
     side = min((s for s in sw if sw[s]), key=lambda s: sw[s][0][0])
     (a, b), g = sw[side][0], legs[legs["side"] == side]
