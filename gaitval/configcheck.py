@@ -197,6 +197,38 @@ def display_path(path: str | Path) -> str:
     return str(path) if rel.startswith("..") else rel
 
 
+def retype_command_line(value: Any) -> Any:
+    """The scalars nested in a ``--config`` value, typed as YAML types them.
+
+    Snakemake parses a top-level ``--config`` value with int, float and bool first, but a
+    mapping or list with YAML's BaseLoader, which keeps every scalar inside it a string:
+    ``--config 'rollator={"pf_seed": 2018}'`` gives ``{"pf_seed": "2018"}``, not what the
+    same line in a config file gives.  Here a nested string becomes the int, float, bool or
+    None that ``yaml.safe_load`` reads from it; any other string (a name, a date) stays as
+    it is, and the top level is left alone.
+    """
+    def scalar(v: Any) -> Any:
+        if not isinstance(v, str) or not v.strip():
+            return v
+        try:
+            typed = yaml.safe_load(v)
+        except yaml.YAMLError:
+            return v
+        return typed if typed is None or isinstance(typed, (bool, int, float)) else v
+
+    def walk(v: Any) -> Any:
+        if isinstance(v, Mapping):
+            return {k: walk(x) for k, x in v.items()}
+        if isinstance(v, list):
+            return [walk(x) for x in v]
+        return scalar(v)
+
+    if isinstance(value, Mapping):
+        return {k: (walk(v) if isinstance(v, (Mapping, list)) else v)
+                for k, v in value.items()}
+    return value
+
+
 def check_config(config: Mapping, layers: Sequence[tuple[str, Any]] | None = None, *,
                  schema: dict | None = None) -> None:
     """Check a whole workflow config; raise :class:`ConfigError` on the first problem.

@@ -130,6 +130,10 @@ def test_a_rollator_setting_reruns_only_the_rollator_trials(tiny_run, tmp_path):
                        str(ROOT / "config" / "config.yaml"), str(overlay), "-n")
     assert res.returncode == 0, res.stderr[-3000:]
     planned = _planned(res)
+    # the same on the command line: the nested 2018 is a number there too
+    cli = run_workflow(tiny_run, tiny_run / "data", 'rollator={"pf_seed": 2018}', "-n")
+    assert cli.returncode == 0, cli.stderr[-3000:]
+    assert _planned(cli) == planned
     sheet = pd.read_csv(tiny_run / "data" / "tiny" / "trials.csv")
     n_rollator = int((sheet["protocol"] == "rollator").sum())
     assert n_rollator > 0

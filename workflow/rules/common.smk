@@ -5,9 +5,10 @@ import sys
 from pathlib import Path
 
 from snakemake.common.configfile import load_configfile
+from snakemake.utils import update_config
 
 from gaitval.configcheck import (check_config, check_study_file, display_path,
-                                 load_schema)
+                                 load_schema, retype_command_line)
 from gaitval.errors import ConfigError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash
@@ -25,7 +26,14 @@ def _config_layers():
     files = [Path(f).resolve() for f in getattr(workflow, "configfiles", ())]
     files = [f for f in files if f not in cli] + cli
     layers = [(display_path(f), load_configfile(str(f))) for f in files if f.is_file()]
-    return layers + [("--config", dict(getattr(settings, "config", None) or {}))]
+    return layers + [("--config", _command_line_config())]
+
+
+def _command_line_config():
+    """--config as Snakemake parsed it, its nested scalars typed as in a config file
+    (gaitval.configcheck.retype_command_line: {"pf_seed": "2018"} -> {"pf_seed": 2018})."""
+    settings = getattr(workflow, "config_settings", None)
+    return retype_command_line(dict(getattr(settings, "config", None) or {}))
 
 
 def _check_study_files(schema):
@@ -43,6 +51,7 @@ DATA = config.get("data_dir", "data")
 # Every key against workflow/schemas/config.schema.yaml, then the studies' study.yaml: a
 # typo stops the run here with the file, the key's path and the nearest valid key
 # (gaitval.configcheck), as one message.
+update_config(config, _command_line_config())  # --config's nested numbers as numbers
 try:
     _SCHEMA = load_schema(Path(workflow.basedir) / "workflow/schemas/config.schema.yaml")
     check_config(config, _config_layers(), schema=_SCHEMA)
