@@ -263,8 +263,8 @@ def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, report
 
     Table 2 shows the method definitions actually run: ``tracking.methods`` and
     ``tracking.overrides`` of each study's ``config.json`` or of its method views
-    ``results/<study>/config_views/<method>.json`` (``configs``, which the workflow gives:
-    the views, so that another study section's change does not rerun these tables; default
+    ``results/<study>/config_views/tug/<method>.json`` (``configs``, which the workflow
+    gives: the views, so that another section's change does not rerun these tables; default
     ``results/<study>/config.json`` above the ``evaluate/<method>/<trial>`` folders).  A
     method run with different parameters in different studies gets one set of rows per
     study, labelled ``<method> (<study>)``.

@@ -30,11 +30,6 @@ def lrs_trials(study_dir: Path) -> pd.DataFrame:
     return tr[[(study_dir / "truth" / t / "legs.parquet").is_file() for t in tr["trial"]]]
 
 
-def swing_minima(study_dir: Path, trial: str) -> np.ndarray:
-    """Per complete swing of a trial: the lowest forward speed of the shin point (m/s)."""
-    return _minima(*_truth(study_dir, trial))
-
-
 def first_swing(study_dir: Path, trial: str) -> tuple[float, float]:
     """The first swing from standing (the trial's earliest lift-off): the lowest forward
     speed of its shin point (m/s) and its duration ÷ the trial's median swing."""
@@ -42,8 +37,9 @@ def first_swing(study_dir: Path, trial: str) -> tuple[float, float]:
 
 
 def swing_stats(study_dir: Path, trial: str) -> tuple[np.ndarray, tuple[float, float]]:
-    """(:func:`swing_minima`, :func:`first_swing`) of a trial, its truth read once: one
-    task per trial of the physical checks (the simulation's worker pool maps it)."""
+    """Per complete swing of a trial the lowest forward speed of the shin point (m/s), and
+    :func:`first_swing`, its truth read once: one task per trial of the physical checks
+    (the simulation's worker pool maps it)."""
     legs, ev = _truth(study_dir, trial)
     return _minima(legs, ev), _first(legs, ev)
 

@@ -48,10 +48,11 @@ def _check_study_files(schema):
 
 
 DATA = config.get("data_dir", "data")
+# Numbers nested in a --config value as numbers (Snakemake leaves them strings).
+update_config(config, _command_line_config())
 # Every key against workflow/schemas/config.schema.yaml, then the studies' study.yaml: a
 # typo stops the run here with the file, the key's path and the nearest valid key
 # (gaitval.configcheck), as one message.
-update_config(config, _command_line_config())  # --config's nested numbers as numbers
 try:
     _SCHEMA = load_schema(Path(workflow.basedir) / "workflow/schemas/config.schema.yaml")
     check_config(config, _config_layers(), schema=_SCHEMA)
