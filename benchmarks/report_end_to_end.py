@@ -69,11 +69,11 @@ def _forked_jobs(log: Path) -> dict[str, list[float]]:
     if not log.is_file():
         return out
     for line in log.read_text().splitlines():
-        m = re.match(r"job (\d+): gaitval (\S+)", line)
+        m = re.match(r"job ([\d.]+): gaitval (\S+)", line)
         if m:
             verb[m[1]] = m[2]
             continue
-        m = re.match(r"job (\d+): exit (-?\d+), wall ([\d.]+) s, cpu ([\d.]+) s", line)
+        m = re.match(r"job ([\d.]+): exit (-?\d+), wall ([\d.]+) s, cpu ([\d.]+) s", line)
         if m:
             acc = out.setdefault(verb.get(m[1], "?"), [0, 0.0])
             acc[0] += 1

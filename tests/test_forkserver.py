@@ -72,20 +72,52 @@ def test_without_a_server_the_plain_command_runs(tmp_path):
 
 
 def test_a_cancelled_job_stops(server, tmp_path):
-    """Killing the client (Snakemake cancelling the job) ends the job's process too."""
+    """Killing the client (Snakemake cancelling the job) ends the job: the worker that ran it
+    and every process it started; the server replaces the worker."""
+    idle = _children_of_server(server)
+    assert len(idle) == 2, "two warm workers wait for jobs"
     # a verb that takes a while: simulate the default preset (about a minute)
     proc = subprocess.Popen([sys.executable, "-I", "-S", str(CLIENT), str(server), "--",
                              "simulate", "--out", str(tmp_path / "study")], cwd=ROOT,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     time.sleep(3)
-    children = _children_of_server(server)
-    assert children, "the job runs in a child of the server"
+    busy = max(_children_of_server(server),
+               key=lambda w: sum(_cpu_ticks(p) for p in _group_of(w)))
+    group = _group_of(busy)
+    assert busy in idle and sum(_cpu_ticks(p) for p in group) > 50, \
+        "the job runs in one of the warm workers (and the processes it started)"
     proc.kill()                                  # SIGKILL: the client cannot pass it on
     proc.wait()
     deadline = time.time() + 20
-    while time.time() < deadline and any(_alive(p) for p in children):
+    while time.time() < deadline and any(_alive(p) for p in group):
         time.sleep(0.2)
-    assert not any(_alive(p) for p in children)
+    assert not any(_alive(p) for p in group), "the job's worker and its processes are gone"
+    while time.time() < deadline and len(_children_of_server(server)) < 2:
+        time.sleep(0.2)
+    fresh = _children_of_server(server)
+    assert len(fresh) == 2 and busy not in fresh, "a fresh worker took its place"
+    r = _client(server, "--version")
+    assert r.returncode == 0 and r.stdout.startswith("gaitval ")
+
+
+def test_a_worker_runs_many_jobs_each_as_a_fresh_process_would(server, tmp_path):
+    """Jobs share a warm worker; what one job sets (environment, folder, warnings shown once)
+    does not reach the next: the same command four times gives the plain command's output
+    four times (a failed job's worker is replaced by a fresh one)."""
+    bad = tmp_path / "broken.c3d"
+    bad.write_bytes(b"\x02\x50" + b"\x00" * 100)
+    ref = _plain("inspect", str(bad), cwd=tmp_path)
+    for _ in range(4):
+        r = _client(server, "inspect", "broken.c3d", cwd=tmp_path)
+        assert (r.returncode, r.stdout) == (ref.returncode, ref.stdout)
+        assert r.stderr.replace(str(tmp_path) + "/", "") == \
+            ref.stderr.replace(str(tmp_path) + "/", "")
+    time.sleep(0.5)                              # failed jobs' workers were replaced
+    before = _children_of_server(server)
+    for _ in range(6):
+        assert _client(server, "--version").returncode == 0
+    assert _children_of_server(server) == before, \
+        "a worker that ran a job successfully stays for the next"
 
 
 def _children_of_server(sock) -> list[int]:
@@ -100,6 +132,32 @@ def _children_of_server(sock) -> list[int]:
             procs[int(d.name)] = (ppid, args)
     srv = [p for p, (_pp, a) in procs.items() if "gaitval.forkserver" in a and str(sock) in a]
     return [p for p, (pp, _a) in procs.items() if srv and pp == srv[0]]
+
+
+def _stat(pid: int) -> list[str]:
+    return (Path("/proc") / str(pid) / "stat").read_text().rsplit(")", 1)[1].split()
+
+
+def _cpu_ticks(pid: int) -> int:
+    """utime + stime of a process, clock ticks (0 when it is gone)."""
+    try:
+        f = _stat(pid)
+    except (OSError, IndexError):
+        return 0
+    return int(f[11]) + int(f[12])
+
+
+def _group_of(pid: int) -> list[int]:
+    """The processes of pid's process group (the worker leads its own)."""
+    out = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                if int(_stat(int(d.name))[2]) == pid:
+                    out.append(int(d.name))
+            except (OSError, ValueError, IndexError):
+                continue
+    return out
 
 
 def _alive(pid: int) -> bool:

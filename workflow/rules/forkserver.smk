@@ -9,13 +9,21 @@ import subprocess
 _FORK_SERVER_PROC = []
 
 
+def _fork_server_workers():
+    """One worker per job Snakemake runs at once: its --cores (at least 1)."""
+    try:
+        return max(1, int(workflow.cores))
+    except Exception:                 # cores not set (WorkflowError) or not a number
+        return 2
+
+
 def _start_fork_server():
     Path("logs").mkdir(exist_ok=True)
     log = open("logs/forkserver.log", "w")
     _FORK_SERVER_PROC.append(
         subprocess.Popen(
             [sys.executable, "-m", "gaitval.forkserver", "--socket", FORK_SOCKET,
-             "--owner", str(os.getpid())],
+             "--owner", str(os.getpid()), "--workers", str(_fork_server_workers())],
             stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
             start_new_session=True,
         )
