@@ -11,7 +11,8 @@ Usage::
     cd /tmp/e2e/run0 && time /path/to/.venv/bin/snakemake -s /path/to/Snakefile \
         --cores 2 --config 'run=["default"]' -n
 
-Each repeat runs Snakemake (``--cores N``) from the checkout's Snakefile in a fresh temp
+Each repeat runs Snakemake from the checkout's Snakefile with the profile of ``python3 run.py
+report`` (``--profile workflow/profiles/default --cores N``) in a fresh temp
 dir (fresh data/, results/, reports/, logs/; the venv is not touched), so the simulation
 is included.  Afterwards one job of each rule is rerun twice in the same folder: once
 with its modules' import recorded (``sys.modules`` at exit) and timed, and once as a
@@ -88,9 +89,10 @@ def _cpu_children() -> float:
 
 def _run_snakemake(root: Path, work: Path, study: str, cores: int, fork_server: bool = True
                    ) -> tuple[float, float, str]:
+    # the profile `python3 run.py report` uses (workflow/profiles/default), cores overridden
     cmd = [sys.executable, "-c", _SNAKEMAKE_SELF, "-s", str(root / "Snakefile"),
-           "--directory", str(work), "--cores", str(cores), "--printshellcmds",
-           "--rerun-incomplete", "--config", f'run=["{study}"]']
+           "--profile", str(root / "workflow" / "profiles" / "default"),
+           "--directory", str(work), "--cores", str(cores), "--config", f'run=["{study}"]']
     if not fork_server:
         cmd.append("fork_server=False")
     c0, t0 = _cpu_children(), time.perf_counter()
