@@ -90,6 +90,11 @@ def preload() -> list[str]:
             importlib.import_module(mod.name)
         except Exception:
             failed.append(mod.name)
+    try:                                       # the CLI's parser, built once for all jobs
+        from gaitval.cli import parser
+        parser()
+    except Exception:
+        failed.append("gaitval.cli.parser")
     try:                                       # parsed once here instead of in every job
         from gaitval.io.trialsheet import load_schema
         for name in ("trials", "subjects"):

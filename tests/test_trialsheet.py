@@ -87,6 +87,32 @@ def test_one_trial_job_checks_its_own_row_not_the_others(tmp_path):
                           tmp_path / "subjects.csv", "tug_S01_1")
 
 
+def test_a_process_running_many_jobs_sees_every_edit_of_the_sheet(tmp_path):
+    """A warm worker remembers validated rows by the files' contents: an edit that breaks
+    the row (sheet or subject table) is caught by the next job, a fixed file passes again,
+    and a job changing the dict it got does not change what the next job gets."""
+    from gaitval.steps import trial_and_subject
+
+    sheet = make_study(tmp_path)
+    subjects = tmp_path / "subjects.csv"
+    row, subj = trial_and_subject(sheet, subjects, "tug_S01_1")
+    row["sensor_height_m"] = -1.0
+    subj["leg_width_m"] = -1.0
+    row2, subj2 = trial_and_subject(sheet, subjects, "tug_S01_1")
+    assert row2["sensor_height_m"] == pytest.approx(0.27)
+    assert subj2["leg_width_m"] == pytest.approx(0.10)
+    good_sheet, good_subjects = sheet.read_text(), subjects.read_text()
+    sheet.write_text(good_sheet.replace(",0.27,", ",tall,"))
+    with pytest.raises(TrialSheetError, match="column 'sensor_height_m'"):
+        trial_and_subject(sheet, subjects, "tug_S01_1")
+    sheet.write_text(good_sheet)
+    subjects.write_text(good_subjects.replace("0.10,0.10", "wide,0.10"))
+    with pytest.raises(TrialSheetError, match="column 'leg_width_m'"):
+        trial_and_subject(sheet, subjects, "tug_S01_1")
+    subjects.write_text(good_subjects)
+    assert trial_and_subject(sheet, subjects, "tug_S01_1")[0]["subject"] == "S01"
+
+
 def test_one_trial_row_names_a_missing_trial(tmp_path):
     from gaitval.io.trialsheet import load_trial_row
 

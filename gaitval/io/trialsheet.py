@@ -13,10 +13,18 @@ that exist and stay inside the sheet's folder, a sensor file that fits the senso
 topic for every ROS bag.  It returns *every* problem (``gaitval validate`` lists them all);
 :func:`load_trial_sheet` raises them as one :class:`~gaitval.errors.TrialSheetError`, each
 naming the file, the row (line number and trial id) and the column.
+
+A process that runs many jobs (a warm worker of :mod:`gaitval.forkserver`) validates a
+trial's row and a subject's row once: :func:`load_trial_row` (without the file checks) and
+:func:`load_subjects` remember their result under the files' contents (SHA-1 of the sheet,
+the subject table and the ``study.yaml`` beside the sheet), so an edited file is validated
+again and an invalid one raises every time.
 """
 from __future__ import annotations
 
+import copy
 import difflib
+import hashlib
 import math
 from functools import lru_cache
 from pathlib import Path
@@ -178,6 +186,29 @@ def _subject_problems(path: Path, problems: list, only: str | None = None) -> pd
     return df
 
 
+#: Results of the row validations, by the validated files' contents (module docstring).
+_MEMO: dict[tuple, object] = {}
+_MEMO_MAX = 2048
+
+
+def _content_key(kind: str, paths, *rest) -> tuple:
+    """(kind, each file's resolved path and SHA-1 of its bytes or None, *rest)."""
+    key: list = [kind]
+    for p in paths:
+        p = Path(p).resolve()
+        try:
+            key += [str(p), hashlib.sha1(p.read_bytes()).digest()]
+        except OSError:
+            key += [str(p), None]
+    return (*key, *rest)
+
+
+def _remember(key: tuple, value) -> None:
+    if len(_MEMO) >= _MEMO_MAX:
+        _MEMO.clear()
+    _MEMO[key] = value
+
+
 def load_subjects(path: str | Path, only: str | None = None) -> pd.DataFrame:
     """Read and validate a subject table; returns one row per subject (index: subject).
 
@@ -188,10 +219,15 @@ def load_subjects(path: str | Path, only: str | None = None) -> pd.DataFrame:
     TrialSheetError
         Every problem found, each naming the row and column.
     """
-    problems: list[GaitvalError] = []
-    df = _subject_problems(Path(path), problems, only)
-    raise_all(problems)
-    return df.drop(columns="row_line")
+    key = _content_key("subjects", [path], only)
+    hit = _MEMO.get(key)
+    if hit is None:
+        problems: list[GaitvalError] = []
+        df = _subject_problems(Path(path), problems, only)
+        raise_all(problems)
+        hit = df.drop(columns="row_line")
+        _remember(key, hit)
+    return hit.copy(deep=True)
 
 
 def raise_all(problems: list[GaitvalError]) -> None:
@@ -369,9 +405,20 @@ def load_trial_row(path: str | Path, subjects: str | Path | None, trial: str, *,
     TrialSheetError
         A problem of the row, its subject or a header; or the trial is not in the sheet.
     """
+    key = None
+    if not check_files:                  # a file's existence may change: checked each time
+        sheet = Path(path).resolve()
+        key = _content_key("row", [sheet, subjects if subjects is not None
+                                   else sheet.parent / "subjects.csv",
+                                   sheet.parent / "study.yaml"], trial)
+        if key in _MEMO:
+            return copy.deepcopy(_MEMO[key])
     df, problems = sheet_problems(path, subjects, check_files=check_files, only=trial)
     raise_all(problems)
     if trial not in df.index:
         raise TrialSheetError(f"trial {trial!r} is not in the trial sheet", path=path,
                               trial=trial)
-    return df.loc[trial].to_dict()
+    row = df.loc[trial].to_dict()
+    if key is not None:
+        _remember(key, copy.deepcopy(row))
+    return row
