@@ -9,15 +9,16 @@ This file is run as a script and imports only C modules of the standard library 
 ``_signal``, ``marshal``, ``array``) and ``os``, so it starts in about 20 ms: it runs once per
 job, ~1,100 times in the default report, where ``json``, ``socket`` and ``signal`` (which pull
 in ``re`` and ``enum``) cost ~30 ms more each time.  It hands its working directory, environment, argument list and its
-standard input/output/error (the job's log) to the server, which forks a child that already
-has numpy, pandas, pyarrow, scipy and gaitval imported; the child runs
-``gaitval.cli.main(args)`` — the same code a plain ``python -m gaitval VERB ARGS`` runs —
-and the client exits with its exit code.
+standard input/output/error (the job's log) to the server, where a warm worker that already
+has numpy, pandas, pyarrow, scipy and gaitval imported runs ``gaitval.cli.main(args)`` —
+the same code a plain ``python -m gaitval VERB ARGS`` runs — and the client exits with its
+exit code.
 
 * No server at SOCKET (a cluster node, a run without the server): the client replaces
   itself with ``python -m gaitval VERB ARGS`` — same result, the usual start-up cost.
-* The client is stopped (Snakemake cancels the job): the signal is passed on to the child,
-  and a child whose client vanished (SIGKILL) stops itself.
+* The client is stopped (Snakemake cancels the job): the signal is passed on to the
+  worker's process group, and a worker whose client vanished (SIGKILL) stops itself; the
+  server starts a fresh worker in its place.
 """
 from __future__ import annotations
 
@@ -68,7 +69,7 @@ def main(argv: list[str]) -> int:
 
     def forward(signum, _frame):
         try:
-            os.killpg(child, signum)           # the job's process group (see forkserver)
+            os.killpg(child, signum)           # the worker's process group (see forkserver)
         except ProcessLookupError:
             pass
         raise SystemExit(128 + signum)

@@ -234,7 +234,7 @@ def build_method(method: str | dict[str, Any], overrides: dict[str, Any] | None 
     """
     m = set_params(get_method(method), overrides)
     if _kind_name(m) == DEFAULT_KIND:
-        return DetectThenTrack(*build_tracker(m))
+        return DetectThenTrack(*build_tracker(m), detector_spec=m["detector"])
     return TRACKER_KINDS.build(m["kind"])
 
 

@@ -173,10 +173,10 @@ def config_view_in(scope):
 # started only when every other trial was done, then its 30 tracks, gait parameters and
 # tables ran alone for ~90 s; the rollator PF likewise waited for its trained models.  So:
 # ultrasonic_noise and rollator_train 100, ultrasonic_track and gait_parameters 50,
-# ingest and register (everything's inputs) 20; config_view 200: with the greedy scheduler
-# (workflow/profiles/default) the views, a few milliseconds each, otherwise waited behind
-# every ingest and held back the registrations and the noise identification (first view at
-# 30 s, last at 86 s of a 95 s run).  Order only: same jobs, same files.
+# ingest and register (everything's inputs) 20.  Order only: same jobs, same files.  (Tried
+# and left out: config_view 200, so the views -- milliseconds each -- run before the
+# ingests; it made every registration ready at once, and the greedy scheduler's rounds over
+# the larger ready set cost Snakemake ~5 CPU-s more (10.3 vs 15.2 s) for no gain in wall.)
 
 # Rule files add functions study -> [report items] here; rule `report` collects them.
 REPORT_ITEM_FUNCS = []

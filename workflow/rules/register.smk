@@ -31,7 +31,6 @@ rule config_view:
         sheet=lambda w: sheet_path(w.study),
     output:
         f"{RESULTS}/{{study}}/config_views/{{scope}}/{{view}}.json",
-    priority: 200  # a JSON file in milliseconds that every per-trial job waits for
     wildcard_constraints:
         scope="|".join((*SCOPES, ALL_SCOPE)),
         view=r"[A-Za-z0-9_.\-]+",
