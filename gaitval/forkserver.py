@@ -39,7 +39,8 @@ group killed; the server replaces the worker.
 
 Log (the server's standard output, ``logs/forkserver.log`` in a workflow run): per job
 ``job <worker pid>.<n>: gaitval ARGS`` when it starts and ``job <worker pid>.<n>: exit <rc>,
-wall <s> s, cpu <s> s`` when it ends (CPU of the worker and the processes it waited for).
+wall <s> s, cpu <s> s, worker peak <MB> MB`` when it ends (CPU of the worker and the
+processes it waited for; the worker's peak resident memory so far).
 
 Usage::
 
@@ -221,8 +222,9 @@ def _serve_one(conn: socket.socket, jid: str, logfd: int) -> int:
             _tidy()
         except Exception:                      # noqa: BLE001 - next job gets a fresh worker
             rc = rc or 1
+    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     _log(logfd, f"job {jid}: exit {rc}, wall {time.perf_counter() - t0:.3f} s, "
-                f"cpu {_cpu() - c0:.3f} s")
+                f"cpu {_cpu() - c0:.3f} s, worker peak {peak_mb:.0f} MB")
     return rc
 
 
@@ -263,7 +265,7 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def serve(path: str, owner: int | None, workers: int = 2, max_jobs: int = 200,
+def serve(path: str, owner: int | None, workers: int = 2, max_jobs: int = 2000,
           max_rss_mb: float = 2048.0) -> int:
     stop = []
     for s in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
@@ -333,7 +335,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="exit when the process with this pid is gone")
     ap.add_argument("--workers", type=int, default=2,
                     help="worker processes, i.e. jobs run at once (the run's cores; default 2)")
-    ap.add_argument("--max-jobs", type=int, default=200,
+    ap.add_argument("--max-jobs", type=int, default=2000,
                     help="a worker makes way for a fresh one after this many jobs")
     ap.add_argument("--max-rss-mb", type=float, default=2048.0,
                     help="... or once its peak memory passed this many MB")

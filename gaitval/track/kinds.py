@@ -47,7 +47,7 @@ class TrackerKind:
 #: detector instead of once per method.  Same numbers: a hit is a copy of what the same
 #: detector returned for the same scans.
 _DETECTIONS: OrderedDict = OrderedDict()
-_DETECTIONS_MAX = 32
+_DETECTIONS_MAX = 256          # a few MB: a trial's detections are ~10^3 rows
 
 
 def _scans_key(scans: ScanSeries) -> bytes:
