@@ -18,9 +18,10 @@ pandas/numpy/gaitval objects it touches) and for its allocator's first pages: me
 0.19 s), about 60 CPU-s over the default report.  A worker keeps its pages.
 
 What a job could leave behind for the next is reset after each: standard streams (the
-descriptors are put back), working directory, environment, ``sys.argv``, warning filters
-and the "shown once" registry (each job runs under ``warnings.catch_warnings()``, so a warning
-appears in every job's log, as in a fresh process), open matplotlib figures.  A worker
+descriptors and the ``sys.std*`` objects are put back), working directory, environment,
+``sys.argv``, signal handlers, numpy's error handling, warning filters and the "shown once"
+registry (each job runs under ``warnings.catch_warnings()``, so a warning appears in every
+job's log, as in a fresh process), open matplotlib figures.  A worker
 that ran a job which failed (exit code not 0), that ran ``--max-jobs`` jobs, or whose peak
 memory passed ``--max-rss-mb`` exits after answering, and the server forks a fresh one.
 
@@ -158,6 +159,15 @@ def _log(fd: int, line: str) -> None:
     os.write(fd, (line + "\n").encode())
 
 
+_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGPIPE, signal.SIGCHLD)
+
+
+def _np_errstate() -> dict | None:
+    """numpy's floating-point error handling (``np.seterr``), which a job could change."""
+    np = sys.modules.get("numpy")
+    return None if np is None else np.geterr()
+
+
 def _tidy() -> None:
     """What a job may leave open in the process: matplotlib figures."""
     plt = sys.modules.get("matplotlib.pyplot")
@@ -173,6 +183,9 @@ def _serve_one(conn: socket.socket, jid: str, logfd: int) -> int:
     done = threading.Event()
     watcher = None
     cwd, env, argv0 = os.getcwd(), dict(os.environ), list(sys.argv)
+    streams = (sys.stdin, sys.stdout, sys.stderr)
+    handlers = {sig: signal.getsignal(sig) for sig in _SIGNALS}
+    np_err = _np_errstate()
     saved = [os.dup(i) for i in range(3)]
     try:
         req, fds = _request(conn)
@@ -214,6 +227,12 @@ def _serve_one(conn: socket.socket, jid: str, logfd: int) -> int:
         for i, fd in enumerate(saved):
             os.dup2(fd, i)
             os.close(fd)
+        sys.stdin, sys.stdout, sys.stderr = streams
+        for sig, handler in handlers.items():
+            if handler is not None:
+                signal.signal(sig, handler)
+        if np_err is not None:
+            sys.modules["numpy"].seterr(**np_err)
         sys.argv = argv0
         os.environ.clear()
         os.environ.update(env)

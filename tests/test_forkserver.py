@@ -166,3 +166,46 @@ def _alive(pid: int) -> bool:
             return fh.read().split()[2] != "Z"
     except FileNotFoundError:
         return False
+
+
+def test_what_a_job_changes_in_its_worker_is_put_back(tmp_path, monkeypatch):
+    """The worker's own bookkeeping, driven directly: a job that changes the environment,
+    folder, numpy's error handling, a signal handler, sys.stdout and the warning filters
+    leaves none of it to the next job, and its exit code reaches the client."""
+    import array
+    import io
+    import marshal
+    import socket
+    import struct
+    import warnings
+
+    import numpy as np
+
+    from gaitval import forkserver as fsv
+
+    def job(argv):
+        os.environ["GAITVAL_LEAK"] = "1"
+        os.chdir(tmp_path)
+        np.seterr(all="raise")
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        sys.stdout = io.StringIO()
+        warnings.simplefilter("error")
+        return 3
+
+    monkeypatch.setattr(fsv, "_call_main", job)
+    state = lambda: (os.getcwd(), dict(os.environ), np.geterr(),  # noqa: E731
+                     signal.getsignal(signal.SIGTERM), sys.stdout, list(warnings.filters))
+    before = state()
+    client, worker = socket.socketpair()
+    body = marshal.dumps({"argv": ["verb"], "cwd": str(ROOT), "env": dict(os.environ)})
+    logr, logw = os.pipe()
+    with open(os.devnull, "r+b") as nul:
+        client.sendmsg([struct.pack("!I", len(body)) + body],
+                       [(socket.SOL_SOCKET, socket.SCM_RIGHTS, array.array("i", [nul.fileno()] * 3))])
+        rc = fsv._serve_one(worker, "test.1", logw)
+    assert state() == before
+    assert rc == 3
+    assert struct.unpack("!ii", client.recv(8)) == (os.getpid(), 3)
+    os.close(logw)
+    log = os.read(logr, 4096).decode()
+    assert log.startswith("job test.1: gaitval verb\njob test.1: exit 3, wall ")
