@@ -207,7 +207,9 @@ def _serve_one(conn: socket.socket, jid: str, logfd: int) -> int:
         traceback.print_exc()
         rc = 1
     finally:
-        for stream in (sys.stdout, sys.stderr):
+        # the job's streams and the worker's own (a job may have replaced sys.stdout):
+        # everything buffered goes to the job's log before its descriptors are put back
+        for stream in (sys.stdout, sys.stderr, *streams[1:]):
             try:
                 stream.flush()
             except Exception:
