@@ -8,6 +8,7 @@ the problem, and exits with status 1; a usage error exits with 2
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import logging
 import sys
@@ -407,15 +408,11 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-_PARSER: list[argparse.ArgumentParser] = []
-
-
+@functools.cache
 def parser() -> argparse.ArgumentParser:
     """:func:`build_parser`, built once per process (~12 ms; a warm fork-server worker runs
     hundreds of jobs)."""
-    if not _PARSER:
-        _PARSER.append(build_parser())
-    return _PARSER[0]
+    return build_parser()
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -155,6 +155,11 @@ def _cpu() -> float:
     return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
 
 
+def _peak_mb() -> float:
+    """This process's peak resident memory so far, MB."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
 def _log(fd: int, line: str) -> None:
     os.write(fd, (line + "\n").encode())
 
@@ -243,9 +248,8 @@ def _serve_one(conn: socket.socket, jid: str, logfd: int) -> int:
             _tidy()
         except Exception:                      # noqa: BLE001 - next job gets a fresh worker
             rc = rc or 1
-    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     _log(logfd, f"job {jid}: exit {rc}, wall {time.perf_counter() - t0:.3f} s, "
-                f"cpu {_cpu() - c0:.3f} s, worker peak {peak_mb:.0f} MB")
+                f"cpu {_cpu() - c0:.3f} s, worker peak {_peak_mb():.0f} MB")
     return rc
 
 
@@ -267,8 +271,7 @@ def _worker(srv: socket.socket, master: int, max_jobs: int, max_rss_mb: float) -
             conn.settimeout(None)
             n += 1
             rc = _serve_one(conn, f"{os.getpid()}.{n}", logfd)
-            peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-            if rc != 0 or peak_mb > max_rss_mb:
+            if rc != 0 or _peak_mb() > max_rss_mb:
                 break
     except BaseException:                      # noqa: BLE001
         traceback.print_exc()
