@@ -261,13 +261,14 @@ def _simulate_trial(out: Path, cfg: dict, study: str, seed: int, idx: int, build
     return realism, sheet, poses
 
 
-def _ultrasonic(out: Path, cfg: dict, study: str, seed: int):
-    """The ultrasonic protocols' (trials, subjects), or the reason they were skipped."""
+def _ultrasonic_plan(cfg: dict, study: str, seed: int):
+    """The ultrasonic protocols' plan (:func:`gaitval.simulate.ultrasonic.plan_ultrasonic`)
+    and its module, or the reason they are skipped (a str)."""
     try:
-        from gaitval.simulate.ultrasonic import generate_ultrasonic
+        from gaitval.simulate import ultrasonic as U
     except ImportError as exc:
-        return str(exc)
-    return generate_ultrasonic(out, {**cfg["ultrasonic"], "study": study}, seed)
+        return str(exc), None
+    return U.plan_ultrasonic({**cfg["ultrasonic"], "study": study}, seed), U
 
 
 def _workers(n_tasks: int, workers: int | None) -> int:
@@ -344,10 +345,13 @@ def generate_study(out_dir: Path, preset: str | dict = "default", seed: int | No
     sheet, realism, poses, subjects = [], [], [], []
     t0 = time.perf_counter()
     tasks = _lrs_tasks(cfg, study, seed, subjects)
-    n_us = 1 if cfg.get("ultrasonic") else 0
-    with _executor(_workers(len(tasks) + n_us, workers)) as ex:
-        # the ultrasonic protocols first: one long task beside the trials
-        us = ex.submit(_ultrasonic, out, cfg, study, seed) if n_us else None
+    us_plan, U = _ultrasonic_plan(cfg, study, seed) if cfg.get("ultrasonic") else (None, None)
+    us_tasks = us_plan.tasks if U is not None else []
+    with _executor(_workers(len(tasks) + len(us_tasks), workers)) as ex:
+        # the ultrasonic trials first (5-min treadmill walks, the longest tasks), each its
+        # own task beside the LRS trials; every trial has its own seed
+        us_futures = [ex.submit(U.simulate_ultrasonic_trial, out, us_plan, task)
+                      for task in us_tasks]
         futures = [ex.submit(_simulate_trial, out, cfg, study, seed, idx, build, bargs,
                              subj, drift)
                    for idx, proto, build, bargs, subj, drift in tasks]
@@ -356,9 +360,11 @@ def generate_study(out_dir: Path, preset: str | dict = "default", seed: int | No
             realism += r
             sheet += sh
             poses += po
-        us = us.result() if us is not None else None
+        us = U.finish_ultrasonic(out, us_plan, [f.result() for f in us_futures]) \
+            if U is not None else us_plan
     log.info("simulated %d LRS trials%s in %.2f s", len(tasks),
-             " and the ultrasonic protocols" if n_us else "", time.perf_counter() - t0)
+             f" and {len(us_tasks)} ultrasonic trials" if us_tasks else "",
+             time.perf_counter() - t0)
     trials = pd.DataFrame(sheet, columns=TRIAL_COLUMNS)
     subj_df = pd.DataFrame(subjects, columns=SUBJECT_COLUMNS)
     if isinstance(us, str):

@@ -85,6 +85,7 @@ Parameters Using a Low-Cost Ultrasonic Motion Analysis System. *Sensors* 2014, 1
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -99,9 +100,11 @@ from gaitval.simulate.us_sensor import (ANCHOR_IDS, PAPER_ANCHORS, PAPER_V_M2, b
 from gaitval.simulate.us_treadmill import (foot_points, heel_path, simulate_treadmill_trial,
                                            stride_plan)
 
-__all__ = ["ANCHOR_IDS", "DEFAULTS", "PAPER_ANCHORS", "PAPER_V_M2", "board_pose",
-           "foot_points", "generate_ultrasonic", "heel_path", "simulate_pendulum_trial",
-           "simulate_treadmill_trial", "speed_of_sound_true", "stride_plan"]
+__all__ = ["ANCHOR_IDS", "DEFAULTS", "PAPER_ANCHORS", "PAPER_V_M2", "UltrasonicPlan",
+           "board_pose", "finish_ultrasonic", "foot_points", "generate_ultrasonic",
+           "heel_path", "plan_ultrasonic", "simulate_pendulum_trial",
+           "simulate_treadmill_trial", "simulate_ultrasonic_trial", "speed_of_sound_true",
+           "stride_plan"]
 
 DEFAULTS: dict = {
     "study": "default",
@@ -175,42 +178,96 @@ def _truth_row(trial: str, meta: dict) -> dict:
             "n_multipath": meta["n_multipath"], "n_dropout": meta["n_dropout"]}
 
 
-def _treadmill_trials(out_dir: Path, cfg: dict, subjects: pd.DataFrame,
-                      t_factor: np.ndarray, R: np.ndarray, o: np.ndarray, trial_seeds,
-                      rows: list, truth_rows: list) -> None:
-    """Simulate and write every subject's treadmill trials (one per belt speed, in order)."""
-    speeds = dict(cfg["speeds"])
-    k = 0
+def _treadmill_tasks(subjects: pd.DataFrame, speeds: dict, t_factor: np.ndarray,
+                     trial_seeds) -> list[tuple]:
+    """One task per treadmill trial (every subject, one per belt speed, in order)."""
+    tasks, k = [], 0
     for si, sub in subjects.iterrows():
         sub = {**sub.to_dict(), "_t_factor": float(t_factor[si])}
         for name, v_nom in speeds.items():
-            rng = np.random.default_rng(trial_seeds[k])
+            tasks.append(("treadmill", f"us_{sub['subject']}_{name}", trial_seeds[k],
+                          {"subject": sub, "speed": name, "v_nom": float(v_nom)}))
             k += 1
-            v = float(round(v_nom + 0.03 * rng.standard_normal(), 3))
-            trial = f"us_{sub['subject']}_{name}"
-            labels, xyz, log, truth_tx, meta, strides = simulate_treadmill_trial(
-                rng, cfg, sub, v, R, o)
-            log.meta["trial"] = trial
-            c3d_rel, us_rel = _write_trial(out_dir, cfg["folder"], trial, labels, xyz,
-                                           cfg["mocap_rate_hz"], log, truth_tx, meta, strides)
-            rows.append(_trial_row(cfg, "treadmill", sub["subject"], trial, c3d_rel, us_rel,
-                                   name, v))
-            truth_rows.append(_truth_row(trial, meta))
+    return tasks
 
 
-def _pendulum_trials(out_dir: Path, cfg: dict, R: np.ndarray, o: np.ndarray, pend_seeds,
-                     rows: list, truth_rows: list) -> None:
-    """Simulate and write the pendulum trials (one child seed each)."""
-    for i, ps in enumerate(pend_seeds):
-        rng = np.random.default_rng(ps)
-        trial = f"us_pendulum_{i + 1:02d}"
-        labels, xyz, log, truth_tx, meta = simulate_pendulum_trial(rng, cfg, R, o)
-        log.meta["trial"] = trial
-        c3d_rel, us_rel = _write_trial(out_dir, cfg["folder"], trial, labels, xyz,
-                                       cfg["mocap_rate_hz"], log, truth_tx, meta, None)
-        rows.append(_trial_row(cfg, "pendulum", "pendulum", trial, c3d_rel, us_rel,
-                               repetition=i + 1))
-        truth_rows.append(_truth_row(trial, meta))
+def _pendulum_tasks(pend_seeds) -> list[tuple]:
+    """One task per pendulum trial (one child seed each)."""
+    return [("pendulum", f"us_pendulum_{i + 1:02d}", ps, {"repetition": i + 1})
+            for i, ps in enumerate(pend_seeds)]
+
+
+@dataclass
+class UltrasonicPlan:
+    """What :func:`plan_ultrasonic` draws before any trial: the full config, the
+    participants, the receiver board's pose in the field (``R``, ``o``) and one task per
+    trial, each with its own seed, so the trials can be simulated in any order or process."""
+
+    cfg: dict
+    subjects: pd.DataFrame
+    R: np.ndarray
+    o: np.ndarray
+    tasks: list = field(default_factory=list)
+
+
+def plan_ultrasonic(cfg: dict | None = None, seed: int = 0) -> UltrasonicPlan:
+    """The draws shared by the trials of the ultrasonic study, and its trial tasks."""
+    cfg = {**DEFAULTS, **(cfg or {})}
+    root = np.random.SeedSequence(seed)
+    s_subj, s_board, s_trials, s_pend = root.spawn(4)
+    subjects = _subjects(np.random.default_rng(s_subj), int(cfg["n_subjects"]))
+    R, o = board_pose(np.random.default_rng(s_board))
+    t_factor = np.exp(0.04 * np.random.default_rng(s_subj.spawn(1)[0]).standard_normal(
+        len(subjects)))
+    speeds = dict(cfg["speeds"])
+    tasks = _treadmill_tasks(subjects, speeds, t_factor,
+                             s_trials.spawn(len(subjects) * len(speeds)))
+    tasks += _pendulum_tasks(s_pend.spawn(int(cfg["n_pendulum_trials"])))
+    return UltrasonicPlan(cfg, subjects, R, o, tasks)
+
+
+def simulate_ultrasonic_trial(out_dir: Path, plan: UltrasonicPlan, task: tuple
+                              ) -> tuple[dict, dict]:
+    """Simulate and write one trial of :func:`plan_ultrasonic`; its (sheet, truth) rows."""
+    kind, trial, trial_seed, extra = task
+    cfg, out_dir = plan.cfg, Path(out_dir)
+    rng = np.random.default_rng(trial_seed)
+    if kind == "treadmill":
+        sub = extra["subject"]
+        v = float(round(extra["v_nom"] + 0.03 * rng.standard_normal(), 3))
+        labels, xyz, log, truth_tx, meta, strides = simulate_treadmill_trial(
+            rng, cfg, sub, v, plan.R, plan.o)
+    else:
+        labels, xyz, log, truth_tx, meta = simulate_pendulum_trial(rng, cfg, plan.R, plan.o)
+        strides = None
+    log.meta["trial"] = trial
+    c3d_rel, us_rel = _write_trial(out_dir, cfg["folder"], trial, labels, xyz,
+                                   cfg["mocap_rate_hz"], log, truth_tx, meta, strides)
+    if kind == "treadmill":
+        row = _trial_row(cfg, "treadmill", sub["subject"], trial, c3d_rel, us_rel,
+                         extra["speed"], v)
+    else:
+        row = _trial_row(cfg, "pendulum", "pendulum", trial, c3d_rel, us_rel,
+                         repetition=extra["repetition"])
+    return row, _truth_row(trial, meta)
+
+
+def finish_ultrasonic(out_dir: Path, plan: UltrasonicPlan, results
+                      ) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Write ``truth/ultrasonic_truth.csv`` from the trials' results (in task order); the
+    (trials, subjects) of :func:`generate_ultrasonic`."""
+    rows = [r for r, _ in results]
+    truth_rows = [t for _, t in results]
+    write_csv(pd.DataFrame(truth_rows), Path(out_dir) / "truth" / "ultrasonic_truth.csv",
+              float_format="%.9g")
+    subjects = plan.subjects
+    if int(plan.cfg["n_pendulum_trials"]) > 0:
+        subjects = pd.concat([subjects, pd.DataFrame([{
+            "subject": "pendulum", "group": "", "age_y": np.nan, "sex": "",
+            "height_m": np.nan, "mass_kg": np.nan, "leg_width_m": 0.05,
+            "knee_width_m": np.nan, "ankle_width_m": np.nan, "leg_length_m": np.nan,
+            "shank_length_m": np.nan, "stick": False}])], ignore_index=True)
+    return pd.DataFrame(rows), subjects
 
 
 def generate_ultrasonic(out_dir: Path, cfg: dict | None = None, seed: int = 0
@@ -242,27 +299,13 @@ def generate_ultrasonic(out_dir: Path, cfg: dict | None = None, seed: int = 0
         Subject-table rows: ``US01..`` (adults like the paper's: 25.7 +- 1.4 y,
         1.714 +- 0.065 m, 62.8 +- 5.6 kg) and a ``pendulum`` row for the pendulum trials
         (``leg_width_m`` is the pendulum arm's width; the subject table requires it).
+
+    Notes
+    -----
+    The same three steps :func:`gaitval.simulate.study.generate_study` spreads over its
+    worker processes: :func:`plan_ultrasonic` (the shared draws), one
+    :func:`simulate_ultrasonic_trial` per task, :func:`finish_ultrasonic`.
     """
-    cfg = {**DEFAULTS, **(cfg or {})}
-    out_dir = Path(out_dir)
-    root = np.random.SeedSequence(seed)
-    s_subj, s_board, s_trials, s_pend = root.spawn(4)
-    subjects = _subjects(np.random.default_rng(s_subj), int(cfg["n_subjects"]))
-    R, o = board_pose(np.random.default_rng(s_board))
-    t_factor = np.exp(0.04 * np.random.default_rng(s_subj.spawn(1)[0]).standard_normal(
-        len(subjects)))
-    rows, truth_rows = [], []
-    _treadmill_trials(out_dir, cfg, subjects, t_factor, R, o,
-                      s_trials.spawn(len(subjects) * len(dict(cfg["speeds"]))),
-                      rows, truth_rows)
-    _pendulum_trials(out_dir, cfg, R, o, s_pend.spawn(int(cfg["n_pendulum_trials"])),
-                     rows, truth_rows)
-    write_csv(pd.DataFrame(truth_rows), out_dir / "truth" / "ultrasonic_truth.csv",
-              float_format="%.9g")
-    if int(cfg["n_pendulum_trials"]) > 0:
-        subjects = pd.concat([subjects, pd.DataFrame([{
-            "subject": "pendulum", "group": "", "age_y": np.nan, "sex": "",
-            "height_m": np.nan, "mass_kg": np.nan, "leg_width_m": 0.05,
-            "knee_width_m": np.nan, "ankle_width_m": np.nan, "leg_length_m": np.nan,
-            "shank_length_m": np.nan, "stick": False}])], ignore_index=True)
-    return pd.DataFrame(rows), subjects
+    plan = plan_ultrasonic(cfg, seed)
+    results = [simulate_ultrasonic_trial(out_dir, plan, task) for task in plan.tasks]
+    return finish_ultrasonic(out_dir, plan, results)
