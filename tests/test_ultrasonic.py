@@ -236,7 +236,7 @@ def _digest(folder):
 
 def test_generator_is_deterministic_and_writes_sheet_rows(tmp_path):
     cfg = {"n_subjects": 1, "speeds": {"normal": 0.99}, "duration_s": 6.0,
-           "n_pendulum_trials": 1, "pendulum_duration_s": 4.0}
+           "n_pendulum_trials": 1, "pendulum_duration_s": 5.0}
     tr1, su1 = S.generate_ultrasonic(tmp_path / "a", cfg, seed=7)
     tr2, su2 = S.generate_ultrasonic(tmp_path / "b", cfg, seed=7)
     assert _digest(tmp_path / "a") == _digest(tmp_path / "b")
@@ -252,7 +252,7 @@ def test_trials_simulated_out_of_order_give_the_same_files(tmp_path):
     # generate_study runs each trial as its own task in a process pool: the order the
     # tasks run in must not change a byte (every trial draws from its own seed)
     cfg = {"n_subjects": 2, "speeds": {"slow": 0.54, "fast": 1.40}, "duration_s": 6.0,
-           "n_pendulum_trials": 1, "pendulum_duration_s": 4.0}
+           "n_pendulum_trials": 1, "pendulum_duration_s": 5.0}
     tr1, su1 = S.generate_ultrasonic(tmp_path / "a", cfg, seed=11)
     plan = S.plan_ultrasonic(cfg, seed=11)
     assert len(plan.tasks) == 5
@@ -288,3 +288,10 @@ def test_track_that_never_finds_a_stride_is_an_error_not_an_empty_table(treadmil
     tr[["x_m", "y_m", "z_m"]] = 0.1                      # a track that never moves
     with pytest.raises(GaitvalError, match="no stride"):
         gait_parameters(tr, treadmill["mocap"], {"trial": "t1"}, SUBJECT, {})
+
+
+def test_a_trial_too_short_for_any_ultrasonic_sample_is_a_config_error(tmp_path):
+    from gaitval.errors import ConfigError
+    with pytest.raises(ConfigError, match="pendulum_duration_s is 3.0 s"):
+        S.generate_ultrasonic(tmp_path, {"n_subjects": 1, "duration_s": 6.0,
+                                         "pendulum_duration_s": 3.0}, seed=1)

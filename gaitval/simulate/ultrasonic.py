@@ -91,6 +91,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from gaitval.errors import ConfigError
 from gaitval.io.atomic import write_csv, write_parquet, write_text
 from gaitval.io.c3d import write_c3d
 from gaitval.io.ultrasonic import write_ultrasonic
@@ -105,6 +106,9 @@ __all__ = ["ANCHOR_IDS", "DEFAULTS", "PAPER_ANCHORS", "PAPER_V_M2", "UltrasonicP
            "heel_path", "plan_ultrasonic", "simulate_pendulum_trial",
            "simulate_treadmill_trial", "simulate_ultrasonic_trial", "speed_of_sound_true",
            "stride_plan"]
+
+#: Shortest treadmill or pendulum trial (s) the simulator accepts.
+MIN_TRIAL_S = 5.0
 
 DEFAULTS: dict = {
     "study": "default",
@@ -213,6 +217,12 @@ class UltrasonicPlan:
 def plan_ultrasonic(cfg: dict | None = None, seed: int = 0) -> UltrasonicPlan:
     """The draws shared by the trials of the ultrasonic study, and its trial tasks."""
     cfg = {**DEFAULTS, **(cfg or {})}
+    for key in ("duration_s", "pendulum_duration_s"):
+        # the log starts up to 3 s after the capture and stops up to 1.5 s before its end
+        # (us_sensor._clock): a shorter trial can leave no ultrasonic sample at all
+        if not float(cfg[key]) >= MIN_TRIAL_S:
+            raise ConfigError(f"ultrasonic.{key} is {cfg[key]!r} s; the simulated trials "
+                              f"need at least {MIN_TRIAL_S:g} s")
     root = np.random.SeedSequence(seed)
     s_subj, s_board, s_trials, s_pend = root.spawn(4)
     subjects = _subjects(np.random.default_rng(s_subj), int(cfg["n_subjects"]))
@@ -280,8 +290,9 @@ def generate_ultrasonic(out_dir: Path, cfg: dict | None = None, seed: int = 0
         Study folder; files go to ``out_dir/<folder>/`` and truth to ``out_dir/truth/``.
     cfg : dict, optional
         Keys (defaults in :data:`DEFAULTS`): ``study`` ("default"), ``n_subjects`` (10),
-        ``speeds`` ({slow: 0.54, normal: 0.99, fast: 1.40} m/s), ``duration_s`` (300),
-        ``n_pendulum_trials`` (5), ``pendulum_duration_s`` (20), ``mocap_rate_hz`` (200),
+        ``speeds`` ({slow: 0.54, normal: 0.99, fast: 1.40} m/s), ``duration_s`` (300;
+        at least :data:`MIN_TRIAL_S`), ``n_pendulum_trials`` (5), ``pendulum_duration_s``
+        (20; at least :data:`MIN_TRIAL_S`), ``mocap_rate_hz`` (200),
         ``us_rate_hz`` (50), ``noise_V_m2`` (the paper's V), ``multipath_prob`` (0.005),
         ``dropout_prob`` (0.002), ``mocap_noise_m`` (0.0004), ``stride_cv`` (0.02),
         ``pendulum_marker_offset_m`` (0.002: largest per-axis offset of the pendulum's
