@@ -116,7 +116,8 @@ def load_ingested(ingest_dir: str | Path, row: dict):
     """The ingested mocap and sensor of a trial (see :mod:`gaitval.io.ingest`)."""
     from gaitval.io.ingest import read_mocap_parquet
     d = Path(ingest_dir)
-    mocap = read_mocap_parquet(d / "mocap.parquet", d / "events.csv")
+    mocap = read_mocap_parquet(d / "mocap.parquet", d / "events.csv",
+                               source=row.get("mocap_path") or None)
     if row["sensor_kind"] == "ultrasonic":
         from gaitval.io.ultrasonic import read_ultrasonic
         sensor = read_ultrasonic(d / "sensor.parquet", trial=row["trial"])
@@ -388,7 +389,7 @@ def gait_parameters_step(track_parquet, ingest_dir, sheet, subjects, trial: str,
     row, subj = trial_and_subject(sheet, subjects, trial)
     d = Path(ingest_dir)
     log = read_ultrasonic(d / "sensor.parquet", trial=trial)
-    mocap = read_mocap_parquet(d / "mocap.parquet")
+    mocap = read_mocap_parquet(d / "mocap.parquet", source=row.get("mocap_path") or None)
     track = pd.read_parquet(track_parquet)
     gp = gait_parameters(track, mocap, row, subj, cfg, anchors=log.anchors)
     write_parquet(gp.reset_index(drop=True), out_parquet)

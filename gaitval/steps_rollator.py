@@ -156,7 +156,8 @@ def rollator_evaluate_step(track_parquet, gt_parquet, registration_json, ingest_
     row, _ = trial_and_subject(sheet, subjects, trial)
     rec = load_json(registration_json)
     track = pd.read_parquet(track_parquet).drop(columns=["trial", "method"])
-    mocap = read_mocap_parquet(Path(ingest_dir) / "mocap.parquet")
+    mocap = read_mocap_parquet(Path(ingest_dir) / "mocap.parquet",
+                               source=row.get("mocap_path") or None)
     labels = rollator_labels(cfg)
     if rec.get("status") == "ok":
         known, inside = pose_known(mocap, track.groupby("k")["t_sensor_s"].first().to_numpy(),

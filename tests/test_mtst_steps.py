@@ -171,3 +171,21 @@ def test_mtst_defaults_match_the_schema():
     check_config({"studies": {}, "run": ["x"], "mtst": DEFAULTS}, schema=schema)
     shipped = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["mtst"]
     assert shipped == DEFAULTS
+
+
+def test_ingested_files_do_not_depend_on_where_the_study_folder_sits(tiny, tmp_path):
+    # a reviewer's rerun in another folder (or on another machine) gives the same bytes;
+    # the steps that have the sheet's row still name the C3D by its absolute path
+    from gaitval.io.ingest import ingest_trial
+    from gaitval.io.trialsheet import load_trial_sheet
+    from gaitval.steps import load_ingested
+
+    moved = tmp_path / "elsewhere" / "tiny"
+    shutil.copytree(tiny / "tiny", moved)
+    row = load_trial_sheet(moved / "trials.csv").loc[TRIAL].to_dict()
+    ingest_trial(row, tmp_path / "ingest")
+    for name in ("mocap.parquet", "sensor.parquet", "events.csv", "ingest.json"):
+        assert (tmp_path / "ingest" / name).read_bytes() == \
+            (tiny / "ingest" / name).read_bytes(), name
+    mocap, _ = load_ingested(tmp_path / "ingest", row)
+    assert mocap.path == row["mocap_path"] == str((moved / row["mocap_file"]).resolve())

@@ -5,7 +5,11 @@ One call per trial (one Snakemake job per trial).  What it writes:
 ``mocap.parquet``
     Tidy marker table ``frame, t_s, marker, x_m, y_m, z_m`` (metres, mocap clock, NaN for
     gaps) with schema metadata ``gaitval:mocap`` (JSON: rate_hz, first_frame, units on disk,
-    source file, labels in order, meta of the loader).
+    source file, labels in order, meta of the loader).  The source file is stored as the
+    trial sheet names it (relative to the sheet's folder), so the ingested files do not
+    depend on where the study folder sits; the steps that have the sheet's row give the
+    reader the absolute path (``read_mocap_parquet(..., source=row["mocap_path"])``) for
+    their error messages.
 ``events.csv``
     C3D events ``context, label, t_s`` (may be empty).
 ``sensor.parquet``
@@ -52,9 +56,13 @@ def read_sensor(row) -> ScanSeries | UltrasonicLog:
                           "or a ROS 2 bag folder)", path=path, trial=trial)
 
 
-def write_mocap_parquet(mocap: MocapTrial, path: str | Path) -> Path:
+def write_mocap_parquet(mocap: MocapTrial, path: str | Path, source: str | None = None
+                        ) -> Path:
+    """``mocap`` as ``mocap.parquet`` (module docstring); ``source``: the file name to
+    record (default ``mocap.path``)."""
     meta = {"rate_hz": mocap.rate_hz, "first_frame": mocap.first_frame,
-            "units": mocap.units, "source": mocap.path, "labels": list(mocap.labels),
+            "units": mocap.units, "source": mocap.path if source is None else source,
+            "labels": list(mocap.labels),
             "meta": {k: v for k, v in mocap.meta.items()
                      if isinstance(v, (str, int, float, bool, list, dict))}}
     return write_parquet(mocap.to_frame(), path,
@@ -62,9 +70,13 @@ def write_mocap_parquet(mocap: MocapTrial, path: str | Path) -> Path:
                                                               default=str)})
 
 
-def read_mocap_parquet(path: str | Path, events_path: str | Path | None = None
-                       ) -> MocapTrial:
-    """Rebuild a :class:`MocapTrial` from an ingested ``mocap.parquet``."""
+def read_mocap_parquet(path: str | Path, events_path: str | Path | None = None,
+                       source: str | None = None) -> MocapTrial:
+    """Rebuild a :class:`MocapTrial` from an ingested ``mocap.parquet``.
+
+    ``source``: the trial's C3D file as ``MocapTrial.path`` (errors name it), e.g. the
+    absolute ``mocap_path`` of the trial sheet's row; default the name stored at ingest
+    (as the sheet gives it, relative to the sheet's folder)."""
     import pyarrow.parquet as pq
 
     tab = pq.read_table(path)
@@ -77,7 +89,7 @@ def read_mocap_parquet(path: str | Path, events_path: str | Path | None = None
     events = pd.DataFrame(columns=["context", "label", "t_s"])
     if events_path is not None and Path(events_path).is_file():
         events = pd.read_csv(events_path, keep_default_na=False)
-    return MocapTrial(path=meta["source"], rate_hz=float(meta["rate_hz"]),
+    return MocapTrial(path=source or meta["source"], rate_hz=float(meta["rate_hz"]),
                       first_frame=int(meta["first_frame"]), labels=list(labels), xyz=xyz,
                       events=events, units=meta["units"], meta=meta.get("meta", {}))
 
@@ -107,7 +119,7 @@ def ingest_trial(row, out_dir: str | Path) -> dict:
         sensor = read_sensor(row)
     except GaitvalError as exc:
         raise exc.with_context(trial=trial) from None
-    write_mocap_parquet(mocap, out / "mocap.parquet")
+    write_mocap_parquet(mocap, out / "mocap.parquet", source=row["mocap_file"])
     write_csv(mocap.events, out / "events.csv")
     gaps = int(np.isnan(mocap.xyz[:, :, 0]).sum())
     summary = {
