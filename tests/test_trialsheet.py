@@ -120,18 +120,3 @@ def test_one_trial_row_names_a_missing_trial(tmp_path):
     assert load_trial_row(sheet, None, "tug_S01_1")["subject"] == "S01"
     with pytest.raises(TrialSheetError, match="'tug_S01_9' is not in the trial sheet"):
         load_trial_row(sheet, None, "tug_S01_9")
-
-
-def test_a_remembered_row_still_has_its_files_checked(tmp_path):
-    # a warm worker remembers a validated row (ingest checks the files, register does
-    # not); a file deleted after that is still the usual error naming row, column and file
-    from gaitval.io.trialsheet import load_trial_row
-
-    sheet = make_study(tmp_path)
-    row = load_trial_row(sheet, None, "tug_S01_1", check_files=False)
-    assert load_trial_row(sheet, None, "tug_S01_1") == row           # files present
-    Path(row["sensor_path"]).unlink()
-    assert load_trial_row(sheet, None, "tug_S01_1", check_files=False) == row
-    with pytest.raises(TrialSheetError, match=r"trial 'tug_S01_1'\), column 'sensor_file': "
-                                              r"file .* not found"):
-        load_trial_row(sheet, None, "tug_S01_1")

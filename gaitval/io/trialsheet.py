@@ -26,7 +26,6 @@ import copy
 import difflib
 import hashlib
 import math
-import os
 from functools import lru_cache
 from pathlib import Path
 
@@ -406,26 +405,20 @@ def load_trial_row(path: str | Path, subjects: str | Path | None, trial: str, *,
     TrialSheetError
         A problem of the row, its subject or a header; or the trial is not in the sheet.
     """
-    sheet = Path(path).resolve()
-    key = _content_key("row", [sheet, subjects if subjects is not None
-                               else sheet.parent / "subjects.csv",
-                               sheet.parent / "study.yaml"], trial)
-    # the row is the same whether or not its files are checked; a file's existence may
-    # change, so it is checked each time, and when one is missing the full check below
-    # raises the usual error (row, column, file)
-    if key in _MEMO and (not check_files or _row_files_exist(_MEMO[key])):
-        return copy.deepcopy(_MEMO[key])
+    key = None
+    if not check_files:                  # a file's existence may change: checked each time
+        sheet = Path(path).resolve()
+        key = _content_key("row", [sheet, subjects if subjects is not None
+                                   else sheet.parent / "subjects.csv",
+                                   sheet.parent / "study.yaml"], trial)
+        if key in _MEMO:
+            return copy.deepcopy(_MEMO[key])
     df, problems = sheet_problems(path, subjects, check_files=check_files, only=trial)
     raise_all(problems)
     if trial not in df.index:
         raise TrialSheetError(f"trial {trial!r} is not in the trial sheet", path=path,
                               trial=trial)
     row = df.loc[trial].to_dict()
-    _remember(key, copy.deepcopy(row))
+    if key is not None:
+        _remember(key, copy.deepcopy(row))
     return row
-
-
-def _row_files_exist(row: dict) -> bool:
-    """Every file a validated row names (its ``*_path`` columns) exists."""
-    return all(os.path.exists(row[c]) for c in ("mocap_path", "sensor_path", "annotation_path")
-               if row.get(c))
