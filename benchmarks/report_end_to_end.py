@@ -14,7 +14,8 @@ Usage::
 Each repeat runs Snakemake from the checkout's Snakefile with the profile of ``python3 run.py
 report`` (``--profile workflow/profiles/default --cores N``) in a fresh temp
 dir (fresh data/, results/, reports/, logs/; the venv is not touched), so the simulation
-is included.  Afterwards one job of each rule is rerun twice in the same folder: once
+is included.  Afterwards one job of each rule is rerun twice in a hard-linked copy of the
+last run's folder (removed afterwards; the run's folder stays as Snakemake left it): once
 with its modules' import recorded (``sys.modules`` at exit) and timed, and once as a
 process that only imports those modules (``python -c 'import ...'``).  The second is the
 job's start-up + import + exit cost; times the rule's job count, summed over the rules,
@@ -33,6 +34,7 @@ count; then the per-rule table and the last line::
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import resource
 import shlex
@@ -175,6 +177,13 @@ def _print_breakdown(log: str, server_log: Path, cpu: float) -> None:
         print(f"    {verb:26s} {n:5d} jobs {c:8.1f} cpu-s ({c / n:.2f} per job)")
 
 
+def _linked_copy(src: Path, dst: Path) -> Path:
+    """``src`` copied to ``dst`` with hard links (same file system; no data copied)."""
+    shutil.copytree(src, dst, copy_function=os.link, symlinks=True,
+                    ignore=shutil.ignore_patterns(".snakemake"))
+    return dst
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--study", default="tiny", choices=["tiny", "default"])
@@ -212,6 +221,11 @@ def main() -> None:
             shutil.copytree(work / "results", args.keep, dirs_exist_ok=True)
         share = float("nan")
         if not args.no_startup:
+            # the jobs below rewrite their outputs (the simulation its data/): run them in
+            # a hard-linked copy of the last run, so the run's own folder keeps the state
+            # Snakemake left (a rerun in it has nothing to do); gaitval writes atomically
+            # (a new file replaces the link), so the original files are never touched
+            work = _linked_copy(work, base / "_startup")
             cmds = _shell_commands(log)
             forked = "forkclient.py" in log
             total_start = 0.0
@@ -236,6 +250,7 @@ def main() -> None:
                 total_start += n * (client if forked else start)
                 print(f"{rule:28s} {n:5d} {job:8.2f} {start:9.2f} {nmod:8d}", flush=True)
             share = 100 * total_start / statistics.median(cpus)
+            shutil.rmtree(work, ignore_errors=True)
     print(f"report {args.study}: wall {statistics.median(walls):.1f} s, "
           f"cpu {statistics.median(cpus):.1f} s, {jobs} jobs, "
           f"start-up+imports {share:.0f} % of cpu")
