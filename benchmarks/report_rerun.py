@@ -24,22 +24,18 @@ from __future__ import annotations
 import argparse
 import json
 import re
-import resource
 import statistics
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+from report_end_to_end import _cpu_children        # this folder's sibling script
+
 ROOT = Path(__file__).resolve().parents[1]
 #: What a new value of one TUG method's parameter may rerun.
 ALLOWED = {"track", "evaluate_tug", "config_view", "study_config", "report_config",
            "tug_tables", "report", "all"}
-
-
-def _cpu_children() -> float:
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
 
 
 def _report(directory: Path, *extra: str) -> tuple[float, float, str]:
