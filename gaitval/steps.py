@@ -117,7 +117,7 @@ def load_ingested(ingest_dir: str | Path, row: dict):
     from gaitval.io.ingest import read_mocap_parquet
     d = Path(ingest_dir)
     mocap = read_mocap_parquet(d / "mocap.parquet", d / "events.csv",
-                               source=row.get("mocap_path") or None)
+                               source=row.get("mocap_path") or None, trial=row["trial"])
     if row["sensor_kind"] == "ultrasonic":
         from gaitval.io.ultrasonic import read_ultrasonic
         sensor = read_ultrasonic(d / "sensor.parquet", trial=row["trial"])
@@ -340,7 +340,7 @@ def ultrasonic_noise_step(ingest_dirs: list[str | Path], trials: list[str], conf
     for d, tid in zip(ingest_dirs, trials):
         d = Path(d)
         pairs.append((read_ultrasonic(d / "sensor.parquet", trial=tid),
-                      read_mocap_parquet(d / "mocap.parquet")))
+                      read_mocap_parquet(d / "mocap.parquet", trial=tid)))
     if not pairs:
         raise GaitvalError("no pendulum trials: the noise identification of seed 003 §4.3 "
                            "needs at least one (protocol 'pendulum' in the trial sheet)")
@@ -389,7 +389,8 @@ def gait_parameters_step(track_parquet, ingest_dir, sheet, subjects, trial: str,
     row, subj = trial_and_subject(sheet, subjects, trial)
     d = Path(ingest_dir)
     log = read_ultrasonic(d / "sensor.parquet", trial=trial)
-    mocap = read_mocap_parquet(d / "mocap.parquet", source=row.get("mocap_path") or None)
+    mocap = read_mocap_parquet(d / "mocap.parquet", source=row.get("mocap_path") or None,
+                               trial=trial)
     track = pd.read_parquet(track_parquet)
     gp = gait_parameters(track, mocap, row, subj, cfg, anchors=log.anchors)
     write_parquet(gp.reset_index(drop=True), out_parquet)

@@ -157,7 +157,7 @@ def rollator_evaluate_step(track_parquet, gt_parquet, registration_json, ingest_
     rec = load_json(registration_json)
     track = pd.read_parquet(track_parquet).drop(columns=["trial", "method"])
     mocap = read_mocap_parquet(Path(ingest_dir) / "mocap.parquet",
-                               source=row.get("mocap_path") or None)
+                               source=row.get("mocap_path") or None, trial=row["trial"])
     labels = rollator_labels(cfg)
     if rec.get("status") == "ok":
         known, inside = pose_known(mocap, track.groupby("k")["t_sensor_s"].first().to_numpy(),

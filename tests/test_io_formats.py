@@ -198,3 +198,55 @@ def test_unknown_and_missing_files(tmp_path):
     folder.mkdir()
     with pytest.raises(FileFormatError, match="unknown file kind"):
         describe(folder)
+
+
+# -- the ingested marker table (mocap.parquet) ---------------------------------------------
+@pytest.mark.realdata
+def test_ingested_marker_table_round_trips_a_real_walk_with_its_gaps(realdata, tmp_path):
+    """A real Vicon walk with missing markers comes back from ``mocap.parquet`` with the
+    same coordinates and gaps; only the label column is dictionary-encoded, and the file
+    still reads as the documented tidy table without gaitval."""
+    import pyarrow.parquet as pq
+
+    from gaitval.io.c3d import read_c3d
+    from gaitval.io.ingest import read_mocap_parquet, write_mocap_parquet
+
+    m = read_c3d(realdata / "c3d" / "PiG_Motion-FlatFoot-Hole.c3d")
+    assert np.isnan(m.xyz).any()                          # the file has real gaps
+    p = write_mocap_parquet(m, tmp_path / "mocap.parquet", source="walk.c3d")
+    back = read_mocap_parquet(p)
+    np.testing.assert_array_equal(back.xyz, m.xyz)        # NaN where NaN, bit for bit
+    assert (back.labels, back.rate_hz, back.first_frame, back.path) == (
+        m.labels, m.rate_hz, m.first_frame, "walk.c3d")
+    tidy = pd.read_parquet(p)
+    assert list(tidy.columns) == ["frame", "t_s", "marker", "x_m", "y_m", "z_m"]
+    assert len(tidy) == m.n_frames * len(m.labels)
+    assert list(tidy["marker"][: len(m.labels)]) == list(m.labels)
+    np.testing.assert_array_equal(tidy["t_s"].to_numpy()[:: len(m.labels)], m.t)
+    rg = pq.ParquetFile(p).metadata.row_group(0)
+    enc = {rg.column(i).path_in_schema: rg.column(i).encodings for i in range(rg.num_columns)}
+    assert "RLE_DICTIONARY" in enc["marker"] and "RLE_DICTIONARY" not in enc["x_m"]
+
+
+def test_a_bad_ingested_marker_table_is_an_error_naming_file_and_trial(tmp_path):
+    from gaitval.io.ingest import read_mocap_parquet
+
+    junk = tmp_path / "junk.parquet"
+    junk.write_bytes(b"not parquet at all")
+    with pytest.raises(FileFormatError, match="not an ingested mocap.parquet") as exc:
+        read_mocap_parquet(junk, trial="T7")
+    assert "junk.parquet" in str(exc.value) and "trial T7" in str(exc.value)
+    plain = tmp_path / "plain.parquet"                   # a Parquet file, no gaitval metadata
+    pd.DataFrame({"x_m": [1.0], "y_m": [2.0], "z_m": [3.0]}).to_parquet(plain)
+    with pytest.raises(FileFormatError, match="not an ingested mocap.parquet"):
+        read_mocap_parquet(plain, trial="T7")
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    torn = pa.table({"x_m": [1.0, 2.0, 3.0], "y_m": [0.0] * 3, "z_m": [0.0] * 3})
+    torn = torn.replace_schema_metadata({b"gaitval:mocap": json.dumps(
+        {"labels": ["A", "B"], "rate_hz": 100, "first_frame": 1, "units": "mm",
+         "source": "x.c3d"}).encode()})
+    pq.write_table(torn, tmp_path / "torn.parquet")
+    with pytest.raises(FileFormatError, match="3 rows are not whole frames of 2 markers"):
+        read_mocap_parquet(tmp_path / "torn.parquet", trial="T7")

@@ -219,7 +219,10 @@ def _extract(path: str) -> dict[str, Any]:
     import ezc3d
     import numpy as np
 
+    from gaitval.io.isolate import keep_until_exit
+
     c = ezc3d.c3d(path)
+    keep_until_exit(c)                 # the child's exit frees it, not its destructor
     params = {g: {n: {"value": v["value"]} for n, v in grp.items() if n != "__METADATA__"}
               for g, grp in c["parameters"].items()}
     h = c["header"]

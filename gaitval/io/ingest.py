@@ -31,8 +31,8 @@ import numpy as np
 import pandas as pd
 
 from gaitval import consts as C
-from gaitval.errors import GaitvalError
-from gaitval.io.atomic import write_csv, write_parquet, write_text
+from gaitval.errors import FileFormatError, GaitvalError
+from gaitval.io.atomic import write_arrow, write_csv, write_text
 from gaitval.types import MocapTrial, ScanSeries, UltrasonicLog
 
 MOCAP_META_KEY = "gaitval:mocap"
@@ -56,36 +56,76 @@ def read_sensor(row) -> ScanSeries | UltrasonicLog:
                           "or a ROS 2 bag folder)", path=path, trial=trial)
 
 
+def mocap_arrow_table(mocap: MocapTrial):
+    """The tidy long table of :meth:`MocapTrial.to_frame` as a ``pyarrow.Table``, built
+    column by column (the marker labels decoded from a dictionary; NaN gaps as nulls, as
+    ``pyarrow.Table.from_pandas`` stores them), without the 540,000 label strings a
+    60,000-frame trial of 9 markers would cost as Python objects."""
+    import pyarrow as pa
+
+    n, m, _ = mocap.xyz.shape
+    labels = pa.array([str(s) for s in mocap.labels], type=pa.large_string())
+    marker = pa.DictionaryArray.from_arrays(
+        pa.array(np.tile(np.arange(m, dtype=np.int32), n)), labels).dictionary_decode()
+    return pa.table({
+        C.FRAME: np.repeat(np.arange(n, dtype=np.int64) + mocap.first_frame, m),
+        C.T: pa.array(np.repeat(mocap.t, m), from_pandas=True),
+        C.MARKER: marker,
+        **{c: pa.array(np.ascontiguousarray(mocap.xyz[:, :, i]).ravel(), from_pandas=True)
+           for i, c in enumerate((C.X, C.Y, C.Z))},
+    })
+
+
 def write_mocap_parquet(mocap: MocapTrial, path: str | Path, source: str | None = None
                         ) -> Path:
     """``mocap`` as ``mocap.parquet`` (module docstring); ``source``: the file name to
-    record (default ``mocap.path``)."""
+    record (default ``mocap.path``).  Only the marker column is dictionary-encoded."""
     meta = {"rate_hz": mocap.rate_hz, "first_frame": mocap.first_frame,
             "units": mocap.units, "source": mocap.path if source is None else source,
             "labels": list(mocap.labels),
             "meta": {k: v for k, v in mocap.meta.items()
                      if isinstance(v, (str, int, float, bool, list, dict))}}
-    return write_parquet(mocap.to_frame(), path,
-                         metadata={MOCAP_META_KEY: json.dumps(meta, sort_keys=True,
-                                                              default=str)})
+    return write_arrow(mocap_arrow_table(mocap), path, dictionary=[C.MARKER],
+                       metadata={MOCAP_META_KEY: json.dumps(meta, sort_keys=True,
+                                                            default=str)})
 
 
 def read_mocap_parquet(path: str | Path, events_path: str | Path | None = None,
-                       source: str | None = None) -> MocapTrial:
+                       source: str | None = None, trial: str | None = None) -> MocapTrial:
     """Rebuild a :class:`MocapTrial` from an ingested ``mocap.parquet``.
 
     ``source``: the trial's C3D file as ``MocapTrial.path`` (errors name it), e.g. the
     absolute ``mocap_path`` of the trial sheet's row; default the name stored at ingest
-    (as the sheet gives it, relative to the sheet's folder)."""
+    (as the sheet gives it, relative to the sheet's folder); ``trial``: named in errors.
+    Only the coordinate columns are read (the frame numbers and times follow from the
+    stored rate and first frame).
+
+    Raises
+    ------
+    FileFormatError
+        The file is not an ingested marker table (unreadable, no ``gaitval:mocap``
+        metadata, or rows that are not whole frames).
+    """
     import pyarrow.parquet as pq
 
-    tab = pq.read_table(path)
-    meta = json.loads(tab.schema.metadata[MOCAP_META_KEY.encode()])
-    df = tab.to_pandas()
+    try:
+        pf = pq.ParquetFile(path)
+        meta = json.loads(pf.schema_arrow.metadata[MOCAP_META_KEY.encode()])
+        tab = pf.read(columns=[C.X, C.Y, C.Z])
+    except (OSError, KeyError, TypeError, ValueError) as exc:
+        raise FileFormatError(f"not an ingested mocap.parquet of gaitval ({exc})",
+                              path=path, trial=trial,
+                              hint="run the ingest step again") from None
     labels = meta["labels"]
     n_m = len(labels)
-    n_f = len(df) // n_m if n_m else 0
-    xyz = df[[C.X, C.Y, C.Z]].to_numpy(dtype=np.float64).reshape(n_f, n_m, 3)
+    n_f = tab.num_rows // n_m if n_m else 0
+    if n_f * n_m != tab.num_rows:
+        raise FileFormatError(f"{tab.num_rows} rows are not whole frames of {n_m} markers",
+                              path=path, trial=trial, hint="run the ingest step again")
+    xyz = np.empty((n_f * n_m, 3))
+    for i, c in enumerate((C.X, C.Y, C.Z)):
+        xyz[:, i] = tab.column(c).to_numpy()        # nulls (gaps) come back as NaN
+    xyz = xyz.reshape(n_f, n_m, 3)
     events = pd.DataFrame(columns=["context", "label", "t_s"])
     if events_path is not None and Path(events_path).is_file():
         events = pd.read_csv(events_path, keep_default_na=False)
