@@ -216,6 +216,8 @@ def test_ingested_marker_table_round_trips_a_real_walk_with_its_gaps(realdata, t
     p = write_mocap_parquet(m, tmp_path / "mocap.parquet", source="walk.c3d")
     back = read_mocap_parquet(p)
     np.testing.assert_array_equal(back.xyz, m.xyz)        # NaN where NaN, bit for bit
+    n_f, n_m, _ = m.xyz.shape                            # the layout readers always had:
+    assert back.xyz.strides == (8 * n_m, 8, 8 * n_f * n_m)   # sums downstream follow it
     assert (back.labels, back.rate_hz, back.first_frame, back.path) == (
         m.labels, m.rate_hz, m.first_frame, "walk.c3d")
     tidy = pd.read_parquet(p)

@@ -122,10 +122,14 @@ def read_mocap_parquet(path: str | Path, events_path: str | Path | None = None,
     if n_f * n_m != tab.num_rows:
         raise FileFormatError(f"{tab.num_rows} rows are not whole frames of {n_m} markers",
                               path=path, trial=trial, hint="run the ingest step again")
-    xyz = np.empty((n_f * n_m, 3))
+    # one row per coordinate, (3, rows), seen as (frames, markers, 3): the layout (strides
+    # 8 n_m, 8, 8 rows) the readers have always been given (pandas' column block), which
+    # the sums downstream follow to the last bit (a C-ordered copy changes the ultrasonic
+    # noise estimate in its 13th digit)
+    cols = np.empty((3, n_f * n_m))
     for i, c in enumerate((C.X, C.Y, C.Z)):
-        xyz[:, i] = tab.column(c).to_numpy()        # nulls (gaps) come back as NaN
-    xyz = xyz.reshape(n_f, n_m, 3)
+        cols[i] = tab.column(c).to_numpy()            # nulls (gaps) come back as NaN
+    xyz = cols.T.reshape(n_f, n_m, 3)
     events = pd.DataFrame(columns=["context", "label", "t_s"])
     if events_path is not None and Path(events_path).is_file():
         events = pd.read_csv(events_path, keep_default_na=False)
