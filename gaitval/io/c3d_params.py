@@ -70,6 +70,8 @@ class Param:
     type: int
     dims: tuple[int, ...]
     data: bytes
+    #: where ``data`` starts in the file (bytes from the file's start; -1 when unknown)
+    offset: int = -1
 
     @property
     def label(self) -> str:
@@ -101,7 +103,7 @@ def parse_parameters(b: bytes, start: int, end: int) -> dict[tuple[str, str], Pa
         of an unknown group, or a chain that does not end.
     """
     groups: dict[int, str] = {}
-    raw: list[tuple[int, str, int, tuple[int, ...], bytes]] = []
+    raw: list[tuple[int, str, int, tuple[int, ...], bytes, int]] = []
     i, last = start + 4, "the section start"
     for _ in range(100_000):
         if i + 2 > end:
@@ -151,7 +153,7 @@ def _group_record(b: bytes, q: int, rec_end: int, name: str, groups: dict, gid: 
 
 
 def _param_record(b: bytes, q: int, rec_end: int, name: str
-                  ) -> tuple[int, tuple[int, ...], bytes]:
+                  ) -> tuple[int, tuple[int, ...], bytes, int]:
     if q + 2 > rec_end:
         raise ParameterProblem(f"parameter {name} is cut off before its type")
     ptype, nd = struct.unpack_from("<bB", b, q)
@@ -172,17 +174,17 @@ def _param_record(b: bytes, q: int, rec_end: int, name: str
     why = _text_problem(b[d0 + size + 1:d0 + size + 1 + dlen])
     if why:
         raise ParameterProblem(f"the description of parameter {name} is unreadable: {why}")
-    return ptype, dims, bytes(b[d0:d0 + size])
+    return ptype, dims, bytes(b[d0:d0 + size]), d0
 
 
 def _assemble(groups: dict[int, str], raw: list) -> dict[tuple[str, str], Param]:
     params: dict[tuple[str, str], Param] = {}
-    for gid, name, ptype, dims, data in raw:
+    for gid, name, ptype, dims, data, offset in raw:
         if gid not in groups:
             raise ParameterProblem(f"parameter {name} belongs to group id {gid}, which the "
                                    "section does not define")
         key = (groups[gid], name)
-        p = Param(key[0], name, ptype, dims, data)
+        p = Param(key[0], name, ptype, dims, data, offset)
         if key in NUMERIC and ptype == -1:
             raise ParameterProblem(f"{p.label} must be a number but is stored as text "
                                    "(type -1)")
