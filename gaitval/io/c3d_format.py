@@ -169,7 +169,28 @@ def _check_size(hdr: dict, params: Parameters, size: int, path: Path,
         raise FileFormatError(f"C3D file is truncated: the header announces {expected} "
                               f"frames of {frame_bytes} bytes, the data section holds "
                               f"{room // frame_bytes}", path=path, trial=trial)
+    trial_frames = _trial_frames(params)
+    if frame_bytes and trial_frames > max(expected, 0xFFFF) \
+            and trial_frames * frame_bytes <= room:
+        raise FileFormatError(
+            f"the capture holds {trial_frames} frames (TRIAL:ACTUAL_START_FIELD/END_FIELD, "
+            f"and the data section has room for them) but the header and POINT:FRAMES stop "
+            f"at {expected}: ezc3d reads only those, and the rest would be lost without a "
+            "word", path=path, trial=trial,
+            hint="export the capture in parts of at most 65,535 frames")
     return max(expected, p_frames if 0 < p_frames < 0xFFFF else 0)
+
+
+def _trial_frames(params: Parameters) -> int:
+    """Frames from TRIAL:ACTUAL_START_FIELD to ACTUAL_END_FIELD (two unsigned 16-bit words
+    each, low first, as Vicon writes captures longer than 65,535 frames); 0 when absent."""
+    words = []
+    for name in ("ACTUAL_START_FIELD", "ACTUAL_END_FIELD"):
+        v = params.numbers("TRIAL", name)
+        if not v or len(v) < 2 or params.params["TRIAL", name].type != 2:
+            return 0
+        words.append((int(v[0]) & 0xFFFF) + ((int(v[1]) & 0xFFFF) << 16))
+    return words[1] - words[0] + 1 if words[1] >= words[0] else 0
 
 
 def _ezc3d_reason(exc: Exception) -> str:
