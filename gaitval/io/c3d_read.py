@@ -194,7 +194,7 @@ def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "s
     if duplicates not in ("suffix", "error"):
         raise ValueError("duplicates must be 'suffix' or 'error'")
     pre = _precheck(path, trial)
-    c = _open_ezc3d(path, trial)
+    c = _open_ezc3d(path, trial, pre)
     pts = _point_data(c, pre, path, trial)                    # (4, n_points, n_frames)
     units, units_assumed = _units(c, path, trial)
     raw_labels = _raw_labels(c, int(pts.shape[1]))
