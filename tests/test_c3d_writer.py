@@ -37,6 +37,7 @@ def test_fast_c3d_writer_gives_ezc3ds_bytes(tmp_path, monkeypatch, n_frames, n_m
     monkeypatch.setattr(W, "_FAST", False)
     whole = W.write_c3d(tmp_path / "ezc3d.c3d", labels, xyz, 200.0, **kw).read_bytes()
     assert fast == whole
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["ezc3d.c3d", "fast.c3d"]  # no debris
     if n_frames > 0xFFFF:        # ezc3d 1.7.2 would read 65,535 of them: refused, not cut
         with pytest.raises(FileFormatError, match=f"the capture holds {n_frames} frames"):
             read_c3d(tmp_path / "fast.c3d")

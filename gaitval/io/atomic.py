@@ -64,17 +64,15 @@ def write_bytes(path: str | Path, data: bytes) -> Path:
     return Path(path)
 
 
-def write_parquet(df: pd.DataFrame, path: str | Path, metadata: dict[str, str] | None = None,
-                  dictionary: list[str] | None = None) -> Path:
+def write_parquet(df: pd.DataFrame, path: str | Path, metadata: dict[str, str] | None = None
+                  ) -> Path:
     """Write a DataFrame as Parquet atomically, optionally with key/value schema metadata.
 
     The output is deterministic for the same frame (no pandas index, no creation time).
-    ``dictionary``: see :func:`write_arrow`.
     """
     import pyarrow as pa
 
-    return write_arrow(pa.Table.from_pandas(df, preserve_index=False), path, metadata,
-                       dictionary=dictionary)
+    return write_arrow(pa.Table.from_pandas(df, preserve_index=False), path, metadata)
 
 
 def write_arrow(table, path: str | Path, metadata: dict[str, str] | None = None,
