@@ -71,18 +71,28 @@ class MocapTrial:
     def has(self, label: str) -> bool:
         return label in self.labels
 
+    def to_arrow(self):
+        """Tidy long table ``frame, t_s, marker, x_m, y_m, z_m`` as a ``pyarrow.Table``
+        (gaps as nulls), built column by column: the marker labels are decoded from a
+        dictionary, without the 540,000 label strings a 60,000-frame trial of 9 markers
+        would cost as Python objects."""
+        import pyarrow as pa
+
+        n, m, _ = self.xyz.shape
+        labels = pa.array([str(s) for s in self.labels], type=pa.large_string())
+        marker = pa.DictionaryArray.from_arrays(
+            pa.array(np.tile(np.arange(m, dtype=np.int32), n)), labels).dictionary_decode()
+        return pa.table({
+            C.FRAME: np.repeat(np.arange(n, dtype=np.int64) + self.first_frame, m),
+            C.T: pa.array(np.repeat(self.t, m), from_pandas=True),
+            C.MARKER: marker,
+            **{c: pa.array(np.ascontiguousarray(self.xyz[:, :, i]).ravel(), from_pandas=True)
+               for i, c in enumerate((C.X, C.Y, C.Z))},
+        })
+
     def to_frame(self) -> pd.DataFrame:
         """Tidy long table: ``frame, t_s, marker, x_m, y_m, z_m`` (NaN for gaps)."""
-        n, m, _ = self.xyz.shape
-        frames = np.repeat(np.arange(n) + self.first_frame, m)
-        return pd.DataFrame({
-            C.FRAME: frames.astype(np.int64),
-            C.T: np.repeat(self.t, m),
-            C.MARKER: np.tile(np.asarray(self.labels, dtype=object), n),
-            C.X: self.xyz[:, :, 0].ravel(),
-            C.Y: self.xyz[:, :, 1].ravel(),
-            C.Z: self.xyz[:, :, 2].ravel(),
-        })
+        return self.to_arrow().to_pandas()
 
 
 @dataclass

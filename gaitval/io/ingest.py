@@ -56,26 +56,6 @@ def read_sensor(row) -> ScanSeries | UltrasonicLog:
                           "or a ROS 2 bag folder)", path=path, trial=trial)
 
 
-def mocap_arrow_table(mocap: MocapTrial):
-    """The tidy long table of :meth:`MocapTrial.to_frame` as a ``pyarrow.Table``, built
-    column by column (the marker labels decoded from a dictionary; NaN gaps as nulls, as
-    ``pyarrow.Table.from_pandas`` stores them), without the 540,000 label strings a
-    60,000-frame trial of 9 markers would cost as Python objects."""
-    import pyarrow as pa
-
-    n, m, _ = mocap.xyz.shape
-    labels = pa.array([str(s) for s in mocap.labels], type=pa.large_string())
-    marker = pa.DictionaryArray.from_arrays(
-        pa.array(np.tile(np.arange(m, dtype=np.int32), n)), labels).dictionary_decode()
-    return pa.table({
-        C.FRAME: np.repeat(np.arange(n, dtype=np.int64) + mocap.first_frame, m),
-        C.T: pa.array(np.repeat(mocap.t, m), from_pandas=True),
-        C.MARKER: marker,
-        **{c: pa.array(np.ascontiguousarray(mocap.xyz[:, :, i]).ravel(), from_pandas=True)
-           for i, c in enumerate((C.X, C.Y, C.Z))},
-    })
-
-
 def write_mocap_parquet(mocap: MocapTrial, path: str | Path, source: str | None = None
                         ) -> Path:
     """``mocap`` as ``mocap.parquet`` (module docstring); ``source``: the file name to
@@ -85,7 +65,7 @@ def write_mocap_parquet(mocap: MocapTrial, path: str | Path, source: str | None 
             "labels": list(mocap.labels),
             "meta": {k: v for k, v in mocap.meta.items()
                      if isinstance(v, (str, int, float, bool, list, dict))}}
-    return write_arrow(mocap_arrow_table(mocap), path, dictionary=[C.MARKER],
+    return write_arrow(mocap.to_arrow(), path, dictionary=[C.MARKER],
                        metadata={MOCAP_META_KEY: json.dumps(meta, sort_keys=True,
                                                             default=str)})
 
