@@ -49,43 +49,67 @@ def _recv_int(sock: _socket.socket) -> int | None:
     return int.from_bytes(buf, "big", signed=True)          # the server's struct "!i"
 
 
+def submit(path: str, args: list[str], *, cwd: str, env: dict, fds: bytes = _FDS,
+           on_start=None, via: str = "client") -> int | None:
+    """Run ``gaitval ARGS`` in the server at ``path``; its exit code, or None when no server
+    listens there (the caller then runs the plain command).
+
+    ``fds``: the job's stdin, stdout and stderr descriptors as C ints (see ``_FDS``), handed
+    over with SCM_RIGHTS.  ``via`` names the sender in the server's log.  ``on_start(pid)``
+    is called with the worker's pid (the leader of its process group) once it has taken the
+    job.  A connection the server closes gives 1 with the reason on this process's standard
+    error.  Used by :func:`main` (one job per process) and by the workflow's ``shell``
+    (workflow/rules/common.smk), which calls it from Snakemake's own job thread, so a local
+    job starts no shell and no client.
+    """
+    sock = _socket.socket(_socket.AF_UNIX, _socket.SOCK_STREAM)
+    try:
+        try:
+            sock.connect(path)
+        except OSError:
+            return None
+        # marshal: the server runs this same interpreter (forkserver._request)
+        body = marshal.dumps({"argv": list(args), "cwd": cwd, "env": dict(env), "via": via})
+        msg = len(body).to_bytes(4, "big") + body
+        sent = sock.sendmsg([msg], [(_socket.SOL_SOCKET, _socket.SCM_RIGHTS, fds)])
+        if sent < len(msg):
+            sock.sendall(msg[sent:])
+        child = _recv_int(sock)
+        if child is None:
+            sys.stderr.write("gaitval: error: the fork server closed the connection\n")
+            return 1
+        if on_start is not None:
+            on_start(child)
+        rc = _recv_int(sock)
+        if rc is None:
+            sys.stderr.write("gaitval: error: the job's process ended without an exit code "
+                             "(killed or crashed)\n")
+            return 1
+        return rc
+    finally:
+        sock.close()
+
+
 def main(argv: list[str]) -> int:
     if len(argv) < 2 or argv[1] != "--":
         sys.stderr.write("usage: forkclient.py SOCKET -- VERB [ARGS...]\n")
         return 2
     path, args = argv[0], argv[2:]
-    sock = _socket.socket(_socket.AF_UNIX, _socket.SOCK_STREAM)
-    try:
-        sock.connect(path)
-    except OSError:
-        sock.close()
-        _plain(args)                       # no server: the plain way (does not return)
-    # marshal: the server runs this same interpreter (forkserver._request)
-    body = marshal.dumps({"argv": args, "cwd": os.getcwd(), "env": dict(os.environ)})
-    msg = len(body).to_bytes(4, "big") + body
-    sent = sock.sendmsg([msg], [(_socket.SOL_SOCKET, _socket.SCM_RIGHTS,
-                                 _FDS)])
-    if sent < len(msg):
-        sock.sendall(msg[sent:])
-    child = _recv_int(sock)
-    if child is None:
-        sys.stderr.write("gaitval: error: the fork server closed the connection\n")
-        return 1
 
-    def forward(signum, _frame):
-        try:
-            os.killpg(child, signum)           # the worker's process group (see forkserver)
-        except ProcessLookupError:
-            pass
-        raise SystemExit(128 + signum)
+    def forward_to(child):
+        def forward(signum, _frame):
+            try:
+                os.killpg(child, signum)       # the worker's process group (see forkserver)
+            except ProcessLookupError:
+                pass
+            raise SystemExit(128 + signum)
 
-    for s in (_signal.SIGTERM, _signal.SIGINT, _signal.SIGHUP):
-        _signal.signal(s, forward)
-    rc = _recv_int(sock)
+        for s in (_signal.SIGTERM, _signal.SIGINT, _signal.SIGHUP):
+            _signal.signal(s, forward)
+
+    rc = submit(path, args, cwd=os.getcwd(), env=os.environ, on_start=forward_to)
     if rc is None:
-        sys.stderr.write("gaitval: error: the job's process ended without an exit code "
-                         "(killed or crashed)\n")
-        return 1
+        _plain(args)                       # no server: the plain way (does not return)
     return rc
 
 

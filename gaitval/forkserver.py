@@ -32,7 +32,7 @@ stops its workers and removes its socket.  The socket lives in a private directo
 0700) under the temporary directory, so only the same user can submit jobs.
 
 Protocol (Unix stream socket): the client sends a 4-byte length and a marshal-ed object
-``{"argv", "cwd", "env"}`` with its stdin/stdout/stderr attached (SCM_RIGHTS); a worker
+``{"argv", "cwd", "env", "via"}`` with its stdin/stdout/stderr attached (SCM_RIGHTS); a worker
 (leader of its own process group) answers its pid (4 bytes), runs the verb with those
 descriptors, working directory and environment, and answers the exit code (4 bytes).  A
 client that disconnects before the end (the job was cancelled) has its worker's process
@@ -40,8 +40,10 @@ group killed; the server replaces the worker.
 
 Log (the server's standard output, ``logs/forkserver.log`` in a workflow run): per job
 ``job <worker pid>.<n>: gaitval ARGS`` when it starts and ``job <worker pid>.<n>: exit <rc>,
-wall <s> s, cpu <s> s, worker peak <MB> MB`` when it ends (CPU of the worker and the
-processes it waited for; the worker's peak resident memory so far).
+wall <s> s, cpu <s> s, worker peak <MB> MB, via <sender>`` when it ends (CPU of the worker
+and the processes it waited for; the worker's peak resident memory so far; ``client`` for
+:mod:`gaitval.forkclient` run as a process, ``snakemake`` for a job sent from Snakemake's
+own job thread by the workflow, see ``workflow/rules/common.smk``).
 
 Usage::
 
@@ -192,8 +194,10 @@ def _serve_one(conn: socket.socket, jid: str, logfd: int) -> int:
     handlers = {sig: signal.getsignal(sig) for sig in _SIGNALS}
     np_err = _np_errstate()
     saved = [os.dup(i) for i in range(3)]
+    via = "client"
     try:
         req, fds = _request(conn)
+        via = str(req.get("via", via))
         _log(logfd, f"job {jid}: gaitval {' '.join(req['argv'])}")
         for i, fd in enumerate(fds[:3]):
             os.dup2(fd, i)
@@ -249,7 +253,7 @@ def _serve_one(conn: socket.socket, jid: str, logfd: int) -> int:
         except Exception:                      # noqa: BLE001 - next job gets a fresh worker
             rc = rc or 1
     _log(logfd, f"job {jid}: exit {rc}, wall {time.perf_counter() - t0:.3f} s, "
-                f"cpu {_cpu() - c0:.3f} s, worker peak {_peak_mb():.0f} MB")
+                f"cpu {_cpu() - c0:.3f} s, worker peak {_peak_mb():.0f} MB, via {via}")
     return rc
 
 

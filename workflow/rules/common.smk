@@ -101,6 +101,102 @@ if not _CONDA:
         f"{shlex.quote(str(Path(workflow.basedir) / 'gaitval' / 'forkclient.py'))} "
         f"{shlex.quote(FORK_SOCKET)} --"
     )
+# Local jobs without a shell.  Every gaitval step's `shell` command reads
+# "{params.gv} VERB ARGS > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)" (or with `{log}`).
+# With the fork server listening, the `shell` below sends VERB ARGS to it straight from
+# Snakemake's job thread (gaitval.forkclient.submit), standard output and error to the log:
+# no bash and no client process, which cost ~10 ms of CPU a job, ~11 CPU-s over the ~1,100
+# jobs of the default report (issue 13; benchmarks/report_end_to_end.py).  Anything else --
+# no server yet or any more, `fork_server: false`, a cluster job, conda deployment, another
+# command -- goes to Snakemake's own shell() unchanged.  The rules keep their `shell:`
+# directives, so a dry run (-n -p) and the log show the very commands, Snakemake's code
+# trigger sees the same text, and on a cluster nothing differs.  (Snakemake's compiled
+# `shell:` rules call the name `shell` of the Snakefile's namespace; should a later
+# Snakemake not, every job simply takes the shell and the client again.)
+from snakemake.shell import shell as _snakemake_shell
+
+_GV_HEAD = "{params.gv} "
+_GV_TAILS = (" > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)",
+             " > {log} 2>&1 || (cat {log} >&2; exit 1)")
+# what a rule function hands on to Snakemake's shell() (conda env, container, job id, ...)
+_SHELL_CONTEXT = ("conda_env", "conda_base_path", "container_img", "env_modules",
+                  "shadow_dir", "resources", "singularity_args", "threads", "runtime_paths",
+                  "jobid", "is_shell")
+# what Snakemake's shell() puts in a job's environment: its thread count for the numeric
+# libraries (the fork server's job gets the same environment)
+_THREAD_VARS = ("OMP_NUM_THREADS", "GOTO_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+                "MKL_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
+
+
+class shell(_snakemake_shell):
+    """Snakemake's shell(), except that a gaitval step's command runs in the fork server
+    when one listens (see above)."""
+
+    def __new__(cls, cmd, *args, **kwargs):
+        from snakemake.common import RULEFUNC_CONTEXT_MARKER
+        from snakemake.utils import format as sm_format
+
+        ctx = sys._getframe(1).f_locals
+        if not ctx.get(RULEFUNC_CONTEXT_MARKER):         # not from a rule: as it is
+            return _snakemake_shell.__new__(
+                cls, sm_format(cmd, *args, stepout=2, **kwargs).replace("{", "{{")
+                .replace("}", "}}"), **kwargs)
+        tail = next((t for t in _GV_TAILS if cmd.endswith(t)), None)
+        if FORK_SERVER and not args and tail and cmd.startswith(_GV_HEAD) \
+                and len(ctx["log"]) == 1:
+            verb = sm_format(cmd[len(_GV_HEAD):-len(tail)], stepout=2)
+            rc = _in_fork_server(verb, str(ctx["log"][0]), ctx)
+            if rc == 0:
+                return None
+            if rc is not None:
+                with open(str(ctx["log"][0]), errors="replace") as fh:
+                    sys.stderr.write(fh.read())                # what `cat log >&2` shows
+                import subprocess
+                raise subprocess.CalledProcessError(rc, sm_format(cmd, stepout=2))
+        # Snakemake's own, with the rule's context (it reads it from its caller's frame)
+        context = {k: ctx[k] for k in _SHELL_CONTEXT if k in ctx}
+        context.update(kwargs)
+        return _snakemake_shell.__new__(
+            cls, sm_format(cmd, *args, stepout=2, **kwargs).replace("{", "{{")
+            .replace("}", "}}"), **context)
+
+
+# The fork server's workers (process group leaders) running a job sent from here: Ctrl-C
+# is passed on to them (forkserver.smk), as the terminal passes it to a shell job.
+FORK_JOBS = set()
+
+
+def _in_fork_server(args, log, ctx):
+    """The job's exit code from the fork server, or None when none listens."""
+    import os
+    import struct
+    from gaitval.forkclient import submit
+
+    env = dict(os.environ)
+    env.update(dict.fromkeys(_THREAD_VARS, str(ctx.get("threads", 1))))
+    tmp = (ctx.get("resources") or {}).get("tmpdir")
+    if tmp:
+        env.update(dict.fromkeys(("TMPDIR", "TMP", "TEMPDIR", "TEMP"), str(tmp)))
+    out = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_CLOEXEC, 0o666)
+    try:
+        nul = os.open(os.devnull, os.O_RDONLY | os.O_CLOEXEC)
+        workers = []
+
+        def started(pid):
+            workers.append(pid)
+            FORK_JOBS.add(pid)
+
+        try:
+            return submit(FORK_SOCKET, shlex.split(args), cwd=os.getcwd(), env=env,
+                          fds=struct.pack("3i", nul, out, out), via="snakemake",
+                          on_start=started)
+        finally:
+            FORK_JOBS.difference_update(workers)
+            os.close(nul)
+    finally:
+        os.close(out)
+
+
 # Hash of the analysis sections only: changing `run` or paths must not rerun the tables.
 CONFIG_HASH = config_hash({k: config[k] for k in ANALYSIS_SECTIONS if k in config})
 

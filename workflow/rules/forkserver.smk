@@ -42,6 +42,26 @@ def _stop_fork_server():
     _FORK_SERVER_PROC.clear()
 
 
+def _pass_interrupt_to_fork_jobs():
+    """Ctrl-C reaches a shell job through the terminal's process group; a job sent to the
+    fork server from Snakemake's thread (common.smk) runs in a worker of its own group, so
+    Snakemake's SIGINT handler passes the signal on to those workers first -- the jobs stop
+    at once instead of running to their end while Snakemake waits for them."""
+    previous = signal.getsignal(signal.SIGINT)
+    if not callable(previous):                # ignored (e.g. a background job): leave it
+        return
+
+    def handler(signum, frame):
+        for pid in list(FORK_JOBS):
+            try:
+                os.killpg(pid, signum)
+            except (ProcessLookupError, PermissionError):
+                pass
+        previous(signum, frame)
+
+    signal.signal(signal.SIGINT, handler)
+
+
 if FORK_SERVER:
 
     onstart:
@@ -49,6 +69,7 @@ if FORK_SERVER:
         # whose jobs run elsewhere, nor a job's own Snakemake on a node)
         if workflow.local_exec and not workflow.remote_exec:
             _start_fork_server()
+            _pass_interrupt_to_fork_jobs()
 
     onsuccess:
         _stop_fork_server()
