@@ -79,7 +79,22 @@ def _coerce(value: str, spec: dict):
 
 
 def _read_csv(path: Path, kind: str) -> pd.DataFrame:
-    """The table as strings; TrialSheetError when it is missing or not UTF-8 CSV."""
+    """The table as strings; TrialSheetError when it is missing or not UTF-8 CSV.
+
+    A table read before (same path, same bytes) is a copy of what was parsed then: a job
+    of a warm worker that misses :func:`load_trial_row`'s memo still parses the sheet and
+    the subject table only once per worker (~2.5 ms each, hundreds of jobs).
+    """
+    key = _content_key(("csv", kind), [path])
+    hit = _MEMO.get(key) if key[2] is not None else None
+    if hit is None:
+        hit = _parse_csv(path, kind)
+        if key[2] is not None:
+            _remember(key, hit)
+    return hit.copy()
+
+
+def _parse_csv(path: Path, kind: str) -> pd.DataFrame:
     try:
         if not path.is_file():
             raise TrialSheetError(f"{kind} not found", path=path)
@@ -172,6 +187,24 @@ def _frame(records: list[dict], schema: dict, columns: list[str]) -> pd.DataFram
 
 
 def _subject_problems(path: Path, problems: list, only: str | None = None) -> pd.DataFrame:
+    """The subject table's valid rows (index: subject; ``attrs['all_ids']``: every subject
+    named), its problems appended to ``problems``.  A table without problems is validated
+    once per process and contents (a copy of the result after that)."""
+    key = _content_key("subject_problems", [path], only)
+    hit = _MEMO.get(key) if key[2] is not None else None
+    if hit is None:
+        found: list = []
+        hit = _subject_frame(path, found, only)
+        problems.extend(found)
+        if found or key[2] is None:
+            return hit
+        _remember(key, hit)
+    df = hit.copy(deep=True)
+    df.attrs = copy.deepcopy(hit.attrs)
+    return df
+
+
+def _subject_frame(path: Path, problems: list, only: str | None) -> pd.DataFrame:
     schema = load_schema("subjects")
     raw, records = _read_table(path, "subject table", schema, problems, only)
     cols = list(dict.fromkeys(["subject"] + list(raw.columns)))   # as the file has them
@@ -240,8 +273,18 @@ def raise_all(problems: list[GaitvalError]) -> None:
 
 
 def _allows_outside(sheet: Path) -> bool:
-    """``allow_outside_paths: true`` in the study.yaml beside the sheet."""
+    """``allow_outside_paths: true`` in the study.yaml beside the sheet (remembered under
+    the file's contents)."""
     cal = sheet.parent / "study.yaml"
+    key = _content_key("allows_outside", [cal])
+    if key in _MEMO:
+        return _MEMO[key]
+    value = _read_allows_outside(cal)
+    _remember(key, value)
+    return value
+
+
+def _read_allows_outside(cal: Path) -> bool:
     try:
         with open(cal, encoding="utf-8") as fh:
             study = yaml.load(fh, Loader=_YAML_LOADER)

@@ -168,7 +168,8 @@ def _xcorr(a, b, nfft, cols=None):
 
 def estimate_clock_offset(t_a, sig_a, t_b, sig_b, max_lag_s: float, *,
                           dt: float | None = None, centre_s: float | None = None,
-                          min_overlap: float = 0.3) -> tuple[float, float]:
+                          min_overlap: float = 0.3, _grids: dict | None = None
+                          ) -> tuple[float, float]:
     """Offset between two clocks from one motion signal seen on both.
 
     Finds ``tau`` such that ``sig_b(t + tau) ~= sig_a(t)``, i.e. clock b reads
@@ -192,6 +193,10 @@ def estimate_clock_offset(t_a, sig_a, t_b, sig_b, max_lag_s: float, *,
     min_overlap : float
         Lags where fewer than this fraction of the shorter signal's samples overlap are
         ignored.
+    _grids : dict, optional
+        :func:`estimate_clock`'s memo of signal ``a`` on its grid, by ``dt``: its windows
+        correlate the same mocap signal with parts of the sensor's (same arrays, same
+        grid, so the same numbers as computing it again).
 
     Returns
     -------
@@ -223,7 +228,12 @@ def estimate_clock_offset(t_a, sig_a, t_b, sig_b, max_lag_s: float, *,
     if dt is None:
         dt = float(min(np.median(np.diff(t_a)), np.median(np.diff(tb_ch[:, 0]))))
     ta0, tb0 = float(np.nanmin(t_a)), float(np.nanmin(tb_ch))
-    Ag, wa = _centred_grid(t_a, A, ta0, dt)
+    if _grids is None:
+        Ag, wa = _centred_grid(t_a, A, ta0, dt)
+    else:
+        if dt not in _grids:
+            _grids[dt] = _centred_grid(t_a, A, ta0, dt)
+        Ag, wa = _grids[dt]
     Bg, wb = _centred_grid(tb_ch, B, tb0, dt)
     na, nb = len(Ag), len(Bg)
     ncc, ea, eb, ov = _masked_ncc(Ag, Bg, wa, wb)
@@ -375,7 +385,9 @@ def estimate_clock(t_mocap: np.ndarray, pred: np.ndarray, obs_t: np.ndarray, obs
     """
     c = dict(DEFAULTS)
     c.update(cfg or {})
-    tau, peak = estimate_clock_offset(t_mocap, pred, obs_t, obs, float(c["sync_max_lag_s"]))
+    grids: dict = {}            # the mocap signal on its grid, once per dt for all windows
+    tau, peak = estimate_clock_offset(t_mocap, pred, obs_t, obs, float(c["sync_max_lag_s"]),
+                                      _grids=grids)
     if not np.isfinite(tau):
         return ClockEstimate(float("nan"), 0.0, 0.0, "ncc")
     t_first = obs_t if np.ndim(obs_t) == 1 else obs_t[:, 0]
@@ -390,7 +402,7 @@ def estimate_clock(t_mocap: np.ndarray, pred: np.ndarray, obs_t: np.ndarray, obs
         if sel.sum() < 10:
             continue
         tw, pw = estimate_clock_offset(t_mocap, pred, obs_t[sel], obs[sel], 0.05,
-                                       centre_s=tau)
+                                       centre_s=tau, _grids=grids)
         if np.isfinite(tw):
             centres.append(0.5 * (edges[w] + edges[w + 1]) - tw)   # mocap time of centre
             taus.append(tw)
