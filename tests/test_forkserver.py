@@ -76,7 +76,7 @@ def test_a_cancelled_job_stops(server, tmp_path):
     and every process it started; the server replaces the worker."""
     idle = _children_of_server(server)
     assert len(idle) == 2, "two warm workers wait for jobs"
-    # a verb that takes a while: simulate the default preset (about a minute)
+    # a verb that takes a while: simulate the default preset (about 10 s on two cores)
     proc = subprocess.Popen([sys.executable, "-I", "-S", str(CLIENT), str(server), "--",
                              "simulate", "--out", str(tmp_path / "study")], cwd=ROOT,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)

@@ -81,9 +81,11 @@ GV = (
 # Local runs: the rules' jobs run in a warm fork server (workflow/rules/forkserver.smk,
 # gaitval/forkserver.py) instead of each starting Python and importing numpy, pandas,
 # scipy and gaitval again.  Same verbs, same arguments, same files; one job per trial as
-# before.  Every rule calls gaitval through the small client (gaitval/forkclient.py); where
-# no server listens -- `fork_server: false`, a cluster executor, a job on a compute node --
-# the client runs the plain `python -m gaitval`.  So GV, a parameter of every rule, is one
+# before.  Every rule's command calls gaitval through the small client
+# (gaitval/forkclient.py); locally, with the server listening, the workflow's `shell` (below)
+# hands the job to the server itself and neither bash nor the client runs.  Where no server
+# listens -- `fork_server: false`, a cluster executor, a job on a compute node -- the client
+# runs the plain `python -m gaitval`.  So GV, a parameter of every rule, is one
 # string whatever the mode and from run to run (the socket path depends only on the working
 # directory): switching the server on or off, a new run, or a cluster job that records its
 # own params reruns nothing.  The server is started only by a local, non-dry run
