@@ -21,9 +21,12 @@ process that only imports those modules (``python -c 'import ...'``).  The secon
 job's start-up + import + exit cost; times the rule's job count, summed over the rules,
 it is the share of the run's CPU that goes to interpreter start-up and imports.
 
-With the fork server (the default for local runs, ``gaitval/forkserver.py``) a job's
-start-up is the small client (``python -I -S gaitval/forkclient.py``, standard library
-only) plus the fork; the server's imports are paid once per run and counted once.
+With the fork server (the default for local runs, ``gaitval/forkserver.py``) the server's
+imports are paid once per run and counted once; a job the workflow sent to it from
+Snakemake's own thread (``via snakemake`` in the server's log) starts no process (its
+~0.1 ms of dispatch is in Snakemake's own CPU); one that went through the small client
+(``python -I -S gaitval/forkclient.py``, ``via client``) costs the client's start; one the
+server did not run (before it was up, e.g. the simulation) costs the plain start-up.
 ``--no-fork-server`` runs the plain one-process-per-job shape for comparison.
 
 Prints per repeat ``wall``, ``cpu`` (user + system of all child processes) and the job
@@ -240,6 +243,8 @@ def main() -> None:
                 total_start += server
                 print(f"fork server: imports once {server:.2f} cpu-s; per job the client "
                       f"{client:.3f} cpu-s (instead of the plain start-up column)")
+            via = _server_jobs(work / "logs" / "forkserver.log")
+            ways = {"snakemake": 0, "client": 0, "plain": 0}
             print(f"{'rule':28s} {'jobs':>5s} {'job cpu':>8s} {'start-up':>9s} {'modules':>8s}")
             for rule, n in sorted(counts.items()):
                 argv = _job_argv(cmds[rule]) if rule in cmds else None
@@ -247,13 +252,42 @@ def main() -> None:
                     print(f"{rule:28s} {n:5d}  (no gaitval shell command: runs in Snakemake)")
                     continue
                 job, start, nmod = _startup_of(argv, work)
-                total_start += n * (client if forked else start)
+                seen = via.get(argv[0], {})
+                direct = min(n, seen.get("snakemake", 0))
+                through = min(n - direct, seen.get("client", 0))
+                ways["snakemake"] += direct
+                ways["client"] += through
+                ways["plain"] += n - direct - through
+                total_start += through * (client if forked else start) \
+                    + (n - direct - through) * start
                 print(f"{rule:28s} {n:5d} {job:8.2f} {start:9.2f} {nmod:8d}", flush=True)
+            print(f"jobs sent to the fork server from Snakemake's thread: {ways['snakemake']}, "
+                  f"through the client: {ways['client']}, plain processes: {ways['plain']}")
             share = 100 * total_start / statistics.median(cpus)
             shutil.rmtree(work, ignore_errors=True)
     print(f"report {args.study}: wall {statistics.median(walls):.1f} s, "
           f"cpu {statistics.median(cpus):.1f} s, {jobs} jobs, "
           f"start-up+imports {share:.0f} % of cpu")
+
+
+def _server_jobs(path: Path) -> dict:
+    """{verb: {"snakemake": n, "client": n}} of the jobs the fork server's log lists (how
+    each reached it: the end line's ``via``; older logs without it: the client)."""
+    out: dict = {}
+    verbs: dict = {}
+    if not path.is_file():
+        return out
+    for line in path.read_text().splitlines():
+        m = re.match(r"job (\S+): gaitval (\S+)", line)
+        if m:
+            verbs[m.group(1)] = m.group(2)
+            continue
+        m = re.match(r"job (\S+): exit .*?(?:, via (\S+))?$", line)
+        if m and m.group(1) in verbs:
+            way = "snakemake" if m.group(2) == "snakemake" else "client"
+            d = out.setdefault(verbs.pop(m.group(1)), {})
+            d[way] = d.get(way, 0) + 1
+    return out
 
 
 if __name__ == "__main__":
