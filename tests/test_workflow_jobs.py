@@ -96,3 +96,37 @@ def test_same_outputs_and_logs_with_and_without_the_server(with_server, without_
     bad = Path("logs") / "ingest" / "tiny" / f"{BAD}.log"         # names the file: its folder
     assert (a / bad).read_text().replace(str(a), "<run>") == \
         (b / bad).read_text().replace(str(b), "<run>")
+
+
+def test_ctrl_c_stops_a_job_running_in_the_server(tmp_path):
+    """Ctrl-C (SIGINT to Snakemake) stops the jobs the server is running for it -- they are
+    in process groups of their own, which the terminal's signal does not reach -- instead of
+    letting them run to their end while Snakemake waits."""
+    import os
+    import signal
+    import time
+
+    cmd = [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(tmp_path),
+           "--cores", "2", "--config", 'run=["tiny"]', f"data_dir={tmp_path / 'data'}"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    log = tmp_path / "logs" / "forkserver.log"
+    job = None
+    deadline = time.time() + 300
+    try:
+        # the ultrasonic tables: the tiny study's longest job (~3 s)
+        while job is None and proc.poll() is None and time.time() < deadline:
+            time.sleep(0.05)
+            text = log.read_text() if log.is_file() else ""
+            m = re.search(r"^job (\S+): gaitval ultrasonic-tables ", text, re.M)
+            if m and f"job {m.group(1)}: exit" not in text:
+                job = m.group(1)
+        assert job is not None, "the run ended before its ultrasonic tables started"
+        os.kill(proc.pid, signal.SIGINT)
+        rc = proc.wait(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert rc != 0
+    end = re.search(rf"^job {re.escape(job)}: exit (-?\d+),", log.read_text(), re.M)
+    assert end and end.group(1) != "0", "the running job was stopped, not finished"
