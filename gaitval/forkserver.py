@@ -355,31 +355,6 @@ def serve(path: str, owner: int | None, workers: int = 2, max_jobs: int = 2000,
     return 0
 
 
-def _preload_in_background() -> list[str]:
-    """:func:`preload` in a thread of lower priority (nice + 10, that thread only).
-
-    The server starts with the run, when its first job (the simulation of a simulated
-    study, two processes) keeps both cores busy: its ~2.5 CPU-s of imports would take
-    CPU from that job, on the run's critical path, while no job can use the server yet.
-    At a lower priority they take the time the first jobs leave idle.  The workers are
-    forked by the main thread afterwards and run at the run's own priority.
-    """
-    out: list[list[str]] = []
-
-    def run():
-        try:
-            tid = threading.get_native_id()
-            os.setpriority(os.PRIO_PROCESS, tid, os.getpriority(os.PRIO_PROCESS, tid) + 10)
-        except (AttributeError, OSError):      # not Linux: at the same priority
-            pass
-        out.append(preload())
-
-    t = threading.Thread(target=run, name="gaitval-preload")
-    t.start()
-    t.join()
-    return out[0] if out else ["(preload failed)"]
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m gaitval.forkserver",
                                  description=__doc__.splitlines()[0])
@@ -394,7 +369,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="... or once its peak memory passed this many MB")
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
-    failed = _preload_in_background()
+    failed = preload()
     gc.freeze()          # the preloaded objects: the workers' collections skip them and so
     #                      leave their pages shared instead of copying them on the first gc
     print(f"gaitval fork server: imports took {time.perf_counter() - t0:.2f} s"
