@@ -271,10 +271,7 @@ def config_view_in(scope):
 # started only when every other trial was done, then its 30 tracks, gait parameters and
 # tables ran alone for ~90 s; the rollator PF likewise waited for its trained models.  So:
 # ultrasonic_noise and rollator_train 100, ultrasonic_track and gait_parameters 50,
-# ingest and register (everything's inputs) 20.  Then the LRS chains whose tables cost
-# most (TUG's and MTST's tables, ~2.5-3 s each): track, evaluate_tug, mtst_track and
-# mtst_evaluate 10, so the rollator's (tables ~1 s) finish the run -- the last tables job
-# and the report run alone on one core.  Order only: same jobs, same files.  (Tried
+# ingest and register (everything's inputs) 20.  Order only: same jobs, same files.  (Tried
 # and left out: config_view 200, so the views -- milliseconds each -- run before the
 # ingests; it made every registration ready at once, and the greedy scheduler's rounds over
 # the larger ready set cost Snakemake ~5 CPU-s more (10.3 vs 15.2 s) for no gain in wall.)

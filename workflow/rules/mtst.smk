@@ -10,7 +10,6 @@ rule mtst_track:
         unpack(mtst_track_inputs),
     output:
         f"{RESULTS}/{{study}}/mtst_track/{{method}}/{{trial}}.parquet",
-    priority: 10  # before the rollator's: its cheap tables last (PRIORITIES in common.smk)
     params:
         gv=GV,
         subjects=lambda w: subjects_path(w.study),
@@ -37,7 +36,6 @@ rule mtst_evaluate:
         gates=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/gates.parquet",
         track_field=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/track_field.parquet",
         targets=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/targets.parquet",
-    priority: 10  # before the rollator's: its cheap tables last (PRIORITIES in common.smk)
     params:
         gv=GV,
         subjects=lambda w: subjects_path(w.study),

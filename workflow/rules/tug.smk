@@ -10,7 +10,6 @@ rule track:
         sheet=lambda w: sheet_path(w.study),
     output:
         f"{RESULTS}/{{study}}/track/{{method}}/{{trial}}.parquet",
-    priority: 10  # before the rollator's: its cheap tables last (PRIORITIES in common.smk)
     params:
         gv=GV,
         subjects=lambda w: subjects_path(w.study),
@@ -33,7 +32,6 @@ rule evaluate_tug:
     output:
         summary=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/summary.parquet",
         frames=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/frames.parquet",
-    priority: 10  # before the rollator's: its cheap tables last (PRIORITIES in common.smk)
     params:
         gv=GV,
         out=parent_of("summary"),
