@@ -15,10 +15,10 @@ topic for every ROS bag.  It returns *every* problem (``gaitval validate`` lists
 naming the file, the row (line number and trial id) and the column.
 
 A process that runs many jobs (a warm worker of :mod:`gaitval.forkserver`) validates a
-trial's row and a subject's row once: :func:`load_trial_row` (without the file checks) and
-:func:`load_subjects` remember their result under the files' contents (SHA-1 of the sheet,
-the subject table and the ``study.yaml`` beside the sheet), so an edited file is validated
-again and an invalid one raises every time.
+trial's row and a subject table once: :func:`load_trial_row` (without the file checks), the
+subject-table validation and the parsed CSVs are remembered under the files' contents
+(SHA-1 of the sheet, the subject table and the ``study.yaml`` beside the sheet), so an
+edited file is read and validated again and an invalid one raises every time.
 """
 from __future__ import annotations
 
@@ -219,7 +219,7 @@ def _subject_frame(path: Path, problems: list, only: str | None) -> pd.DataFrame
     return df
 
 
-#: Results of the row validations, by the validated files' contents (module docstring).
+#: Parsed tables and validation results, by the files' contents (module docstring).
 _MEMO: dict[tuple, object] = {}
 _MEMO_MAX = 2048
 
@@ -252,15 +252,10 @@ def load_subjects(path: str | Path, only: str | None = None) -> pd.DataFrame:
     TrialSheetError
         Every problem found, each naming the row and column.
     """
-    key = _content_key("subjects", [path], only)
-    hit = _MEMO.get(key)
-    if hit is None:
-        problems: list[GaitvalError] = []
-        df = _subject_problems(Path(path), problems, only)
-        raise_all(problems)
-        hit = df.drop(columns="row_line")
-        _remember(key, hit)
-    return hit.copy(deep=True)
+    problems: list[GaitvalError] = []
+    df = _subject_problems(Path(path), problems, only)   # remembered there when valid
+    raise_all(problems)
+    return df.drop(columns="row_line")
 
 
 def raise_all(problems: list[GaitvalError]) -> None:

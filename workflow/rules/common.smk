@@ -139,12 +139,9 @@ class shell(_snakemake_shell):
         from snakemake.utils import format as sm_format
 
         ctx = sys._getframe(1).f_locals
-        if not ctx.get(RULEFUNC_CONTEXT_MARKER):         # not from a rule: as it is
-            return _snakemake_shell.__new__(
-                cls, sm_format(cmd, *args, stepout=2, **kwargs).replace("{", "{{")
-                .replace("}", "}}"), **kwargs)
+        from_rule = bool(ctx.get(RULEFUNC_CONTEXT_MARKER))
         tail = next((t for t in _GV_TAILS if cmd.endswith(t)), None)
-        if FORK_SERVER and not args and tail and cmd.startswith(_GV_HEAD) \
+        if FORK_SERVER and from_rule and not args and tail and cmd.startswith(_GV_HEAD) \
                 and len(ctx["log"]) == 1:
             verb = sm_format(cmd[len(_GV_HEAD):-len(tail)], stepout=2)
             rc = _in_fork_server(verb, str(ctx["log"][0]), ctx)
@@ -155,8 +152,9 @@ class shell(_snakemake_shell):
                     sys.stderr.write(fh.read())                # what `cat log >&2` shows
                 import subprocess
                 raise subprocess.CalledProcessError(rc, sm_format(cmd, stepout=2))
-        # Snakemake's own, with the rule's context (it reads it from its caller's frame)
-        context = {k: ctx[k] for k in _SHELL_CONTEXT if k in ctx}
+        # Snakemake's own, with the rule's context (it reads it from its caller's frame,
+        # which is now this one) and the command formatted in the caller's namespace
+        context = {k: ctx[k] for k in _SHELL_CONTEXT if k in ctx} if from_rule else {}
         context.update(kwargs)
         return _snakemake_shell.__new__(
             cls, sm_format(cmd, *args, stepout=2, **kwargs).replace("{", "{{")
