@@ -23,6 +23,7 @@ from gaitval import consts as C
 from gaitval.config import deep_merge
 from gaitval.errors import ConfigError, GaitvalError
 from gaitval.io.atomic import write_csv, write_parquet, write_text
+from gaitval.io.parquet import read_parquet
 from gaitval.io.trialsheet import load_subjects, load_trial_row
 
 #: Config sections that parameterise the analysis (copied into the per-study config).
@@ -248,8 +249,8 @@ def evaluate_tug_step(track_parquet, gt_parquet, registration_json, trial: str, 
                "summary": pd.DataFrame([{"trial": trial, "method": method, "success": False,
                                          "category": "not_registered"}])}
     else:
-        track = pd.read_parquet(track_parquet).drop(columns=["trial", "method"])
-        gt = pd.read_parquet(gt_parquet)
+        track = read_parquet(track_parquet).drop(columns=["trial", "method"])
+        gt = read_parquet(gt_parquet)
         res = evaluate_tug_trial(track, gt, trial=trial, method=method,
                                  cfg=(cfg.get("evaluation") or {}).get("tug"))
     for name, df in res.items():
@@ -279,7 +280,7 @@ def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, report
     parts: dict[str, list[pd.DataFrame]] = {"frames": [], "summary": [], "events": []}
     for d in eval_dirs:
         for name in parts:
-            df = pd.read_parquet(Path(d) / f"{name}.parquet")
+            df = read_parquet(Path(d) / f"{name}.parquet")
             if len(df):
                 parts[name].append(df)
     empty = {"frames": pd.DataFrame(columns=list(FRAME_COLUMNS)),
@@ -391,7 +392,7 @@ def gait_parameters_step(track_parquet, ingest_dir, sheet, subjects, trial: str,
     log = read_ultrasonic(d / "sensor.parquet", trial=trial)
     mocap = read_mocap_parquet(d / "mocap.parquet", source=row.get("mocap_path") or None,
                                trial=trial)
-    track = pd.read_parquet(track_parquet)
+    track = read_parquet(track_parquet)
     gp = gait_parameters(track, mocap, row, subj, cfg, anchors=log.anchors)
     write_parquet(gp.reset_index(drop=True), out_parquet)
     return gp
@@ -404,7 +405,7 @@ def ultrasonic_tables_step(inputs: list[str | Path], tables_dir, figures_dir, re
     from gaitval.report.stats_figures import write_ultrasonic_figures
     from gaitval.tables.ultrasonic import write_ultrasonic_tables
 
-    gp = pd.concat([pd.read_parquet(p) for p in inputs], ignore_index=True)
+    gp = pd.concat([read_parquet(p) for p in inputs], ignore_index=True)
     paths = write_ultrasonic_tables(gp, tables_dir)
     stamp("ultrasonic_tables", paths, reports_dir, config_hash_=config_hash)
     figs = write_ultrasonic_figures(gp, figures_dir)

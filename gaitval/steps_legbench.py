@@ -31,6 +31,7 @@ import pandas as pd
 
 from gaitval.errors import ConfigError, GaitvalError
 from gaitval.io.atomic import write_parquet
+from gaitval.io.parquet import read_parquet
 from gaitval.steps import load_json, method_definition
 
 INITS = ("own", "annotation")
@@ -232,10 +233,10 @@ def legbench_tables_step(inputs, tables_dir, figures_dir, reports_dir, config_ha
 
     summaries, frames = [], {}
     for d in map(Path, inputs):
-        s = pd.read_parquet(d / SUMMARY_FILE)
+        s = read_parquet(d / SUMMARY_FILE)
         summaries.append(s)
         r = s.iloc[0]
-        frames[(r["trial"], r["method"], r["init"])] = pd.read_parquet(d / FRAMES_FILE)
+        frames[(r["trial"], r["method"], r["init"])] = read_parquet(d / FRAMES_FILE)
     summary = pd.concat(summaries, ignore_index=True)
     paths = write_legbench_table(summary, Path(tables_dir) / "legbench_clearmot",
                                  methods=methods, inits=inits)

@@ -36,6 +36,7 @@ import pandas as pd
 
 from gaitval.errors import ConfigError, FileFormatError, GaitvalError
 from gaitval.io.atomic import write_parquet
+from gaitval.io.parquet import read_parquet
 from gaitval.steps import load_json, method_definition, trial_and_subject
 
 TARGET_COLUMNS = ("target", "x_m", "y_m", "color", "assigned")
@@ -236,11 +237,11 @@ def mtst_evaluate_step(track_parquet, sheet, subjects, trial: str, method: str, 
     ann = _annotations(row, s, trial, sheet)
     truth = None
     if groundtruth and Path(groundtruth).is_file() and rec and rec.get("status") == "ok":
-        truth = pd.read_parquet(groundtruth)
+        truth = read_parquet(groundtruth)
     height = subj.get("height_m")
     if height is None or not np.isfinite(height):
         height = float(s["foot"]["default_height_m"])
-    track = pd.read_parquet(track_parquet).drop(columns=["trial", "method"])
+    track = read_parquet(track_parquet).drop(columns=["trial", "method"])
     res = evaluate_mtst_trial(
         track, trial=trial, method=method, stick=bool(row.get("stick", False)), pose=pose,
         leg_width_m=float(subj["leg_width_m"]), height_m=float(height), targets=targets,
@@ -267,7 +268,7 @@ def mtst_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, repor
         for name in EVAL_TABLES:
             p = Path(d) / f"{name}.parquet"
             if p.is_file():
-                df = pd.read_parquet(p)
+                df = read_parquet(p)
                 if len(df):
                     parts[name].append(df)
     data = {n: (pd.concat(v, ignore_index=True) if v else pd.DataFrame())

@@ -29,6 +29,7 @@ import pandas as pd
 
 from gaitval.errors import GaitvalError
 from gaitval.io.atomic import write_parquet, write_text
+from gaitval.io.parquet import read_parquet
 from gaitval.steps import load_json, method_definition, trial_and_subject
 
 #: defaults of the ``rollator:`` keys read here
@@ -78,7 +79,7 @@ def rollator_train_step(results_dir, sheet, subjects, subject: str, config_json,
             skipped.append(trial)
             continue
         scans = read_scanlog(rd / "ingest" / trial / "sensor.parquet", trial=trial)
-        gt = pd.read_parquet(rd / "register" / trial / "groundtruth.parquet")
+        gt = read_parquet(rd / "register" / trial / "groundtruth.parquet")
         w = _leg_width(subj.loc[row["subject"]].to_dict(), cfg)
         samples.append(training_samples(scans, gt, w))
         used.append(trial)
@@ -155,7 +156,7 @@ def rollator_evaluate_step(track_parquet, gt_parquet, registration_json, ingest_
     cfg = load_json(config_json)
     row, _ = trial_and_subject(sheet, subjects, trial)
     rec = load_json(registration_json)
-    track = pd.read_parquet(track_parquet).drop(columns=["trial", "method"])
+    track = read_parquet(track_parquet).drop(columns=["trial", "method"])
     mocap = read_mocap_parquet(Path(ingest_dir) / "mocap.parquet",
                                source=row.get("mocap_path") or None, trial=row["trial"])
     labels = rollator_labels(cfg)
@@ -163,7 +164,7 @@ def rollator_evaluate_step(track_parquet, gt_parquet, registration_json, ingest_
         known, inside = pose_known(mocap, track.groupby("k")["t_sensor_s"].first().to_numpy(),
                                    rec["clock_offset_s"], rec["clock_drift_ppm"] or 0.0,
                                    labels, trial=trial)
-        res = evaluate_rollator_trial(track, pd.read_parquet(gt_parquet), known, inside,
+        res = evaluate_rollator_trial(track, read_parquet(gt_parquet), known, inside,
                                       trial=trial, tracker=method,
                                       cfg={"error_m": rollator_cfg(cfg)["error_m"]})
         summary = res["summary"].assign(status="ok")
@@ -196,9 +197,9 @@ def rollator_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, r
 
     frames, summaries = [], []
     for d in eval_dirs:
-        s = pd.read_parquet(Path(d) / "summary.parquet")
+        s = read_parquet(Path(d) / "summary.parquet")
         summaries.append(s)
-        f = pd.read_parquet(Path(d) / "frames.parquet")
+        f = read_parquet(Path(d) / "frames.parquet")
         if len(f):
             frames.append(f.merge(s[["trial", "tracker", "subject", "scenario",
                                      "repetition"]], on=["trial", "tracker"]))

@@ -31,6 +31,7 @@ Reading it without gaitval::
 """
 from __future__ import annotations
 
+import copy
 import json
 from pathlib import Path
 
@@ -39,6 +40,7 @@ import pandas as pd
 
 from gaitval.errors import FileFormatError
 from gaitval.io.atomic import atomic_path
+from gaitval.io.filememo import FileMemo
 from gaitval.io.guard import column_names, json_meta, loader, number
 from gaitval.types import ScanSeries
 
@@ -46,6 +48,9 @@ META_KEY = b"gaitval:scanlog"
 FORMAT = "gaitval-scanlog"
 VERSION = 1
 SUFFIX = ".scan.parquet"
+#: Scan logs read in this process (a warm worker runs every method of a trial: seed 000's
+#: six tracks read the same log), by file identity; a caller gets its own copy.
+_READ = FileMemo(256 * 2 ** 20)
 
 
 def clean_ranges(ranges: np.ndarray, range_min: float, range_max: float
@@ -133,13 +138,17 @@ def read_scanlog(path: str | Path, *, trial: str | None = None) -> ScanSeries:
         ``range_max_m``, ``angle_increment_rad`` 0), a newer version, non-finite
         timestamps, or a ``ranges`` column whose length does not match ``n_beams``.
     """
-    import pyarrow.parquet as pq
+    from gaitval.io.parquet import read_table
 
     path = Path(path)
+    key = _READ.key(path, str(path))
+    hit = _READ.get(key)
+    if hit is not None:
+        return copy.deepcopy(hit)
     if not path.is_file():
         raise FileFormatError("scan log not found", path=path, trial=trial)
     try:
-        tab = pq.read_table(path)
+        tab = read_table(path, remember=False)
     except Exception as exc:  # noqa: BLE001 - pyarrow: ArrowInvalid, OSError, ...
         raise FileFormatError(f"not a readable Parquet scan log: {exc}", path=path,
                               trial=trial) from None
@@ -157,13 +166,15 @@ def read_scanlog(path: str | Path, *, trial: str | None = None) -> ScanSeries:
     if g["unit"] == "mm":
         raw = raw / 1000.0
     ranges, n_bad = clean_ranges(raw, g["rmin"], g["rmax"])
-    return ScanSeries(
+    series = ScanSeries(
         t=t, ranges=ranges, angle_min=g["amin"], angle_increment=g["ainc"],
         range_min=g["rmin"], range_max=g["rmax"],
         sensor_model=str(meta.get("sensor_model", "unknown")),
         mounting_height_m=g["height"], source=str(path),
         timestamp_issues=check_timestamps(t), n_no_return_raw=n_bad,
         meta={k: v for k, v in meta.items() if k not in {"n_beams"}})
+    _READ.put(key, copy.deepcopy(series), ranges.nbytes + t.nbytes)
+    return series
 
 
 def _meta_fields(meta: dict, path: Path, trial: str | None) -> dict:

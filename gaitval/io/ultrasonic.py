@@ -154,13 +154,13 @@ def read_ultrasonic(path: str | Path, *, trial: str | None = None) -> Ultrasonic
         unknown ``quantity``, missing or non-numeric columns, non-finite times or
         temperatures (the row is named).
     """
-    import pyarrow.parquet as pq
+    from gaitval.io.parquet import read_table
 
     path = Path(path)
     if not path.is_file():
         raise FileFormatError("ultrasonic log not found", path=path, trial=trial)
     try:
-        tab = pq.read_table(path)
+        tab = read_table(path)
     except Exception as exc:  # noqa: BLE001 - pyarrow: ArrowInvalid, OSError, ...
         raise FileFormatError(f"not a readable Parquet ultrasonic log: {exc}", path=path,
                               trial=trial) from None

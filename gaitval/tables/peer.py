@@ -15,6 +15,7 @@ from pathlib import Path
 import pandas as pd
 
 from gaitval.errors import FileFormatError
+from gaitval.io.parquet import read_parquet
 from gaitval.stats import agreement, icc_mixed, loa_nested, proportional_bias
 from gaitval.stats._refs import SINGLE2024
 from gaitval.tables.render import write_table
@@ -51,7 +52,7 @@ SUBJECT_COLUMNS = ("subject", "participant", "subject_id", "participant_id")
 def _read(parquet_path: str | Path) -> pd.DataFrame:
     path = Path(parquet_path)
     try:
-        return pd.read_parquet(path)
+        return read_parquet(path)
     except FileNotFoundError:
         raise FileFormatError("peer results file not found", path=path) from None
     except Exception as exc:  # pyarrow raises several types for a non-parquet file

@@ -1,0 +1,77 @@
+"""What a warm process read from a file, remembered under the file's identity (issue 13).
+
+A worker of :mod:`gaitval.forkserver` runs job after job, and the jobs of one trial read
+the same inputs again: the six TUG tracks of a trial read its scan log, the evaluations of
+its methods its ground truth.  :class:`FileMemo` keeps what was read under the file's
+**identity** — resolved path, device, inode, size and modification time in nanoseconds —
+so a file rewritten in any way is read again: gaitval replaces its outputs by renaming a
+new file over them (a new inode), and an edit in place changes the modification time.
+
+Entries are evicted oldest first past a byte budget.  A value handed out must not be
+changed by the caller: keep immutable values (an Arrow table), or give the caller a copy
+(:func:`gaitval.io.scanlog.read_scanlog` does).  A process that runs one job (a cluster
+job, a plain ``gaitval`` command) pays one ``stat`` per read and never hits.
+"""
+from __future__ import annotations
+
+import os
+from collections import OrderedDict
+from pathlib import Path
+from typing import Any
+
+
+def file_identity(path: str | os.PathLike) -> tuple | None:
+    """``(resolved path, st_dev, st_ino, st_size, st_mtime_ns)``, or None when the file
+    cannot be stat'ed (the caller then reads it and reports the problem)."""
+    try:
+        p = Path(path).resolve()
+        st = os.stat(p)
+    except (OSError, RuntimeError, ValueError):
+        return None
+    return (str(p), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+
+
+class FileMemo:
+    """Values read from files, by file identity and the reader's own options.
+
+    ``max_bytes``: the budget; an entry's size is what the caller says it is (an entry
+    larger than the budget is not kept).
+    """
+
+    def __init__(self, max_bytes: int):
+        self.max_bytes = int(max_bytes)
+        self._entries: OrderedDict[tuple, tuple[Any, int]] = OrderedDict()
+        self._bytes = 0
+
+    def key(self, path: str | os.PathLike, *options) -> tuple | None:
+        """The key of ``path`` read with ``options``; None: do not remember."""
+        ident = file_identity(path)
+        return None if ident is None else (ident, options)
+
+    def get(self, key: tuple | None) -> Any | None:
+        if key is None:
+            return None
+        hit = self._entries.get(key)
+        if hit is None:
+            return None
+        self._entries.move_to_end(key)
+        return hit[0]
+
+    def put(self, key: tuple | None, value: Any, nbytes: int) -> None:
+        if key is None or nbytes > self.max_bytes:
+            return
+        old = self._entries.pop(key, None)
+        if old is not None:
+            self._bytes -= old[1]
+        self._entries[key] = (value, int(nbytes))
+        self._bytes += int(nbytes)
+        while self._bytes > self.max_bytes and self._entries:
+            _, (_, n) = self._entries.popitem(last=False)
+            self._bytes -= n
+
+    def clear(self) -> None:
+        self._entries.clear()
+        self._bytes = 0
+
+    def __len__(self) -> int:
+        return len(self._entries)
