@@ -48,6 +48,11 @@ def ensure_env(extras: str) -> None:
                    check=True)
     subprocess.run([str(PY), "-m", "pip", "install", "--quiet", "-e",
                     f"{ROOT}[{extras}]" if extras else str(ROOT)], check=True)
+    # the particle filter's numba kernels, compiled into their cache now (~10 s CPU) rather
+    # than by each worker of the first report (gaitval/track/pf.py, warm_up)
+    print("[run.py] compiling the particle filter's kernels (first run only) ...", flush=True)
+    subprocess.run([str(PY), "-c", "from gaitval.track.pf import warm_up; warm_up()"],
+                   check=False)
     stamp.write_text(key)
 
 

@@ -99,6 +99,11 @@ def preload() -> list[str]:
         parser()
     except Exception:
         failed.append("gaitval.cli.parser")
+    try:                                       # the PF's compiled kernels, loaded (or
+        from gaitval.track.pf import warm_up   # compiled) once for all workers
+        warm_up()
+    except Exception:
+        failed.append("gaitval.track.pf.warm_up")
     try:                                       # parsed once here instead of in every job
         from gaitval.io.trialsheet import load_schema
         for name in ("trials", "subjects"):

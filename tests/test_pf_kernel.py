@@ -248,3 +248,34 @@ def _numpy_step(P, rng, X, Y, prev, dt, N=500):
     est = np.concatenate([np.einsum("ln,lnj->lj", ws, pos), np.einsum("ln,lnj->lj", ws, v)],
                          axis=1)
     return est, cnt.max(axis=1) > 0, need.size
+
+
+def test_warm_up_compiles_what_a_track_then_uses(tmp_path):
+    """gaitval.track.pf.warm_up (run by the fork server before it forks its workers, and by
+    run.py after installing) gives every kernel a track calls the specialisation the track
+    needs: a track afterwards compiles nothing new.  In a fresh process, so that no other
+    test's track has compiled them first."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = (
+        "import sys\n"
+        f"sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
+        "from gaitval.track import pf_kernels as K\n"
+        "from gaitval.track.pf import ParticleFilterTracker, warm_up\n"
+        "from rollator_synth import walk\n"
+        "names = [n for n in dir(K) if hasattr(getattr(K, n), 'signatures')]\n"
+        "warm_up()\n"
+        "before = {n: list(getattr(K, n).signatures) for n in names}\n"
+        "assert before['propagate_weigh'] and before['resample_move'] and before['estimate']\n"
+        "assert before['leg_likelihood']\n"
+        "scans, _ = walk(40, seed=3)\n"
+        "res = ParticleFilterTracker(seed=0, resample_fraction=1.0).track(scans, 0.10)\n"
+        "assert res.k_init is not None and res.k_init >= 0\n"
+        "after = {n: list(getattr(K, n).signatures) for n in names}\n"
+        "print({n: (len(before[n]), len(after[n])) for n in names})\n"
+        "assert after == before, (before, after)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=tmp_path, timeout=300)
+    assert out.returncode == 0, out.stderr[-3000:]

@@ -57,7 +57,7 @@ from gaitval.track.init import INITIALISERS
 from gaitval.track.kinds import TRACKER_KINDS, RawScanTracker
 from gaitval.track.leg import TrackResult, empty_result
 from gaitval.track.observations import WindowedDetections
-from gaitval.track.pf_likelihood import PFArrays, draw_mixture, sample_velocities
+from gaitval.track.pf_likelihood import PFArrays, draw_mixture, likelihood, sample_velocities
 from gaitval.track.pf_model import default_pf_model
 from gaitval.track.phase import PHASE_MODELS
 from gaitval.track.tracker import step_durations
@@ -182,3 +182,28 @@ class ParticleFilterTracker(RawScanTracker):
         res.phase[k0:] = [phase.identify(tuple(e[0]), tuple(e[1])) for e in est[k0:]]
         return res
 
+
+
+def warm_up() -> None:
+    """Compile the kernels a PF track (and the training's likelihood) runs, or load them
+    from numba's cache, on a tiny problem (two scans of an arc, eight particles per leg,
+    resampling forced).
+
+    The fork server calls it before forking its workers, so that a report loads them once
+    (≈ 0.4 s CPU) instead of once per worker, and a checkout without a cache compiles them
+    once (≈ 10 s CPU) instead of in every worker that runs a PF; ``run.py`` calls it after
+    installing.  The arguments have the types and layouts of :meth:`ParticleFilterTracker.
+    step`'s (float64 C arrays, the scan's rows, an int64 leg index), so a track afterwards
+    finds the same specialisations (tests/test_pf_kernel.py checks that it adds none).
+    """
+    tracker = ParticleFilterTracker(n_particles=8, resample_fraction=1.0)
+    P = PFArrays(default_pf_model(0.10))
+    a = np.linspace(-1.0, 1.0, 41)
+    r = np.full((2, a.size), 0.5)
+
+    class _Arc:
+        X, Y = r * np.cos(a), r * np.sin(a)
+
+    prev = np.array([[0.55, 0.06, 0.0, 0.0], [0.55, -0.06, 0.0, 0.0]])
+    tracker.step(P, np.random.default_rng(0), _Arc, 1, prev, 0.028)
+    likelihood(P, np.full(8, 0.55), np.full(8, 0.06), _Arc.X[1], _Arc.Y[1], 0.55, -0.06)
