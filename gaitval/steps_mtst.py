@@ -36,6 +36,7 @@ import pandas as pd
 
 from gaitval.errors import ConfigError, FileFormatError, GaitvalError
 from gaitval.io.atomic import write_parquet
+from gaitval.io.filememo import FileMemo
 from gaitval.io.parquet import read_parquet
 from gaitval.steps import load_json, method_definition, trial_and_subject
 
@@ -161,6 +162,23 @@ def load_targets(s: dict, sheet, trial: str, *, required: bool) -> pd.DataFrame 
             return None
         raise FileFormatError("target layout file not found", path=path, **where,
                               hint="mtst.targets names a CSV relative to the trial sheet")
+    key = _TARGETS.key(path, trial, required)
+    hit = _TARGETS.get(key)
+    if hit is not None:
+        return None if hit is _NONE else hit.copy(deep=True)
+    out = _read_targets(path, trial, required=required)
+    _TARGETS.put(key, _NONE if out is None else out.copy(deep=True), 4096)
+    return out
+
+
+#: Target layouts read in this process, by file identity, trial and ``required`` (the four
+#: methods of a trial read the same one); _NONE: the file has no targets for the trial.
+_TARGETS = FileMemo(16 * 2 ** 20)
+_NONE = object()
+
+
+def _read_targets(path: Path, trial: str, *, required: bool) -> pd.DataFrame | None:
+    where = dict(trial=trial)
     try:
         df = pd.read_csv(path, dtype={"target": str, "color": str})
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:

@@ -84,3 +84,37 @@ def test_the_memo_keeps_to_its_byte_budget_oldest_out_first(tmp_path):
     memo.put(memo.key(tmp_path / "0.bin"), "big", 101)      # over the budget: not kept
     assert memo.get(memo.key(tmp_path / "0.bin")) is None
     assert memo.key(tmp_path / "missing") is None and memo.get(None) is None
+
+
+def test_annotations_read_twice_are_independent_copies(tmp_path):
+    from gaitval.io.annotations import read_annotations, write_annotations
+
+    ev = pd.DataFrame({"t_s": [1.0, 2.5], "event": ["contact", "contact"], "side": ["L", "R"]})
+    p = write_annotations(tmp_path / "a.annotations.csv", ev, time_offset_s=0.5)
+    a, meta = read_annotations(p, trial="t1")
+    a.loc[0, "t_s"] = -1.0
+    meta["rater"] = "changed"
+    b, meta_b = read_annotations(p, trial="t1")
+    assert b["t_s"].tolist() == [1.0, 2.5] and b["t_mocap_s"].tolist() == [1.5, 3.0]
+    assert meta_b["rater"] == "R1"
+
+
+def test_a_target_layout_without_the_trial_is_none_or_an_error_as_asked(tmp_path):
+    """The layout is remembered per trial and per `required`: a file without the trial's
+    targets gives None when targets are optional, and still the error when they are not."""
+    import pytest
+
+    from gaitval.errors import FileFormatError
+    from gaitval.steps_mtst import load_targets
+
+    (tmp_path / "targets.csv").write_text(
+        "trial,target,x_m,y_m,color,assigned\nother,T1,0.5,0.2,red,true\n")
+    s = {"targets": "targets.csv"}
+    sheet = tmp_path / "trials.csv"
+    assert load_targets(s, sheet, "mine", required=False) is None
+    assert load_targets(s, sheet, "mine", required=False) is None
+    with pytest.raises(FileFormatError, match="no targets for this trial"):
+        load_targets(s, sheet, "mine", required=True)
+    got = load_targets(s, sheet, "other", required=True)
+    got.loc[0, "x_m"] = 9.0
+    assert load_targets(s, sheet, "other", required=True)["x_m"].tolist() == [0.5]

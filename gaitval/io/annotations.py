@@ -22,6 +22,7 @@ Columns (header row required; order free):
 """
 from __future__ import annotations
 
+import copy
 import io
 from pathlib import Path
 
@@ -31,6 +32,7 @@ import pandas as pd
 from gaitval.errors import FileFormatError
 from gaitval.io.atomic import write_text
 from gaitval.io.guard import loader, number
+from gaitval.io.filememo import FileMemo
 
 MAGIC = "# gaitval-annotations v1"
 COLUMNS = ["t_s", "event", "side", "target", "value", "rater"]
@@ -54,6 +56,11 @@ def write_annotations(path: str | Path, events: pd.DataFrame, *, time_base: str 
     return write_text(path, "\n".join(head) + "\n" + body)
 
 
+#: Annotation files read in this process (the four MTST methods of a trial read the same
+#: one), by file identity; a caller gets its own copy.
+_READ = FileMemo(32 * 2 ** 20)
+
+
 @loader("annotation file")
 def read_annotations(path: str | Path, *, trial: str | None = None
                      ) -> tuple[pd.DataFrame, dict]:
@@ -67,7 +74,15 @@ def read_annotations(path: str | Path, *, trial: str | None = None
     meta : dict
         The ``# key: value`` header.
     """
-    path = Path(path)
+    key = _READ.key(path)
+    hit = _READ.get(key)
+    if hit is None:
+        hit = _read_annotations(Path(path), trial)
+        _READ.put(key, hit, int(hit[0].memory_usage(deep=True).sum()))
+    return hit[0].copy(deep=True), copy.deepcopy(hit[1])
+
+
+def _read_annotations(path: Path, trial: str | None) -> tuple[pd.DataFrame, dict]:
     if not path.is_file():
         raise FileFormatError("annotation file not found", path=path, trial=trial)
     try:
