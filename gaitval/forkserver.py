@@ -374,6 +374,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="... or once its peak memory passed this many MB")
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
+    from gaitval.io.filememo import set_cap, worker_budget_mb
+    set_cap(worker_budget_mb(a.workers))       # what a worker may keep of the files it read
     failed = preload()
     gc.freeze()          # the preloaded objects: the workers' collections skip them and so
     #                      leave their pages shared instead of copying them on the first gc

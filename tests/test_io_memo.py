@@ -118,3 +118,20 @@ def test_a_target_layout_without_the_trial_is_none_or_an_error_as_asked(tmp_path
     got = load_targets(s, sheet, "other", required=True)
     got.loc[0, "x_m"] = 9.0
     assert load_targets(s, sheet, "other", required=True)["x_m"].tolist() == [0.5]
+
+
+def test_a_cap_bounds_every_memo_and_shrinks_with_more_workers(tmp_path):
+    from gaitval.io.filememo import set_cap, worker_budget_mb
+
+    memo = FileMemo(10 * 2 ** 20)
+    f = tmp_path / "a.bin"
+    f.write_bytes(b"x")
+    try:
+        set_cap(1)                                           # 1 MB
+        assert memo.max_bytes == 2 ** 20
+        memo.put(memo.key(f), "big", 2 * 2 ** 20)
+        assert memo.get(memo.key(f)) is None
+    finally:
+        set_cap(None)
+    assert memo.max_bytes == 10 * 2 ** 20
+    assert worker_budget_mb(64) < worker_budget_mb(2) and worker_budget_mb(10 ** 6) == 16.0

@@ -11,6 +11,11 @@ Entries are evicted oldest first past a byte budget.  A value handed out must no
 changed by the caller: keep immutable values (an Arrow table), or give the caller a copy
 (:func:`gaitval.io.scanlog.read_scanlog` does).  A process that runs one job (a cluster
 job, a plain ``gaitval`` command) pays one ``stat`` per read and never hits.
+
+The budgets are per process, so a fork server with many workers would multiply them: it
+caps every memo's budget (:func:`set_cap`) at an eighth of the machine's memory shared
+among its workers (:func:`worker_budget_mb`; on a 24 GB machine with two workers the cap,
+1.5 GB, is above every budget; with 64 workers on 64 GB it is 128 MB).
 """
 from __future__ import annotations
 
@@ -18,6 +23,13 @@ import os
 from collections import OrderedDict
 from pathlib import Path
 from typing import Any
+
+_CAP: list[int] = []          # the most bytes any one memo of this process may keep
+
+
+def set_cap(mb: float | None) -> None:
+    """Cap every memo's budget at ``mb`` megabytes (None: no cap)."""
+    _CAP[:] = [] if mb is None else [int(mb * 2 ** 20)]
 
 
 def file_identity(path: str | os.PathLike) -> tuple | None:
@@ -39,9 +51,14 @@ class FileMemo:
     """
 
     def __init__(self, max_bytes: int):
-        self.max_bytes = int(max_bytes)
+        self._own = int(max_bytes)
         self._entries: OrderedDict[tuple, tuple[Any, int]] = OrderedDict()
         self._bytes = 0
+
+    @property
+    def max_bytes(self) -> int:
+        """The budget: the one given, capped by :func:`set_cap`."""
+        return min([self._own, *_CAP])
 
     def key(self, path: str | os.PathLike, *options) -> tuple | None:
         """The key of ``path`` read with ``options``; None: do not remember."""
@@ -58,14 +75,15 @@ class FileMemo:
         return hit[0]
 
     def put(self, key: tuple | None, value: Any, nbytes: int) -> None:
-        if key is None or nbytes > self.max_bytes:
+        budget = self.max_bytes
+        if key is None or nbytes > budget:
             return
         old = self._entries.pop(key, None)
         if old is not None:
             self._bytes -= old[1]
         self._entries[key] = (value, int(nbytes))
         self._bytes += int(nbytes)
-        while self._bytes > self.max_bytes and self._entries:
+        while self._bytes > budget and self._entries:
             _, (_, n) = self._entries.popitem(last=False)
             self._bytes -= n
 
@@ -75,3 +93,13 @@ class FileMemo:
 
     def __len__(self) -> int:
         return len(self._entries)
+
+
+def worker_budget_mb(workers: int) -> float:
+    """The cap a fork server with ``workers`` workers sets (:func:`set_cap`): an eighth
+    of the machine's physical memory divided among the workers, at least 16 MB."""
+    try:
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        total = 8 * 2 ** 30
+    return max(16.0, total / 8 / max(1, workers) / 2 ** 20)
