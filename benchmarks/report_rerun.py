@@ -12,9 +12,9 @@ the rebuild command it names differs), then ``--repeat`` times more, each of whi
 find nothing to do; prints their wall and CPU times.  Then plans (``-n``) the rerun after a
 new value of one tracker method's parameter (``tracking.overrides.<method>``, default
 ``tug_m1``'s ``occlusion__max_n``) and prints Snakemake's job counts per rule; the jobs it
-may plan are that method's ``track`` and ``evaluate_tug`` (the method and its reading
-variant, e.g. ``tug_m1_stance_first``), the config views and records, the TUG tables and
-the report.  Exits 1 when a rerun did work or the plan holds another rule or method.
+may plan are that method's ``track`` jobs, each tracking and evaluating one trial (the
+method and its reading variant, e.g. ``tug_m1_stance_first``), the config views and
+records, the TUG tables and the report.  Exits 1 when a rerun did work or the plan holds another rule or method.
 
 Last line: ``rerun <folder>: nothing changed <median> s wall (bar 5 s); one method's
 parameter: <n> jobs, only its own: yes|no``.
@@ -34,7 +34,7 @@ from report_end_to_end import _cpu_children        # this folder's sibling scrip
 
 ROOT = Path(__file__).resolve().parents[1]
 #: What a new value of one TUG method's parameter may rerun.
-ALLOWED = {"track", "evaluate_tug", "config_view", "study_config", "report_config",
+ALLOWED = {"track", "config_view", "study_config", "report_config",
            "tug_tables", "report", "all"}
 
 

@@ -55,6 +55,28 @@ def test_dag_runs_end_to_end_and_index_has_provenance(tiny_run):
 
 
 @pytest.mark.slow
+def test_a_track_job_tracks_then_evaluates_both_in_the_fork_server(tiny_run):
+    """Issue 13: a TUG or MTST job runs two gaitval steps (tracking, then its evaluation);
+    locally both go to the fork server from Snakemake's thread, one after the other, and
+    the job's log holds what both printed (the evaluation's summary row)."""
+    import re
+
+    log = (tiny_run / "logs" / "forkserver.log").read_text()
+    cmds = dict(re.findall(r"^job (\S+): gaitval (\S+) ", log, re.M))
+    via = dict(re.findall(r"^job (\S+): exit 0, .*, via (\S+)$", log, re.M))
+    for track, evaluate in (("track", "evaluate-tug"), ("mtst-track", "mtst-evaluate")):
+        ran = [j for j, v in cmds.items() if v == track]
+        evals = [j for j, v in cmds.items() if v == evaluate]
+        assert ran and len(evals) == len(ran), (track, len(ran), len(evals))
+        assert {via.get(j) for j in ran + evals} <= {"snakemake", None}    # None: plain start
+    n_trials = len(list((tiny_run / "results" / "tiny" / "track" / "tug_m1").glob("*.parquet")))
+    job_logs = sorted((tiny_run / "logs" / "track" / "tiny" / "tug_m1").glob("*.log"))
+    assert len(job_logs) == n_trials
+    for f in job_logs:
+        assert "category" in f.read_text(), f        # the evaluation's summary, appended
+
+
+@pytest.mark.slow
 def test_same_config_and_seed_give_byte_identical_tables(tiny_run, tmp_path):
     res = run_workflow(tmp_path, tiny_run / "data")
     assert res.returncode == 0, res.stderr[-4000:]
@@ -95,7 +117,7 @@ def _planned(res: subprocess.CompletedProcess) -> dict[str, int]:
 @pytest.mark.slow
 def test_one_methods_parameter_reruns_only_that_methods_trials(tiny_run):
     """Issue 13: after the tiny report, a new value of one TUG method's parameter plans
-    that method's tracks and evaluations (and its eq. (3)-(4) reading variant's, which
+    that method's tracks with their evaluations (and its eq. (3)-(4) reading variant's, which
     inherits the override), the TUG tables and the report -- no registration, no
     other method's track, no ultrasonic noise identification or track, no other study
     section's tables or summaries."""
@@ -105,7 +127,8 @@ def test_one_methods_parameter_reruns_only_that_methods_trials(tiny_run):
     planned = _planned(res)
     n_tug = len(list((tiny_run / "results" / "tiny" / "track" / "tug_m1").glob("*.parquet")))
     assert n_tug > 0
-    assert planned["track"] == planned["evaluate_tug"] == 2 * n_tug    # tug_m1 + variant
+    assert planned["track"] == 2 * n_tug          # tug_m1 + variant, each evaluated in its job
+    assert "evaluate_tug" not in planned          # no such rule since the track job evaluates
     assert planned["config_view"] == 2
     for rule in ("register", "ingest", "mtst_track", "rollator_track", "ultrasonic_noise",
                  "ultrasonic_track", "gait_parameters", "rollator_train", "mtst_tables",
@@ -140,7 +163,7 @@ def test_a_rollator_setting_reruns_only_the_rollator_trials(tiny_run, tmp_path):
     assert planned["rollator_track"] == 2 * n_rollator            # KF and PF
     assert planned["rollator_tables"] == 1
     assert planned.get("register", 0) <= n_rollator             # its view holds rollator:
-    for rule in ("track", "evaluate_tug", "mtst_track", "mtst_evaluate", "ultrasonic_noise",
+    for rule in ("track", "mtst_track", "ultrasonic_noise",
                  "ultrasonic_track", "gait_parameters", "tug_tables", "mtst_tables",
                  "ultrasonic_tables", "ingest"):
         assert rule not in planned, (rule, planned)

@@ -104,7 +104,9 @@ if not _CONDA:
         f"{shlex.quote(FORK_SOCKET)} --"
     )
 # Local jobs without a shell.  Every gaitval step's `shell` command reads
-# "{params.gv} VERB ARGS > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)" (or with `{log}`).
+# "{params.gv} VERB ARGS > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)" (or with `{log}`), or
+# chains steps: "{params.gv} A > {log:q} 2>&1 && {params.gv} B >> {log:q} 2>&1 || (...)"
+# (a trial's tracking and its evaluation: one job instead of two, issue 13).
 # With the fork server listening, the `shell` below sends VERB ARGS to it straight from
 # Snakemake's job thread (gaitval.forkclient.submit), standard output and error to the log:
 # no bash and no client process, which cost ~10 ms of CPU a job, ~11 CPU-s over the ~1,100
@@ -118,8 +120,26 @@ if not _CONDA:
 from snakemake.shell import shell as _snakemake_shell
 
 _GV_HEAD = "{params.gv} "
-_GV_TAILS = (" > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)",
-             " > {log} 2>&1 || (cat {log} >&2; exit 1)")
+
+
+def _gv_steps(cmd):
+    """The gaitval steps (VERB ARGS, unformatted) of a rule's command of the forms above,
+    in order; None for any other command."""
+    if not cmd.startswith(_GV_HEAD):
+        return None
+    for q in (":q", ""):
+        fail = f" || (cat {{log{q}}} >&2; exit 1)"
+        if not cmd.endswith(fail):
+            continue
+        steps = []
+        for i, part in enumerate(cmd[len(_GV_HEAD):-len(fail)].split(" && " + _GV_HEAD)):
+            redirect = f" {'>' if i == 0 else '>>'} {{log{q}}} 2>&1"
+            if not part.endswith(redirect) or "{params.gv}" in part:
+                return None
+            steps.append(part[:-len(redirect)])
+        return steps
+    return None
+
 # what a rule function hands on to Snakemake's shell() (conda env, container, job id, ...)
 _SHELL_CONTEXT = ("conda_env", "conda_base_path", "container_img", "env_modules",
                   "shadow_dir", "resources", "singularity_args", "threads", "runtime_paths",
@@ -140,11 +160,16 @@ class shell(_snakemake_shell):
 
         ctx = sys._getframe(1).f_locals
         from_rule = bool(ctx.get(RULEFUNC_CONTEXT_MARKER))
-        tail = next((t for t in _GV_TAILS if cmd.endswith(t)), None)
-        if FORK_SERVER and from_rule and not args and tail and cmd.startswith(_GV_HEAD) \
-                and len(ctx["log"]) == 1:
-            verb = sm_format(cmd[len(_GV_HEAD):-len(tail)], stepout=2)
-            rc = _in_fork_server(verb, str(ctx["log"][0]), ctx)
+        steps = _gv_steps(cmd) if FORK_SERVER and from_rule and not args else None
+        if steps and len(ctx["log"]) == 1:
+            # each step in turn, the first truncating the log and the others appending,
+            # as the shell would; no server (at the start or gone since): the whole
+            # command the shell's way (its steps write their outputs atomically)
+            for i, step in enumerate(steps):
+                rc = _in_fork_server(sm_format(step, stepout=2), str(ctx["log"][0]), ctx,
+                                     append=i > 0)
+                if rc != 0:
+                    break
             if rc == 0:
                 return None
             if rc is not None:
@@ -166,8 +191,9 @@ class shell(_snakemake_shell):
 FORK_JOBS = set()
 
 
-def _in_fork_server(args, log, ctx):
-    """The job's exit code from the fork server, or None when none listens."""
+def _in_fork_server(args, log, ctx, append=False):
+    """The job's exit code from the fork server, or None when none listens.  ``append``:
+    add to the log (a later step of a chain) instead of starting it."""
     import os
     import struct
     from gaitval.forkclient import submit
@@ -177,7 +203,8 @@ def _in_fork_server(args, log, ctx):
     tmp = (ctx.get("resources") or {}).get("tmpdir")
     if tmp:
         env.update(dict.fromkeys(("TMPDIR", "TMP", "TEMPDIR", "TEMP"), str(tmp)))
-    out = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_CLOEXEC, 0o666)
+    mode = os.O_APPEND if append else os.O_TRUNC
+    out = os.open(log, os.O_WRONLY | os.O_CREAT | mode | os.O_CLOEXEC, 0o666)
     try:
         nul = os.open(os.devnull, os.O_RDONLY | os.O_CLOEXEC)
         workers = []

@@ -1,34 +1,16 @@
-# Multi-target stepping task (seed 001): one tracking and one evaluation job per (trial,
-# method), then Tables 1, 3, 4 and the trial figure.  A trial without mocap (annotations
+# Multi-target stepping task (seed 001): one job per (trial, method) that tracks and
+# evaluates, then Tables 1, 3, 4 and the trial figure.  A trial without mocap (annotations
 # only) is tracked from its raw scan log; its pose comes from mtst.poles_m and its clock
 # from the trial sheet (gaitval.steps_mtst).
 include: "mtst_common.smk"
 
 
 rule mtst_track:
+    # the tracking and then its evaluation: two gaitval steps in one job (see rule track)
     input:
-        unpack(mtst_track_inputs),
+        unpack(mtst_inputs),
     output:
-        f"{RESULTS}/{{study}}/mtst_track/{{method}}/{{trial}}.parquet",
-    params:
-        gv=GV,
-        subjects=lambda w: subjects_path(w.study),
-        reg=mtst_optional("reg", "--registration"),
-    conda:
-        "../envs/gaitval.yaml"
-    log:
-        "logs/mtst_track/{study}/{method}/{trial}.log",
-    shell:
-        "{params.gv} mtst-track --sensor {input.sensor} --sheet {input.sheet}"
-        " --subjects {params.subjects} --trial {wildcards.trial} --method {wildcards.method}"
-        " --config {input.config} {params.reg} --out {output}"
-        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
-
-
-rule mtst_evaluate:
-    input:
-        unpack(mtst_eval_inputs),
-    output:
+        track=f"{RESULTS}/{{study}}/mtst_track/{{method}}/{{trial}}.parquet",
         summary=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/summary.parquet",
         contacts=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/contacts.parquet",
         steps=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/steps.parquet",
@@ -45,12 +27,15 @@ rule mtst_evaluate:
     conda:
         "../envs/gaitval.yaml"
     log:
-        "logs/mtst_evaluate/{study}/{method}/{trial}.log",
+        "logs/mtst_track/{study}/{method}/{trial}.log",
     shell:
-        "{params.gv} mtst-evaluate --track {input.track} --sheet {input.sheet}"
+        "{params.gv} mtst-track --sensor {input.sensor} --sheet {input.sheet}"
+        " --subjects {params.subjects} --trial {wildcards.trial} --method {wildcards.method}"
+        " --config {input.config} {params.reg} --out {output.track} > {log} 2>&1"
+        " && {params.gv} mtst-evaluate --track {output.track} --sheet {input.sheet}"
         " --subjects {params.subjects} --trial {wildcards.trial} --method {wildcards.method}"
         " --config {input.config} {params.reg} {params.gt} --out {params.out}"
-        " > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        " >> {log} 2>&1 || (cat {log} >&2; exit 1)"
 
 
 rule mtst_tables:

@@ -56,21 +56,12 @@ def mtst_targets_file(wildcards):
     return [str(path)] if path.is_file() else []
 
 
-def mtst_track_inputs(wildcards):
+def mtst_inputs(wildcards):
+    """What a trial's tracking and evaluation read: the scan log, the method's config view,
+    the sheet, the registration and ground truth (a trial with mocap), the target layout and
+    the rater annotations (when there are)."""
     files = {
         "sensor": mtst_sensor(wildcards),
-        "config": config_view_file(wildcards),
-        "sheet": sheet_path(wildcards.study),
-    }
-    reg = mtst_registration(wildcards)
-    if reg:
-        files["reg"] = reg["reg"]
-    return files
-
-
-def mtst_eval_inputs(wildcards):
-    files = {
-        "track": f"{RESULTS}/{wildcards.study}/mtst_track/{wildcards.method}/{wildcards.trial}.parquet",
         "config": config_view_file(wildcards),
         "sheet": sheet_path(wildcards.study),
         "targets": mtst_targets_file(wildcards),

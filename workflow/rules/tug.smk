@@ -1,18 +1,26 @@
-# TUG leg tracking (seed 000): one job per (trial, method), evaluation against the
-# registered ground truth, then Tables 2-5 and the figures.  The methods run are
+# TUG leg tracking (seed 000): one job per (trial, method) that tracks and evaluates
+# against the registered ground truth, then Tables 2-5 and the figures.  The methods run are
 # tug_runs() (common.smk): tug.methods and their reading variants (tug.phase_readings).
 
 
 rule track:
+    # the tracking and then its evaluation against the registered ground truth: two gaitval
+    # steps in one job (one job fewer per (trial, method) for Snakemake to schedule and
+    # record, issue 13); on a cluster the same two commands run in one job's shell
     input:
         sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
+        gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
+        reg=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
         config=config_view_file,
         sheet=lambda w: sheet_path(w.study),
     output:
-        f"{RESULTS}/{{study}}/track/{{method}}/{{trial}}.parquet",
+        track=f"{RESULTS}/{{study}}/track/{{method}}/{{trial}}.parquet",
+        summary=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/summary.parquet",
+        frames=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/frames.parquet",
     params:
         gv=GV,
         subjects=lambda w: subjects_path(w.study),
+        out=parent_of("summary"),
     conda:
         "../envs/gaitval.yaml"
     log:
@@ -20,29 +28,11 @@ rule track:
     shell:
         "{params.gv} track --sensor {input.sensor:q} --sheet {input.sheet:q}"
         " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} --out {output:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
-
-
-rule evaluate_tug:
-    input:
-        track=f"{RESULTS}/{{study}}/track/{{method}}/{{trial}}.parquet",
-        gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
-        reg=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
-        config=config_view_file,
-    output:
-        summary=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/summary.parquet",
-        frames=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/frames.parquet",
-    params:
-        gv=GV,
-        out=parent_of("summary"),
-    conda:
-        "../envs/gaitval.yaml"
-    log:
-        "logs/evaluate_tug/{study}/{method}/{trial}.log",
-    shell:
-        "{params.gv} evaluate-tug --track {input.track:q} --groundtruth {input.gt:q}"
+        " --config {input.config:q} --out {output.track:q} > {log:q} 2>&1"
+        " && {params.gv} evaluate-tug --track {output.track:q} --groundtruth {input.gt:q}"
         " --registration {input.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} --out {params.out:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+        " --config {input.config:q} --out {params.out:q} >> {log:q} 2>&1"
+        " || (cat {log:q} >&2; exit 1)"
 
 
 rule tug_tables:
