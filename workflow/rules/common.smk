@@ -132,7 +132,7 @@ def _gv_steps(cmd):
         if not cmd.endswith(fail):
             continue
         steps = []
-        for i, part in enumerate(cmd[len(_GV_HEAD):-len(fail)].split(" && " + _GV_HEAD)):
+        for i, part in enumerate(cmd[len(_GV_HEAD):-len(fail)].split(f" && {_GV_HEAD}")):
             redirect = f" {'>' if i == 0 else '>>'} {{log{q}}} 2>&1"
             if not part.endswith(redirect) or "{params.gv}" in part:
                 return None
