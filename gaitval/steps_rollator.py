@@ -29,6 +29,7 @@ import pandas as pd
 
 from gaitval.errors import GaitvalError
 from gaitval.io.atomic import write_parquet, write_text
+from gaitval.io.filememo import FileMemo, file_identity
 from gaitval.io.parquet import read_parquet
 from gaitval.steps import load_json, method_definition, trial_and_subject
 
@@ -51,6 +52,12 @@ def _leg_width(subj: dict, cfg: dict) -> float:
 
 
 # -- train ----------------------------------------------------------------------------------
+#: A trial's training samples, by its scan log's and ground truth's identities and the leg
+#: width: the leave-one-subject-out models each train on every other subject's trials, so
+#: a worker that trains two models would compute most trials' samples twice.
+_SAMPLES = FileMemo(128 * 2 ** 20)
+
+
 def rollator_train_step(results_dir, sheet, subjects, subject: str, config_json,
                         out_json) -> dict:
     """Learn the PF model for held-out ``subject`` from the other subjects' trials.
@@ -78,10 +85,16 @@ def rollator_train_step(results_dir, sheet, subjects, subject: str, config_json,
         if reg.get("status") != "ok":
             skipped.append(trial)
             continue
-        scans = read_scanlog(rd / "ingest" / trial / "sensor.parquet", trial=trial)
-        gt = read_parquet(rd / "register" / trial / "groundtruth.parquet")
+        sensor = rd / "ingest" / trial / "sensor.parquet"
+        gt_path = rd / "register" / trial / "groundtruth.parquet"
         w = _leg_width(subj.loc[row["subject"]].to_dict(), cfg)
-        samples.append(training_samples(scans, gt, w))
+        key = _SAMPLES.key(sensor, file_identity(gt_path), w)
+        got = _SAMPLES.get(key)
+        if got is None:
+            got = training_samples(read_scanlog(sensor, trial=trial), read_parquet(gt_path), w)
+            _SAMPLES.put(key, got, sum(getattr(v, "nbytes", 8) for v in got.values()))
+        samples.append({k: v.copy() if isinstance(v, np.ndarray) else v
+                        for k, v in got.items()})
         used.append(trial)
     if samples:
         try:
