@@ -23,6 +23,7 @@ from gaitval import consts as C
 from gaitval.config import deep_merge
 from gaitval.errors import ConfigError, GaitvalError
 from gaitval.io.atomic import write_csv, write_parquet, write_text
+from gaitval.io.filememo import FileMemo
 from gaitval.io.parquet import read_parquet
 from gaitval.io.trialsheet import load_subjects, load_trial_row
 
@@ -229,6 +230,11 @@ def track_step(sensor_parquet, sheet, subjects, trial: str, method: str, config_
     return track
 
 
+#: A trial's TUG phase bounds and true stance intervals, by its ground truth's identity and
+#: the evaluation settings: the same for all six tracks of a trial.
+_TRUTH_PHASES = FileMemo(16 * 2 ** 20)
+
+
 def evaluate_tug_step(track_parquet, gt_parquet, registration_json, trial: str, method: str,
                       config_json, out_dir) -> pd.DataFrame:
     """Evaluate one tracked TUG trial against its registered ground truth.
@@ -237,7 +243,7 @@ def evaluate_tug_step(track_parquet, gt_parquet, registration_json, trial: str, 
     ``summary.parquet`` (see :func:`gaitval.evaluate.tug.evaluate_tug_trial`).  A trial whose
     registration was refused gets an empty evaluation and ``category = not_registered``.
     """
-    from gaitval.evaluate.tug import FRAME_COLUMNS, evaluate_tug_trial
+    from gaitval.evaluate.tug import FRAME_COLUMNS, evaluate_tug_trial, truth_phases_of
 
     cfg = load_json(config_json)
     rec = load_json(registration_json)
@@ -251,8 +257,14 @@ def evaluate_tug_step(track_parquet, gt_parquet, registration_json, trial: str, 
     else:
         track = read_parquet(track_parquet).drop(columns=["trial", "method"])
         gt = read_parquet(gt_parquet)
-        res = evaluate_tug_trial(track, gt, trial=trial, method=method,
-                                 cfg=(cfg.get("evaluation") or {}).get("tug"))
+        ecfg = (cfg.get("evaluation") or {}).get("tug")
+        key = _TRUTH_PHASES.key(gt_parquet, json.dumps(ecfg, sort_keys=True, default=str))
+        phases = _TRUTH_PHASES.get(key)
+        if phases is None:
+            phases = truth_phases_of(gt, ecfg)
+            _TRUTH_PHASES.put(key, phases, 4096)
+        res = evaluate_tug_trial(track, gt, trial=trial, method=method, cfg=ecfg,
+                                 truth_phases=(dict(phases[0]), phases[1].copy()))
     for name, df in res.items():
         write_parquet(df.reset_index(drop=True), out / f"{name}.parquet")
     return res["summary"]

@@ -83,7 +83,7 @@ from gaitval.evaluate.tug_truth import (DEFAULTS, TRUTH_COLUMNS, TUG_PHASES, _cf
 
 __all__ = ["DEFAULTS", "FRAME_COLUMNS", "TRUTH_COLUMNS", "TUG_PHASES", "align_truth",
            "evaluate_tug_trial", "false_tracking", "stance_failures",
-           "truth_stance_intervals", "tug_phase_bounds", "tug_phase_of"]
+           "truth_phases_of", "truth_stance_intervals", "tug_phase_bounds", "tug_phase_of"]
 
 FRAME_COLUMNS = (C.TRIAL, C.METHOD, "k", C.T_SENSOR, C.SIDE, C.X, C.Y, C.XS, C.YS,
                  C.VALID, "err_x_m", "err_y_m", "observed", "interpolated", "pattern",
@@ -184,8 +184,16 @@ def stance_failures(frames: pd.DataFrame, stance: pd.DataFrame, cfg: dict | None
                                        "identified", "n_stance_scans"])
 
 
+def truth_phases_of(truth: pd.DataFrame, cfg: dict | None = None) -> tuple:
+    """What the evaluation takes from the ground truth alone: the TUG phase bounds
+    (:func:`tug_phase_bounds`) and the true stance intervals
+    (:func:`truth_stance_intervals`)."""
+    return tug_phase_bounds(truth, cfg), truth_stance_intervals(truth, cfg)
+
+
 def evaluate_tug_trial(track: pd.DataFrame, truth: pd.DataFrame, *, trial: str = "",
-                       method: str = "", cfg: dict | None = None) -> dict[str, pd.DataFrame]:
+                       method: str = "", cfg: dict | None = None,
+                       truth_phases: tuple | None = None) -> dict[str, pd.DataFrame]:
     """Evaluate one tracked TUG trial.
 
     Parameters
@@ -198,6 +206,9 @@ def evaluate_tug_trial(track: pd.DataFrame, truth: pd.DataFrame, *, trial: str =
         Identifiers copied into every output.
     cfg : dict, optional
         Overrides of :data:`DEFAULTS`.
+    truth_phases : tuple, optional
+        :func:`truth_phases_of` the same ``truth`` and ``cfg`` when the caller has them
+        (they do not depend on the track: a trial's methods share them).
 
     Returns
     -------
@@ -209,7 +220,8 @@ def evaluate_tug_trial(track: pd.DataFrame, truth: pd.DataFrame, *, trial: str =
         n_ft_events (swap + lost), n_drift_events, stance_failure, sf_phase, n_stance_true,
         n_stance_failures, success, category, t_turn_start_s, t_turn_end_s``).
     """
-    bounds = tug_phase_bounds(truth, cfg)
+    bounds, truth_stance = truth_phases if truth_phases is not None else \
+        truth_phases_of(truth, cfg)
     fr = align_truth(track, truth)
     fr["tug_phase"] = tug_phase_of(fr[C.T_SENSOR].to_numpy(float), bounds)
     bad, events = false_tracking(fr, cfg)
@@ -220,7 +232,7 @@ def evaluate_tug_trial(track: pd.DataFrame, truth: pd.DataFrame, *, trial: str =
         if col not in fr:
             fr[col] = False
     fr = fr[list(FRAME_COLUMNS)]
-    stance = stance_failures(fr, truth_stance_intervals(truth, cfg), cfg)
+    stance = stance_failures(fr, truth_stance.copy(), cfg)
     for d in (events, stance):
         d.insert(0, C.METHOD, method)
         d.insert(0, C.TRIAL, trial)
