@@ -56,7 +56,8 @@ def test_dag_runs_end_to_end_and_index_has_provenance(tiny_run):
 
 @pytest.mark.slow
 def test_a_track_job_tracks_then_evaluates_both_in_the_fork_server(tiny_run):
-    """Issue 13: a TUG or MTST job runs two gaitval steps (tracking, then its evaluation);
+    """Issue 13: a TUG, MTST, rollator or ultrasonic tracking job runs two gaitval steps
+    (tracking, then its evaluation or the gait parameters);
     locally both go to the fork server from Snakemake's thread, one after the other, and
     the job's log holds what both printed (the evaluation's summary row)."""
     import re
@@ -64,7 +65,9 @@ def test_a_track_job_tracks_then_evaluates_both_in_the_fork_server(tiny_run):
     log = (tiny_run / "logs" / "forkserver.log").read_text()
     cmds = dict(re.findall(r"^job (\S+): gaitval (\S+) ", log, re.M))
     via = dict(re.findall(r"^job (\S+): exit 0, .*, via (\S+)$", log, re.M))
-    for track, evaluate in (("track", "evaluate-tug"), ("mtst-track", "mtst-evaluate")):
+    for track, evaluate in (("track", "evaluate-tug"), ("mtst-track", "mtst-evaluate"),
+                            ("rollator-track", "rollator-evaluate"),
+                            ("ultrasonic-track", "gait-parameters")):
         ran = [j for j, v in cmds.items() if v == track]
         evals = [j for j, v in cmds.items() if v == evaluate]
         assert ran and len(evals) == len(ran), (track, len(ran), len(evals))
@@ -131,7 +134,7 @@ def test_one_methods_parameter_reruns_only_that_methods_trials(tiny_run):
     assert "evaluate_tug" not in planned          # no such rule since the track job evaluates
     assert planned["config_view"] == 2
     for rule in ("register", "ingest", "mtst_track", "rollator_track", "ultrasonic_noise",
-                 "ultrasonic_track", "gait_parameters", "rollator_train", "mtst_tables",
+                 "ultrasonic_track", "rollator_train", "mtst_tables",
                  "rollator_tables", "ultrasonic_tables", "ingest_summary",
                  "registration_summary"):
         assert rule not in planned, (rule, planned)
@@ -164,7 +167,7 @@ def test_a_rollator_setting_reruns_only_the_rollator_trials(tiny_run, tmp_path):
     assert planned["rollator_tables"] == 1
     assert planned.get("register", 0) <= n_rollator             # its view holds rollator:
     for rule in ("track", "mtst_track", "ultrasonic_noise",
-                 "ultrasonic_track", "gait_parameters", "tug_tables", "mtst_tables",
+                 "ultrasonic_track", "tug_tables", "mtst_tables",
                  "ultrasonic_tables", "ingest"):
         assert rule not in planned, (rule, planned)
 

@@ -295,7 +295,7 @@ def config_view_in(scope):
 # Snakemake log) was the ultrasonic chain: the noise identification (one ~30 CPU-s job)
 # started only when every other trial was done, then its 30 tracks, gait parameters and
 # tables ran alone for ~90 s; the rollator PF likewise waited for its trained models.  So:
-# ultrasonic_noise and rollator_train 100, ultrasonic_track and gait_parameters 50,
+# ultrasonic_noise and rollator_train 100, ultrasonic_track (with the gait parameters) 50,
 # ingest and register (everything's inputs) 20.  Order only: same jobs, same files.  (Tried
 # and left out: config_view 200, so the views -- milliseconds each -- run before the
 # ingests; it made every registration ready at once, and the greedy scheduler's rounds over

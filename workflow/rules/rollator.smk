@@ -1,6 +1,6 @@
-# Robotic rollator (seed 002): the PF's parameters learned leave-one-subject-out, one track
-# job per (trial, method) for the KF and the PF, evaluation against the registered ground
-# truth in the moving laser frame, then Tables I, II and the turning-trial figure.
+# Robotic rollator (seed 002): the PF's parameters learned leave-one-subject-out, one job
+# per (trial, method) for the KF and the PF that tracks and evaluates against the registered
+# ground truth in the moving laser frame, then Tables I, II and the turning-trial figure.
 # Paths stay under results/<study>/rollator/ with no "track/" or "evaluate/" folder, so the
 # TUG rules' unconstrained patterns never match them.
 
@@ -33,39 +33,17 @@ rule rollator_train:
 
 
 rule rollator_track:
+    # the track and then its evaluation: two gaitval steps in one job (see rule track)
     input:
         sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
-        config=config_view_file,
-        sheet=lambda w: sheet_path(w.study),
-        model=rollator_model,
-    output:
-        f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}.track.parquet",
-    wildcard_constraints:
-        **ROLLATOR_WC,
-    params:
-        gv=GV,
-        subjects=lambda w: subjects_path(w.study),
-        model=lambda w, input: ["--model", str(input.model)] if input.model else [],
-    conda:
-        "../envs/gaitval.yaml"
-    log:
-        "logs/rollator_track/{study}/{method}/{trial}.log",
-    shell:
-        "{params.gv} rollator-track --sensor {input.sensor:q} --sheet {input.sheet:q}"
-        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} {params.model:q} --out {output:q}"
-        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
-
-
-rule rollator_evaluate:
-    input:
-        track=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}.track.parquet",
         gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
         reg=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
         mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
         config=config_view_file,
         sheet=lambda w: sheet_path(w.study),
+        model=rollator_model,
     output:
+        track=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}.track.parquet",
         summary=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}/summary.parquet",
         frames=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}/frames.parquet",
     wildcard_constraints:
@@ -73,17 +51,22 @@ rule rollator_evaluate:
     params:
         gv=GV,
         subjects=lambda w: subjects_path(w.study),
+        model=lambda w, input: ["--model", str(input.model)] if input.model else [],
         ingest=lambda w, input: str(Path(input.mocap).parent),
         out=parent_of("summary"),
     conda:
         "../envs/gaitval.yaml"
     log:
-        "logs/rollator_evaluate/{study}/{method}/{trial}.log",
+        "logs/rollator_track/{study}/{method}/{trial}.log",
     shell:
-        "{params.gv} rollator-evaluate --track {input.track:q} --groundtruth {input.gt:q}"
+        "{params.gv} rollator-track --sensor {input.sensor:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
+        " --config {input.config:q} {params.model:q} --out {output.track:q} > {log:q} 2>&1"
+        " && {params.gv} rollator-evaluate --track {output.track:q} --groundtruth {input.gt:q}"
         " --registration {input.reg:q} --ingest {params.ingest:q} --sheet {input.sheet:q}"
         " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} --out {params.out:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+        " --config {input.config:q} --out {params.out:q} >> {log:q} 2>&1"
+        " || (cat {log:q} >&2; exit 1)"
 
 
 rule rollator_tables:

@@ -42,47 +42,33 @@ rule ultrasonic_noise:
 
 
 rule ultrasonic_track:
+    # the UKF track and then its gait parameters: two gaitval steps in one job (rule track)
     input:
         sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
+        mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
         config=config_view_file,
         noise=f"{RESULTS}/ultrasonic_noise.json",
+        sheet=lambda w: sheet_path(w.study),
     output:
-        f"{RESULTS}/{{study}}/ultrasonic/track/{{trial}}.parquet",
+        track=f"{RESULTS}/{{study}}/ultrasonic/track/{{trial}}.parquet",
+        gait=f"{RESULTS}/{{study}}/ultrasonic/gait/{{trial}}.parquet",
     priority: 50  # critical path first (PRIORITIES in common.smk)
     params:
         gv=GV,
         ingest=lambda w, input: str(Path(input.sensor).parent),
+        subjects=lambda w: subjects_path(w.study),
     conda:
         "../envs/gaitval.yaml"
     log:
         "logs/ultrasonic_track/{study}/{trial}.log",
     shell:
         "{params.gv} ultrasonic-track --ingest {params.ingest:q} --trial {wildcards.trial:q}"
-        " --config {input.config:q} --noise {input.noise:q} --out {output:q}"
-        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
-
-
-rule gait_parameters:
-    input:
-        track=f"{RESULTS}/{{study}}/ultrasonic/track/{{trial}}.parquet",
-        mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
-        config=config_view_file,
-        sheet=lambda w: sheet_path(w.study),
-    output:
-        f"{RESULTS}/{{study}}/ultrasonic/gait/{{trial}}.parquet",
-    priority: 50  # critical path first (PRIORITIES in common.smk)
-    params:
-        gv=GV,
-        subjects=lambda w: subjects_path(w.study),
-        ingest=lambda w, input: str(Path(input.mocap).parent),
-    conda:
-        "../envs/gaitval.yaml"
-    log:
-        "logs/gait_parameters/{study}/{trial}.log",
-    shell:
-        "{params.gv} gait-parameters --track {input.track:q} --ingest {params.ingest:q}"
+        " --config {input.config:q} --noise {input.noise:q} --out {output.track:q}"
+        " > {log:q} 2>&1"
+        " && {params.gv} gait-parameters --track {output.track:q} --ingest {params.ingest:q}"
         " --sheet {input.sheet:q} --subjects {params.subjects:q} --trial {wildcards.trial:q}"
-        " --config {input.config:q} --out {output:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+        " --config {input.config:q} --out {output.gait:q} >> {log:q} 2>&1"
+        " || (cat {log:q} >&2; exit 1)"
 
 
 rule ultrasonic_tables:
