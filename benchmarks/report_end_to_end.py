@@ -133,9 +133,21 @@ def _shell_commands(log: str) -> dict[str, str]:
     return out
 
 
+def _job_argvs(cmd: str) -> list[list[str]] | None:
+    """The argv of each gaitval step of a rule's shell command, in order: one, or several
+    chained with ``&&`` (a track job's tracking and evaluation)."""
+    out = []
+    for part in cmd.split(" && "):
+        argv = _job_argv(part)
+        if argv is None:
+            break
+        out.append(argv)
+    return out or None
+
+
 def _job_argv(cmd: str) -> list[str] | None:
     """The argv after `-m gaitval` of a rule's shell command (up to the redirection)."""
-    words = shlex.split(cmd.split(" > ")[0])
+    words = shlex.split(re.split(r" >>? ", cmd)[0])
     if any(w.endswith("forkclient.py") for w in words) and "--" in words:
         return words[words.index("--") + 1:]
     try:
@@ -247,22 +259,25 @@ def main() -> None:
             ways = {"snakemake": 0, "client": 0, "plain": 0}
             print(f"{'rule':28s} {'jobs':>5s} {'job cpu':>8s} {'start-up':>9s} {'modules':>8s}")
             for rule, n in sorted(counts.items()):
-                argv = _job_argv(cmds[rule]) if rule in cmds else None
-                if argv is None:
+                argvs = _job_argvs(cmds[rule]) if rule in cmds else None
+                if argvs is None:
                     print(f"{rule:28s} {n:5d}  (no gaitval shell command: runs in Snakemake)")
                     continue
-                job, start, nmod = _startup_of(argv, work)
-                seen = via.get(argv[0], {})
-                direct = min(n, seen.get("snakemake", 0))
-                through = min(n - direct, seen.get("client", 0))
-                ways["snakemake"] += direct
-                ways["client"] += through
-                ways["plain"] += n - direct - through
-                total_start += through * (client if forked else start) \
-                    + (n - direct - through) * start
-                print(f"{rule:28s} {n:5d} {job:8.2f} {start:9.2f} {nmod:8d}", flush=True)
-            print(f"jobs sent to the fork server from Snakemake's thread: {ways['snakemake']}, "
-                  f"through the client: {ways['client']}, plain processes: {ways['plain']}")
+                for i, argv in enumerate(argvs):   # a chained job: a row per gaitval step
+                    job, start, nmod = _startup_of(argv, work)
+                    seen = via.get(argv[0], {})
+                    direct = min(n, seen.get("snakemake", 0))
+                    through = min(n - direct, seen.get("client", 0))
+                    ways["snakemake"] += direct
+                    ways["client"] += through
+                    ways["plain"] += n - direct - through
+                    total_start += through * (client if forked else start) \
+                        + (n - direct - through) * start
+                    label = rule if i == 0 else f"  then {argv[0]}"
+                    print(f"{label:28s} {n:5d} {job:8.2f} {start:9.2f} {nmod:8d}", flush=True)
+            print(f"gaitval steps sent to the fork server from Snakemake's thread: "
+                  f"{ways['snakemake']}, through the client: {ways['client']}, plain "
+                  f"processes: {ways['plain']}")
             share = 100 * total_start / statistics.median(cpus)
             shutil.rmtree(work, ignore_errors=True)
     print(f"report {args.study}: wall {statistics.median(walls):.1f} s, "
