@@ -3,9 +3,10 @@
 A worker of :mod:`gaitval.forkserver` runs job after job, and the jobs of one trial read
 the same inputs again: the six TUG tracks of a trial read its scan log, the evaluations of
 its methods its ground truth.  :class:`FileMemo` keeps what was read under the file's
-**identity** — resolved path, device, inode, size and modification time in nanoseconds —
-so a file rewritten in any way is read again: gaitval replaces its outputs by renaming a
-new file over them (a new inode), and an edit in place changes the modification time.
+**identity** — resolved path, device, inode, size, and modification and status-change
+times in nanoseconds — so a file rewritten in any way is read again: gaitval replaces its
+outputs by renaming a new file over them (a new inode), and an edit in place changes the
+times.
 
 Entries are evicted oldest first past a byte budget.  A value handed out must not be
 changed by the caller: keep immutable values (an Arrow table), or give the caller a copy
@@ -33,14 +34,14 @@ def set_cap(mb: float | None) -> None:
 
 
 def file_identity(path: str | os.PathLike) -> tuple | None:
-    """``(resolved path, st_dev, st_ino, st_size, st_mtime_ns)``, or None when the file
-    cannot be stat'ed (the caller then reads it and reports the problem)."""
+    """``(resolved path, st_dev, st_ino, st_size, st_mtime_ns, st_ctime_ns)``, or None
+    when the file cannot be stat'ed (the caller then reads it and reports the problem)."""
     try:
         p = Path(path).resolve()
         st = os.stat(p)
     except (OSError, RuntimeError, ValueError):
         return None
-    return (str(p), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+    return (str(p), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
 
 
 class FileMemo:
