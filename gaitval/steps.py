@@ -258,11 +258,9 @@ def evaluate_tug_step(track_parquet, gt_parquet, registration_json, trial: str, 
         track = read_parquet(track_parquet).drop(columns=["trial", "method"])
         gt = read_parquet(gt_parquet)
         ecfg = (cfg.get("evaluation") or {}).get("tug")
-        key = _TRUTH_PHASES.key(gt_parquet, json.dumps(ecfg, sort_keys=True, default=str))
-        phases = _TRUTH_PHASES.get(key)
-        if phases is None:
-            phases = truth_phases_of(gt, ecfg)
-            _TRUTH_PHASES.put(key, phases, 4096)
+        phases = _TRUTH_PHASES.fetch(
+            _TRUTH_PHASES.key(gt_parquet, json.dumps(ecfg, sort_keys=True, default=str)),
+            lambda: truth_phases_of(gt, ecfg), lambda _: 4096)
         res = evaluate_tug_trial(track, gt, trial=trial, method=method, cfg=ecfg,
                                  truth_phases=(dict(phases[0]), phases[1].copy()))
     for name, df in res.items():

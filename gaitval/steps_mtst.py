@@ -162,13 +162,13 @@ def load_targets(s: dict, sheet, trial: str, *, required: bool) -> pd.DataFrame 
             return None
         raise FileFormatError("target layout file not found", path=path, **where,
                               hint="mtst.targets names a CSV relative to the trial sheet")
-    key = _TARGETS.key(path, trial, required)
-    hit = _TARGETS.get(key)
-    if hit is not None:
-        return None if hit is _NONE else hit.copy(deep=True)
-    out = _read_targets(path, trial, required=required)
-    _TARGETS.put(key, _NONE if out is None else out.copy(deep=True), 4096)
-    return out
+
+    def read():
+        out = _read_targets(path, trial, required=required)
+        return _NONE if out is None else out
+
+    got = _TARGETS.fetch(_TARGETS.key(path, trial, required), read, lambda _: 4096)
+    return None if got is _NONE else got.copy(deep=True)
 
 
 #: Target layouts read in this process, by file identity, trial and ``required`` (the four

@@ -88,11 +88,11 @@ def rollator_train_step(results_dir, sheet, subjects, subject: str, config_json,
         sensor = rd / "ingest" / trial / "sensor.parquet"
         gt_path = rd / "register" / trial / "groundtruth.parquet"
         w = _leg_width(subj.loc[row["subject"]].to_dict(), cfg)
-        key = _SAMPLES.key(sensor, file_identity(gt_path), w)
-        got = _SAMPLES.get(key)
-        if got is None:
-            got = training_samples(read_scanlog(sensor, trial=trial), read_parquet(gt_path), w)
-            _SAMPLES.put(key, got, sum(getattr(v, "nbytes", 8) for v in got.values()))
+        got = _SAMPLES.fetch(
+            _SAMPLES.key(sensor, file_identity(gt_path), w),
+            lambda: training_samples(read_scanlog(sensor, trial=trial), read_parquet(gt_path),
+                                     w),
+            lambda got: sum(getattr(v, "nbytes", 8) for v in got.values()))
         samples.append({k: v.copy() if isinstance(v, np.ndarray) else v
                         for k, v in got.items()})
         used.append(trial)

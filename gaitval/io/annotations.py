@@ -74,12 +74,9 @@ def read_annotations(path: str | Path, *, trial: str | None = None
     meta : dict
         The ``# key: value`` header.
     """
-    key = _READ.key(path)
-    hit = _READ.get(key)
-    if hit is None:
-        hit = _read_annotations(Path(path), trial)
-        _READ.put(key, hit, int(hit[0].memory_usage(deep=True).sum()))
-    return hit[0].copy(deep=True), copy.deepcopy(hit[1])
+    events, meta = _READ.fetch(_READ.key(path), lambda: _read_annotations(Path(path), trial),
+                               lambda got: int(got[0].memory_usage(deep=True).sum()))
+    return events.copy(deep=True), copy.deepcopy(meta)
 
 
 def _read_annotations(path: Path, trial: str | None) -> tuple[pd.DataFrame, dict]:

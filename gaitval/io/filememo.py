@@ -23,7 +23,7 @@ from __future__ import annotations
 import os
 from collections import OrderedDict
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 _CAP: list[int] = []          # the most bytes any one memo of this process may keep
 
@@ -88,12 +88,16 @@ class FileMemo:
             _, (_, n) = self._entries.popitem(last=False)
             self._bytes -= n
 
-    def clear(self) -> None:
-        self._entries.clear()
-        self._bytes = 0
-
-    def __len__(self) -> int:
-        return len(self._entries)
+    def fetch(self, key: tuple | None, read: Callable[[], Any],
+              size: Callable[[Any], int]) -> Any:
+        """The value remembered under ``key``, else ``read()``, remembered as ``size(value)``
+        bytes.  The value is the memo's own: copy it before handing it to code that may
+        change it."""
+        hit = self.get(key)
+        if hit is None:
+            hit = read()
+            self.put(key, hit, size(hit))
+        return hit
 
 
 def worker_budget_mb(workers: int) -> float:

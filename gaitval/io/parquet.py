@@ -31,15 +31,14 @@ def read_table(path: str | os.PathLike, columns: list[str] | None = None, *,
     """
     import pyarrow.parquet as pq
 
+    def read():
+        with pq.ParquetFile(path) as pf:
+            return pf.read(columns=columns, use_threads=False,
+                           use_pandas_metadata=pandas_metadata)
+
     key = (TABLES.key(path, None if columns is None else tuple(columns), pandas_metadata)
            if remember else None)
-    tab = TABLES.get(key)
-    if tab is None:
-        with pq.ParquetFile(path) as pf:
-            tab = pf.read(columns=columns, use_threads=False,
-                          use_pandas_metadata=pandas_metadata)
-        TABLES.put(key, tab, tab.nbytes)
-    return tab
+    return TABLES.fetch(key, read, lambda tab: tab.nbytes)
 
 
 def read_parquet(path: str | os.PathLike, columns: list[str] | None = None) -> pd.DataFrame:

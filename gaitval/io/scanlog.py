@@ -138,13 +138,16 @@ def read_scanlog(path: str | Path, *, trial: str | None = None) -> ScanSeries:
         ``range_max_m``, ``angle_increment_rad`` 0), a newer version, non-finite
         timestamps, or a ``ranges`` column whose length does not match ``n_beams``.
     """
+    path = Path(path)
+    series = _READ.fetch(_READ.key(path, str(path)),           # str(path): the series' source
+                         lambda: _read_scanlog(path, trial),
+                         lambda got: got.ranges.nbytes + got.t.nbytes)
+    return copy.deepcopy(series)
+
+
+def _read_scanlog(path: Path, trial: str | None) -> ScanSeries:
     from gaitval.io.parquet import read_table
 
-    path = Path(path)
-    key = _READ.key(path, str(path))
-    hit = _READ.get(key)
-    if hit is not None:
-        return copy.deepcopy(hit)
     if not path.is_file():
         raise FileFormatError("scan log not found", path=path, trial=trial)
     try:
@@ -166,15 +169,13 @@ def read_scanlog(path: str | Path, *, trial: str | None = None) -> ScanSeries:
     if g["unit"] == "mm":
         raw = raw / 1000.0
     ranges, n_bad = clean_ranges(raw, g["rmin"], g["rmax"])
-    series = ScanSeries(
+    return ScanSeries(
         t=t, ranges=ranges, angle_min=g["amin"], angle_increment=g["ainc"],
         range_min=g["rmin"], range_max=g["rmax"],
         sensor_model=str(meta.get("sensor_model", "unknown")),
         mounting_height_m=g["height"], source=str(path),
         timestamp_issues=check_timestamps(t), n_no_return_raw=n_bad,
         meta={k: v for k, v in meta.items() if k not in {"n_beams"}})
-    _READ.put(key, copy.deepcopy(series), ranges.nbytes + t.nbytes)
-    return series
 
 
 def _meta_fields(meta: dict, path: Path, trial: str | None) -> dict:
