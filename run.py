@@ -48,11 +48,12 @@ def ensure_env(extras: str) -> None:
                    check=True)
     subprocess.run([str(PY), "-m", "pip", "install", "--quiet", "-e",
                     f"{ROOT}[{extras}]" if extras else str(ROOT)], check=True)
-    # the particle filter's numba kernels, compiled into their cache now (~10 s CPU) rather
-    # than by each worker of the first report (gaitval/track/pf.py, warm_up)
-    print("[run.py] compiling the particle filter's kernels (first run only) ...", flush=True)
-    subprocess.run([str(PY), "-c", "from gaitval.track.pf import warm_up; warm_up()"],
-                   check=False)
+    # the particle filter's and the UKF's numba kernels, compiled into their cache now
+    # (~15 s CPU) rather than by each worker of the first report (warm_up in
+    # gaitval/track/pf.py and gaitval/track/ukf.py)
+    print("[run.py] compiling the trackers' kernels (first run only) ...", flush=True)
+    subprocess.run([str(PY), "-c", "from gaitval.track import pf, ukf; pf.warm_up(); "
+                    "ukf.warm_up()"], check=False)
     stamp.write_text(key)
 
 

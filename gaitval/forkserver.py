@@ -99,11 +99,11 @@ def preload() -> list[str]:
         parser()
     except Exception:
         failed.append("gaitval.cli.parser")
-    try:                                       # the PF's compiled kernels, loaded (or
-        from gaitval.track.pf import warm_up   # compiled) once for all workers
-        warm_up()
-    except Exception:
-        failed.append("gaitval.track.pf.warm_up")
+    for name in ("gaitval.track.pf", "gaitval.track.ukf"):
+        try:                                   # the PF's and the UKF's compiled kernels,
+            importlib.import_module(name).warm_up()   # loaded (or compiled) once for all
+        except Exception:                      # workers
+            failed.append(f"{name}.warm_up")
     try:                                       # parsed once here instead of in every job
         from gaitval.io.trialsheet import load_schema
         for name in ("trials", "subjects"):
