@@ -12,6 +12,7 @@ as a warm worker runs it: ``gaitval.cli.main(args)``.  That isolates a stage's C
 Snakemake and the machine's other jobs, so two versions of the code can be compared in
 alternation (``PYTHONPATH=<other checkout>``).  ``--profile N``: cProfile, N lines by
 cumulative time.  ``--compare``: check each rewritten file against the run folder's.
+``--keep DIR``: replay in ``DIR`` (new) and keep it, to compare the values.
 
 The last line is exactly ``replay <verbs>: <n> jobs, <cpu> cpu-s``.
 """
@@ -49,6 +50,8 @@ def main() -> None:
     ap.add_argument("verbs", nargs="+")
     ap.add_argument("--profile", type=int, default=0)
     ap.add_argument("--compare", action="store_true")
+    ap.add_argument("--keep", type=Path, default=None,
+                    help="replay in this new folder and keep it (to compare values)")
     args = ap.parse_args()
     log = args.run / "logs" / "forkserver.log"
     if not log.is_file():
@@ -67,7 +70,7 @@ def main() -> None:
 
     fs.preload()
     with tempfile.TemporaryDirectory() as tmp:
-        work = Path(tmp) / "run"
+        work = args.keep.resolve() if args.keep else Path(tmp) / "run"
         _link_copy(args.run.resolve(), work)
         os.chdir(work)
         prof = cProfile.Profile() if args.profile else None

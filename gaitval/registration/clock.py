@@ -282,13 +282,21 @@ def _masked_ncc(Ag, Bg, wa, wb):
     # places so the sum over channels adds the same numbers in the same order.
     act = np.flatnonzero((Ag != 0).any(axis=0) | (Bg != 0).any(axis=0))
     num = _xcorr(Ag, Bg, nfft, act)
-    ea = _xcorr(Ag * Ag, wb, nfft, act)
-    eb = _xcorr(wa, Bg * Bg, nfft, act)
+    # When every channel of one side shares its mask (an LRS scan has all its beams, the
+    # mocap all its frames: every LRS and most ultrasonic trials), the other side's energy
+    # correlates with that one mask: sum_c xcorr(a_c^2, w) = xcorr(sum_c a_c^2, w), one
+    # FFT pair instead of one per active channel (the same sums in another order)
+    same_a = Ag.shape[1] > 1 and bool((wa == wa[:, :1]).all())
+    same_b = Bg.shape[1] > 1 and bool((wb == wb[:, :1]).all())
+    ea = _xcorr((Ag * Ag).sum(axis=1, keepdims=True), wb[:, :1], nfft) if same_b \
+        else _xcorr(Ag * Ag, wb, nfft, act)
+    eb = _xcorr(wa[:, :1], (Bg * Bg).sum(axis=1, keepdims=True), nfft) if same_a \
+        else _xcorr(wa, Bg * Bg, nfft, act)
     # the overlap (a count, compared with a 0.1 % margin): one FFT when every channel
     # shares the masks of one side
-    if Ag.shape[1] > 1 and (wa == wa[:, :1]).all():
+    if same_a:
         ov = _xcorr(wa[:, :1], wb.sum(axis=1, keepdims=True), nfft)
-    elif Bg.shape[1] > 1 and (wb == wb[:, :1]).all():
+    elif same_b:
         ov = _xcorr(wa.sum(axis=1, keepdims=True), wb[:, :1], nfft)
     else:
         ov = _xcorr(wa, wb, nfft)
