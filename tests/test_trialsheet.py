@@ -120,3 +120,27 @@ def test_one_trial_row_names_a_missing_trial(tmp_path):
     assert load_trial_row(sheet, None, "tug_S01_1")["subject"] == "S01"
     with pytest.raises(TrialSheetError, match="'tug_S01_9' is not in the trial sheet"):
         load_trial_row(sheet, None, "tug_S01_9")
+
+
+def test_one_trial_row_from_a_remembered_sheet_keeps_per_row_errors(tmp_path):
+    """load_trial_row validates the whole sheet once and then picks rows from it; a
+    problem on another row, or a file deleted after that validation, still gives the
+    same per-row answers as checking the row alone."""
+    from gaitval.io.trialsheet import load_trial_row
+
+    row2 = ROW.replace("tug_S01_1", "tug_S01_2").replace("m/a.c3d", "m/b.c3d")
+    sheet = make_study(tmp_path, rows=ROW + row2)
+    def same(a, b):                                     # NaN where empty: compare reprs
+        return {k: repr(v) for k, v in a.items()} == {k: repr(v) for k, v in b.items()}
+
+    first = load_trial_row(sheet, None, "tug_S01_1")
+    assert load_trial_row(sheet, None, "tug_S01_2")["mocap_path"].endswith("b.c3d")
+    (tmp_path / "m/b.c3d").unlink()                     # same sheet: remembered as clean
+    assert same(load_trial_row(sheet, None, "tug_S01_1"), first)
+    assert load_trial_row(sheet, None, "tug_S01_2", check_files=False)["subject"] == "S01"
+    with pytest.raises(TrialSheetError, match=r"row 3 \(trial 'tug_S01_2'\).*not found"):
+        load_trial_row(sheet, None, "tug_S01_2")
+    sheet.write_text(HEADER + ROW + row2.replace(",0.27,", ",tall,"))   # row 3 now bad
+    assert same(load_trial_row(sheet, None, "tug_S01_1"), first)
+    with pytest.raises(TrialSheetError, match="row 3.*'sensor_height_m'"):
+        load_trial_row(sheet, None, "tug_S01_2", check_files=False)
