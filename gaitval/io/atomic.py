@@ -77,8 +77,13 @@ def write_parquet(df: pd.DataFrame, path: str | Path, metadata: dict[str, str] |
 
 def write_arrow(table, path: str | Path, metadata: dict[str, str] | None = None,
                 dictionary: list[str] | None = None) -> Path:
-    """Write a ``pyarrow.Table`` as zstd-compressed Parquet atomically, optionally with
+    """Write a ``pyarrow.Table`` as LZ4-compressed Parquet atomically, optionally with
     key/value schema metadata.
+
+    LZ4 rather than zstd: the default report's 127 mocap tables (19.6 million rows) are
+    written in 1.8 instead of 2.6 CPU-s and read in 0.7 instead of 1.1, for 376 instead of
+    311 MB (measured 2026-11-27); these are intermediate results, read back by the next
+    steps.
 
     ``dictionary``: the only columns Parquet may dictionary-encode (default: pyarrow's
     choice, every column).  Naming the columns with few distinct values (a marker label)
@@ -93,7 +98,7 @@ def write_arrow(table, path: str | Path, metadata: dict[str, str] | None = None,
         md.update({k.encode(): v.encode() for k, v in metadata.items()})
         table = table.replace_schema_metadata(md)
     with atomic_path(path) as tmp:
-        pq.write_table(table, tmp, compression="zstd",
+        pq.write_table(table, tmp, compression="lz4",
                        use_dictionary=True if dictionary is None else list(dictionary))
     return Path(path)
 
