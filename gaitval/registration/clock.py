@@ -121,7 +121,11 @@ def _uniform(t, x, t0, dt, n):
         gap = np.diff(tj) > 3 * np.median(np.diff(tj))
         bad = _gap_mask(tj, g, gap) if gap.any() else None
         xs = x[mask]
-        for j in range(x.shape[1]):
+        nz = (xs != 0).any(axis=0)
+        # a channel of zeros (an LRS beam bin no leg ever crosses: most of them) is 0 on
+        # [tj[0], tj[-1]] and NaN outside, as np.interp gives it
+        out[(g >= tj[0]) & (g <= tj[-1])] = 0.0
+        for j in np.flatnonzero(nz):
             out[:, j] = np.interp(g, tj, xs[:, j], left=np.nan, right=np.nan)
         if bad is not None:
             out[bad] = np.nan
@@ -133,11 +137,17 @@ def _uniform(t, x, t0, dt, n):
             T = t[:, cols]
             d = np.diff(T, axis=0)
             gaps = d > 3 * np.median(d, axis=0)
-            for i, j in enumerate(cols):
-                v = np.interp(g, T[:, i], x[:, j], left=np.nan, right=np.nan)
-                if gaps[:, i].any():
-                    v[_gap_mask(T[:, i], g, gaps[:, i])] = np.nan
-                out[:, j] = v
+            # a channel of zeros is 0 on [T[0], T[-1]] and NaN outside, as np.interp
+            # gives it: all of them at once
+            zero = ~(x[:, cols] != 0).any(axis=0)
+            if zero.any():
+                inside = (g[:, None] >= T[0, zero]) & (g[:, None] <= T[-1, zero])
+                out[:, cols[zero]] = np.where(inside, 0.0, np.nan)
+            for i in np.flatnonzero(~zero):
+                out[:, cols[i]] = np.interp(g, T[:, i], x[:, cols[i]], left=np.nan,
+                                            right=np.nan)
+            for i in np.flatnonzero(gaps.any(axis=0)):
+                out[_gap_mask(T[:, i], g, gaps[:, i]), cols[i]] = np.nan
             done[cols] = True
     for j in np.flatnonzero(~done):
         okj = ok[:, j]
@@ -263,10 +273,16 @@ def _centred_grid(t: np.ndarray, x: np.ndarray, t0: float, dt: float
         1 where a channel has a sample, else 0.
     """
     n = int(np.floor((np.nanmax(t) - t0) / dt)) + 1
-    g = _uniform(t, x, t0, dt, n)
-    w = np.isfinite(g).astype(float)
-    g = np.where(w > 0, g - np.nanmean(np.where(w > 0, g, np.nan), axis=0), 0.0)
-    return np.nan_to_num(g), w
+    g = _uniform(t, x, t0, dt, n)          # finite where a channel has a sample, else NaN
+    fin = np.isfinite(g)
+    # centred where a channel has samples, 0 elsewhere; a channel of zeros stays 0, so
+    # only the others are centred
+    act = np.flatnonzero(np.where(fin, g, 0.0).any(axis=0))
+    out = np.zeros_like(g)
+    if act.size:
+        ga = g[:, act]
+        out[:, act] = np.where(fin[:, act], ga - np.nanmean(ga, axis=0), 0.0)
+    return out, fin.astype(float)
 
 
 def _masked_ncc(Ag, Bg, wa, wb):
