@@ -296,8 +296,11 @@ def _masked_ncc(Ag, Bg, wa, wb):
     # Only channels with a non-zero value (foreground, or a predicted leg) add to the
     # correlation and the energies; the others' products are exact zeros, kept in their
     # places so the sum over channels adds the same numbers in the same order.
-    act = np.flatnonzero((Ag != 0).any(axis=0) | (Bg != 0).any(axis=0))
-    num = _xcorr(Ag, Bg, nfft, act)
+    nz_a, nz_b = (Ag != 0).any(axis=0), (Bg != 0).any(axis=0)
+    act = np.flatnonzero(nz_a | nz_b)
+    # the products a_c b_c: only channels non-zero on both sides (an LRS trial's sensor
+    # side may show foreground in every bin, its mocap side legs in a third of them)
+    num = _xcorr(Ag, Bg, nfft, np.flatnonzero(nz_a & nz_b))
     # When every channel of one side shares its mask (an LRS scan has all its beams, the
     # mocap all its frames: every LRS and most ultrasonic trials), the other side's energy
     # correlates with that one mask: sum_c xcorr(a_c^2, w) = xcorr(sum_c a_c^2, w), one
