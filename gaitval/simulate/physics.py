@@ -130,11 +130,10 @@ def poisson_ci(k: int, level: float = 0.95) -> tuple[float, float]:
 
 
 def _swing_rows(study_dir: Path, trials: pd.DataFrame, real: dict | None,
-                map_fn=map) -> list[dict]:
+                stats: dict) -> list[dict]:
+    """The swing rows from ``stats``: :func:`swing_stats` of every trial, by name."""
     rows = []
     ref = real["swing_fwd_min_mps"] if real else np.nan
-    names = list(trials["trial"])                 # one task per trial, results in order
-    stats = dict(zip(names, map_fn(swing_stats, [study_dir] * len(names), names)))
     for proto, g in trials.groupby("protocol", sort=True):
         mins = np.concatenate([stats[t][0] for t in g["trial"]])
         n_back = int(np.sum(mins < SWING_BACKWARD_MPS))
@@ -373,17 +372,36 @@ def physics_table(study_dir: str | Path, walkers: list | None = None,
     if realdata is None:
         realdata = Path(__file__).resolve().parents[3] / "shared" / "realdata" / "c3d"
     realdata = Path(realdata)
-    shin_rows, real = _shin_rows(walkers, realdata if realdata.is_dir() else None)
     lrs = lrs_trials(d)
-    rows = _swing_rows(d, lrs, real, map_fn) + shin_rows + _step_rows(d, lrs)
     tug = lrs[lrs["protocol"] == "tug"]
-    if len(tug):
-        rows += _tug_phase_rows(d, tug) + _tug_path_rows(d, tug)
     mtst = lrs[lrs["protocol"] == "mtst"]
+    # every group of rows and every trial's swing statistics is a task of ``map_fn``
+    # (the simulation's process pool), the groups first (the longest); rows in this order
+    names = list(lrs["trial"])
+    tasks = [("shin", walkers, realdata if realdata.is_dir() else None),
+             ("steps", d, lrs), ("tug_phase", d, tug), ("tug_path", d, tug),
+             ("mtst", d, mtst), ("treadmill", d)] + [("swing", d, t) for t in names]
+    out = list(map_fn(_physics_task, tasks))
+    (shin_rows, real), steps, tug_phase, tug_path, mtst_rows, treadmill = out[:6]
+    stats = dict(zip(names, out[6:]))
+    rows = _swing_rows(d, lrs, real, stats) + shin_rows + steps
+    if len(tug):
+        rows += tug_phase + tug_path
     if len(mtst):
-        rows += _mtst_rows(d, mtst)
-    rows += _treadmill_rows(d)
+        rows += mtst_rows
+    rows += treadmill
     return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def _physics_task(task: tuple):
+    """One task of :func:`physics_table`: ``(kind, *arguments)``."""
+    kind, *args = task
+    if kind in ("tug_phase", "tug_path", "mtst") and not len(args[1]):
+        return []
+    fn = {"shin": _shin_rows, "steps": _step_rows, "tug_phase": _tug_phase_rows,
+          "tug_path": _tug_path_rows, "mtst": _mtst_rows, "treadmill": _treadmill_rows,
+          "swing": swing_stats}[kind]
+    return fn(*args)
 
 
 def write_physics(study_dir: str | Path, walkers: list | None = None,
