@@ -296,7 +296,11 @@ def config_view_in(scope):
 # started only when every other trial was done, then its 30 tracks, gait parameters and
 # tables ran alone for ~90 s; the rollator PF likewise waited for its trained models.  So:
 # ultrasonic_noise and rollator_train 100, ultrasonic_track (with the gait parameters) 50,
-# ingest and register (everything's inputs) 20.  Order only: same jobs, same files.  (Tried
+# ingest and register (everything's inputs) 20; rollator_track -10: once the UKF ran
+# compiled (2026-11-27) the run ended with the TUG tracks and then `tug_tables` (~2.2 s)
+# alone on one core; the rollator tracks (32 jobs of ~0.3 s) now run last, beside the
+# other studies' tables, and only `rollator_tables` (~0.9 s) and the report end alone.
+# Order only: same jobs, same files.  (Tried
 # and left out: config_view 200, so the views -- milliseconds each -- run before the
 # ingests; it made every registration ready at once, and the greedy scheduler's rounds over
 # the larger ready set cost Snakemake ~5 CPU-s more (10.3 vs 15.2 s) for no gain in wall.)

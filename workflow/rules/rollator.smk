@@ -46,6 +46,7 @@ rule rollator_track:
         track=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}.track.parquet",
         summary=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}/summary.parquet",
         frames=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}/frames.parquet",
+    priority: -10  # last: fills both cores at the end (PRIORITIES in common.smk)
     wildcard_constraints:
         **ROLLATOR_WC,
     params:
