@@ -310,6 +310,20 @@ def test_manual_offset_overrides(scene):
     assert rec.clock_offset_s == 2.5 and np.isnan(rec.sync_peak)
 
 
+def test_narrow_lag_search_equals_the_wide_one():
+    """A search of +-0.2 s around a known centre correlates only the band of the long
+    signal that can meet the short one (the drift windows'); its offset and peak equal
+    those of a search over every lag that finds the same peak."""
+    t_a = np.arange(0, 120, 1 / 100)
+    t_b = 0.4321 + np.arange(50, 58, 1 / 40)             # 8 s in the middle of 120 s
+    sig_a, sig_b = _smooth_signal(t_a), _smooth_signal(t_b - 0.4321)
+    wide = estimate_clock_offset(t_a, sig_a, t_b, sig_b, max_lag_s=60.0, centre_s=0.4)
+    narrow = estimate_clock_offset(t_a, sig_a, t_b, sig_b, max_lag_s=0.2, centre_s=0.4)
+    assert wide[0] == pytest.approx(0.4321, abs=1e-3)
+    assert narrow[0] == pytest.approx(wide[0], abs=1e-12)
+    assert narrow[1] == pytest.approx(wide[1], abs=1e-12)
+
+
 def test_drift_estimated_on_long_signals():
     t_a = np.arange(0, 240, 1 / 100)
     off, ppm = 0.8, 300.0
