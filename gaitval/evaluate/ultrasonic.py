@@ -143,8 +143,9 @@ def _stride_rows(base: dict, st_r: pd.DataFrame, st_s: pd.DataFrame,
     """S, NS, T, V, NV, C of every matched stride (eq. 17–22)."""
     n = len(pairs)
     rows = []
+    rec_r, rec_s = st_r.to_dict("records"), st_s.to_dict("records")   # not .iloc per row
     for i, j in pairs:
-        r, s = st_r.iloc[i], st_s.iloc[j]
+        r, s = rec_r[i], rec_s[j]
         for p in _PER_STRIDE:
             rv, sv = float(r[p]), float(s[p])
             if p.endswith("_norm"):              # seed003 eq. (18), (21): n = matched strides
