@@ -566,3 +566,14 @@ def test_tiny_study_ultrasonic_acceptance(tiny):
         assert rec.pole_residual_m < 0.005
         gt = ground_truth(mocap, log, rec, tr, None, cfg)
         assert gt.valid.mean() > 0.9
+
+
+def test_beam_bins_are_the_means_of_neighbouring_columns():
+    """_bin (the clock estimate's 0.5 deg bins) gives numpy's reshape-mean bit for bit."""
+    from gaitval.registration.clock import _bin
+
+    rng = np.random.default_rng(3)
+    for k in (1, 2, 3, 5, 7, 9):
+        x = rng.random((50, 1081)) * rng.choice([1e-3, 1.0, 1e3], size=(50, 1081))
+        n = 1081 // k * k
+        assert np.array_equal(_bin(x, k), x[:, :n].reshape(50, -1, k).mean(axis=2))

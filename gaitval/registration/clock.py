@@ -363,10 +363,23 @@ def beam_times(sensor) -> np.ndarray:
 
 
 def _bin(x: np.ndarray, k: int) -> np.ndarray:
+    """Means of ``k`` neighbouring columns (the last ``shape[1] % k`` dropped).
+
+    Summed slice by slice, left to right, then divided by ``k``: for ``k < 8`` the same
+    additions in the same order as ``reshape(..., k).mean(axis=2)`` (numpy's pairwise sum
+    adds fewer than 8 values one by one), so the same bits, without a reduction over an
+    axis of length ``k`` for every element.
+    """
     if k <= 1:
         return x
     n = x.shape[1] // k * k
-    return x[:, :n].reshape(x.shape[0], -1, k).mean(axis=2)
+    if k >= 8:
+        return x[:, :n].reshape(x.shape[0], -1, k).mean(axis=2)
+    s = x[:, 0:n:k] + x[:, 1:n:k]
+    for j in range(2, k):
+        s += x[:, j:n:k]
+    s /= k
+    return s
 
 
 def lrs_occupancy_signals(sensor, background: np.ndarray, legs_s: np.ndarray,
