@@ -255,13 +255,9 @@ def test_warm_up_compiles_what_a_track_then_uses(tmp_path):
     run.py after installing) gives every kernel a track calls the specialisation the track
     needs: a track afterwards compiles nothing new.  In a fresh process, so that no other
     test's track has compiled them first."""
-    import subprocess
-    import sys
-    from pathlib import Path
+    from fresh_process import run_fresh
 
     code = (
-        "import sys\n"
-        f"sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
         "from gaitval.track import pf_kernels as K\n"
         "from gaitval.track.pf import ParticleFilterTracker, warm_up\n"
         "from rollator_synth import walk\n"
@@ -276,6 +272,4 @@ def test_warm_up_compiles_what_a_track_then_uses(tmp_path):
         "after = {n: list(getattr(K, n).signatures) for n in names}\n"
         "print({n: (len(before[n]), len(after[n])) for n in names})\n"
         "assert after == before, (before, after)\n")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         cwd=tmp_path, timeout=300)
-    assert out.returncode == 0, out.stderr[-3000:]
+    run_fresh(code, tmp_path)

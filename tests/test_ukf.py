@@ -206,13 +206,9 @@ def test_warm_up_compiles_what_a_track_then_uses(tmp_path):
     """gaitval.track.ukf.warm_up (the fork server's and run.py's) gives the UKF kernel the
     specialisation a track needs: a track of a 4-anchor log afterwards compiles nothing
     new.  In a fresh process, so that no other test's track has compiled it first."""
-    import subprocess
-    import sys
-    from pathlib import Path
+    from fresh_process import run_fresh
 
     code = (
-        "import sys\n"
-        f"sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
         "from gaitval.track import ukf_kernel as K\n"
         "from gaitval.track.ukf import ToaUkf, warm_up\n"
         "from test_ukf import SIG, W, _log, _path\n"
@@ -224,6 +220,4 @@ def test_warm_up_compiles_what_a_track_then_uses(tmp_path):
         "e = (tr[['x_m', 'y_m', 'z_m']].to_numpy() - _path(300)[1])[25:]\n"
         "assert (e ** 2).mean(axis=0).max() ** 0.5 < 0.006, e\n"
         "assert list(K.ukf_steps.signatures) == before, K.ukf_steps.signatures\n")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         cwd=tmp_path, timeout=300)
-    assert out.returncode == 0, out.stderr[-3000:]
+    run_fresh(code, tmp_path)
