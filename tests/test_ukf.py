@@ -221,3 +221,68 @@ def test_warm_up_compiles_what_a_track_then_uses(tmp_path):
         "assert (e ** 2).mean(axis=0).max() ** 0.5 < 0.006, e\n"
         "assert list(K.ukf_steps.signatures) == before, K.ukf_steps.signatures\n")
     run_fresh(code, tmp_path)
+
+
+# -- the compiled kernel against the numpy formulation it replaced ---------------------------
+def _eventful_ranges(near_plane=True):
+    """Ranges with every branch of the per-sample cycle: noise, irregular sample times,
+    single and double late echoes, a missing echo, a stretch with no echo at all (the
+    filter starves and re-initialises), and (``near_plane``) passes within 1 cm of the
+    receiver plane (the mirror state is reflected; there depth is barely observable and
+    the track chaotic)."""
+    rng = np.random.default_rng(11)
+    n = 900
+    t = np.cumsum(rng.choice([0.019, 0.020, 0.021], n))     # three distinct time steps
+    depth = 0.01 if near_plane else 0.25
+    pos = np.column_stack([0.16 + 0.2 * np.sin(t), 0.1 + 0.05 * np.cos(t),
+                           -depth - 0.2 * (1 + np.cos(2 * t)) / 2])
+    d = toa_ranges(pos, ANCHORS) + rng.standard_normal((n, 4)) * SIG
+    d[rng.choice(n, 20, replace=False), 2] += 0.3            # late echoes on receiver 3
+    both = rng.choice(n, 8, replace=False)
+    d[both, 0] += 0.25                                       # two at once
+    d[both, 1] += 0.15
+    d[rng.choice(n, 15, replace=False), 3] = np.nan          # missing echoes
+    d[500:520] = np.nan                                      # no echo: starve, re-initialise
+    return t, d
+
+
+@pytest.mark.parametrize("gate", [4.0, np.inf])
+def test_kernel_repeats_the_numpy_formulation_bit_for_bit(gate):
+    """The numba kernel calls numpy's BLAS and scipy's LAPACK routines with the numpy
+    formulation's arguments in its order (gaitval.track.ukf_kernel notes), so every
+    output is the same to the last bit; W_0 ≈ -1e6 would show any other order."""
+    import ukf_numpy_reference as ref
+
+    from gaitval.track.ukf import _pointers
+
+    if not _pointers().all():
+        pytest.skip("numpy/scipy without the scipy-openblas symbols: the kernel runs its "
+                    "loops (equal to round-off only, the next test)")
+    t, d = _eventful_ranges()
+    kw = dict(W_sigma=[50.0] * 3, V=SIG ** 2, init_guess=GUESS, gate_sigma=gate)
+    new, old = run_toa_ukf(t, d, ANCHORS, **kw), ref.run_toa_ukf(t, d, ANCHORS, **kw)
+    assert new.reinit.sum() >= 2 and new.reflected.any()
+    assert new.rejected.any() == np.isfinite(gate)
+    for name in ("x", "P_diag", "used", "rejected", "reinit", "reflected"):
+        a, b = getattr(new, name), getattr(old, name)
+        assert np.array_equal(a, b, equal_nan=True), (name, np.argwhere(a != b)[:3])
+
+
+def test_kernel_loops_agree_with_the_numpy_formulation(monkeypatch):
+    """Without the BLAS symbols the kernel runs the same routines as loops: the same
+    decisions (gate, re-initialisation) and states equal to round-off, away from the
+    receiver plane (near it a round-off decides on which side the state lands)."""
+    import ukf_numpy_reference as ref
+
+    from gaitval.track import ukf
+
+    monkeypatch.setattr(ukf, "_pointers", lambda: np.zeros(5, dtype=np.int64))
+    t, d = _eventful_ranges(near_plane=False)
+    kw = dict(W_sigma=[50.0] * 3, V=SIG ** 2, init_guess=GUESS)
+    new, old = run_toa_ukf(t, d, ANCHORS, **kw), ref.run_toa_ukf(t, d, ANCHORS, **kw)
+    assert new.rejected.any() and new.reinit.sum() >= 2
+    for name in ("used", "rejected", "reinit", "reflected"):
+        assert np.array_equal(getattr(new, name), getattr(old, name)), name
+    assert np.array_equal(np.isnan(new.x), np.isnan(old.x))
+    assert np.nanmax(np.abs(new.x[:, :3] - old.x[:, :3])) < 1e-7      # metres
+    assert np.nanmax(np.abs(new.P_diag - old.P_diag) / old.P_diag) < 1e-6

@@ -34,10 +34,12 @@ Two things the paper leaves open are made explicit here:
   the round-off of the large negative weight ``W_0`` that ``alpha = 1e-3`` produces.
 
 The per-sample cycle (predict, sigma points, gate, update, reflect) runs compiled
-(:mod:`gaitval.track.ukf_kernel`, numba): ≈ 23× less CPU than the numpy version it
-replaces, the same numbers to round-off.  ``W_0 ≈ -10^6`` amplifies round-off, so a
-track's last digits depend on the order of the sums; the numpy version's order was
-OpenBLAS's, which differs between CPU kernels (docs/speed.md, sixth session).
+(:mod:`gaitval.track.ukf_kernel`, numba): ≈ 13× less CPU than the numpy formulation it
+replaces, with the same numbers bit for bit.  ``W_0 ≈ -10^6`` amplifies round-off, so a
+track's last digits depend on the order of every sum: the kernel calls the BLAS and LAPACK
+routines the numpy formulation's ``@`` and ``dpotrf``/``dposv`` called, with the same
+arguments (OpenBLAS chooses its kernels for the CPU, so the digits are the machine's;
+docs/speed.md, seventh session).
 
 References
 ----------
@@ -47,6 +49,7 @@ Parameters Using a Low-Cost Ultrasonic Motion Analysis System. *Sensors* 2014, 1
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -191,8 +194,8 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     Notes
     -----
     Per sample: (re-)initialise by trilateration when needed, predict (eq. 8, closed form),
-    update from the anchors that pass the gate (eq. 9–11, :func:`_update`), reflect a
-    mirror state back.
+    update from the anchors that pass the gate (eq. 9–11), reflect a mirror state back;
+    all but the trilateration in :func:`gaitval.track.ukf_kernel.ukf_steps`.
     """
     from gaitval.track.ukf_kernel import ukf_steps   # numba: only a UKF job pays it
 
@@ -227,12 +230,12 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
             force = True                            # still lost: predict and update anyway
         if k < n_s:
             # per sample: predict (eq. 8), update (eq. 9-11), reflect (module notes)
-            k = ukf_steps(k, force, t, d, n_finite, anchors, mdl.Wm, mdl.Wc, mdl.scale,
-                          mdl.Vm, mdl.Q4, mdl.Q3, mdl.Q2, mdl.gate2, mdl.use_gate,
-                          mdl.max_reject, min_anchors, reinit_after,
+            k = ukf_steps(k, force, _pointers(), t, d, n_finite, anchors, mdl.S, mdl.Wm,
+                          mdl.Wc, mdl.scale, mdl.Vm, mdl.Q4, mdl.Q3, mdl.Q2, mdl.gate2,
+                          mdl.use_gate, mdl.max_reject, min_anchors, reinit_after,
                           centre if normal is None else normal, centre,
-                          normal is not None, x, P, starved, res.x, res.P_diag, res.used,
-                          res.rejected, res.reflected)
+                          normal is not None, x, P.reshape(-1), starved, res.x, res.P_diag,
+                          res.used, res.rejected, res.reflected)
     return res
 
 
@@ -244,7 +247,10 @@ class _Model:
         self.Wm, self.Wc, lam = ukf_weights(N_STATE, alpha, beta, kappa)
         self.scale = N_STATE + lam                       # B = chol((n + lambda) P), eq. (7)
         V = np.asarray(V, dtype=float)
-        self.Vm = np.ascontiguousarray(np.diag(V) if V.ndim == 1 else V)
+        self.Vm = np.ascontiguousarray(np.diag(V) if V.ndim == 1 else V, float).ravel()
+        # chi_i - X = S B^T, seed003 eq. (7)
+        I6 = np.eye(N_STATE)
+        self.S = np.vstack([np.zeros((1, N_STATE)), I6, -I6]).ravel()
         # seed003 eq. (5): A = I + dt E,  G W G^T = dt^4/4 Q4 + dt^3/2 Q3 + dt^2 Q2,
         # W = diag(q)
         q = np.asarray(W_sigma, dtype=float) ** 2
@@ -252,9 +258,19 @@ class _Model:
         self.Q4[:3, :3] = np.diag(q)
         self.Q3[:3, 3:] = self.Q3[3:, :3] = np.diag(q)
         self.Q2[3:, 3:] = np.diag(q)
+        self.Q4, self.Q3, self.Q2 = self.Q4.ravel(), self.Q3.ravel(), self.Q2.ravel()
         self.gate2 = float(gate_sigma) ** 2
         self.use_gate = bool(np.isfinite(gate_sigma))
         self.max_reject = int(max_reject)
+
+
+@functools.cache
+def _pointers() -> np.ndarray:
+    """The kernel's BLAS and LAPACK entry points (:func:`gaitval.track.ukf_kernel.
+    blas_pointers`), looked up once per process."""
+    from gaitval.track.ukf_kernel import blas_pointers
+
+    return blas_pointers()
 
 
 def _mirror_plane(anchors: np.ndarray, guess: np.ndarray, guard: bool):
