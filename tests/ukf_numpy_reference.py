@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from gaitval.track.ukf import N_STATE, ToaUkfResult, trilaterate, ukf_weights
+from gaitval.track.ukf import (N_STATE, ToaUkfResult, _mirror_plane, trilaterate,
+                               ukf_weights)
 
 _NO_ANCHOR = np.zeros(0, dtype=np.intp)
 
@@ -21,42 +22,8 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
                 init_sigma_pos: float = 0.05, init_sigma_vel: float = 1.0,
                 gate_sigma: float = 4.0, max_reject: int = 2, min_anchors: int = 3,
                 reinit_after: int = 10, mirror_guard: bool = True) -> ToaUkfResult:
-    """Track one transmitter from its ranges to fixed receivers with a UKF.
-
-    Parameters
-    ----------
-    t, d, anchors : ndarray, shapes (n,), (n, m), (m, 3)
-        Sample times (s, increasing; ``Delta t_k = t_{k+1} - t_k``, eq. 5), measured
-        ranges (m) to the ``m`` anchors (NaN where no echo arrived), anchor positions (m).
-    W_sigma : array_like, shape (3,)
-        Process-noise sds per axis (acceleration, m/s^2): ``W = diag(sigma^2)`` (eq. 4–5).
-    V : array_like, shape (m,) or (m, m)
-        Measurement-noise covariance (m^2): per-anchor variances ``e_j^2`` or a full matrix.
-    alpha, beta, kappa : float
-        Unscented-transform parameters (eq. 12–13).
-    init_guess : array_like, shape (3,), optional
-        Start of the trilateration that initialises the filter; it selects the side of a
-        planar receiver array.  Default: the anchor centroid.
-    init_sigma_pos, init_sigma_vel : float
-        Standard deviations of the initial covariance (position m, velocity m/s).
-    gate_sigma, max_reject : float, int
-        Innovation gate in predicted sds (``inf``: no gating) and the most anchors it may
-        drop in one step (when more fail it, none is dropped).
-    min_anchors, reinit_after : int
-        Fewer usable anchors than ``min_anchors`` for ``reinit_after`` steps re-initialises.
-    mirror_guard : bool
-        Keep the state on the ``init_guess`` side of a planar array (module notes).
-
-    Returns
-    -------
-    ToaUkfResult
-
-    Notes
-    -----
-    Per sample: (re-)initialise by trilateration when needed, predict (eq. 8, closed form),
-    update from the anchors that pass the gate (eq. 9–11, :func:`_update`), reflect a
-    mirror state back.
-    """
+    """The numpy formulation of :func:`gaitval.track.ukf.run_toa_ukf` (same parameters,
+    same result type), as of gaitval 055770d."""
     t = np.asarray(t, dtype=float)
     d = np.asarray(d, dtype=float)
     anchors = np.asarray(anchors, dtype=float)
@@ -146,15 +113,6 @@ class _Model:
             if len(self._transitions) < 4096:
                 self._transitions[dt] = hit
         return hit
-
-
-def _mirror_plane(anchors: np.ndarray, guess: np.ndarray, guard: bool):
-    """Normal of a planar array pointing to the physical side (the guess's), or None."""
-    centre = anchors.mean(axis=0)
-    _, sv, vt = np.linalg.svd(anchors - centre)
-    if guard and len(anchors) >= 3 and sv[-1] < 1e-3 * max(sv[0], 1e-12):
-        return vt[-1] * np.sign(vt[-1] @ (guess - centre) or 1.0), centre
-    return None, centre
 
 
 def _sigma_statistics(mdl: _Model, x: np.ndarray, P: np.ndarray):

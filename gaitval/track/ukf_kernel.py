@@ -228,6 +228,26 @@ def dot(fp, n, X, Y):
 
 
 @njit(cache=True)
+def _cholesky_loops(n, A):
+    """Lower Cholesky factor of the column-major ``n×n`` ``A`` in place (its lower
+    triangle read and written); LAPACK's ``info``: 0, or ``j + 1`` at a pivot ≤ 0 or NaN."""
+    for j in range(n):
+        s = A[j + j * n]
+        for c in range(j):
+            s -= A[j + c * n] * A[j + c * n]
+        if not s > 0.0:
+            return j + 1
+        d = math.sqrt(s)
+        A[j + j * n] = d
+        for i in range(j + 1, n):
+            v = A[i + j * n]
+            for c in range(j):
+                v -= A[i + c * n] * A[j + c * n]
+            A[i + j * n] = v / d
+    return 0
+
+
+@njit(cache=True)
 def potrf_lower(fp, n, A):
     """Lower Cholesky factor of the column-major ``n×n`` ``A`` in place (its lower
     triangle read), the upper triangle zeroed (scipy's ``dpotrf(lower=1, clean=1)``);
@@ -235,21 +255,7 @@ def potrf_lower(fp, n, A):
     if fp[POTRF] != 0:
         info = _lapack_dpotrf(fp[POTRF], ord("L"), n, A, n)
     else:
-        info = 0
-        for j in range(n):
-            s = A[j + j * n]
-            for c in range(j):
-                s -= A[j + c * n] * A[j + c * n]
-            if not s > 0.0:
-                info = j + 1
-                break
-            d = math.sqrt(s)
-            A[j + j * n] = d
-            for i in range(j + 1, n):
-                v = A[i + j * n]
-                for c in range(j):
-                    v -= A[i + c * n] * A[j + c * n]
-                A[i + j * n] = v / d
+        info = _cholesky_loops(n, A)
     for j in range(n):
         for i in range(j):
             A[i + j * n] = 0.0
@@ -259,34 +265,26 @@ def potrf_lower(fp, n, A):
 @njit(cache=True)
 def posv_upper(fp, n, nrhs, A, B):
     """Solve ``A X = B`` for the SPD column-major ``n×n`` ``A`` (upper triangle read) and
-    the column-major ``n×nrhs`` ``B``, ``X`` into ``B`` (LAPACK ``dposv('U')``); True when
-    ``A`` is positive definite."""
+    the column-major ``n×nrhs`` ``B``, ``X`` into ``B`` (LAPACK ``dposv('U')``; ``A`` is
+    overwritten by a factor); True when ``A`` is positive definite."""
     if fp[POSV] != 0:
         return _lapack_dposv(fp[POSV], ord("U"), n, nrhs, A, n, B, n) == 0
-    for j in range(n):                          # A = U^T U, U in the upper triangle
-        s = A[j + j * n]
-        for c in range(j):
-            s -= A[c + j * n] * A[c + j * n]
-        if not s > 0.0:
-            return False
-        d = math.sqrt(s)
-        A[j + j * n] = d
+    for j in range(n):                          # the upper triangle mirrored: A = L L^T
         for i in range(j + 1, n):
-            v = A[j + i * n]
-            for c in range(j):
-                v -= A[c + j * n] * A[c + i * n]
-            A[j + i * n] = v / d
+            A[i + j * n] = A[j + i * n]
+    if _cholesky_loops(n, A) != 0:
+        return False
     for r in range(nrhs):
         b = r * n
-        for i in range(n):                      # U^T y = b
+        for i in range(n):                      # L y = b
             v = B[b + i]
             for j in range(i):
-                v -= A[j + i * n] * B[b + j]
+                v -= A[i + j * n] * B[b + j]
             B[b + i] = v / A[i + i * n]
-        for i in range(n - 1, -1, -1):          # U x = y
+        for i in range(n - 1, -1, -1):          # L^T x = y
             v = B[b + i]
             for j in range(i + 1, n):
-                v -= A[i + j * n] * B[b + j]
+                v -= A[j + i * n] * B[b + j]
             B[b + i] = v / A[i + i * n]
     return True
 
