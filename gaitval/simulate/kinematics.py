@@ -245,7 +245,7 @@ def _swing_amplitudes(tl: _Timeline, gp: GaitParams) -> tuple[np.ndarray, np.nda
     Before the first swing (initial stance) both are the first swing's; after the last
     contact both are the last swing's.
     """
-    fxy, j, jn, m = tl.fxy, tl.j, tl.jn, len(tl.fxy)
+    fxy, j, m = tl.fxy, tl.j, len(tl.fxy)
     travel = np.hypot(*np.diff(fxy, axis=0).T) if m > 1 else np.zeros(0)
     scale = swing_scale(travel, gp) if m > 1 else np.ones(1)   # scale[k]: swing k -> k+1
     a_next = np.where(tl.has_next, scale[np.clip(j, 0, len(scale) - 1)],
