@@ -286,3 +286,12 @@ def test_kernel_loops_agree_with_the_numpy_formulation(monkeypatch):
     assert np.array_equal(np.isnan(new.x), np.isnan(old.x))
     assert np.nanmax(np.abs(new.x[:, :3] - old.x[:, :3])) < 1e-7      # metres
     assert np.nanmax(np.abs(new.P_diag - old.P_diag) / old.P_diag) < 1e-6
+
+
+def test_kernel_without_the_blas_symbols_runs_its_loops(monkeypatch):
+    """Another BLAS build (no scipy-openblas symbols): no address, so the loops run."""
+    from gaitval.track import ukf_kernel
+
+    assert ukf_kernel.blas_pointers().shape == (5,)
+    monkeypatch.setattr(ukf_kernel, "NUMPY_SYMBOLS", ("no_such_cblas_dgemm",) * 3)
+    assert not ukf_kernel.blas_pointers().any()

@@ -61,15 +61,18 @@ def blas_pointers() -> np.ndarray:
     ``dpotrf``, ``dposv`` (int64, in :data:`GEMM` … :data:`POSV` order), looked up in the
     libraries numpy's and scipy's extension modules are linked to; all zero when one is
     missing (then the kernel runs its loops)."""
-    import numpy._core._multiarray_umath as npcore
-    import scipy.linalg._flapack as flapack
-
     out = np.zeros(5, dtype=np.int64)
     try:
+        try:
+            from numpy._core import _multiarray_umath as npcore
+        except ImportError:                     # numpy 1.x
+            from numpy.core import _multiarray_umath as npcore
+        from scipy.linalg import _flapack as flapack
+
         np_lib, sp_lib = ctypes.CDLL(npcore.__file__), ctypes.CDLL(flapack.__file__)
         syms = [getattr(np_lib, s) for s in NUMPY_SYMBOLS]
         syms += [getattr(sp_lib, s) for s in SCIPY_SYMBOLS]
-    except (AttributeError, OSError):
+    except (ImportError, AttributeError, OSError):
         return out
     out[:] = [ctypes.cast(s, ctypes.c_void_p).value for s in syms]
     return out
