@@ -217,9 +217,10 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
         # here the filter has no state yet, or has starved for reinit_after samples
         p0 = trilaterate(d[k], anchors, guess)       # from the guess: its side of the array
         if np.all(np.isfinite(p0)):
-            x, P, starved[0] = np.concatenate([p0, np.zeros(3)]), P0.copy(), 0
+            # the kernel keeps P row-major and flat (36,)
+            x, P, starved[0] = np.concatenate([p0, np.zeros(3)]), P0.flatten(), 0
             res.reinit[k] = True
-            res.x[k], res.P_diag[k] = x, P.diagonal()
+            res.x[k], res.P_diag[k] = x, P0.diagonal()
             k += 1
             force = False
         elif x is None:
@@ -234,7 +235,7 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
                           mdl.Wc, mdl.scale, mdl.Vm, mdl.Q4, mdl.Q3, mdl.Q2, mdl.gate2,
                           mdl.use_gate, mdl.max_reject, min_anchors, reinit_after,
                           centre if normal is None else normal, centre,
-                          normal is not None, x, P.reshape(-1), starved, res.x, res.P_diag,
+                          normal is not None, x, P, starved, res.x, res.P_diag,
                           res.used, res.rejected, res.reflected)
     return res
 
