@@ -28,6 +28,9 @@ def cmd_validate(a) -> int:
     from gaitval.io.trialsheet import sheet_problems
     df, problems = sheet_problems(a.sheet, a.subjects, check_files=not a.no_file_check,
                                   allow_outside_paths=a.allow_outside_paths or None)
+    if a.deep and not a.no_file_check:
+        from gaitval.io.deepcheck import deep_problems
+        problems += deep_problems(df, a.sheet, jobs=a.jobs)
     if problems:
         for p in problems:
             print(f"gaitval: error: {p}", file=sys.stderr)
@@ -35,7 +38,9 @@ def cmd_validate(a) -> int:
               file=sys.stderr)
         return 1
     counts = df.groupby("protocol").size().to_dict()
-    print(f"{a.sheet}: {len(df)} trials OK ({', '.join(f'{k}: {v}' for k, v in counts.items())})")
+    opened = ", every file opened with its loader" if a.deep else ""
+    print(f"{a.sheet}: {len(df)} trials OK ({', '.join(f'{k}: {v}' for k, v in counts.items())})"
+          f"{opened}")
     return 0
 
 
@@ -176,6 +181,12 @@ def _add_input_verbs(sub) -> None:
     s.add_argument("--no-file-check", action="store_true")
     s.add_argument("--allow-outside-paths", action="store_true",
                    help="accept paths outside the sheet's folder (default: as study.yaml says)")
+    s.add_argument("--deep", action="store_true",
+                   help="also open every file with the loader the pipeline uses (C3D, scan "
+                   "log or bag topic, ultrasonic log, annotations) and report each that does "
+                   "not load or holds no data")
+    s.add_argument("--jobs", type=int, default=None,
+                   help="processes for --deep (default: one per core)")
     s.set_defaults(func=cmd_validate)
 
     s = sub.add_parser("simulate", help="generate a simulated study (raw files + truth/)")

@@ -144,3 +144,82 @@ def test_one_trial_row_from_a_remembered_sheet_keeps_per_row_errors(tmp_path):
     assert same(load_trial_row(sheet, None, "tug_S01_1"), first)
     with pytest.raises(TrialSheetError, match="row 3.*'sensor_height_m'"):
         load_trial_row(sheet, None, "tug_S01_2", check_files=False)
+
+
+# -- issue 33: ids that name folders, rows that lost cells, values no sheet should hold ----
+@pytest.mark.parametrize("trial, expect", [
+    ("..", "parent folder"),
+    (".", "own or parent folder"),
+    ("t" * 5000, "5000 characters long (at most 128)"),
+    ("a b", "' '"),
+    ("x$(id)", "'$'"),
+    ("a/b", "'/'"),
+])
+def test_trial_ids_that_cannot_name_a_folder_are_refused(tmp_path, trial, expect):
+    with pytest.raises(TrialSheetError) as ei:
+        load_trial_sheet(make_study(tmp_path, rows=ROW.replace("tug_S01_1", trial)))
+    msg = str(ei.value)
+    assert "row 2" in msg and "column 'trial'" in msg and expect in msg, msg
+    assert len(msg) < 600, "a 5,000-character id is not echoed whole"
+
+
+def test_a_128_character_id_is_fine(tmp_path):
+    trial = "t" * 128
+    assert list(load_trial_sheet(make_study(tmp_path, rows=ROW.replace("tug_S01_1", trial)))
+                .index) == [trial]
+
+
+def test_rows_missing_trailing_cells_are_refused_with_their_rows(tmp_path):
+    short = ROW.rsplit(",", 3)[0] + "\n"                      # the last three cells lost
+    with pytest.raises(TrialSheetError) as ei:
+        load_trial_sheet(make_study(tmp_path, rows=ROW.replace("tug_S01_1", "b") + short))
+    msg = str(ei.value)
+    assert "row 3: 13 cells" in msg and "header's 16" in msg, msg
+
+
+def test_a_header_only_sheet_is_refused(tmp_path):
+    with pytest.raises(TrialSheetError, match="header but no trials"):
+        load_trial_sheet(make_study(tmp_path, rows=""))
+
+
+def test_an_implausible_count_is_refused(tmp_path):
+    with pytest.raises(TrialSheetError, match=r"column 'repetition': '1e308' is not a plausible"):
+        load_trial_sheet(make_study(tmp_path, rows=ROW.replace(",1\n", ",1e308\n")))
+
+
+def test_a_nul_byte_in_a_cell_is_refused(tmp_path):
+    rows = ROW.replace("l/a.scan.parquet,,", "l/b.bag,/scan\0x,")
+    with pytest.raises(TrialSheetError) as ei:
+        load_trial_sheet(make_study(tmp_path, rows=rows))
+    assert "column 'sensor_topic': holds control character(s) '\\x00'" in str(ei.value)
+
+
+# -- issue 33: `validate --deep` opens what it checks --------------------------------------
+def _deep(tmp_path, rows, *extra):
+    import subprocess
+    import sys
+    sheet = make_study(tmp_path, rows=rows)
+    return subprocess.run([sys.executable, "-m", "gaitval", "validate", str(sheet),
+                           "--allow-outside-paths", "--deep", *extra],
+                          capture_output=True, text=True, timeout=300)
+
+
+@pytest.mark.realdata
+def test_deep_validate_opens_real_files_and_names_each_that_does_not_load(tmp_path,
+                                                                          realdata):
+    c3d = realdata / "c3d" / "FunctionalWalk.c3d"
+    bag = realdata / "lrs" / "positive_1.bag"
+    good = (f"s,tug,S01,good,lrs,{c3d},{bag},right_scan,,0.27,,,,false,,1\n")
+    empty = "s,tug,S01,empty,lrs,m/a.c3d,l/b.bag,right_scan,,0.27,,,,false,,1\n"
+    topic = f"s,tug,S01,topic,lrs,{c3d},{bag},no_such_topic,,0.27,,,,false,,1\n"
+    res = _deep(tmp_path, good, "--jobs", "1")
+    assert res.returncode == 0, res.stderr
+    assert "1 trials OK" in res.stdout and "every file opened" in res.stdout
+    res = _deep(tmp_path, good + empty + topic)
+    assert res.returncode == 1
+    err = res.stderr
+    assert "3 problems" in err, err                           # each file said once
+    assert "row 3 (trial 'empty'), column 'mocap_file'" in err
+    assert "row 3 (trial 'empty'), column 'sensor_file'" in err
+    assert "row 4 (trial 'topic'), column 'sensor_file'" in err and "no_such_topic" in err
+    assert "row 2" not in err and "Traceback" not in err

@@ -52,6 +52,37 @@ def load_schema(name: str) -> dict:
         return yaml.safe_load(fh)
 
 
+#: Id columns: each becomes a folder name under results/ and a word of a job's command.
+ID_COLUMNS = ("study", "subject", "trial")
+ID_MAX_LEN = 128
+_ID_CHARS = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_.-")
+#: Whole numbers past this are typos (``repetition=1e308``), not counts.
+MAX_INTEGER = 1_000_000
+
+
+def id_problem(value: str) -> str | None:
+    """Why ``value`` cannot be an id (study, subject, trial), or None.
+
+    Ids name folders (``results/<study>/ingest/<trial>/``): letters, digits and ``_ . -``
+    only, at most 128 characters, and neither ``.`` nor ``..`` (they would name the folder
+    itself or its parent)."""
+    if not value:
+        return "is empty"
+    if len(value) > ID_MAX_LEN:
+        return f"is {len(value)} characters long (at most {ID_MAX_LEN})"
+    if value in (".", ".."):
+        return f"{value!r} names a folder's own or parent folder"
+    bad = sorted(set(value) - _ID_CHARS)
+    if bad:
+        shown = ", ".join(repr(c) for c in bad[:5])
+        return f"has the character(s) {shown}; ids use letters, digits and _ . - only"
+    return None
+
+
+def _control_chars(value: str) -> list[str]:
+    return sorted({repr(c) for c in value if ord(c) < 32 or ord(c) == 127})
+
+
 def _coerce(value: str, spec: dict):
     """Convert one CSV cell to the schema's type; empty → None (left out of the record)."""
     v = value.strip()
@@ -68,6 +99,8 @@ def _coerce(value: str, spec: dict):
                              "value is unknown)")
         if t == "integer" and not f.is_integer():
             raise ValueError(f"{v!r} is not a whole number")
+        if t == "integer" and abs(f) > MAX_INTEGER:
+            raise ValueError(f"{v!r} is not a plausible count (at most {MAX_INTEGER:,})")
         return int(f) if t == "integer" else f
     if t == "boolean":
         if v.lower() in TRUE:
@@ -98,14 +131,33 @@ def _parse_csv(path: Path, kind: str) -> pd.DataFrame:
     try:
         if not path.is_file():
             raise TrialSheetError(f"{kind} not found", path=path)
-        return pd.read_csv(path, dtype=str, keep_default_na=False, comment=None,
-                           encoding="utf-8")
+        df = pd.read_csv(path, dtype=str, keep_default_na=False, comment=None,
+                         encoding="utf-8", index_col=False)
+        _check_ragged(path, kind, len(df.columns))
+        return df
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError,
             ValueError) as exc:
         raise TrialSheetError(f"cannot parse {kind} as UTF-8 CSV: {exc}", path=path,
                               hint="save it as CSV (UTF-8) with a header row") from None
     except OSError as exc:
         raise TrialSheetError(f"cannot read {kind}: {exc.strerror or exc}", path=path) from None
+
+
+def _check_ragged(path: Path, kind: str, n_columns: int) -> None:
+    """Every row holds as many cells as the header (pandas fills missing trailing cells
+    with "" and would take a short row for one with empty optional columns)."""
+    import csv
+
+    with open(path, encoding="utf-8", newline="") as fh:
+        bad = [(i, len(row)) for i, row in enumerate(csv.reader(fh), start=1)
+               if row and len(row) != n_columns and i > 1]
+    if bad:
+        rows = "; ".join(f"row {i}: {n} cells" for i, n in bad[:20])
+        more = f" (and {len(bad) - 20} more)" if len(bad) > 20 else ""
+        raise TrialSheetError(f"{kind} has rows whose number of cells differs from the "
+                              f"header's {n_columns}: {rows}{more}", path=path,
+                              hint="every row needs one cell per column (empty cells "
+                              "between commas for unknown values)")
 
 
 def _read_table(path: Path, kind: str, schema: dict, problems: list, only: str | None = None
@@ -138,10 +190,28 @@ def _read_table(path: Path, kind: str, schema: dict, problems: list, only: str |
         rows = raw.iloc[picked].to_dict("records")
     for i, row in zip(picked, rows):
         ident = row.get(key, "")
-        where = f"row {i + 2} ({key} {ident!r})" if ident else f"row {i + 2}"  # header: 1
-        trial = ident if key == "trial" and ident else None
+        safe = bool(ident) and id_problem(str(ident).strip()) is None
+        shown = ident if safe else str(ident)[:40]
+        where = f"row {i + 2} ({key} {shown!r})" if ident else f"row {i + 2}"  # header: 1
+        trial = ident if key == "trial" and safe else None
         rec, bad = {}, set()
         for col, val in row.items():
+            ctl = _control_chars(str(val))
+            if ctl:
+                problems.append(TrialSheetError(
+                    f"{where}, column {col!r}: holds control character(s) {', '.join(ctl)}",
+                    path=path, trial=trial))
+                bad.add(col)
+                continue
+            if col in ID_COLUMNS and str(val).strip():
+                why = id_problem(str(val).strip())
+                if why:
+                    shown = str(val)[:40] + ("..." if len(str(val)) > 40 else "")
+                    problems.append(TrialSheetError(
+                        f"{where}, column {col!r}: id {shown!r} {why}", path=path,
+                        trial=None))
+                    bad.add(col)
+                    continue
             try:
                 cv = _coerce(str(val), props.get(col, {"type": "string"}))
             except ValueError as exc:
@@ -303,6 +373,9 @@ def sheet_problems(path: str | Path, subjects: str | Path | None = None, *,
     problems: list[GaitvalError] = []
     schema = load_schema("trials")
     raw, records = _read_table(path, "trial sheet", schema, problems, only)
+    if raw.empty and "trial" in raw.columns:
+        problems.append(TrialSheetError("the trial sheet has a header but no trials",
+                                        path=path, hint="add one row per trial"))
     cols = list(dict.fromkeys(list(schema["properties"]) + list(raw.columns)))
     df = _frame(records, schema, cols + ["row_line"])
     for trial, rows in df.groupby("trial", sort=False)["row_line"]:
@@ -325,8 +398,11 @@ def sheet_problems(path: str | Path, subjects: str | Path | None = None, *,
     for col, new in (("mocap_file", "mocap_path"), ("sensor_file", "sensor_path"),
                      ("annotation_file", "annotation_path")):
         df[new] = [_absolute(path.parent, v) for v in df[col]]
-    df = df.drop_duplicates("trial").drop(columns="row_line")
-    return df.set_index("trial", drop=False), problems
+    df = df.drop_duplicates("trial")
+    row_lines = dict(zip(df["trial"], (int(x) for x in df["row_line"])))
+    df = df.drop(columns="row_line").set_index("trial", drop=False)
+    df.attrs["row_lines"] = row_lines          # the sheet's line of each trial
+    return df, problems
 
 
 def _absolute(base: Path, rel: str) -> str:

@@ -25,7 +25,7 @@ rule legbench_track:
     shell:
         "{params.gv} legbench-track --sensor {input.sensor:q} --annotations {input.annotations:q}"
         " {params.topics:q} --method {wildcards.method:q} --init {wildcards.init:q}"
-        " --leg-width-m {params.leg_width} --config {input.config:q}"
+        " --leg-width-m {params.leg_width:q} --config {input.config:q}"
         " --trial {wildcards.trial:q} --out {output:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
@@ -50,7 +50,7 @@ rule legbench_evaluate:
         "logs/legbench_evaluate/{study}/{method}/{init}/{trial}.log",
     shell:
         "{params.gv} legbench-evaluate --track {input.track:q} --annotations {input.annotations:q}"
-        " {params.topics:q} --match-m {params.match_m} --min-false-s {params.min_false_s}"
+        " {params.topics:q} --match-m {params.match_m:q} --min-false-s {params.min_false_s:q}"
         " --trial {wildcards.trial:q} --out {params.out:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 

@@ -29,13 +29,13 @@ rule mtst_track:
     log:
         "logs/mtst_track/{study}/{method}/{trial}.log",
     shell:
-        "{params.gv} mtst-track --sensor {input.sensor} --sheet {input.sheet}"
-        " --subjects {params.subjects} --trial {wildcards.trial} --method {wildcards.method}"
-        " --config {input.config} {params.reg} --out {output.track} > {log} 2>&1"
-        " && {params.gv} mtst-evaluate --track {output.track} --sheet {input.sheet}"
-        " --subjects {params.subjects} --trial {wildcards.trial} --method {wildcards.method}"
-        " --config {input.config} {params.reg} {params.gt} --out {params.out}"
-        " >> {log} 2>&1 || (cat {log} >&2; exit 1)"
+        "{params.gv} mtst-track --sensor {input.sensor:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
+        " --config {input.config:q} {params.reg:q} --out {output.track:q} > {log:q} 2>&1"
+        " && {params.gv} mtst-evaluate --track {output.track:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
+        " --config {input.config:q} {params.reg:q} {params.gt:q} --out {params.out:q}"
+        " >> {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 rule mtst_tables:
@@ -70,9 +70,9 @@ rule mtst_tables:
         "logs/mtst_tables.log",
     shell:
         "{params.gv} mtst-tables {params.dirs:q} --methods {params.methods:q}"
-        " --config {params.config} --tables-dir {params.tables}"
-        " --figures-dir {params.figures} --reports-dir {params.reports}"
-        " --config-hash {params.chash} > {log} 2>&1 || (cat {log} >&2; exit 1)"
+        " --config {params.config:q} --tables-dir {params.tables:q}"
+        " --figures-dir {params.figures:q} --reports-dir {params.reports:q}"
+        " --config-hash {params.chash:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 REPORT_ITEM_FUNCS.append(

@@ -74,8 +74,9 @@ def mtst_inputs(wildcards):
 
 
 def mtst_optional(name, flag):
-    """Param function: ``--flag path`` when input `name` is there, else nothing."""
-    return lambda wildcards, input: f"{flag} {input[name]}" if name in input.keys() else ""
+    """Param function: ``[--flag, path]`` when input `name` is there, else nothing (a list,
+    so the rule's ``{params.x:q}`` quotes each word)."""
+    return lambda wildcards, input: [flag, str(input[name])] if name in input.keys() else []
 
 
 def mtst_summaries(wildcards):
