@@ -250,7 +250,7 @@ class MotionCheck:
                     lost[f] += 1
                     continue
                 z, p = obs[g], pos[f]
-                if still[k]:
+                if still[k] and still[k - 1]:          # a step within a still scene
                     dx, dy = z[0] - p[0], z[1] - p[1]
                     pending[f].append((k, g, z, dx, dy))
                     reach[f] += hypot(dx, dy)

@@ -25,6 +25,13 @@ walking direction (start → goal) is the left leg; without a lane, the one at t
 bearing (the convention of ``closest_pair``; the tracker decides the sides from the
 walking direction afterwards).
 
+**No phantom participant** (issue 36): the pair found this way is kept only when some
+leg-like pair of the trial *moves* (:class:`gaitval.track.init.MotionCheck`, the check of
+TUG's ``closest_pair``: both legs travel ≥ 0.5 m over still scans, off the learned
+background).  A participant who walks the mat always does; chair and table legs in an
+empty room never do, and the run then reports no track instead of following furniture
+from the first scan to the last.  ``require_motion: false`` gives the rule above alone.
+
 ``lane`` is the centreline ``[[x_start, y_start], [x_goal, y_goal]]`` *in the sensor
 frame*: a trial's value comes from the registered sensor pose and the mat geometry
 (``mtst.mat`` in the config; :mod:`gaitval.steps_mtst` sets it as the override
@@ -44,7 +51,7 @@ from __future__ import annotations
 import math
 
 from gaitval.errors import ConfigError
-from gaitval.track.init import INITIALISERS, Initialiser
+from gaitval.track.init import INITIALISERS, Initialiser, MotionCheck
 
 
 @INITIALISERS.register("mtst_participant")
@@ -65,10 +72,19 @@ class MatLaneParticipant(Initialiser):
         Largest distance between the two legs (a standing or walking person, ≤ one step).
     min_leg_widths : float
         Smallest distance between the two legs, in leg widths (two shanks cannot overlap).
+    require_motion, min_travel_m, max_step_m, max_lost_scans, min_scans
+        The motion check (module notes), as
+        :class:`gaitval.track.init.ClosestMovingPair`'s; its defaults too.
     """
 
     def __init__(self, lane=None, half_width_m: float = 0.675, margin_before_m: float = 1.5,
-                 max_pair_m: float = 0.8, min_leg_widths: float = 0.7):
+                 max_pair_m: float = 0.8, min_leg_widths: float = 0.7,
+                 require_motion: bool = True, min_travel_m: float = 0.5,
+                 max_step_m: float = 0.7, max_lost_scans: int = 8, min_scans: int = 10):
+        self.require_motion = bool(require_motion)
+        self.min_scans = int(min_scans)
+        self.check = MotionCheck(min_travel_m=min_travel_m, max_step_m=max_step_m,
+                                 max_lost_scans=max_lost_scans)
         if lane is not None:
             try:
                 (x0, y0), (x1, y1) = lane
@@ -105,6 +121,15 @@ class MatLaneParticipant(Initialiser):
         return out, -self.margin_before_m, length
 
     def find(self, source, leg_width_m):
+        start = self._lane_pair(source, leg_width_m)
+        if start is None or not self.require_motion or len(source) < self.min_scans:
+            return start
+        d_min = self.min_leg_widths * leg_width_m
+        moving = self.check.moving_pair(source, d_min, self.max_pair_m, first_scan=start[0])
+        return start if moving is not None else None
+
+    def _lane_pair(self, source, leg_width_m):
+        """The first scan's pair on the lane (rule in the module notes), or None."""
         d_min = self.min_leg_widths * leg_width_m
         for k in range(len(source)):
             obs = source.array(k)
