@@ -24,6 +24,7 @@ Scan rate
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +36,9 @@ from gaitval.io.parquet import read_parquet
 from gaitval.steps import load_json, method_definition
 
 INITS = ("own", "annotation")
+#: How many of the person's later clicks the annotation initialiser is given: at least its
+#: ``search_scans`` (10), so every scan it searches has the click nearest in time.
+ANNOTATION_PATH_LEN = 20
 SUMMARY_FILE, FRAMES_FILE = "summary.parquet", "frames.parquet"
 
 
@@ -73,9 +77,14 @@ def with_init(method_def, init: str, positions: pd.DataFrame) -> dict:
         raise ConfigError(f"unknown legbench init {init!r}", hint=f"one of {', '.join(INITS)}")
     if positions.empty:
         raise GaitvalError("init 'annotation' needs at least one annotated position")
-    first = positions.sort_values(["k", "id"], kind="stable").iloc[0]
+    ordered = positions.sort_values(["k", "id"], kind="stable")
+    first = ordered.iloc[0]
+    # the same person's next clicks, for the scans searched after the first (init_annotated)
+    later = ordered[(ordered["id"] == first["id"]) & (ordered["k"] > first["k"])].head(
+        ANNOTATION_PATH_LEN)
     spec = {"name": "annotated_pair", "k": int(first["k"]), "x_m": float(first["x_m"]),
-            "y_m": float(first["y_m"])}
+            "y_m": float(first["y_m"]),
+            "path": [[int(r.k), float(r.x_m), float(r.y_m)] for r in later.itertuples()]}
     kind = m.get("kind")
     raw_scan = isinstance(kind, dict) and kind.get("name", "detect_then_track") != \
         "detect_then_track"
@@ -114,6 +123,11 @@ def legbench_track_step(sensor, method: str, out_parquet, *, init: str = "own",
         raise exc.with_context(path=sensor, trial=trial) from None
     track = res.to_frame()
     k_init = getattr(res, "k_init", None)
+    if k_init is None or k_init < 0:
+        print(f"gaitval: warning: trial {trial}, method {method} ({init} init): the "
+              f"initialiser found nobody in {sensor}{f' ({scan_topic})' if scan_topic else ''}"
+              "; the track is empty and every annotation will count as a miss",
+              file=sys.stderr)
     meta = {"gaitval_legbench": json.dumps({
         "method": method, "init": init, "trial": trial,
         "k_init": None if k_init is None or k_init < 0 else int(k_init),
@@ -141,14 +155,23 @@ def read_track(path) -> tuple[pd.DataFrame, dict]:
 def legbench_evaluate_step(track_parquet, annotations, out_dir, *,
                            annotation_topic: str | None = None, scan_topic: str | None = None,
                            match_m: float = 0.75, min_false_s: float = 0.5,
-                           trial: str | None = None) -> pd.DataFrame:
+                           trial: str | None = None, sector_deg=None,
+                           benchmark_set: str = "") -> pd.DataFrame:
     """CLEAR-MOT and false leg tracks of one track against the annotations.
 
     Writes ``summary.parquet`` (one row: trial, method, init, the CLEAR-MOT counts and
-    rates, false leg tracks, the initial person's offset from the annotation) and
-    ``frames.parquet`` (per scan: annotated and tracked person, the CLEAR-MOT event).
+    rates, the benchmark's following reading and reference ID switches, false leg tracks,
+    the initial person's offset from the annotation) and ``frames.parquet`` (per scan:
+    annotated and tracked person, the CLEAR-MOT event).
+
+    ``sector_deg``: ``(lo, hi)`` bearings in degrees; annotations and person hypotheses
+    outside are left out of the scoring (the general-tracking sets' −80°…+12°); None: the
+    whole scan.  ``benchmark_set``: the published set the recording belongs to
+    (:data:`gaitval.tables.legbench.BENCHMARK_SETS`; its published rows stand beside this
+    one), or "".
     """
-    from gaitval.evaluate.clearmot import clear_mot, false_leg_tracks, person_hypotheses
+    from gaitval.evaluate.clearmot import (clear_mot, false_leg_tracks, following_counts,
+                                           in_sector, person_hypotheses)
 
     track, meta = read_track(track_parquet)
     trial = trial or meta.get("trial")
@@ -162,7 +185,12 @@ def legbench_evaluate_step(track_parquet, annotations, out_dir, *,
                            f"track has {n} scans: not the same recording or scan topic",
                            path=annotations, trial=trial)
     hyp = person_hypotheses(x, y, meta.get("restarts") or [])
+    if sector_deg is not None:
+        positions = positions[in_sector(positions["x_m"], positions["y_m"], sector_deg)]
+        hyp = hyp[in_sector(hyp["x_m"], hyp["y_m"], sector_deg)]
+        positions, hyp = positions.reset_index(drop=True), hyp.reset_index(drop=True)
     summary, events = clear_mot(positions, hyp, n, match_m=match_m)
+    follow = following_counts(summary, events)
     legs = false_leg_tracks(x, y, t, positions, match_m=match_m, min_false_s=min_false_s)
     k0 = meta.get("k_init")
     offset = float("nan")
@@ -177,6 +205,11 @@ def legbench_evaluate_step(track_parquet, annotations, out_dir, *,
            "k_init": -1 if k0 is None else int(k0),
            "t_init_s": float(t[k0] - t[0]) if k0 is not None else float("nan"),
            "init_offset_m": offset, **summary, **legs,
+           "idsw_ref": follow["idsw_ref"], "matched_ref": follow["matched"],
+           "mota_following": follow["mota_following"],
+           "sector_deg": ("" if sector_deg is None
+                          else f"{float(sector_deg[0]):g}..{float(sector_deg[1]):g}"),
+           "benchmark_set": str(benchmark_set or ""),
            "tracked_fraction": float(len(hyp) / n) if n else float("nan"),
            "annotated_scans": int(positions["k"].nunique()), "n_scans": int(n),
            "annotations_in_window": window,
@@ -259,8 +292,15 @@ def add_legbench_verbs(sub) -> None:
             s = legbench_evaluate_step(a.track, a.annotations, a.out,
                                        annotation_topic=a.annotation_topic,
                                        scan_topic=a.scan_topic, match_m=a.match_m,
-                                       min_false_s=a.min_false_s, trial=a.trial)
-            cols = ["method", "init", "mota", "motp_m", "idsw", "idf1", "fn", "fp", "gt",
+                                       min_false_s=a.min_false_s, trial=a.trial,
+                                       sector_deg=a.sector_deg,
+                                       benchmark_set=a.benchmark_set or "")
+            if s.iloc[0]["gt"] == 0:
+                print(f"gaitval: warning: no annotated person in {a.annotations}"
+                      f"{' inside the sector' if a.sector_deg else ''}: nothing to score",
+                      file=sys.stderr)
+            cols = ["method", "init", "mota", "motp_m", "idsw", "idsw_ref", "idf1",
+                    "matches", "fn", "fp", "gt", "mota_following",
                     "false_leg_tracks_per_min"]
             print(s[cols].to_string(index=False))
         else:
@@ -290,6 +330,12 @@ def add_legbench_verbs(sub) -> None:
     s.add_argument("--scan-topic")
     s.add_argument("--match-m", type=float, default=0.75)
     s.add_argument("--min-false-s", type=float, default=0.5)
+    s.add_argument("--sector-deg", type=float, nargs=2, metavar=("LO", "HI"),
+                   help="score only what lies at bearings LO..HI degrees (the general "
+                   "tracking sets: -80 12)")
+    s.add_argument("--benchmark-set", default="",
+                   help="the published set the recording belongs to (e.g. "
+                   "following_outdoor): its published rows stand beside gaitval's")
     s.add_argument("--trial")
     s.add_argument("--out", required=True)
     s.set_defaults(func=run)

@@ -199,3 +199,74 @@ def test_track_and_evaluate_the_outdoor_bag_from_its_first_annotation(outdoor, t
     legbench_evaluate_step(tmp_path / "track.parquet", path, tmp_path / "b", **topics)
     for f in ("summary.parquet", "frames.parquet"):
         assert (tmp_path / "a" / f).read_bytes() == (tmp_path / "b" / f).read_bytes()
+
+
+# -- issue 36: scoring like the benchmark's authors --------------------------------------------
+def test_reference_id_switches_also_count_a_hypothesis_that_moves_to_another_person():
+    from gaitval.evaluate.clearmot import following_counts, reference_id_switches
+    # two people A (x = 0) and B (x = 3); hypothesis 1 follows A, then jumps to B while
+    # hypothesis 2 picks A up: A changes hypothesis (both counts), and hypothesis 1 changes
+    # person (the reference script's count only); frame 3 has nobody annotated
+    gt = pd.DataFrame([(0, "A", 0.0, 0.0), (0, "B", 3.0, 0.0), (1, "A", 0.0, 0.0),
+                       (1, "B", 3.0, 0.0), (2, "A", 0.0, 0.0), (2, "B", 3.0, 0.0)],
+                      columns=["k", "id", "x_m", "y_m"])
+    hyp = pd.DataFrame([(0, 1, 0.1, 0.0), (1, 1, 0.1, 0.0), (2, 1, 3.1, 0.0),
+                        (2, 2, 0.1, 0.0), (3, 9, 5.0, 5.0)],
+                       columns=["k", "hyp_id", "x_m", "y_m"])
+    s, events = clear_mot(gt, hyp, n_frames=4)
+    # A: hyp 1, 1, then 2 (a switch); B: missed twice, then matched to hyp 1 for the first
+    # time (motmetrics: no switch for B; the reference script: hyp 1 was A's, a switch)
+    assert s["idsw"] == 1
+    assert reference_id_switches(events) == 2
+    f = following_counts(s, events)
+    # 4 matched pairs, 2 of them switches by the reference rule: "valid" = 2, and
+    # valid + IDSW + misses = the 6 annotations, as in the benchmark's Table III
+    assert (f["pairs"], f["matched"], f["misses"], f["idsw"], f["idsw_ref"]) == \
+        (4, 2, 2, 1, 2)
+    # following: the false positive of frame 3 is ignored
+    assert f["mota_following"] == pytest.approx(1 - (2 + 1) / 6)
+    assert s["fp"] == 1 and s["mota"] == pytest.approx(1 - (2 + 1 + 1) / 6)
+
+
+def test_sector_keeps_bearings_inside_its_bounds():
+    from gaitval.evaluate.clearmot import in_sector
+    x = np.array([1.0, 1.0, 1.0, -1.0])
+    y = np.array([0.0, 1.0, -1.0, 0.0])          # 0°, 45°, -45°, 180°
+    assert in_sector(x, y, (-80, 12)).tolist() == [True, False, True, False]
+    assert in_sector(x, y, None).all()
+
+
+def test_annotation_initialiser_follows_the_annotation_while_it_searches():
+    # the person walks away from the first click: scans 0-2 show one leg only, scan 3 the
+    # pair at x = 2.0, 0.9 m from the first click but beside the click of scan 3
+    far = np.array([[2.0, 0.25], [2.0, -0.05]])
+    src = DetectionSeries([np.array([[1.1, 0.1]])] * 3 + [far], [["SL"]] * 3 + [["SL"] * 2])
+    held = INITIALISERS.build({"name": "annotated_pair", "k": 0, "x_m": 1.1, "y_m": 0.1})
+    assert held.find(src, 0.1) is None                    # the first click held: too far
+    follows = INITIALISERS.build({"name": "annotated_pair", "k": 0, "x_m": 1.1, "y_m": 0.1,
+                                  "path": [[1, 1.4, 0.1], [3, 2.0, 0.1]]})
+    assert follows.find(src, 0.1) == (3, 0, 1)
+
+
+def test_benchmark_table_sets_published_rows_beside_gaitvals():
+    from gaitval.tables.legbench import benchmark_table
+    row = {"trial": "t", "method": "tug_m1", "init": "annotation", "mota": 0.5,
+           "motp_m": 0.1, "idsw": 1, "idsw_ref": 2, "idf1": 0.6, "gt": 100, "fn": 9,
+           "fp": 40, "matches": 90, "matched_ref": 89, "mota_following": 0.9,
+           "sector_deg": "",
+           "false_leg_tracks": 0, "false_leg_tracks_per_min": 0.0, "false_leg_time_s": 0.0,
+           "tracked_fraction": 1.0, "k_init": 0, "t_init_s": 0.0, "init_offset_m": 0.1,
+           "annotations_in_window": np.nan, "benchmark_set": "following_outdoor"}
+    b = benchmark_table(pd.DataFrame([row, {**row, "trial": "u", "matches": 80,
+                                            "matched_ref": 79, "fn": 19, "motp_m": 0.2}]))
+    assert b["source"].tolist()[:3] == ["Leigh et al. ICRA 2015, Table III"] * 3
+    joint = b.iloc[2]
+    assert (joint["tracker"], joint["matched"], joint["idsw_ref"], joint["misses"]) == \
+        ("leg_tracker Joint Leg", 6073, 21, 104)
+    assert joint["matched_pct"] == pytest.approx(100 * 6073 / (6073 + 21 + 104))
+    ours = b.iloc[3]
+    assert (ours["matched"], ours["misses"], ours["idsw"], ours["idsw_ref"]) == (168, 28, 2, 4)
+    assert ours["fp"] == ""                                   # following: FPs ignored
+    assert ours["mota_pct"] == pytest.approx(100 * (1 - (28 + 2) / 200))
+    assert ours["motp_m"] == pytest.approx((91 * 0.1 + 81 * 0.2) / 172)   # over all pairs
+    assert benchmark_table(pd.DataFrame([{**row, "benchmark_set": ""}])).empty

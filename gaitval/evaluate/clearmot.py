@@ -26,6 +26,15 @@ scans of one leg lasting at least ``min_false_s``; the rate is their number per 
 recording (scan span + one period).  Leg-level CLEAR-MOT needs leg annotations, which the
 leg_tracker bags do not have.
 
+Benchmark scoring (issue 36; ``../shared/specs/leg-tracker-benchmark.md``): besides full
+CLEAR-MOT, :func:`following_counts` gives the *following* reading the benchmark's authors
+use when only the followed person is annotated — false positives ignored, MOTA' = 1 −
+(FN + IDSW) / GT — and :func:`reference_id_switches` counts ID switches as their
+``clear_mot.py`` does: a matched pair counts when the hypothesis was last matched to
+another person **or** the person was last matched to another hypothesis (py-motmetrics'
+``num_switches`` counts only the second).  :func:`in_sector` keeps what lies in a bearing
+sector (the general-tracking sets score −80°…+12° only).
+
 References
 ----------
 Bernardin, K.; Stiefelhagen, R. Evaluating multiple object tracking performance: the
@@ -219,3 +228,46 @@ def false_leg_tracks(x: np.ndarray, y: np.ndarray, t: np.ndarray, gt: pd.DataFra
             "false_leg_tracks_per_min": float(count / minutes) if minutes > 0 else float("nan"),
             "false_leg_time_s": float(false_s), "leg_time_s": leg_s,
             "recording_min": float(minutes)}
+
+
+def in_sector(x, y, sector_deg) -> np.ndarray:
+    """Per point: its bearing ``atan2(y, x)`` lies in ``[lo, hi]`` degrees (inclusive); all
+    True when ``sector_deg`` is None."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if sector_deg is None:
+        return np.ones(x.shape, dtype=bool)
+    lo, hi = (float(v) for v in sector_deg)
+    b = np.degrees(np.arctan2(y, x))
+    return (b >= lo) & (b <= hi)
+
+
+def reference_id_switches(events: pd.DataFrame) -> int:
+    """ID switches as the benchmark's ``clear_mot.py`` counts them (module notes), over the
+    matched pairs of :func:`clear_mot`'s events, in frame order."""
+    pairs = events[events["type"].isin(["MATCH", "SWITCH"])].sort_values("k", kind="stable")
+    last_hyp: dict = {}
+    last_gt: dict = {}
+    count = 0
+    for g, h in zip(pairs["gt_id"], pairs["hyp_id"]):
+        if (g in last_hyp and last_hyp[g] != h) or (h in last_gt and last_gt[h] != g):
+            count += 1
+        last_hyp[g], last_gt[h] = h, g
+    return count
+
+
+def following_counts(summary: dict, events: pd.DataFrame) -> dict:
+    """The benchmark's *following* reading of a :func:`clear_mot` result (module notes).
+
+    ``pairs``: matched (person, hypothesis) pairs, switches included; ``idsw``:
+    py-motmetrics' switches; ``idsw_ref``: the reference script's; ``matched``: the
+    benchmark's "valid" = pairs − ``idsw_ref`` (so matched + ``idsw_ref`` + misses = GT, as
+    in its Table III); ``misses``; ``motp_m``; ``mota_following`` = 1 − (FN + IDSW) / GT
+    with py-motmetrics' IDSW.  False positives are not counted."""
+    gt = int(summary["gt"])
+    idsw = int(summary["idsw"])
+    fn = int(summary["fn"])
+    pairs = int(summary["matches"]) + idsw
+    ref = reference_id_switches(events)
+    return {"pairs": pairs, "matched": pairs - ref, "misses": fn, "idsw": idsw,
+            "idsw_ref": ref, "motp_m": summary["motp_m"],
+            "mota_following": (1.0 - (fn + idsw) / gt) if gt else float("nan")}

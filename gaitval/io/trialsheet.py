@@ -442,6 +442,12 @@ def _row_problems(r, sheet: Path, subj, sub_path: Path, check_files: bool,
         add("sensor_file", f"{r.sensor_file!r} is not a {r.sensor_kind} log (expected "
             f"{', '.join(x for x in _SENSOR_SUFFIXES[r.sensor_kind] if x)}"
             f"{' or a ROS 2 bag folder' if r.sensor_kind == 'lrs' else ''})")
+    lo, hi = getattr(r, "sector_min_deg", np.nan), getattr(r, "sector_max_deg", np.nan)
+    if np.isnan(lo) != np.isnan(hi):
+        add("sector_min_deg" if np.isnan(lo) else "sector_max_deg",
+            "is empty while the other sector bound is set (give both, or neither)")
+    elif not np.isnan(lo) and lo >= hi:
+        add("sector_max_deg", f"{hi:g} is not above sector_min_deg {lo:g}")
     is_bag = name.endswith(".bag") or _is_dir(base / r.sensor_file)
     if r.sensor_kind == "lrs" and is_bag and not r.sensor_topic:
         add("sensor_topic", "a ROS bag needs the LaserScan topic",

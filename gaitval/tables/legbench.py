@@ -16,9 +16,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from gaitval.tables._published_leigh2015 import BENCHMARK_SETS, SOURCE, TABLE3
 from gaitval.tables.render import write_table
 
-COLUMNS = ["trial", "method", "init", "mota", "motp_m", "idsw", "idf1", "gt", "fn", "fp",
+__all__ = ["BENCHMARK_SETS", "benchmark_table", "legbench_table", "write_legbench_table"]
+
+COLUMNS = ["trial", "method", "init", "mota", "motp_m", "idsw", "idsw_ref", "idf1", "gt",
+           "fn", "fp", "mota_following", "sector_deg",
            "false_leg_tracks", "false_leg_tracks_per_min", "false_leg_time_s",
            "tracked_fraction", "k_init",
            "t_init_s", "init_offset_m", "annotations_in_window"]
@@ -75,11 +79,109 @@ def _notes(t: pd.DataFrame, summary: pd.DataFrame) -> list[str]:
     return notes
 
 
+BENCH_COLUMNS = ["benchmark_set", "tracker", "source", "annotations", "matched",
+                 "matched_pct", "misses", "idsw", "idsw_ref", "fp", "mota_pct", "motp_m"]
+
+
+def benchmark_table(summary: pd.DataFrame, methods=None, inits=None) -> pd.DataFrame:
+    """The published rows of each benchmark set beside gaitval's, counted the way the
+    set's authors count (issue 36; spec ``leg-tracker-benchmark.md``).
+
+    Per set: the paper's trackers (matched, ID switches, misses, FP, MOTA, MOTP), then
+    every gaitval (method, init) summed over the set's recordings.  Following sets ignore
+    false positives (``fp`` empty; MOTA = 1 − (misses + IDSW)/annotations); general sets
+    count them.  ``annotations`` of a published row is its own matched + IDSW + misses
+    (the paper's counts do not add up to the released bags' annotations), so
+    ``matched_pct`` compares rates.  ``matched`` is the benchmark's "valid": matched pairs
+    less the reference script's ID switches (matched + ``idsw_ref`` + misses =
+    annotations).  ``idsw`` is py-motmetrics' count (a person matched to another
+    hypothesis), ``idsw_ref`` the reference script's (also a hypothesis matched to another
+    person); published rows have only the reference count.
+    """
+    rows = []
+    sets = [b for b in BENCHMARK_SETS if "benchmark_set" in summary.columns
+            and (summary["benchmark_set"] == b).any()]
+    for b in sets:
+        following = BENCHMARK_SETS[b]["mode"] == "following"
+        for name, matched, idsw, misses, fp, mota, motp in TABLE3[b]:
+            n = matched + idsw + misses
+            rows.append({"benchmark_set": b, "tracker": name, "source": SOURCE,
+                         "annotations": n, "matched": matched,
+                         "matched_pct": 100.0 * matched / n, "misses": misses,
+                         "idsw": np.nan, "idsw_ref": idsw,
+                         "fp": np.nan if fp is None else fp,
+                         "mota_pct": np.nan if mota is None else mota, "motp_m": motp})
+        t = legbench_table(summary[summary["benchmark_set"] == b], methods, inits)
+        t = t.assign(benchmark_set=b)
+        extra = summary[summary["benchmark_set"] == b].set_index(["trial", "method", "init"])
+        for (m, i), g in t.groupby(["method", "init"], sort=False):
+            ex = extra.loc[[(tr, m, i) for tr in g["trial"]]]
+            gt = int(g["gt"].sum())
+            pairs = ex["matches"] + ex["idsw"]          # MOTP averages over every pair
+            matched = int(ex["matched_ref"].sum())      # the benchmark's "valid"
+            fn, sw, fp = int(g["fn"].sum()), int(g["idsw"].sum()), int(g["fp"].sum())
+            d = (ex["motp_m"].fillna(0.0) * pairs).sum()
+            rows.append({"benchmark_set": b, "tracker": f"gaitval {m} ({i} init)",
+                         "source": "reproduced", "annotations": gt, "matched": matched,
+                         "matched_pct": 100.0 * matched / gt if gt else np.nan,
+                         "misses": fn, "idsw": sw, "idsw_ref": int(g["idsw_ref"].sum()),
+                         "fp": np.nan if following else fp,
+                         "mota_pct": (100.0 * (1 - (fn + sw + (0 if following else fp)) / gt)
+                                      if gt else np.nan),
+                         "motp_m": float(d / pairs.sum()) if pairs.sum() else np.nan})
+    out = pd.DataFrame(rows, columns=BENCH_COLUMNS)
+    for c in ("idsw", "fp"):            # counts, empty where a row has none (not 0.000)
+        out[c] = ["" if pd.isna(v) else int(v) for v in out[c]]
+        out[c] = out[c].astype(object)
+    return out
+
+
+def _bench_notes(b: pd.DataFrame) -> list[str]:
+    notes = ["Counted as the benchmark's authors count (Leigh et al. ICRA 2015 §V-C and "
+             "their clear_mot.py): per person, a match needs < 0.75 m; on the following "
+             "sets only the followed person is annotated, so false positives are ignored "
+             "and MOTA = 1 − (misses + IDSW) / annotations; the general sets count false "
+             "positives and score bearings −80°…+12° only.",
+             "annotations of a published row = its matched + ID switches + misses (on the "
+             "outdoor set 7,728 / 6,288 / 6,198 against the released bag's 6,179 "
+             "annotations): compare matched_pct as well as counts.",
+             "idsw: py-motmetrics (a person matched to a new hypothesis); idsw_ref: the "
+             "reference script's count (also a hypothesis matched to a new person) — the "
+             "count the published rows use."]
+    for bset, g in b.groupby("benchmark_set", sort=False):
+        ours = g[g["source"] == "reproduced"]
+        pub = g[g["source"] != "reproduced"]
+        if ours.empty or pub.empty:
+            continue
+        r = ours.loc[ours["matched_pct"].idxmax()]
+        best = pub.loc[pub["matched_pct"].idxmax()]
+        motp = f"{r['motp_m']:.3f} m" if np.isfinite(r["motp_m"]) else "no match"
+        notes.append(f"{bset}: gaitval's best, {r['tracker']}, matched {r['matched']} of "
+                     f"{r['annotations']} ({r['matched_pct']:.1f} %), {r['idsw_ref']} ID "
+                     f"switches (reference count), MOTP {motp}; {best['tracker']}: "
+                     f"{best['matched_pct']:.1f} %, {int(best['idsw_ref'])}, "
+                     f"{best['motp_m']:.2f} m.")
+    return notes
+
+
 def write_legbench_table(summary: pd.DataFrame, stem, methods=None, inits=None
                          ) -> list[Path]:
-    """Write ``<stem>.csv/.md/.tex``."""
+    """Write ``<stem>.csv/.md/.tex`` and, when a recording belongs to a published
+    benchmark set, ``legbench_benchmark.*`` beside it."""
     t = legbench_table(summary, methods, inits)
-    return write_table(
+    b = benchmark_table(summary, methods, inits)
+    extra = []
+    if not len(b):                      # no published set any more: no stale table left
+        for suffix in (".csv", ".md", ".tex"):
+            Path(stem).with_name("legbench_benchmark" + suffix).unlink(missing_ok=True)
+    else:
+        extra = write_table(
+            b, Path(stem).with_name("legbench_benchmark"),
+            caption="The leg_tracker benchmark (Leigh et al. ICRA 2015, Table III): its "
+                    "published trackers beside gaitval's, counted by the authors' rules per "
+                    "set (following sets: false positives ignored).",
+            notes=_bench_notes(b), digits=3)
+    return extra + write_table(
         t, stem,
         caption="CLEAR-MOT of gaitval's leg trackers on hand-annotated laser recordings "
                 "without motion capture (py-motmetrics, 0.75 m), with false leg tracks per "

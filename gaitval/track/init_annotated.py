@@ -14,7 +14,10 @@ midpoint is nearest the annotated person position ``(x_m, y_m)`` at scan ``k``:
   CLEAR-MOT match distance of the leg_tracker benchmark: a start farther away would
   already count as a miss);
 * when scan ``k`` has no such pair (a leg hidden), the next ``search_scans`` scans are
-  tried with the same annotated position; then None (no subject: the run has no track).
+  tried, each with *its own* annotated position when the rater clicked that scan too
+  (``path``: the person's annotations in scan order), else with the latest one before it
+  — the person walks on while the legs are searched for, so the first click is not held
+  fixed (issue 36); then None (no subject: the run has no track).
 
 The left leg is the one at the larger bearing (the ``closest_pair`` convention; the
 tracker may decide the sides from the walking direction afterwards).  The workflow sets
@@ -48,13 +51,16 @@ class AnnotatedPair(Initialiser):
         Largest distance of the pair's midpoint from the annotation (m).
     search_scans : int
         Further scans tried when scan ``k`` has no pair near the annotation.
+    path : list of [k, x_m, y_m], optional
+        The same person's later annotations (scan, position), used for the scans searched
+        after ``k`` (module notes).
     max_pair_m, min_leg_widths : float
         What counts as a leg pair (as ``closest_pair``).
     """
 
     def __init__(self, k=None, x_m=None, y_m=None, max_offset_m: float = 0.75,
                  search_scans: int = 10, max_pair_m: float = 0.8,
-                 min_leg_widths: float = 0.7):
+                 min_leg_widths: float = 0.7, path=None):
         try:
             self.k, self.x, self.y = int(k), float(x_m), float(y_m)
         except (TypeError, ValueError):
@@ -67,15 +73,31 @@ class AnnotatedPair(Initialiser):
         self.search_scans = int(search_scans)
         self.max_pair_m = float(max_pair_m)
         self.min_leg_widths = float(min_leg_widths)
+        try:
+            later = sorted((int(a), float(b), float(c)) for a, b, c in (path or ()))
+        except (TypeError, ValueError):
+            raise ConfigError("init annotated_pair: path must be a list of [k, x_m, y_m]; "
+                              f"got {path!r}") from None
+        self.path = [(self.k, self.x, self.y)] + [p for p in later if p[0] > self.k]
+
+    def position_at(self, k: int) -> tuple[float, float]:
+        """The annotated position for scan ``k``: its own click, else the latest before."""
+        x, y = self.x, self.y
+        for kk, xx, yy in self.path:
+            if kk > k:
+                break
+            x, y = xx, yy
+        return x, y
 
     def find(self, source, leg_width_m):
         d_min = self.min_leg_widths * leg_width_m
         for k in range(self.k, min(len(source), self.k + self.search_scans + 1)):
             obs = source.array(k)
+            ax, ay = self.position_at(k)
             near = []
             for i, j, d in leg_pairs(obs, d_min, self.max_pair_m):
-                off = math.hypot(0.5 * (obs[i][0] + obs[j][0]) - self.x,
-                                 0.5 * (obs[i][1] + obs[j][1]) - self.y)
+                off = math.hypot(0.5 * (obs[i][0] + obs[j][0]) - ax,
+                                 0.5 * (obs[i][1] + obs[j][1]) - ay)
                 if off <= self.max_offset_m:
                     near.append(((off, d), i, j))
             best = min(near, key=lambda c: c[0], default=None)   # nearest (first of equals)

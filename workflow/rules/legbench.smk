@@ -41,6 +41,7 @@ rule legbench_evaluate:
     params:
         gv=GV,
         topics=legbench_args,
+        score=legbench_score_args,
         out=parent_of("summary"),
         match_m=legbench_cfg()["match_m"],
         min_false_s=legbench_cfg()["min_false_s"],
@@ -50,7 +51,8 @@ rule legbench_evaluate:
         "logs/legbench_evaluate/{study}/{method}/{init}/{trial}.log",
     shell:
         "{params.gv} legbench-evaluate --track {input.track:q} --annotations {input.annotations:q}"
-        " {params.topics:q} --match-m {params.match_m:q} --min-false-s {params.min_false_s:q}"
+        " {params.topics:q} {params.score:q} --match-m {params.match_m:q}"
+        " --min-false-s {params.min_false_s:q}"
         " --trial {wildcards.trial:q} --out {params.out:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 

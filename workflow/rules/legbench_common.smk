@@ -41,6 +41,24 @@ def legbench_args(w):
     return args
 
 
+def legbench_score_args(w):
+    """The trial's scoring options: its published benchmark set (trial sheet `scenario`,
+    one of gaitval.tables.legbench.BENCHMARK_SETS) and bearing sector (`sector_min_deg`,
+    `sector_max_deg`; else the set's own, e.g. -80..12 for the general-tracking sets)."""
+    from gaitval.tables.legbench import BENCHMARK_SETS
+
+    row = trial_row(w.study, w.trial)
+    bset = row.get("scenario") or ""
+    args = ["--benchmark-set", bset] if bset in BENCHMARK_SETS else []
+    sector = [row.get("sector_min_deg"), row.get("sector_max_deg")]
+    sector = [float(v) for v in sector if v is not None and float(v) == float(v)]  # not NaN
+    if len(sector) < 2 and bset in BENCHMARK_SETS:
+        sector = list(BENCHMARK_SETS[bset]["sector_deg"] or ())
+    if len(sector) == 2:
+        args += ["--sector-deg", f"{sector[0]:g}", f"{sector[1]:g}"]
+    return args
+
+
 def legbench_leg_width(w):
     subj = load_subjects(subjects_path(w.study)).loc[trial_row(w.study, w.trial)["subject"]]
     return float(subj["leg_width_m"])
