@@ -198,15 +198,19 @@ def registration_summary(inputs: list[str | Path], study: str, out_csv, out_stem
     write_csv(df, out_csv, float_format="%.6g")
     show = df.copy()
     show["yaw_deg"] = np.degrees(show["yaw_rad"].astype(float))
-    show = show[[C.TRIAL, "protocol", C.X, C.Y, "yaw_deg", C.CLOCK_OFFSET,
-                 "clock_drift_ppm", "pole_residual_m", "sync_peak", "joint_centre_source",
-                 "gt_frames_excluded", "status", "reason"]]
+    by_hand = (["manual_pose_diff_m", "manual_pose_diff_deg"]
+               if show["manual_pose_diff_m"].notna().any() else [])
+    show = show[[C.TRIAL, "protocol", C.X, C.Y, "yaw_deg", "pose_source", *by_hand,
+                 C.CLOCK_OFFSET, "clock_drift_ppm", "pole_residual_m", "sync_peak",
+                 "joint_centre_source", "gt_frames_excluded", "status", "reason"]]
     n_ref = int((df["status"] != "ok").sum())
     notes = [f"{n_ref} trial(s) refused; their reason is given and later tables leave them "
              "out."] if n_ref else []
     paths = write_table(show, out_stem, digits=4, notes=notes, caption=(
         f"Registration of each trial of study '{study}': estimated sensor pose in the mocap "
-        "field (from the calibration poles; rollator trials have a per-frame pose, shown "
+        "field (pose_source: from the calibration poles, or measured by hand where the C3D "
+        "has no poles — where both exist, the poles' pose minus the hand-measured one; "
+        "rollator trials have a per-frame pose, shown "
         "empty; ultrasonic trials show the receiver frame), clock offset and drift (sensor "
         "minus mocap), worst pole residual, correlation peak of the clock synchronisation, "
         "which joint-centre source built the ground truth, and mocap frames excluded for "

@@ -448,6 +448,12 @@ def _row_problems(r, sheet: Path, subj, sub_path: Path, check_files: bool,
             "is empty while the other sector bound is set (give both, or neither)")
     elif not np.isnan(lo) and lo >= hi:
         add("sector_max_deg", f"{hi:g} is not above sector_min_deg {lo:g}")
+    pose = [getattr(r, c, np.nan) for c in ("sensor_x_m", "sensor_y_m", "sensor_yaw_deg")]
+    if any(np.isnan(pose)) and not all(np.isnan(pose)):
+        empty = [c for c, v in zip(("sensor_x_m", "sensor_y_m", "sensor_yaw_deg"), pose)
+                 if np.isnan(v)]
+        add(empty[0], "is empty while other cells of the hand-measured sensor pose are set "
+            "(give sensor_x_m, sensor_y_m and sensor_yaw_deg, or none)")
     is_bag = name.endswith(".bag") or _is_dir(base / r.sensor_file)
     if r.sensor_kind == "lrs" and is_bag and not r.sensor_topic:
         add("sensor_topic", "a ROS bag needs the LaserScan topic",

@@ -4,7 +4,12 @@
 ``results/<study>/registration.csv`` (:data:`RECORD_FIELDS`).
 
 * Fixed LRS (TUG, MTST, ...): pose from the calibration poles
-  (:func:`~gaitval.registration.poles.register_poles`).
+  (:func:`~gaitval.registration.poles.register_poles`).  A pose measured by hand (trial
+  sheet ``sensor_x_m``, ``sensor_y_m``, ``sensor_yaw_deg``, field frame) is checked against
+  the poles where the C3D has them — the poles' pose is used and the difference recorded
+  (``manual_pose_diff_m``, ``manual_pose_diff_deg``) — and used alone where it has none
+  (``pose_source`` ``manual``, ``pole_residual_m`` NaN): a lab without calibration poles
+  can still register its sensor.
 * Moving LRS (protocol ``rollator``): per-frame pose from the rollator markers and the mount
   (:mod:`~gaitval.registration.moving`); the record's ``x_m, y_m, yaw_rad`` and
   ``pole_residual_m`` are NaN (the per-frame pose is recomputed by the ground truth).
@@ -44,7 +49,10 @@ from gaitval.types import MocapTrial, ScanSeries, UltrasonicLog
 
 #: Columns of ``registration.csv`` (issue 4), in order.
 RECORD_FIELDS = (C.TRIAL, C.X, C.Y, "yaw_rad", C.CLOCK_OFFSET, "clock_drift_ppm",
-                 "pole_residual_m", "sync_peak", "joint_centre_source", "gt_frames_excluded")
+                 "pole_residual_m", "sync_peak", "joint_centre_source", "gt_frames_excluded",
+                 "pose_source", "manual_pose_diff_m", "manual_pose_diff_deg")
+#: Trial-sheet columns of a pose measured by hand (field frame; metres, degrees).
+MANUAL_POSE_COLUMNS = ("sensor_x_m", "sensor_y_m", "sensor_yaw_deg")
 
 #: Defaults of the ``registration:`` keys read here (plus those of poles and clock).
 DEFAULTS = {
@@ -74,6 +82,12 @@ class RegistrationRecord:
     joint_centre_source : str
     gt_frames_excluded : int
         Mocap frames without a ground-truth point (either leg) after short-gap filling.
+    pose_source : str
+        ``poles``, ``manual`` (measured by hand, no poles), ``anchors`` (ultrasonic),
+        ``rollator markers`` (moving sensor).
+    manual_pose_diff_m, manual_pose_diff_deg : float
+        Pole pose minus the pose measured by hand (position distance, yaw difference);
+        NaN without one of the two.
     """
 
     trial: str
@@ -86,6 +100,9 @@ class RegistrationRecord:
     sync_peak: float
     joint_centre_source: str
     gt_frames_excluded: int
+    pose_source: str = "poles"
+    manual_pose_diff_m: float = float("nan")
+    manual_pose_diff_deg: float = float("nan")
 
     def as_row(self) -> dict:
         return asdict(self)
@@ -107,6 +124,28 @@ def reg_cfg(cfg: dict | None) -> dict:
 
 def _manual_offset(trial: dict | None) -> float | None:
     return as_float((trial or {}).get(C.CLOCK_OFFSET))
+
+
+def manual_pose(trial: dict | None) -> tuple[float, float, float] | None:
+    """``(x_m, y_m, yaw_rad)`` measured by hand (:data:`MANUAL_POSE_COLUMNS`), or None when
+    the sheet gives none.  Part of a pose is refused: it cannot be checked or used."""
+    vals = [as_float((trial or {}).get(k)) for k in MANUAL_POSE_COLUMNS]
+    if all(v is None for v in vals):
+        return None
+    if any(v is None for v in vals):
+        missing = [k for k, v in zip(MANUAL_POSE_COLUMNS, vals) if v is None]
+        raise RegistrationError(f"a sensor pose measured by hand needs all of "
+                                f"{', '.join(MANUAL_POSE_COLUMNS)}; {', '.join(missing)} "
+                                "empty", hint="fill the three cells, or leave all empty")
+    return vals[0], vals[1], math.radians(vals[2])
+
+
+def _has_pole_markers(mocap: MocapTrial, c: dict) -> bool:
+    try:
+        PO.mocap_pole_positions(mocap, c.get("pole_labels"))
+    except RegistrationError:
+        return False
+    return True
 
 
 def _leg_width(subject, c) -> float:
@@ -170,13 +209,23 @@ def register_trial(mocap: MocapTrial, sensor, trial: dict, subject: dict | None,
 def _register_lrs(mocap, sensor, trial, subject, cfg, tid, legs):
     c = reg_cfg(cfg)
     moving = is_moving(trial)
+    by_hand = manual_pose(trial)
+    diff_m = diff_deg = float("nan")
     if moving:
         pose = None
         x = y = yaw = resid = float("nan")
+        source = "rollator markers"
+    elif by_hand is not None and not _has_pole_markers(mocap, c):
+        x, y, yaw = by_hand                        # no poles: the measured pose alone
+        resid, source = float("nan"), "manual"
+        pose = by_hand
     else:
         pf = PO.register_poles(sensor, mocap, c, leg_xy_field=pole_evidence(legs), trial=tid)
         x, y, yaw, resid = pf.x_m, pf.y_m, pf.yaw_rad, pf.worst_residual_m
-        pose = (x, y, yaw)
+        pose, source = (x, y, yaw), "poles"
+        if by_hand is not None:                    # checked against the poles
+            diff_m = math.hypot(x - by_hand[0], y - by_hand[1])
+            diff_deg = math.degrees(float(wrap_angle(yaw - by_hand[2])))
     manual = _manual_offset(trial)
     if manual is not None:
         ce = CK.ClockEstimate(manual, 0.0, float("nan"), "manual")
@@ -190,7 +239,8 @@ def _register_lrs(mocap, sensor, trial, subject, cfg, tid, legs):
         ce = CK.estimate_clock(legs.t, pred, obs_t, obs, c)
         _check_peak(ce, c, sensor.source, tid)
     return RegistrationRecord(tid, x, y, yaw, ce.clock_offset_s, ce.clock_drift_ppm, resid,
-                              ce.sync_peak, legs.source, legs.n_excluded)
+                              ce.sync_peak, legs.source, legs.n_excluded, source, diff_m,
+                              diff_deg)
 
 
 def _check_peak(ce, c, path, tid):
@@ -257,4 +307,4 @@ def _register_ultrasonic(mocap, log, trial, cfg, tid, tx):
         ce = CK.estimate_clock(mocap.t, pred, log.t, anchor_distances(log), c)
         _check_peak(ce, c, log.source, tid)
     return RegistrationRecord(tid, x, y, yaw, ce.clock_offset_s, ce.clock_drift_ppm, resid,
-                              ce.sync_peak, "tx_marker", n_excl)
+                              ce.sync_peak, "tx_marker", n_excl, "anchors")
