@@ -159,6 +159,7 @@ def build_mtst(rng, study, subj, gp, trial, rep, sensor_pose, cfg, color, stick,
     t0 = float(rng.uniform(0.6, 1.0))
     plan, which = plan_mtst(rng, gp, targets, color, t0)
     walker = Walker(plan=plan, gp=gp, leg_width_m=subj["leg_width_m"],
+                    sensor_height_m=cfg["sensor_height_m"],
                     stick_side=(1 if stick else None))
     # attendant: same path shifted, own gait, same speed
     agp = attendant_gp
@@ -167,7 +168,8 @@ def build_mtst(rng, study, subj, gp, trial, rep, sensor_pose, cfg, color, stick,
     agp = GaitParams(**{**agp.__dict__, "step_time_s": dur / (n_att + 1)})
     apath = make_path((-0.6, -0.75), 0.0, [("line", MAT_LENGTH + 0.7, "walk")])
     aplan = plan_steps(apath, agp, rng, t0=t0 + 0.1, first_side=int(rng.integers(0, 2)))
-    attendant = Walker(plan=aplan, gp=agp, leg_width_m=0.11)
+    attendant = Walker(plan=aplan, gp=agp, leg_width_m=0.11,
+                       sensor_height_m=cfg["sensor_height_m"])
     poles = np.array([POLES_M[1], POLES_M[0]])
     circles = [(x, y, POLE_RADIUS_M, ID_POLE) for x, y in poles]
     t_end = plan.t_end + float(rng.uniform(0.8, 1.2))
