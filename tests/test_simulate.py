@@ -501,3 +501,56 @@ def test_swings_clear_of_the_standing_leg_are_left_straight():
     w = Walker(plan=plan, gp=gp, leg_width_m=0.10)
     assert (w.plan.detour == 0).all()
     assert np.array_equal(w.plan.xy, plan.xy)
+
+
+# ----------------------------------------------------------------- free choices of the twin
+@pytest.mark.parametrize("preset, key, value", [
+    ("mtst_sensor_beside", "sensor_nominal_pose", [2.0, 1.6, -np.pi / 2]),
+    ("mtst_attendant_left", "attendant", {"side": "left", "lateral_m": 0.75, "behind_m": 0.25}),
+])
+def test_sensitivity_presets_change_one_choice(preset, key, value):
+    """Issue 34: each sensitivity preset is the default study with one MTST choice changed
+    (same seed, participants and trials; the ultrasonic protocol left out)."""
+    d, p = load_preset("default"), load_preset(preset)
+    assert p["seed"] == d["seed"] and p["tug"] == d["tug"] and p["rollator"] == d["rollator"]
+    assert "ultrasonic" not in p
+    changed = {k for k in set(d["mtst"]) | set(p["mtst"]) if d["mtst"].get(k) != p["mtst"].get(k)}
+    assert changed == {key}
+    assert np.allclose(p["mtst"][key], value) if key != "attendant" else p["mtst"][key] == value
+
+
+def test_attendant_side_moves_the_attendant_only():
+    """The attendant's side is read from the preset: mirrored across the mat, the
+    participant's own plan unchanged; an unknown side is a ConfigError."""
+    from gaitval.simulate import study as S
+    cfg = load_preset("tiny")
+    seed = int(cfg["seed"])
+    tasks = [t for t in S._lrs_tasks(cfg, "tiny", seed, []) if t[1] == "mtst"]
+    idx, _, build, bargs, _, _ = tasks[0]
+    right = build(S._rng(seed, 3, idx), *bargs)
+    args = list(bargs)
+    args[6] = {**bargs[6], "attendant": {"side": "left"}}
+    left = build(S._rng(seed, 3, idx), *args)
+    assert np.array_equal(right.walker.plan.xy, left.walker.plan.xy)
+    assert np.median(right.attendant.plan.xy[:, 1]) < -0.5 < 0.5 < np.median(
+        left.attendant.plan.xy[:, 1])
+    args[6] = {**bargs[6], "attendant": {"side": "behind"}}
+    with pytest.raises(ConfigError, match="attendant.side"):
+        build(S._rng(seed, 3, idx), *args)
+
+
+def test_sensitivity_table_names_the_flips(tmp_path):
+    from gaitval.tables.sensitivity import sensitivity_table
+    cols = ["study", "comparison", "source", "published", "reproduced", "criterion",
+            "reproduced_in_direction", "note"]
+    rows = [["mtst", "Success M1", "Table 3", "0.96", "0.63", "ci", "no", ""],
+            ["mtst", "Success M2", "Table 3", "0.92", "0.90", "ci", "yes", ""]]
+    for name, v in (("ref", ["no", "yes"]), ("alt", ["yes", "yes"])):
+        (tmp_path / name).mkdir()
+        df = pd.DataFrame(rows, columns=cols).assign(reproduced_in_direction=v)
+        df.to_csv(tmp_path / name / "verdicts.csv", index=False)
+    t = sensitivity_table([tmp_path / "ref", tmp_path / "alt"])
+    assert list(t["flips_under"]) == ["alt", ""]
+    assert list(t["alt_verdict"]) == ["yes", "yes"]
+    with pytest.raises(GaitvalError, match="verdicts.csv"):
+        sensitivity_table([tmp_path / "ref", tmp_path / "nothing"])
