@@ -552,5 +552,10 @@ def test_sensitivity_table_names_the_flips(tmp_path):
     t = sensitivity_table([tmp_path / "ref", tmp_path / "alt"])
     assert list(t["flips_under"]) == ["alt", ""]
     assert list(t["alt_verdict"]) == ["yes", "yes"]
+    # a verdict the alternative does not compute is "absent", not a flip
+    pd.DataFrame(rows[:1], columns=cols).to_csv(tmp_path / "alt" / "verdicts.csv", index=False)
+    t = sensitivity_table([tmp_path / "ref", tmp_path / "alt"])
+    assert list(t["alt_verdict"]) == ["no", "absent"]
+    assert list(t["flips_under"]) == ["", ""] and list(t["absent_in"]) == ["", "alt"]
     with pytest.raises(GaitvalError, match="verdicts.csv"):
         sensitivity_table([tmp_path / "ref", tmp_path / "nothing"])

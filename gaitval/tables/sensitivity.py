@@ -44,9 +44,10 @@ def _verdicts(report_dir: Path) -> pd.DataFrame:
 def sensitivity_table(reports: list[Path], names: list[str] | None = None,
                       protocols: tuple[str, ...] | None = None) -> pd.DataFrame:
     """One row per verdict of the reference report (``reports[0]``): its reproduced value
-    and verdict, then per alternative report the same, and ``flips`` (the alternatives
-    whose verdict differs).  ``protocols`` keeps only those ``study`` values (None: all).
-    A verdict missing in an alternative shows "absent" (that counts as a flip)."""
+    and verdict, then per alternative report the same, ``flips_under`` (the alternatives
+    whose verdict differs) and ``absent_in`` (the alternatives that do not compute it,
+    e.g. a preset without the ultrasonic protocol: shown "absent", not a flip).
+    ``protocols`` keeps only those ``study`` values (None: all)."""
     names = names or [Path(r).name for r in reports]
     ref = _verdicts(reports[0])
     if protocols:
@@ -55,6 +56,7 @@ def sensitivity_table(reports: list[Path], names: list[str] | None = None,
     out[f"{names[0]}_reproduced"] = ref["reproduced"].to_numpy()
     out[f"{names[0]}_verdict"] = ref["reproduced_in_direction"].to_numpy()
     flips = [[] for _ in range(len(out))]
+    absent = [[] for _ in range(len(out))]
     for rep, name in zip(reports[1:], names[1:]):
         alt = _verdicts(rep).drop_duplicates(KEY).set_index(KEY)
         idx = pd.MultiIndex.from_frame(out[KEY])
@@ -63,9 +65,12 @@ def sensitivity_table(reports: list[Path], names: list[str] | None = None,
         verdict = got["reproduced_in_direction"].fillna("absent").to_numpy()
         out[f"{name}_verdict"] = verdict
         for k, (a, b) in enumerate(zip(out[f"{names[0]}_verdict"], verdict)):
-            if a != b:
+            if b == "absent":
+                absent[k].append(name)
+            elif a != b:
                 flips[k].append(name)
-    out["flips_under"] = ["; ".join(f) if f else "" for f in flips]
+    out["flips_under"] = ["; ".join(f) for f in flips]
+    out["absent_in"] = ["; ".join(f) for f in absent]
     return out.reset_index(drop=True)
 
 
@@ -75,9 +80,11 @@ def write_sensitivity(reports: list[Path], out_stem: Path, names: list[str] | No
     df = sensitivity_table(reports, names, protocols)
     names = names or [Path(r).name for r in reports]
     n_flip = int((df["flips_under"] != "").sum())
+    n_abs = int((df["absent_in"] != "").sum())
     caption = (f"Verdicts of the {names[0]} study beside the same verdicts under each "
                f"alternative free choice of the twin ({', '.join(names[1:])}); "
-               f"{n_flip} of {len(df)} verdicts flip.")
+               f"{n_flip} of {len(df) - n_abs} verdicts computed under every alternative "
+               f"flip" + (f" ({n_abs} not computed in some alternative)." if n_abs else "."))
     notes = ["Each alternative is the default study with one set-up choice the paper leaves "
              "open changed (config/studies/<name>.yaml; docs/simulator.md, 'Free choices "
              "of the twin'); same seed, subjects and trials.",
