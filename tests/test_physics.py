@@ -114,3 +114,44 @@ def test_physics_table_without_real_data_marks_shin_rows_unchecked(tiny, tmp_pat
     shin = t[t["check"].isin(["shin_swing_peak", "shin_stance_speed"])]
     assert len(shin) and shin["passed"].isna().all()
     assert shin["source"].str.contains("not checked").all()
+
+
+def test_contact_rows_pass_on_tiny(physics):
+    """Issue 34: the contact rows exist for every protocol and pass -- no swing closer than
+    0.95 leg widths, no scan with overlapping shanks, feet back at hip width when seated,
+    no cross step in the turn to sit."""
+    clear = physics[physics["check"] == "shank_clearance"]
+    scans = physics[physics["check"] == "shank_overlap_scans"]
+    assert set(clear["protocol"]) == set(scans["protocol"]) == {"tug", "mtst", "rollator"}
+    assert (clear["value"] >= 0.95).all() and clear["passed"].astype(bool).all()
+    assert (scans["value"] == 0).all() and scans["passed"].astype(bool).all()
+    p = physics.set_index("check")
+    assert p.loc["tug_sit_foot_separation", "value"] <= 0.05
+    assert p.loc["tug_turn_to_sit_cross", "value"] == 0
+    assert bool(p.loc["tug_turn_to_sit", "passed"])
+
+
+def test_contact_statistics_see_overlapping_shanks(tmp_path):
+    """The clearance statistic is not blind: a trial whose two shanks pass through each
+    other (written by hand) gives a per-swing minimum below 0.95 and overlapping scans."""
+    from gaitval.simulate.physics import contact_stats
+    d = tmp_path / "truth" / "x_t1"
+    d.mkdir(parents=True)
+    pd.DataFrame({"trial": ["x_t1"], "subject": ["S1"]}).to_csv(tmp_path / "trials.csv",
+                                                                index=False)
+    pd.DataFrame({"subject": ["S1"], "leg_width_m": [0.10]}).to_csv(tmp_path / "subjects.csv",
+                                                                    index=False)
+    t = np.arange(0.0, 1.0, 0.01)
+    xl = np.where(t < 0.2, -0.3, np.where(t > 0.8, 0.3, -0.3 + (t - 0.2) / 0.6 * 0.6))
+    legs = pd.concat([pd.DataFrame({"t_s": t, "side": "L", "x_m": xl, "y_m": 0.02}),
+                      pd.DataFrame({"t_s": t, "side": "R", "x_m": 0.0, "y_m": -0.02})])
+    legs.to_parquet(d / "legs.parquet")
+    pd.DataFrame({"t_s": [0.2, 0.8], "event": ["foot_off", "foot_contact"], "side": ["L", "L"],
+                  "label": ["", "walk"], "x_m": [np.nan, 0.3], "y_m": [np.nan, 0.02]}
+                 ).to_csv(d / "events.csv", index=False)
+    sc = legs.rename(columns={"t_s": "t_mocap_s"}).assign(scan=lambda f: (f["t_mocap_s"] * 100
+                                                                           ).round().astype(int))
+    sc.to_parquet(d / "scans_legs.parquet")
+    mins, n_close, n_scans = contact_stats(tmp_path, "x_t1")
+    assert len(mins) == 1 and mins[0] == pytest.approx(0.4, abs=0.05)
+    assert n_scans == 100 and 0 < n_close < 100

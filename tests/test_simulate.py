@@ -408,3 +408,154 @@ def test_simulated_shin_speed_profile_matches_real_walks(realdata):
             assert m[k] == pytest.approx(ref[k], rel=0.15), (group, k, m[k], ref[k])
         assert m["stance_norm"] == pytest.approx(ref["stance_norm"], rel=0.30), group
         assert m["p99_norm"] < 1.2 * ref["p99_norm"], group
+
+
+# ----------------------------------------------------------------- contact physics
+def _built_trials(preset):
+    """Every LRS trial of ``preset`` as built (TrialSim), without rendering."""
+    from gaitval.simulate import study as S
+    cfg = load_preset(preset)
+    seed = int(cfg["seed"])
+    for idx, proto, build, bargs, _subj, _drift in S._lrs_tasks(cfg, cfg["study"], seed, []):
+        yield proto, build(S._rng(seed, 3, idx), *bargs)
+
+
+@pytest.mark.parametrize("preset", ["tiny", "default"])
+def test_two_shanks_never_overlap(preset):
+    """Issue 34: in every swing of every TUG, MTST and rollator trial the two shank
+    centres at sensor height stay at least 0.95 leg widths apart (the old straight swings
+    came to 0.05 leg widths: 112 of 391 TUG swings of the default study overlapped), and
+    the turn to sit has no cross step."""
+    seen = set()
+    for proto, sim in _built_trials(preset):
+        w = sim.walker
+        t = np.arange(0.0, sim.t_end_s, 0.005)
+        L, R = w.legs(t)
+        d = np.hypot(*(L.point_at_height(sim.sensor_height_m)
+                       - R.point_at_height(sim.sensor_height_m)).T)
+        p = w.plan
+        n = 0
+        for a, b in zip(p.t_off, p.t_contact):
+            m = (t >= a) & (t <= b)
+            if np.isfinite(a) and m.any():
+                assert d[m].min() >= 0.95 * w.leg_width_m, (sim.trial, a, b, d[m].min())
+                n += 1
+        assert n >= 6, sim.trial
+        assert d.min() >= 0.95 * w.leg_width_m, sim.trial      # double support too
+        if proto == "tug":
+            tts = p.label.astype(str) == "turn_to_sit"
+            assert tts.sum() >= 3 and not p.cross[tts].any(), sim.trial
+        seen.add(proto)
+    assert seen == {"tug", "mtst", "rollator"}
+
+
+def _cross_plan(gp):
+    """Three contacts by hand: the right foot stands at the origin and the left foot
+    swings from behind-right of it to ahead-left of it, its straight chord right through
+    the standing foot (a cross step back to its own side)."""
+    from gaitval.simulate.kinematics import plan_from_footholds
+    xy = np.array([[-0.30, -0.06], [0.0, 0.0], [0.32, 0.06]])
+    sides = np.array([0, 1, 0])
+    tc = np.array([-np.inf, -np.inf, 1.2])
+    return plan_from_footholds(sides, tc, xy, np.zeros(3), np.array(["walk"] * 3, dtype=object),
+                               np.array([0.5]), gp, 0.7)
+
+
+def test_a_swing_bends_around_the_standing_shank():
+    """The path model (gaitval.simulate.contact): the straight swing would pass through the
+    standing leg; the planned swing keeps one leg width plus the clearance, lifts off and
+    lands where the plan says, and passes beside the standing leg (not over it)."""
+    from gaitval.simulate.contact import CONTACT_CLEARANCE_M, swing_detours
+    from gaitval.simulate.scene import Walker
+    gp = GaitParams(step_length_m=0.6, step_width_m=0.10, step_time_s=0.5)
+    plan = _cross_plan(gp)
+    t = np.linspace(0.7, 1.2, 101)
+    fn = lambda p, s, tt: leg_kinematics(p, s, tt, gp)      # noqa: E731
+
+    def closest(pl):
+        a, b = (fn(pl, s, t).point_at_height(0.27) for s in (0, 1))
+        return float(np.hypot(*(a - b).T).min())
+
+    assert closest(plan) < 0.03                                # straight: through the leg
+    det = swing_detours(plan, fn, 0.10, heights=(0.24, 0.27, 0.30))
+    assert det[2, 0] > 0.0 and (det[:2] == 0).all()
+    bent = plan.with_detours(det)
+    assert closest(bent) >= 0.10 + CONTACT_CLEARANCE_M - 1e-3
+    # lift-off and landing unchanged: the detour vanishes at both ends of the swing
+    for tt in (0.7, 1.2):
+        a0 = fn(plan, 0, np.array([tt])).ankle
+        a1 = fn(bent, 0, np.array([tt])).ankle
+        assert np.allclose(a0, a1)
+    # the Walker does the same by itself, at its sensor height
+    w = Walker(plan=plan, gp=gp, leg_width_m=0.10, sensor_height_m=0.27)
+    assert w.plan.detour is not None and w.plan.detour[2, 0] > 0.0
+    assert closest(w.plan) >= 0.95 * 0.10
+
+
+def test_swings_clear_of_the_standing_leg_are_left_straight():
+    """Steps at a normal width need no detour: the path model changes nothing there."""
+    from gaitval.simulate.scene import Walker
+    gp = GaitParams(step_length_m=0.7, step_width_m=0.14, step_time_s=0.5, place_sd_m=0.0)
+    path = make_path((0.0, 0.0), 0.0, [("line", 4.0, "walk")])
+    plan = plan_steps(path, gp, np.random.default_rng(1), t0=0.5)
+    w = Walker(plan=plan, gp=gp, leg_width_m=0.10)
+    assert (w.plan.detour == 0).all()
+    assert np.array_equal(w.plan.xy, plan.xy)
+
+
+# ----------------------------------------------------------------- free choices of the twin
+@pytest.mark.parametrize("preset, key, value", [
+    ("mtst_sensor_beside", "sensor_nominal_pose", [2.0, 1.6, -np.pi / 2]),
+    ("mtst_attendant_left", "attendant", {"side": "left", "lateral_m": 0.75, "behind_m": 0.25}),
+])
+def test_sensitivity_presets_change_one_choice(preset, key, value):
+    """Issue 34: each sensitivity preset is the default study with one MTST choice changed
+    (same seed, participants and trials; the ultrasonic protocol left out)."""
+    d, p = load_preset("default"), load_preset(preset)
+    assert p["seed"] == d["seed"] and p["tug"] == d["tug"] and p["rollator"] == d["rollator"]
+    assert "ultrasonic" not in p
+    changed = {k for k in set(d["mtst"]) | set(p["mtst"]) if d["mtst"].get(k) != p["mtst"].get(k)}
+    assert changed == {key}
+    assert np.allclose(p["mtst"][key], value) if key != "attendant" else p["mtst"][key] == value
+
+
+def test_attendant_side_moves_the_attendant_only():
+    """The attendant's side is read from the preset: mirrored across the mat, the
+    participant's own plan unchanged; an unknown side is a ConfigError."""
+    from gaitval.simulate import study as S
+    cfg = load_preset("tiny")
+    seed = int(cfg["seed"])
+    tasks = [t for t in S._lrs_tasks(cfg, "tiny", seed, []) if t[1] == "mtst"]
+    idx, _, build, bargs, _, _ = tasks[0]
+    right = build(S._rng(seed, 3, idx), *bargs)
+    args = list(bargs)
+    args[6] = {**bargs[6], "attendant": {"side": "left"}}
+    left = build(S._rng(seed, 3, idx), *args)
+    assert np.array_equal(right.walker.plan.xy, left.walker.plan.xy)
+    assert np.median(right.attendant.plan.xy[:, 1]) < -0.5 < 0.5 < np.median(
+        left.attendant.plan.xy[:, 1])
+    args[6] = {**bargs[6], "attendant": {"side": "behind"}}
+    with pytest.raises(ConfigError, match="attendant.side"):
+        build(S._rng(seed, 3, idx), *args)
+
+
+def test_sensitivity_table_names_the_flips(tmp_path):
+    from gaitval.tables.sensitivity import sensitivity_table
+    cols = ["study", "comparison", "source", "published", "reproduced", "criterion",
+            "reproduced_in_direction", "note"]
+    rows = [["mtst", "Success M1", "Table 3", "0.96", "0.63", "ci", "no", ""],
+            ["mtst", "Success M2", "Table 3", "0.92", "0.90", "ci", "yes", ""]]
+    for name, v in (("ref", ["no", "yes"]), ("alt", ["yes", "yes"])):
+        (tmp_path / name).mkdir()
+        df = pd.DataFrame(rows, columns=cols).assign(reproduced_in_direction=v)
+        df.to_csv(tmp_path / name / "verdicts.csv", index=False)
+    t = sensitivity_table([tmp_path / "ref", tmp_path / "alt"])
+    assert list(t["flips_under"]) == ["alt", ""]
+    assert list(t["alt_verdict"]) == ["yes", "yes"]
+    # a verdict the alternative does not compute is "absent", not a flip
+    pd.DataFrame(rows[:1], columns=cols).to_csv(tmp_path / "alt" / "verdicts.csv", index=False)
+    t = sensitivity_table([tmp_path / "ref", tmp_path / "alt"])
+    assert list(t["alt_verdict"]) == ["no", "absent"]
+    assert list(t["flips_under"]) == ["", ""] and list(t["absent_in"]) == ["", "alt"]
+    with pytest.raises(GaitvalError, match="verdicts.csv"):
+        sensitivity_table([tmp_path / "ref", tmp_path / "nothing"])

@@ -134,6 +134,8 @@ class StepPlan:
     ``t_contact``, ``t_off`` (lift-off time of this foot *before* this contact; NaN for
     the initial stance), ``xy`` (n, 2), ``heading`` (n,), ``label`` (path label),
     ``cross`` (True when the foot landed across the line of the other, stance foot).
+    ``detour`` (n, 4), optional: per contact the sideways detour of the swing that ends
+    there, ``b, tau_c, n_x, n_y`` (:mod:`gaitval.simulate.contact`; None: straight swings).
     """
 
     side: np.ndarray
@@ -145,11 +147,23 @@ class StepPlan:
     cross: np.ndarray
     t_start: float
     t_end: float
+    detour: np.ndarray | None = None
 
     def foot(self, side: int) -> dict:
         m = self.side == side
-        return {k: getattr(self, k)[m] for k in ("t_contact", "t_off", "xy", "heading",
-                                                   "label", "cross")}
+        out = {k: getattr(self, k)[m] for k in ("t_contact", "t_off", "xy", "heading",
+                                                  "label", "cross")}
+        out["detour"] = (np.zeros((int(m.sum()), 4)) if self.detour is None
+                         else self.detour[m])
+        return out
+
+    def with_detours(self, detour: np.ndarray | None) -> "StepPlan":
+        """The same plan whose swings take the detours ``detour`` (None: straight)."""
+        from dataclasses import replace
+        return replace(self, detour=None if detour is None else np.asarray(detour, float))
+
+    def without_detours(self) -> "StepPlan":
+        return self.with_detours(None)
 
 
 @dataclass
@@ -222,21 +236,44 @@ def _walk_path(fh: _Footholds, path: Path2D, gp: GaitParams, rng: np.random.Gene
 
 
 def _pivot_steps(fh: _Footholds, path: Path2D, gp: GaitParams, rng: np.random.Generator,
-                 t: float, side: int, end_pose: tuple, label=None) -> tuple[float, int]:
+                 t: float, side: int, end_pose: tuple, label=None,
+                 end_half_width: float | None = None) -> tuple[float, int]:
     """After the path, pivot in ``n_steps`` small steps to ``end_pose`` (turn to sit, TUG);
-    the steps carry ``label`` (default: the path's last label)."""
+    the steps carry ``label`` (default: the path's last label).
+
+    The body's centre moves from between the last two footholds to ``(x, y)`` while its
+    heading turns to ``heading`` in equal parts; each foot lands beside the centre on its
+    own side, ``end_half_width`` from it (one turns on the spot with the feet about hip
+    width apart, and they end there, as before the trial), with placement scatter.  A pivot step
+    never crosses: where the scatter or the turn would set the foot down across the line
+    of the standing foot (the cross-step definition of :func:`plan_from_footholds`), it is
+    set down on its own side, one step width from the standing foot.  Step time: a
+    turning step's (``turn_time_factor × step_time``).
+    """
     ex, ey, eh, n_piv = end_pose
+    hw0 = gp.step_width_m / 2
+    hw1 = hw0 if end_half_width is None else float(end_half_width)
     start_c = 0.5 * (np.array(fh.xy[-1]) + np.array(fh.xy[-2]))
     h_start = fh.hd[-1]
     for j in range(1, int(n_piv) + 1):
         f = j / n_piv
-        c = (1 - f) * start_c + f * np.array([ex, ey])
+        fc = min(1.0, 1.5 * f)            # the body reaches its place by 2/3 of the turn
+        c = (1 - fc) * start_c + fc * np.array([ex, ey])
         h = (1 - f) * h_start + f * eh
         nrm = np.array([-np.sin(h), np.cos(h)])
         sgn = 1.0 if side == 0 else -1.0
-        T = gp.step_time_s * gp.turn_time_factor * 1.2 * (1 + gp.step_cv * rng.standard_normal())
+        T = gp.step_time_s * gp.turn_time_factor * (1 + gp.step_cv * rng.standard_normal())
         t = t + T
-        foot = c + sgn * nrm * gp.step_width_m / 2 + gp.place_sd_m * rng.standard_normal(2)
+        hw = hw1
+        foot = c + sgn * nrm * hw + gp.place_sd_m * rng.standard_normal(2)
+        # no crossover: lateral offset from the standing foot in the frame of the two
+        # feet's mean heading (as plan_from_footholds judges a cross step)
+        other, h_other = np.array(fh.xy[-1]), fh.hd[-1]
+        hb = float(np.angle(np.exp(1j * h_other) + np.exp(1j * h)))
+        nb = np.array([-np.sin(hb), np.cos(hb)])
+        lateral = float((foot - other) @ nb) * sgn
+        if lateral < gp.step_width_m:
+            foot = foot + (gp.step_width_m - lateral) * sgn * nb
         fh.add(side, t, foot, h, path.labels[-1] if label is None else label, T)
         side = 1 - side
     return t, side
@@ -245,7 +282,7 @@ def _pivot_steps(fh: _Footholds, path: Path2D, gp: GaitParams, rng: np.random.Ge
 def plan_steps(path: Path2D, gp: GaitParams, rng: np.random.Generator, *, t0: float = 0.0,
                first_side: int = 1, end_pose: tuple | None = None,
                targets: np.ndarray | None = None, start_half_width: float | None = None,
-               end_label=None) -> StepPlan:
+               end_label=None, end_half_width: float | None = None) -> StepPlan:
     """Footholds and contact times along ``path``.
 
     Parameters
@@ -267,6 +304,9 @@ def plan_steps(path: Path2D, gp: GaitParams, rng: np.random.Generator, *, t0: fl
     end_label : str, optional
         Label of the pivot steps to ``end_pose`` and of the closing step (default: the
         path's last label), e.g. ``turn_to_sit``.
+    end_half_width : float, optional
+        Half distance between the feet after the closing step (default: half step width;
+        the TUG sits down with the feet at hip width, as it started).
 
     Notes
     -----
@@ -281,7 +321,8 @@ def plan_steps(path: Path2D, gp: GaitParams, rng: np.random.Generator, *, t0: fl
     _initial_stance(fh, path, hw)
     t, side = _walk_path(fh, path, gp, rng, t0, first_side, targets)
     if end_pose is not None:
-        t, side = _pivot_steps(fh, path, gp, rng, t, side, end_pose, end_label)
+        t, side = _pivot_steps(fh, path, gp, rng, t, side, end_pose, end_label,
+                               end_half_width)
     # closing step: the trailing foot joins the other one
     h = fh.hd[-1]
     nrm = np.array([-np.sin(h), np.cos(h)])
@@ -289,7 +330,8 @@ def plan_steps(path: Path2D, gp: GaitParams, rng: np.random.Generator, *, t0: fl
     other = np.array(fh.xy[-1])
     T = gp.step_time_s * (1 + gp.step_cv * rng.standard_normal())
     t = t + T
-    fh.add(side, t, other + (2 * sgn * nrm * gp.step_width_m / 2), h, fh.lab[-1], T)
+    hw = gp.step_width_m / 2 if end_half_width is None else float(end_half_width)
+    fh.add(side, t, other + (2 * sgn * nrm * hw), h, fh.lab[-1], T)
 
     return plan_from_footholds(np.array(fh.sides), np.array(fh.tc, dtype=float),
                                np.array(fh.xy), np.array(fh.hd),

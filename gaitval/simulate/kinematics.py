@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from gaitval.simulate.contact import bump as detour_bump
 from gaitval.simulate.footsteps import (GaitParams, Path2D, StepPlan, make_path,
                                         plan_from_footholds, plan_steps)
 
@@ -138,6 +139,7 @@ class _Timeline:
     t_c: np.ndarray
     st_dur: np.ndarray
     stance_prog: np.ndarray
+    detour: np.ndarray | None = None
 
 
 def _timeline(plan: StepPlan, side: int, t: np.ndarray) -> _Timeline:
@@ -159,7 +161,8 @@ def _timeline(plan: StepPlan, side: int, t: np.ndarray) -> _Timeline:
     st_dur = np.where(has_next, off_next - t_c, np.inf)
     stance_prog = np.clip((t - t_c) / np.where(np.isfinite(st_dur), st_dur, 1.0), 0, 1)
     return _Timeline(tc=tc, fxy=fxy, fh=fh, j=j, jn=jn, has_next=has_next, off_next=off_next,
-                     swing=swing, tau=tau, t_c=t_c, st_dur=st_dur, stance_prog=stance_prog)
+                     swing=swing, tau=tau, t_c=t_c, st_dur=st_dur, stance_prog=stance_prog,
+                     detour=f["detour"])
 
 
 def _ankle_path(tl: _Timeline, t: np.ndarray, gp: GaitParams, a_prev: np.ndarray,
@@ -210,6 +213,11 @@ def _ankle_path(tl: _Timeline, t: np.ndarray, gp: GaitParams, a_prev: np.ndarray
     ax = np.where(swing[:, None], toe_off_xy + (land_xy - toe_off_xy) * g[:, None],
                   fxy[j] + (roll_fwd * u ** 3 - gp.rocker_m * k_prev * (1 - w) ** 2)[:, None]
                   * fwd0)
+    if tl.detour is not None and np.any(tl.detour[:, 0] != 0.0):
+        # contact physics: the swing bends around the standing leg (simulate/contact.py)
+        dt = tl.detour[jn]
+        off = np.where(swing, dt[:, 0] * detour_bump(tau, dt[:, 1]), 0.0)
+        ax = ax + off[:, None] * dt[:, 2:4]
     az = gp.ankle_height_m + roll_up * heel
     # swing height: the toe-off rise decays over the first 70 % of swing, plus a clearance
     # arc peaking early in swing (real walks: ankle highest at ≈ 15–25 % of swing)
@@ -290,8 +298,10 @@ def _shank_tilt(tl: _Timeline, t: np.ndarray, gp: GaitParams,
     if posture_tilt is not None:
         # the sit-to-stand lean of the shank belongs to a foot on the floor: it fades out
         # over the pre-swing ramp before the foot's first lift-off (the swing leg's shank
-        # follows its swing) and applies again after the last contact (sitting down)
-        w = np.where(pre, 1.0 - ramp, np.where(post, 1.0, 0.0))
+        # follows its swing) and applies again after the last contact (sitting down),
+        # taken up over 0.25 s: a foot set down while the body already lowers (the TUG's
+        # closing step) leans with it from its contact on, without a jump
+        w = np.where(pre, 1.0 - ramp, np.where(post, _smoothstep((t - t_c) / 0.25), 0.0))
         tilt = tilt + w * posture_tilt
     return tilt
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from gaitval.errors import ConfigError
 from gaitval.simulate.footsteps import first_swing_s
 from gaitval.simulate.kinematics import (GaitParams, StepPlan, make_path, plan_from_footholds,
                                          plan_steps)
@@ -27,6 +28,10 @@ COLORS = ("red", "blue", "white")
 #: calibration poles (field frame); in :func:`mtst_calibration` the one at the smaller beam
 #: angle of the nominal sensor (beyond the goal, facing the walker) comes first
 POLES_M = ((3.0, 1.35), (5.6, -1.3))
+#: The nursing attendant's place (seed 001: "walked alongside the participant"; side and
+#: distance are the twin's choice): side of the walker, distance from the mat's centreline
+#: and how far behind the participant's start the attendant starts (m).
+ATTENDANT_DEFAULT = {"side": "right", "lateral_m": 0.75, "behind_m": 0.25}
 #: where each trial's target layout is written, relative to the study folder
 TARGETS_FILE = "targets/{trial}.targets.csv"
 
@@ -151,23 +156,34 @@ def build_mtst(rng, study, subj, gp, trial, rep, sensor_pose, cfg, color, stick,
                attendant_gp) -> TrialSim:
     """MTST trial: start → goal along the mat stepping on the assigned colour, attendant beside.
 
-    The LRS stands 1.0 m beyond the goal end of the mat facing the walker (x = 6.85 m,
-    yaw = π nominal).  The nursing attendant walks 0.75 m to the participant's right,
-    0.25 m behind, at the participant's speed.
+    The LRS stands where ``cfg["sensor_nominal_pose"]`` puts it (default preset: 1.0 m
+    beyond the goal end of the mat facing the walker, x = 6.85 m, yaw = π).  The nursing
+    attendant walks ``cfg["attendant"]`` (default: ``side: right``, ``lateral_m: 0.75``
+    from the mat's centreline, ``behind_m: 0.25`` behind the participant's start) at the
+    participant's speed.  Both are free choices of the twin (seed 001 states neither;
+    ``docs/simulator.md``).
     """
     targets = mtst_targets(rng)
     t0 = float(rng.uniform(0.6, 1.0))
     plan, which = plan_mtst(rng, gp, targets, color, t0)
     walker = Walker(plan=plan, gp=gp, leg_width_m=subj["leg_width_m"],
+                    sensor_height_m=cfg["sensor_height_m"],
                     stick_side=(1 if stick else None))
     # attendant: same path shifted, own gait, same speed
     agp = attendant_gp
     dur = plan.t_end - t0
     n_att = max(2, int(round((MAT_LENGTH + 0.7) / agp.step_length_m)))
     agp = GaitParams(**{**agp.__dict__, "step_time_s": dur / (n_att + 1)})
-    apath = make_path((-0.6, -0.75), 0.0, [("line", MAT_LENGTH + 0.7, "walk")])
+    att = {**ATTENDANT_DEFAULT, **(cfg.get("attendant") or {})}
+    if att["side"] not in ("right", "left"):
+        raise ConfigError(f"mtst.attendant.side must be 'right' or 'left', got {att['side']!r}",
+                          hint="config/studies/<preset>.yaml")
+    ay = (-1.0 if att["side"] == "right" else 1.0) * float(att["lateral_m"])
+    apath = make_path((-0.35 - float(att["behind_m"]), ay), 0.0,
+                      [("line", MAT_LENGTH + 0.7, "walk")])
     aplan = plan_steps(apath, agp, rng, t0=t0 + 0.1, first_side=int(rng.integers(0, 2)))
-    attendant = Walker(plan=aplan, gp=agp, leg_width_m=0.11)
+    attendant = Walker(plan=aplan, gp=agp, leg_width_m=0.11,
+                       sensor_height_m=cfg["sensor_height_m"])
     poles = np.array([POLES_M[1], POLES_M[0]])
     circles = [(x, y, POLE_RADIUS_M, ID_POLE) for x, y in poles]
     t_end = plan.t_end + float(rng.uniform(0.8, 1.2))

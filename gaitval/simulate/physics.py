@@ -37,6 +37,20 @@ tug_marker_clearance      closest approach of a shank's surface to the marker co
                           during the turn (the legs go around it, not through it); pass: > 0
 tug_turn_radius           mean distance of the turning footholds from the marker; no
                           published value (shown; the clearance row is its check)
+shank_clearance           per protocol: per swing, the closest the two shank centres come
+                          (truth legs at sensor height, mocap rate) ÷ the subject's leg
+                          width; value: the smallest over all swings (issue 34: a swing
+                          shank goes around the standing one); pass: ≥ 0.95 in every swing
+                          (:data:`SHANK_CLEARANCE_MIN`; the note counts swings below it)
+shank_overlap_scans       per protocol: fraction of scans (truth ``scans_legs``, inside the
+                          capture) whose two shank centres are closer than 0.95 × leg
+                          width; reference 0; pass: 0
+tug_sit_foot_separation   per TUG trial, |distance between the shank centres when seated
+                          at the end − the same at the start| (feet back at hip width, as
+                          when the trial began); value: the worst trial; pass: ≤
+                          :data:`SIT_SEPARATION_TOL_M`
+tug_turn_to_sit_cross     cross steps among the turn-to-sit steps (people pivot without
+                          crossing the legs); reference 0; pass: 0
 mtst_cross_steps          cross steps per 100 steps from the twin's truth footfalls vs seed 001
                           Table 4 (19 of 414 = 4.6); pass: inside the exact 95 % Poisson
                           interval of 19 counts (2.8–7.2 per 100)
@@ -88,6 +102,13 @@ OCCLUSION_FACTOR = 1.5
 #: Final 180° turn (turn to sit) of the instrumented TUG, healthy controls: mean, SD (s).
 TURN_TO_SIT_S = (1.7, 0.5)
 RETURN_OFFSET_MAX_M = 0.25
+#: Issue 34 (stated before the contact model was written): the two shank centres at sensor
+#: height never come closer than this many leg widths in any swing (two 10 cm sections
+#: touch at 1.0; 5 % for soft tissue and trouser cloth), and no scan has them closer.
+SHANK_CLEARANCE_MIN = 0.95
+#: Issue 34: feet back at hip width when seated: the end's shank-centre distance within
+#: this of the start's (m), worst trial.
+SIT_SEPARATION_TOL_M = 0.05
 #: seed 001 Table 4: cross steps, steps.
 MTST_CROSS = (19, 414)
 #: seed 003 Table 2, reference system: per-subject stride-length SD range (m).
@@ -316,6 +337,93 @@ def _tug_path_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
     return rows
 
 
+def _contact_rows(study_dir: Path, trials: pd.DataFrame, stats: dict) -> list[dict]:
+    """Shank clearance per swing and overlapping scans, per protocol (issue 34)."""
+    rows = []
+    for proto, g in trials.groupby("protocol", sort=True):
+        per_swing = np.concatenate([stats[t][0] for t in g["trial"]])
+        n_close = sum(stats[t][1] for t in g["trial"])
+        n_scans = sum(stats[t][2] for t in g["trial"])
+        bad = int(np.sum(per_swing < SHANK_CLEARANCE_MIN))
+        rows.append(_row("shank_clearance", proto,
+                         float(per_swing.min()) if len(per_swing) else np.nan, 1.0,
+                         SHANK_CLEARANCE_MIN, None, "leg widths",
+                         f"≥ {SHANK_CLEARANCE_MIN} × leg width in every swing",
+                         "physics: a swinging shank passes the standing one, it does not go "
+                         "through it (issue 34)", group=GROUP_OF.get(proto, ""),
+                         note=f"{bad} of {len(per_swing)} swings closer than "
+                              f"{SHANK_CLEARANCE_MIN} leg widths; median closest "
+                              f"{np.median(per_swing) if len(per_swing) else np.nan:.2f}"))
+        rows.append(_row("shank_overlap_scans", proto, n_close / max(n_scans, 1), 0.0, None,
+                         0.0, "fraction", "0 (no scan)",
+                         "physics: two shanks never overlap (issue 34)",
+                         group=GROUP_OF.get(proto, ""),
+                         note=f"{n_close} of {n_scans} scans with shank centres closer than "
+                              f"{SHANK_CLEARANCE_MIN} leg widths"))
+    return rows
+
+
+def contact_stats(study_dir: Path, trial: str) -> tuple[np.ndarray, int, int]:
+    """One trial's contact statistics from its truth: per complete swing the closest
+    shank-centre distance ÷ leg width (legs at sensor height, mocap rate), and the number
+    of scans with the centres closer than :data:`SHANK_CLEARANCE_MIN` leg widths, of all
+    scans inside the capture."""
+    from gaitval.simulate.swings import swings
+
+    d = Path(study_dir) / "truth" / trial
+    tr = pd.read_csv(Path(study_dir) / "trials.csv").set_index("trial")
+    subj = pd.read_csv(Path(study_dir) / "subjects.csv").set_index("subject")
+    w = float(subj.loc[tr.loc[trial, "subject"], "leg_width_m"])
+    legs = pd.read_parquet(d / "legs.parquet")
+    ev = pd.read_csv(d / "events.csv")
+    L = legs[legs["side"] == "L"].sort_values("t_s")
+    R = legs[legs["side"] == "R"].sort_values("t_s")
+    t = L["t_s"].to_numpy(float)
+    dist = np.hypot(*(L[["x_m", "y_m"]].to_numpy(float) - R[["x_m", "y_m"]].to_numpy(float)).T)
+    mins = []
+    for side in ("L", "R"):
+        for a, b in swings(ev, side):
+            m = (t >= a) & (t <= b)
+            if m.any():
+                mins.append(float(dist[m].min()) / w)
+    s = pd.read_parquet(d / "scans_legs.parquet")
+    s = s[(s["t_mocap_s"] >= 0) & (s["t_mocap_s"] <= float(t.max()))]
+    p = s.pivot_table(index="scan", columns="side", values=["x_m", "y_m"], aggfunc="first")
+    ds = np.hypot(p[("x_m", "L")] - p[("x_m", "R")], p[("y_m", "L")] - p[("y_m", "R")])
+    return np.array(mins), int(np.sum(ds.to_numpy(float) < SHANK_CLEARANCE_MIN * w)), len(ds)
+
+
+def _tug_sit_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
+    """Feet back at hip width when seated, and no cross step in the turn to sit (issue 34)."""
+    seps, n_cross, n_tts = [], 0, 0
+    for t in trials["trial"]:
+        d = study_dir / "truth" / t
+        legs = pd.read_parquet(d / "legs.parquet")
+        first = legs[legs["t_s"] == legs["t_s"].min()].set_index("side")
+        last = legs[legs["t_s"] == legs["t_s"].max()].set_index("side")
+        sep = lambda f: float(np.hypot(f.loc["L", "x_m"] - f.loc["R", "x_m"],
+                                       f.loc["L", "y_m"] - f.loc["R", "y_m"]))
+        seps.append((sep(first), sep(last)))
+        ev = pd.read_csv(d / "events.csv")
+        c = ev[(ev["event"] == "foot_contact") & (ev["label"].astype(str) == "turn_to_sit")]
+        x = ev[ev["event"] == "cross_step"]
+        n_tts += len(c)
+        n_cross += int(np.isin(np.round(x["t_s"].to_numpy(float), 5),
+                               np.round(c["t_s"].to_numpy(float), 5)).sum())
+    seps = np.array(seps) if seps else np.zeros((0, 2))
+    worst = float(np.max(np.abs(seps[:, 1] - seps[:, 0]))) if len(seps) else np.nan
+    return [
+        _row("tug_sit_foot_separation", "tug", worst, 0.0, None, SIT_SEPARATION_TOL_M, "m",
+             f"≤ {SIT_SEPARATION_TOL_M} m (worst trial)",
+             "seated at the end as at the start: feet at hip width (issue 34)", group="young",
+             note=f"shank-centre distance seated at the start {seps[:, 0].mean():.3f} m, at "
+                  f"the end {seps[:, 1].mean():.3f} m (means over {len(seps)} trials)"),
+        _row("tug_turn_to_sit_cross", "tug", n_cross, 0, None, 0, "steps", "0",
+             "people pivot to sit without crossing the legs (issue 34)", group="young",
+             note=f"{n_cross} cross steps of {n_tts} turn-to-sit steps"),
+    ]
+
+
 def _mtst_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
     n_cross = n_steps = 0
     for t in trials["trial"]:
@@ -380,13 +488,15 @@ def physics_table(study_dir: str | Path, walkers: list | None = None,
     names = list(lrs["trial"])
     tasks = [("shin", walkers, realdata if realdata.is_dir() else None),
              ("steps", d, lrs), ("tug_phase", d, tug), ("tug_path", d, tug),
-             ("mtst", d, mtst), ("treadmill", d)] + [("swing", d, t) for t in names]
+             ("tug_sit", d, tug), ("mtst", d, mtst), ("treadmill", d)] + \
+        [("swing", d, t) for t in names] + [("contact", d, t) for t in names]
     out = list(map_fn(_physics_task, tasks))
-    (shin_rows, real), steps, tug_phase, tug_path, mtst_rows, treadmill = out[:6]
-    stats = dict(zip(names, out[6:]))
-    rows = _swing_rows(d, lrs, real, stats) + shin_rows + steps
+    (shin_rows, real), steps, tug_phase, tug_path, tug_sit, mtst_rows, treadmill = out[:7]
+    stats = dict(zip(names, out[7:7 + len(names)]))
+    contact = dict(zip(names, out[7 + len(names):]))
+    rows = _swing_rows(d, lrs, real, stats) + _contact_rows(d, lrs, contact) + shin_rows + steps
     if len(tug):
-        rows += tug_phase + tug_path
+        rows += tug_phase + tug_path + tug_sit
     if len(mtst):
         rows += mtst_rows
     rows += treadmill
@@ -396,11 +506,11 @@ def physics_table(study_dir: str | Path, walkers: list | None = None,
 def _physics_task(task: tuple):
     """One task of :func:`physics_table`: ``(kind, *arguments)``."""
     kind, *args = task
-    if kind in ("tug_phase", "tug_path", "mtst") and not len(args[1]):
+    if kind in ("tug_phase", "tug_path", "tug_sit", "mtst") and not len(args[1]):
         return []
     fn = {"shin": _shin_rows, "steps": _step_rows, "tug_phase": _tug_phase_rows,
-          "tug_path": _tug_path_rows, "mtst": _mtst_rows, "treadmill": _treadmill_rows,
-          "swing": swing_stats}[kind]
+          "tug_path": _tug_path_rows, "tug_sit": _tug_sit_rows, "mtst": _mtst_rows,
+          "treadmill": _treadmill_rows, "swing": swing_stats, "contact": contact_stats}[kind]
     return fn(*args)
 
 

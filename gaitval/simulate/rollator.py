@@ -60,7 +60,8 @@ def build_rollator(rng, study, subj, gp, trial, rep, scenario, cfg) -> TrialSim:
     path = rollator_path(scenario)
     t0 = float(rng.uniform(0.8, 1.2))
     plan = plan_steps(path, gp, rng, t0=t0, first_side=int(rng.integers(0, 2)))
-    walker = Walker(plan=plan, gp=gp, leg_width_m=subj["leg_width_m"])
+    walker = Walker(plan=plan, gp=gp, leg_width_m=subj["leg_width_m"],
+                    sensor_height_m=cfg["sensor_height_m"])
     sway = rng.normal(0, 0.01)
 
     def rpose(t):

@@ -11,6 +11,7 @@ from typing import Callable
 
 import numpy as np
 
+from gaitval.simulate.contact import CHECK_HEIGHTS_REL_M, separate_footholds, swing_detours
 from gaitval.simulate.kinematics import GaitParams, LegState, StepPlan, leg_kinematics
 
 # object ids used in ray-casting truth
@@ -40,6 +41,9 @@ class Walker:
         Extra shank tilt of sit-to-stand (knees move forward as the trunk leans).
     stick_side : int or None
         Hand holding a stick (0 = L, 1 = R); the stick moves with the opposite leg.
+    sensor_height_m : float
+        Height of the scan plane: the two shanks are kept apart there and 3 cm above and
+        below (contact physics, :mod:`gaitval.simulate.contact`).
     """
 
     plan: StepPlan
@@ -48,7 +52,18 @@ class Walker:
     sit: Callable | None = None
     posture_tilt: Callable | None = None
     stick_side: int | None = None
+    sensor_height_m: float = 0.27
     _pelvis_cache: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self):
+        # contact physics: each swing that would pass through the standing leg bends
+        # around it (gaitval.simulate.contact); part of the plan, drawn before any frame
+        if self.plan.detour is None:
+            gp = self.gp
+            fn = lambda p, s, t: leg_kinematics(p, s, t, gp)      # noqa: E731
+            hs = tuple(self.sensor_height_m + dh for dh in CHECK_HEIGHTS_REL_M)
+            plan = separate_footholds(self.plan, fn, self.leg_width_m, hs)
+            self.plan = plan.with_detours(swing_detours(plan, fn, self.leg_width_m, hs))
 
     def legs(self, t: np.ndarray) -> tuple[LegState, LegState]:
         pt = None if self.posture_tilt is None else self.posture_tilt(t)

@@ -29,6 +29,12 @@ MARKER_CLEARANCE_M = 0.05
 TURN_TO_SIT_FROM_M = 0.45
 #: Feet under the chair's front edge when seated (x), on the course axis (y = 0).
 SEAT_X_M = 0.12
+#: Half the distance between the feet when seated, at the start and again at the end (m):
+#: seated people keep the feet about hip width apart.
+SEATED_HALF_WIDTH_M = 0.10
+#: Pivot steps of the turn to sit (180° in equal parts), the closing step not counted:
+#: 60° per step, a turn without crossing the legs (docs/simulator.md, issue 34).
+TURN_TO_SIT_STEPS = 3
 #: The capture ends this long after the participant is seated (s, uniform): the timed
 #: span of the TUG ends when the participant sits (Podsiadlo & Richardson 1991).
 END_AFTER_SEATED_S = (0.1, 0.3)
@@ -83,17 +89,24 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     x = :data:`SEAT_X_M`.  The path (:func:`tug_path`) is out and back around the marker
     at (3, 0): out on the marker's right, a left turn of radius :func:`turn_radius`
     around it, back on the tangent towards the chair.  Where the return line ends
-    (:data:`TURN_TO_SIT_FROM_M` before the seat) the participant turns to sit in two
-    pivot steps that end at the seat facing +x, the other foot joins, and they sit down.
+    (:data:`TURN_TO_SIT_FROM_M` before the seat) the participant turns to sit in
+    :data:`TURN_TO_SIT_STEPS` pivot steps without crossover that end at the seat facing
+    +x, the other foot joins at hip width (:data:`SEATED_HALF_WIDTH_M`, as at the start),
+    and they sit down: the descent starts as the last pivot step lands (the closing step
+    is taken while lowering).
     """
     t_rise = float(rng.uniform(0.5, 0.9))
     rise_dur = float(rng.normal(0.9, 0.08))
     t0 = t_rise + 0.6 * rise_dur                       # gait initiation during the rise
     path = tug_path(turn_radius(gp, subj["leg_width_m"]))
     plan = plan_steps(path, gp, rng, t0=t0, first_side=int(rng.integers(0, 2)),
-                      end_pose=(SEAT_X_M, 0.0, 2 * np.pi, 2), start_half_width=0.10,
-                      end_label="turn_to_sit")
-    t_sit = plan.t_end + 0.15
+                      end_pose=(SEAT_X_M, 0.0, 2 * np.pi, TURN_TO_SIT_STEPS),
+                      start_half_width=SEATED_HALF_WIDTH_M, end_label="turn_to_sit",
+                      end_half_width=SEATED_HALF_WIDTH_M)
+    # the descent begins as the last pivot step lands: the trailing foot joins while the
+    # body lowers (before issue 34 it began 0.15 s after the closing step; the change
+    # brings the return phase from 4.5 s towards seed 000 Table 4's 3.34 s)
+    t_sit = float(plan.t_contact[-2])
     sit_dur = float(rng.normal(1.0, 0.08))
     t_end = t_sit + sit_dur + float(rng.uniform(*END_AFTER_SEATED_S))
 
@@ -109,6 +122,7 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
         return np.deg2rad(15.0) * (np.sin(np.pi * u) ** 2 + np.sin(np.pi * d) ** 2)
 
     walker = Walker(plan=plan, gp=gp, leg_width_m=subj["leg_width_m"], sit=sit,
+                    sensor_height_m=cfg["sensor_height_m"],
                     posture_tilt=ptilt)
     chair = [(-0.02, 0.22), (-0.02, -0.22), (-0.42, 0.22), (-0.42, -0.22)]
     circles = [(x, y, 0.015, ID_CHAIR) for x, y in chair]
