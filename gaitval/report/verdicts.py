@@ -17,7 +17,7 @@ Outcomes (column ``outcome``):
   of another hypothesis, Table C1's grouping, NS/NV's definition of n — recognised by the
   table's note, so a table that stops saying so is scored again), or the study is too
   small for the comparison (a statistic undefined, or a 95 % interval wider than half
-  the range, which no published value could fall outside of);
+  the range: too wide to test a published value with);
 * ``not run`` — the run has no study with the paper's protocol.
 
 One primary reading per comparison.  TUG's Methods run under two readings of seed 000
@@ -60,7 +60,8 @@ SHORT = {"tug_m1": "M1", "tug_m2": "M2", "tug_m3": "M3", "mtst_m1": "M1", "mtst_
          "mtst_m3": "M3", "mtst_proposed": "proposed"}
 #: TUG: the primary reading of seed000 eq. (3)-(4) (module notes).
 PRIMARY_READING = "swing_first"
-#: A 95 % interval wider than this (as a proportion) cannot fail: too small to compare.
+#: A 95 % interval wider than this (as a proportion) is too wide to test a published
+#: value with: the comparison is "not comparable: too small".
 MAX_CI_WIDTH = 0.5
 #: What a table's notes say when its numbers are not comparable with the paper's.
 NOT_COMPARABLE_NOTE = {"ultrasonic_table7": "not comparable",
@@ -109,9 +110,9 @@ def _proportion_verdict(k, n, published_frac):
         return "no trials", None, "too small: no trials to compare"
     text = f"{_pct(k / n)} ({int(k)}/{int(n)}); {_ci(lo, hi)}"
     if hi - lo > MAX_CI_WIDTH:
-        return text, None, (f"too small: with {int(n)} trial{'s' * (n != 1)} the 95% CI "
-                            f"spans {100 * (hi - lo):.0f} percentage points, so no "
-                            "published value could fall outside it")
+        return text, None, (f"too small: with {int(n)} trial{'s' * (int(n) != 1)} the 95% "
+                            f"CI spans {100 * (hi - lo):.0f} percentage points, too wide "
+                            "to test the paper's value")
     return text, lo <= published_frac <= hi, None
 
 
