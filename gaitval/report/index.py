@@ -161,6 +161,40 @@ def _read_table(csv: Path) -> pd.DataFrame:
     return pd.read_csv(csv)
 
 
+def _md_cells(md_path: Path) -> tuple[list[str], list[list[str]]] | None:
+    """Header and cells of the (first) pipe table of a table's ``.md`` — the strings
+    :func:`gaitval.tables.render.write_table` printed from the typed table, so the HTML
+    shows exactly what the Markdown shows (a CSV read back loses a text column's type)."""
+    if not md_path.is_file():
+        return None
+    header, rows = None, []
+    for ln in md_path.read_text(encoding="utf-8").splitlines():
+        if ln.startswith("| "):
+            cells = [c.strip().replace("\\|", "|")
+                     for c in re.split(r"(?<!\\)\|", ln.strip())[1:-1]]
+            if header is None:
+                header = cells
+            else:
+                rows.append(cells)
+        elif header is not None and not ln.startswith("|---"):
+            break
+    return (header, rows) if header else None
+
+
+def _published_beside(header: list[str], rows: list[list[str]]
+                      ) -> tuple[list[tuple[str, bool]], list[list[str]]]:
+    """Each ``<q>_published`` column moved right after ``<q>``."""
+    cols = [c for c in header if not c.endswith("_published") or c[:-10] not in header]
+    order = []
+    for c in cols:
+        order.append(c)
+        if f"{c}_published" in header:
+            order.append(f"{c}_published")
+    idx = [header.index(c) for c in order]
+    return ([(c, c.endswith("_published")) for c in order],
+            [[r[i] if i < len(r) else "" for i in idx] for r in rows])
+
+
 def display_table(df: pd.DataFrame, table: str | None = None
                   ) -> tuple[list[tuple[str, bool]], list[list[str]]]:
     """Header ``(name, is_published)`` and formatted rows for the HTML report.
@@ -215,12 +249,16 @@ def collect(reports_dir: str | Path, study_names: list[str] | None = None,
     sections = []
     for sec in SECTION_TITLES:
         items = []
-        for p in tables:
-            if _section(p.stem) != sec:
+        expected = EXPECTED_TABLES.get(sec, [])
+        for p in sorted(tables, key=lambda q: (expected.index(q.stem) if q.stem in expected
+                                               else len(expected), q.stem)):
+            if _section(p.stem) != sec:             # the paper's tables first, in order
                 continue
             rel = str(p.relative_to(rd))
             cap, notes = _caption_notes(p.with_suffix(".md"))
-            header, rows = display_table(_read_table(p), p.stem)
+            md_cells = _md_cells(p.with_suffix(".md"))
+            header, rows = (_published_beside(*md_cells) if md_cells else
+                            display_table(_read_table(p), p.stem))
             items.append({"kind": "table", "stem": p.stem, "caption": cap, "notes": notes,
                           "md": (p.with_suffix(".md").read_text(encoding="utf-8").rstrip()
                                  if p.with_suffix(".md").is_file() else ""),

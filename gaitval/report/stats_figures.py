@@ -319,7 +319,8 @@ def write_ultrasonic_figures(gait_params: pd.DataFrame, out_dir: str | Path,
             continue
         paths.append(bland_altman_figure(
             sub, "reference", "system", out_dir / f"ultrasonic_bland_altman_{p}.png",
-            title=f"Bland-Altman: {_label(p)}, {speed} speed", unit=PARAM_INFO[p][2],
+            title=f"Bland-Altman: {p.replace('_', ' ')} {PARAM_INFO[p][0]}, {speed} speed",
+            unit=PARAM_INFO[p][2],
             subject="subject", limits=limits[limits["parameter"] == p].iloc[0],
             published=published_bias(p) if speed == "normal" else None))
     return paths

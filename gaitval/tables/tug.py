@@ -237,8 +237,9 @@ def tug_table4(frames, summaries, definitions: Mapping | None = None) -> pd.Data
     -------
     DataFrame
         One row per method and TUG phase (forward, turning, return, total):
-        ``method, base_method, phase_reading, label, tug_phase, n_success_trials, n_uo,
-        n_steps, occlusion_rate, rmse_x_m, rmse_y_m`` and the ``*_published`` columns.
+        ``method, phase_reading, label, tug_phase, n_success_trials, n_uo, n_steps,
+        occlusion_rate, rmse_x_m, rmse_y_m``, the ``*_published`` columns and
+        ``base_method`` last.
     """
     f, s = _concat(frames), _concat(summaries)
     good = _success_frames(f, s)
@@ -263,8 +264,10 @@ def tug_table4(frames, summaries, definitions: Mapping | None = None) -> pd.Data
                 "rmse_x_m": _rmse(e["err_x_m"]), "rmse_x_m_published": pub[2] if pub else np.nan,
                 "rmse_y_m": _rmse(e["err_y_m"]), "rmse_y_m_published": pub[3] if pub else np.nan,
             })
-    return _tidy_counts(pd.DataFrame(rows), ["n_success_trials_published", "n_uo_published",
-                                             "n_steps_published"])
+    t = _tidy_counts(pd.DataFrame(rows), ["n_success_trials_published", "n_uo_published",
+                                          "n_steps_published"])
+    # results first, the method's base (a definition) last
+    return t[[c for c in t.columns if c != "base_method"] + ["base_method"]]
 
 
 def tug_table5(frames, summaries, definitions: Mapping | None = None) -> pd.DataFrame:
