@@ -107,7 +107,7 @@ def test_a_study_too_small_says_so_instead_of_scoring(tmp_path):
     tug = v[v["study"] == "tug"]
     assert (tug["outcome"] == "not comparable").all()
     assert tug["why"].str.startswith("too small").all()
-    assert "TUG leg tracking (seed 000): 0 of 0 comparable comparisons reproduced; 4 not " \
+    assert "TUG leg tracking (seed 000): no comparison could be scored; 4 not " \
            "comparable" in summary_lines(v)[0]
     # build_verdicts needs ultrasonic_table8 for the ultrasonic builder: C1 alone is not run
     from gaitval.report.verdicts import ultrasonic_verdicts

@@ -129,6 +129,14 @@ def headline(studies: list[StudyData]) -> list[str]:
     if not studies:
         return ["Data: no study named (an index built outside the workflow)."]
     out = ["Data: " + "; ".join(f"**{s.name}**: {s.label}" for s in studies) + "."]
+    for s in studies:
+        small = [paper for paper, protos in PAPER_PROTOCOLS.items()
+                 if any(p in s.sizes for p in protos) and max(
+                     s.sizes[p][0] for p in protos if p in s.sizes) < PAPER_SIZE[paper][0]]
+        if small:
+            out.append(f"**{s.name}** has fewer subjects than the paper for "
+                       f"{', '.join(small)}: a comparison it is too small for is reported "
+                       "as _not comparable (too small)_, and the others rest on few walks.")
     kinds = dict.fromkeys(s.kind for s in studies)
     out += [MEANING[k] for k in kinds if k in MEANING]
     if any(k == "unknown" for k in kinds):

@@ -24,7 +24,6 @@ import re
 from pathlib import Path
 
 import jinja2
-import numpy as np
 import pandas as pd
 
 from gaitval import __version__

@@ -63,6 +63,12 @@ PRIMARY_READING = "swing_first"
 #: A 95 % interval wider than this (as a proportion) is too wide to test a published
 #: value with: the comparison is "not comparable: too small".
 MAX_CI_WIDTH = 0.5
+#: Fewer tracking-success trials than this: an RMSE compares single walks (TUG Tables 4-5).
+MIN_SUCCESS_TRIALS = 2
+#: Fewer subjects than this: a paired t-test (ultrasonic Table 8) has under 2 degrees of
+#: freedom, a "most subject × scenario cells" majority (rollator Table I) is one subject's.
+MIN_SUBJECTS_T = 3
+MIN_SUBJECTS_CELLS = 2
 #: What a table's notes say when its numbers are not comparable with the paper's.
 NOT_COMPARABLE_NOTE = {"ultrasonic_table7": "not comparable",
                        "ultrasonic_tableC1": "by design",
@@ -242,7 +248,14 @@ def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[
         def fmt(x3, x2, y3, y2):
             return f"x {x3:.3f} vs {x2:.3f} m, y {y3:.3f} vs {y2:.3f} m"
         finite = np.isfinite([a.rmse_x_m, b.rmse_x_m, a.rmse_y_m, b.rmse_y_m]).all()
-        if finite:
+        g3 = t3[t3["phase_reading"] == primary].set_index("base_method")
+        n_ok = {m: int(g3.loc[m, "n_success"]) for m in ("tug_m2", "tug_m3") if m in g3.index}
+        if finite and n_ok and min(n_ok.values()) < MIN_SUCCESS_TRIALS:
+            ok, rep = None, fmt(a.rmse_x_m, b.rmse_x_m, a.rmse_y_m, b.rmse_y_m)
+            why = (f"too small: an RMSE over {min(n_ok.values())} tracking-success trial(s) "
+                   f"(M2 {n_ok.get('tug_m2', 0)}, M3 {n_ok.get('tug_m3', 0)}; the paper: 25 "
+                   "and 27) compares single walks, not the methods")
+        elif finite:
             ok = bool(a.rmse_x_m < b.rmse_x_m and a.rmse_y_m < b.rmse_y_m)
             lower = [ax for ax in ("x", "y") if a[f"rmse_{ax}_m"] < b[f"rmse_{ax}_m"]]
             n_steps = ("time_steps" if "time_steps" in d else "n_steps")
@@ -372,12 +385,17 @@ def rollator_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> 
             n_pub, n_rep = int((pp < pk)[mp].sum()), int((rp < rk)[mr].sum())
             nr = int(mr.sum())
             ok = ((n_rep * 2 > nr) == (n_pub * 2 > int(mp.sum()))) if nr else None
+            n_subj = int(d.loc[mr, "subject_no"].nunique())
             if not nr:
                 why = "too small: no cell with both trackers' errors"
+            elif n_subj < MIN_SUBJECTS_CELLS:
+                ok = None
+                why = (f"too small: {nr} cell(s) of {n_subj} subject; the paper's majority "
+                       "is over 4 subjects × 2 scenarios")
             else:
                 worse = d[mr & (rp >= rk)]
                 why = (f"PF lower in {n_rep} of {nr} cells (paper {n_pub} of {int(mp.sum())})"
-                       + (f"; PF not lower for subject/scenario "
+                       + ("; PF not lower for subject/scenario "
                           + ", ".join(f"{int(a)}/{int(b)}" for a, b in
                                       zip(worse["subject_no"], worse["scenario_no"].fillna(0)))
                           if len(worse) and not ok else "") + ".")
@@ -488,8 +506,11 @@ def ultrasonic_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -
                              for s in ("slow", "fast"))
         same = all((np.sign(pub[s] - pub["normal"]) == np.sign(rep[s] - rep["normal"]))
                    and ((p_pub[s] < 0.05) == (p_rep[s] < 0.05)) for s in ("slow", "fast"))
-        small_t = (None if np.isfinite(list(p_rep.values())).all() else
-                   "too small: the paired t-test needs two subjects with both speeds")
+        n_subj = int(getattr(r, "n_subjects", MIN_SUBJECTS_T))
+        small_t = (None if np.isfinite(list(p_rep.values())).all()
+                   and n_subj >= MIN_SUBJECTS_T else
+                   f"too small: a paired t-test on {n_subj} subject(s) has "
+                   f"{max(n_subj - 1, 0)} degree(s) of freedom (the paper: 10 subjects)")
         differ = [s for s in ("slow", "fast")
                   if not ((np.sign(pub[s] - pub["normal"]) == np.sign(rep[s] - rep["normal"]))
                           and ((p_pub[s] < 0.05) == (p_rep[s] < 0.05)))]
@@ -599,7 +620,8 @@ def summary_lines(v: pd.DataFrame) -> list[str]:
         yes, no, nc = (int(c.get(k, 0)) for k in ("reproduced", "not reproduced",
                                                    "not comparable"))
         data = str(g["data"].iloc[0])
-        line = f"{name}: {yes} of {yes + no} comparable comparisons reproduced"
+        line = (f"{name}: {yes} of {yes + no} comparable comparisons reproduced"
+                if yes + no else f"{name}: no comparison could be scored")
         line += f"; {nc} not comparable" if nc else ""
         line += f" — on {data}." if data else "."
         out.append(line)
