@@ -37,8 +37,11 @@ def test_bland_altman_draws_the_published_line_and_transparent_points(tmp_path, 
         from matplotlib.collections import PathCollection
         seen["alphas"] = {c.get_alpha() for c in ax.collections
                           if isinstance(c, PathCollection)}          # the scatter points
-        seen["labels"] = [t.get_text() for t in ax.get_legend().get_texts()]
+        from matplotlib.legend import Legend
+        legends = [a for a in ax.findobj(Legend)]
+        seen["labels"] = [t.get_text() for leg in legends for t in leg.get_texts()]
         seen["title"] = ax.get_title()
+
         return real(fig, path)
 
     monkeypatch.setattr(sf, "save_figure", spy)
@@ -49,6 +52,42 @@ def test_bland_altman_draws_the_published_line_and_transparent_points(tmp_path, 
     assert "published bias (Table X)" in seen["labels"]
     assert {"S0", "S5", "repeated-measures bias"} <= set(seen["labels"])
     assert "no published limits of agreement" in seen["title"]
+
+
+def test_bland_altman_in_display_unit_with_legends_below(tmp_path, monkeypatch):
+    """Issue 35: limits in the quantity's display unit (mm for a length in m), fixed
+    decimals in the title (no 0.00907-style metres), legends below the plot; pooled and
+    repeated-measures lines in different styles."""
+    rng = np.random.default_rng(1)
+    n = 200
+    df = pd.DataFrame({"subject": [f"S{i % 5}" for i in range(n)],
+                       "ref": rng.normal(1.3, 0.05, n)})
+    df["pro"] = df["ref"] + rng.normal(0.017, 0.013, n)          # metres
+    seen = {}
+    real = sf.save_figure
+
+    def spy(fig, path):
+        ax = fig.axes[0]
+        from matplotlib.legend import Legend
+        seen["title"], seen["ylabel"] = ax.get_title(), ax.get_ylabel()
+        seen["legends"] = [leg for leg in ax.findobj(Legend)]
+        seen["styles"] = {ln.get_label(): (ln.get_linestyle(), ln.get_color())
+                          for ln in ax.get_lines()}
+        return real(fig, path)
+
+    monkeypatch.setattr(sf, "save_figure", spy)
+    sf.bland_altman_figure(df, "ref", "pro", tmp_path / "ba.png", subject="subject",
+                           unit="m")
+    assert seen["ylabel"] == "system - reference (mm)"
+    bias = float(seen["title"].split("pooled: bias ")[1].split(" mm")[0])
+    assert 10 < bias < 25 and "e-0" not in seen["title"]           # mm, not 0.017 m
+    assert len(seen["legends"]) == 2
+    for leg in seen["legends"]:                                    # below the axes
+        assert leg.get_bbox_to_anchor().transformed(
+            seen["legends"][0].axes.transAxes.inverted()).y0 < 0
+    pooled = seen["styles"]["pooled limits (strides independent)"]
+    rm = seen["styles"]["repeated-measures limits (subjects random)"]
+    assert pooled != rm
 
 
 def test_tug_figure_picks_a_successful_and_a_failed_trial():

@@ -1,15 +1,21 @@
 """``reports/index.md`` and ``reports/index.html``: every table and figure with provenance.
 
-Both files are rendered from one content model (:func:`collect`): the verdict table on top
-(:mod:`gaitval.report.verdicts`), then every table under ``reports/tables`` and figure under
-``reports/figures`` grouped by protocol, each table with its caption, its notes (parsed from
-the table's ``.md``), its file links and the provenance record of the step that made it
-(:mod:`gaitval.report.provenance`), and, for honesty, the paper tables not produced yet
-(in the sections of the protocols the run produced anything for; the verdict table says
-which papers were not run).
+Both files are rendered from one content model (:func:`collect`): first what the data are
+(:mod:`gaitval.report.datakind`: simulated replica, replay of real mocap or real recordings,
+and what a verdict on them can show), then the verdict table
+(:mod:`gaitval.report.verdicts`: outcome and why), then every table under
+``reports/tables`` and figure under ``reports/figures`` grouped by protocol — the papers'
+results first, the study's ingest and registration tables last, as an appendix — each
+table with its caption, its notes (parsed from the table's ``.md``), its file links and
+the provenance record of the step that made it (:mod:`gaitval.report.provenance`), each
+figure with its caption (:data:`FIGURE_CAPTIONS`), and, for honesty, the paper tables not
+produced yet (in the sections of the protocols the run produced anything for; the verdict
+table says which papers were not run).
 The Markdown is written directly; the HTML through the jinja2 template
 ``templates/index.html.j2``, with each ``*_published`` column placed right after the
-reproduced column it belongs to and numbers printed at the precision the paper prints.
+reproduced column it belongs to and every number printed by
+:mod:`gaitval.tables.numbers`, so a cell reads the same in the HTML as in the table's
+``.md``.
 """
 from __future__ import annotations
 
@@ -18,13 +24,14 @@ import re
 from pathlib import Path
 
 import jinja2
-import numpy as np
 import pandas as pd
 
 from gaitval import __version__
 from gaitval.io.atomic import write_text
 from gaitval.report.provenance import load_all
+from gaitval.report.datakind import PAPER_PROTOCOLS, headline, paper_data, run_data
 from gaitval.report.verdicts import VERDICT_COLUMNS, build_verdicts, summary_lines
+from gaitval.tables.numbers import format_value, to_display
 
 #: The paper tables gaitval renders (see ../shared/seeds/README.md), by protocol.
 EXPECTED_TABLES = {
@@ -34,14 +41,51 @@ EXPECTED_TABLES = {
     "ultrasonic": [f"ultrasonic_table{i}" for i in range(1, 9)] + ["ultrasonic_tableC1"],
 }
 SECTION_TITLES = {
-    "study": "Study, ingest and registration",
     "tug": "TUG leg tracking (Yorozu et al., Sensors 2015, seed 000)",
     "mtst": "Multi-target stepping task (Yorozu et al., Sensors 2015, seed 001)",
     "rollator": "Robotic rollator, KF vs PF (Chalvatzaki et al., 2017, seed 002)",
     "ultrasonic": "Ultrasonic foot tracking (Qi et al., Sensors 2014, seed 003)",
     "legbench": "Annotated recordings without mocap: CLEAR-MOT (Leigh et al., ICRA 2015)",
     "peer": "Worked example: agreement statistics on a peer's published data",
+    "study": "Appendix: study, ingest and registration",
 }
+#: Captions of the figures, by stem (``{p}``: the parameter of a per-parameter figure).
+FIGURE_CAPTIONS = {
+    "tug_trajectories": "TUG: tracked (thin) and true (thick) leg trajectories of a "
+    "successful and a failed trial (rows), one column per method, each panel saying "
+    "success or FAILED (cf. seed 000 Fig. 14).",
+    "tug_false_tracking": "TUG: the first false tracking of a failed trial — both legs' "
+    "tracks and truth around the moment a track jumped to the other leg or was lost "
+    "(cf. seed 000 Fig. 11).",
+    "mtst_trial": "MTST: a successful and a failed trial on the mat (rows): tracked legs "
+    "(thin) against the mocap legs (thick), foot contacts, targets, target steps judged (O) "
+    "and cross steps detected (+) (cf. seed 001 Fig. 10).",
+    "rollator_turning_trial": "Rollator: lateral and forward position of each leg over "
+    "time in a successful and a failed trial; truth red, KF black, PF blue; grey bands: "
+    "KF error frames, dotted lines: KF re-initialisations (cf. seed 002 Fig. 4).",
+    "ultrasonic_figA1": "Ultrasonic: histograms of the stride-parameter differences system "
+    "− reference at normal speed (cf. seed 003 Fig. A1).",
+    "ultrasonic_figB1": "Ultrasonic: per-subject boxplots of the system's stride "
+    "parameters at normal speed (cf. seed 003 Fig. B1).",
+    "ultrasonic_fig5": "Ultrasonic: mean ± SD of reference and system per walking speed; "
+    "* p < 0.05 against normal speed (paired t-test, Table 8; cf. seed 003 Fig. 5).",
+    "ultrasonic_bland_altman_{p}": "Ultrasonic: Bland–Altman plot of {p} at normal speed, "
+    "system − reference against their mean, in the quantity's display unit; points "
+    "coloured by subject; pooled bias and limits of agreement (grey, dashed, 95 % CIs as "
+    "bands), repeated-measures ones (black, solid, CIs as bars) and the paper's mean "
+    "difference (green, dash-dot) where it gives one; the legend is below the plot.",
+    "legbench_tracks": "Annotated recordings: tracked person (leg midpoint) against the "
+    "hand-annotated person over time, one row per method; misses marked below.",
+}
+def figure_caption(stem: str) -> str:
+    """The caption of figure ``stem`` (:data:`FIGURE_CAPTIONS`; a generic one otherwise)."""
+    if stem in FIGURE_CAPTIONS:
+        return FIGURE_CAPTIONS[stem]
+    for key, cap in FIGURE_CAPTIONS.items():
+        head = key.split("{")[0]
+        if "{" in key and stem.startswith(head):
+            return cap.format(p=stem[len(head):].replace("_", " "))
+    return stem.replace("_", " ") + "."
 
 
 def _section(name: str) -> str:
@@ -111,60 +155,63 @@ def _provenance(rd: Path, rec: dict | None) -> list[str]:
     return out
 
 
-def _decimals(col: pd.Series) -> int | None:
-    """Decimals the paper prints in a ``*_published`` column (as stored in the CSV)."""
-    vals = [str(v) for v in col if str(v) not in ("", "nan")]
-    ds = [len(v.split(".")[1]) if "." in v and "e" not in v.lower() else 0 for v in vals]
-    return min(max(ds), 4) if ds else None          # ratios stored in full: 4 at most
+def _read_table(csv: Path) -> pd.DataFrame:
+    """A table's CSV with its types (numbers as numbers, ``True``/``False`` as booleans)."""
+    return pd.read_csv(csv)
 
 
-def _fmt_cell(v, decimals: int | None, pcol: bool) -> str:
-    if isinstance(v, str):
-        try:
-            x = float(v) if v not in ("", "True", "False") else v
-        except ValueError:
-            return v
-        if isinstance(x, str):
-            return {"True": "yes", "False": "no"}.get(x, x)
-        if "." not in v and "e" not in v.lower():
-            return v                                  # integers as written
-        v = x
-    if isinstance(v, (int, np.integer)):
-        return str(v)
-    if v is None or not np.isfinite(v):
-        return ""
-    if pcol:
-        return "< 0.001" if v < 0.001 else f"{v:.3f}"
-    if decimals is not None:
-        return f"{v:.{decimals}f}"
-    if v != 0 and (abs(v) < 1e-3 or abs(v) >= 1e6):
-        return f"{v:.3g}"
-    return f"{v:.3f}"
+def _md_cells(md_path: Path) -> tuple[list[str], list[list[str]]] | None:
+    """Header and cells of the (first) pipe table of a table's ``.md`` — the strings
+    :func:`gaitval.tables.render.write_table` printed from the typed table, so the HTML
+    shows exactly what the Markdown shows (a CSV read back loses a text column's type)."""
+    if not md_path.is_file():
+        return None
+    header, rows = None, []
+    for ln in md_path.read_text(encoding="utf-8").splitlines():
+        if ln.startswith("| "):
+            cells = [c.strip().replace("\\|", "|")
+                     for c in re.split(r"(?<!\\)\|", ln.strip())[1:-1]]
+            if header is None:
+                header = cells
+            else:
+                rows.append(cells)
+        elif header is not None and not ln.startswith("|---"):
+            break
+    return (header, rows) if header else None
 
 
-def display_table(df: pd.DataFrame) -> tuple[list[tuple[str, bool]], list[list[str]]]:
-    """Header ``(name, is_published)`` and formatted rows for the HTML report.
-
-    Each ``<q>_published`` column moves right after ``<q>``; ``<q>`` and its published
-    column are printed with the decimals the paper prints (those of the published column);
-    p-values as ``< 0.001`` or three decimals; other floats with three decimals.
-    """
-    cols = [c for c in df.columns if not str(c).endswith("_published")
-            or str(c)[:-10] not in df.columns]
+def _published_beside(header: list[str], rows: list[list[str]]
+                      ) -> tuple[list[tuple[str, bool]], list[list[str]]]:
+    """Each ``<q>_published`` column moved right after ``<q>``."""
+    cols = [c for c in header if not c.endswith("_published") or c[:-10] not in header]
     order = []
     for c in cols:
         order.append(c)
-        if f"{c}_published" in df.columns:
+        if f"{c}_published" in header:
             order.append(f"{c}_published")
-    out = []
-    for c in order:
-        base = c[:-10] if c.endswith("_published") else c
-        dec = _decimals(df[f"{base}_published"]) if f"{base}_published" in df else None
-        pcol = base == "p" or base.endswith("_p")
-        out.append((c, dec, pcol))
-    rows = [[_fmt_cell(df[c].iloc[i], dec, pcol) for c, dec, pcol in out]
-            for i in range(len(df))]
-    return [(c, c.endswith("_published")) for c, _, _ in out], rows
+    idx = [header.index(c) for c in order]
+    return ([(c, c.endswith("_published")) for c in order],
+            [[r[i] if i < len(r) else "" for i in idx] for r in rows])
+
+
+def display_table(df: pd.DataFrame, table: str | None = None
+                  ) -> tuple[list[tuple[str, bool]], list[list[str]]]:
+    """Header ``(name, is_published)`` and formatted rows for the HTML report.
+
+    The table in its display units (:func:`gaitval.tables.numbers.to_display`), each
+    ``<q>_published`` column right after ``<q>``, every cell by
+    :func:`gaitval.tables.numbers.format_value` — the strings of the table's ``.md``.
+    """
+    d = to_display(df, table)
+    cols = [c for c in d.columns if not str(c).endswith("_published")
+            or str(c)[:-10] not in d.columns]
+    order = []
+    for c in cols:
+        order.append(c)
+        if f"{c}_published" in d.columns:
+            order.append(f"{c}_published")
+    rows = [[format_value(d[c].iloc[i], c, table) for c in order] for i in range(len(d))]
+    return [(c, c.endswith("_published")) for c in order], rows
 
 
 _MD_INLINE = [(re.compile(r"`([^`]+)`"), r"<code>\1</code>"),
@@ -195,17 +242,22 @@ def collect(reports_dir: str | Path, study_names: list[str] | None = None,
     tables = sorted((rd / "tables").glob("*.csv"))
     figures = sorted((rd / "figures").glob("*.png"))
     present = {p.stem for p in tables}
-    verdicts = build_verdicts(rd / "tables")
+    studies = run_data(rd, study_names)
+    verdicts = build_verdicts(rd / "tables", {p: paper_data(studies, p)
+                                              for p in PAPER_PROTOCOLS})
     sections = []
     for sec in SECTION_TITLES:
         items = []
-        for p in tables:
-            if _section(p.stem) != sec:
+        expected = EXPECTED_TABLES.get(sec, [])
+        for p in sorted(tables, key=lambda q: (expected.index(q.stem) if q.stem in expected
+                                               else len(expected), q.stem)):
+            if _section(p.stem) != sec:             # the paper's tables first, in order
                 continue
             rel = str(p.relative_to(rd))
             cap, notes = _caption_notes(p.with_suffix(".md"))
-            df = pd.read_csv(p, keep_default_na=False, dtype=str)
-            header, rows = display_table(df)
+            md_cells = _md_cells(p.with_suffix(".md"))
+            header, rows = (_published_beside(*md_cells) if md_cells else
+                            display_table(_read_table(p), p.stem))
             items.append({"kind": "table", "stem": p.stem, "caption": cap, "notes": notes,
                           "md": (p.with_suffix(".md").read_text(encoding="utf-8").rstrip()
                                  if p.with_suffix(".md").is_file() else ""),
@@ -217,6 +269,7 @@ def collect(reports_dir: str | Path, study_names: list[str] | None = None,
             if _section(p.stem) == sec:
                 rel = str(p.relative_to(rd))
                 items.append({"kind": "figure", "stem": p.stem, "src": rel,
+                              "caption": figure_caption(p.stem),
                               "prov": _prov_line(prov.get(rel))})
         # a protocol without any item was not in the run's studies (an MTST study
         # without mocap has no TUG trials): its section is absent, not "not produced"
@@ -226,22 +279,29 @@ def collect(reports_dir: str | Path, study_names: list[str] | None = None,
                              "missing": miss})
     vd = verdicts.astype(str)
     return {"version": __version__, "studies": ", ".join(study_names or []) or "-",
-            "verdict_summary": summary_lines(verdicts),
+            "data": headline(studies), "verdict_summary": summary_lines(verdicts),
+            "verdicts": verdicts,
             "verdict_header": list(VERDICT_COLUMNS), "verdict_rows": vd.values.tolist(),
             "sections": sections, "provenance": _provenance(rd, report_prov)}
 
 
 def render_markdown(c: dict) -> str:
-    md = ["# gaitval report", "",
-          f"gaitval {c['version']}. Studies: {c['studies']}.",
-          "Every item below names the step, configuration hash, package version and git "
-          "commit that produced it; how to rebuild the whole report, the resolved "
-          "configuration, checksums of the inputs and exact package versions are under "
-          "[Provenance](#provenance). Published values stand beside reproduced ones in the "
-          "paper tables.", "", "## Verdicts: which published comparisons were reproduced", ""]
+    md = ["# gaitval report", ""]
+    for ln in c["data"]:
+        md += [ln, ""]
+    md += [f"gaitval {c['version']}. Studies: {c['studies']}. Every item below names the "
+           "step, configuration hash, package version and git commit that produced it; how "
+           "to rebuild the whole report, the resolved configuration, checksums of the "
+           "inputs and exact package versions are under [Provenance](#provenance). "
+           "Published values stand beside reproduced ones in the paper tables; the study's "
+           "ingest and registration tables are the appendix.", "",
+           "## Verdicts: which published comparisons were reproduced", ""]
     md += [f"- {s}" for s in c["verdict_summary"]] + [""]
-    rows = [[*r[:-1], f"[{r[-1]}](#{r[-1]})" if r[-1] else ""] for r in c["verdict_rows"]]
-    md += [_md_table(c["verdict_header"], rows), ""]
+    head = c["verdict_header"]
+    ti = head.index("table")
+    rows = [[*r[:ti], f"[{r[ti]}](#{r[ti]})" if r[ti] else "", *r[ti + 1:]]
+            for r in c["verdict_rows"]]
+    md += [_md_table(head, rows), ""]
     for sec in c["sections"]:
         md += [f"## {sec['title']}", ""]
         for it in sec["items"]:
@@ -252,7 +312,7 @@ def render_markdown(c: dict) -> str:
                        f"_{it['prov']}_", ""]
             else:
                 md += [f"### {it['stem']}", "", f"![{it['stem']}]({it['src']})", "",
-                       f"_{it['prov']}_", ""]
+                       f"*Figure: {it['caption']}*", "", f"_{it['prov']}_", ""]
         if sec["missing"]:
             md += ["_Not produced yet: " + ", ".join(sec["missing"]) + "_", ""]
     md += ["## Provenance", ""] + [f"- {ln}" for ln in c["provenance"]] + [""]
@@ -279,9 +339,9 @@ def build_index(reports_dir: str | Path, *, study_names: list[str] | None = None
 
     rd = Path(reports_dir)
     c = collect(rd, study_names, write_report_provenance(rd))
-    write_table(build_verdicts(rd / "tables"), rd / "verdicts",
-                caption="Published comparisons of the seed papers and whether the "
-                "reproduction goes the same way (gaitval.report.verdicts).",
-                notes=c["verdict_summary"])
+    write_table(c["verdicts"], rd / "verdicts",
+                caption="Published comparisons of the seed papers: reproduced, not "
+                "reproduced or not comparable, and why (gaitval.report.verdicts).",
+                notes=c["data"] + c["verdict_summary"])
     return (write_text(rd / "index.md", render_markdown(c)),
             write_text(rd / "index.html", render_html(c)))

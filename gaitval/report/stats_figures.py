@@ -23,10 +23,22 @@ import numpy as np
 import pandas as pd
 
 from gaitval.report.figures import plt, save_figure
+from gaitval.tables.numbers import fixed
 from gaitval.stats import agreement, loa_nested
 from gaitval.tables.ultrasonic import (PARAM_INFO, PARAMETERS, SPEEDS, SUMMARY_PARAMETERS,
                                        _subject_order, check_gait_params, table8)
 from gaitval.tables.ultrasonic_agreement import POOLED, REPEATED, agreement_table
+
+
+#: Display unit of a Bland–Altman plot per CSV unit: (unit, factor, decimals) — the size of
+#: the differences in a unit the papers use (mm for lengths, ms for durations).
+BA_UNITS = {"m": ("mm", 1000.0, 1), "s": ("ms", 1000.0, 1), "m/s": ("cm/s", 100.0, 2),
+            "stride/s": ("stride/min", 60.0, 2), "-": ("-", 1.0, 4), "": ("", 1.0, 3)}
+
+
+def ba_unit(unit: str) -> tuple[str, float, int]:
+    """(display unit, factor from ``unit``, decimals) of a Bland–Altman plot."""
+    return BA_UNITS.get(unit, (unit, 1.0, 3))
 
 
 def _label(param: str) -> str:
@@ -177,16 +189,23 @@ def bland_altman_figure(df: pd.DataFrame, ref: str, pro: str, path: str | Path,
 
     Notes
     -----
-    Pooled (every pair independent): grey, dashed limits, grey bands for the 95% CIs.
-    Repeated measures: black, solid limits, 95% CIs as bars at the right edge (with few
+    Values in the quantity's display unit (:data:`BA_UNITS`: mm, ms, cm/s for the CSV's
+    m, s, m/s), printed with fixed decimals.  Legends below the plot (lines, then subjects).
+    Pooled (every pair independent): grey, dotted bias and dashed limits drawn on top,
+    grey bands for the 95% CIs.
+    Repeated measures: black, thick solid limits underneath (both visible where they
+    coincide), 95% CIs as bars at the right edge (with few
     subjects they can be far wider than the points, so they are not drawn as bands).
     """
     lim = dict(limits) if limits is not None else _limits(df, ref, pro, subject)
-    r = pd.to_numeric(df[ref], errors="coerce").to_numpy(dtype=float)
-    p = pd.to_numeric(df[pro], errors="coerce").to_numpy(dtype=float)
+    unit, k, dec = ba_unit(unit)
+    lim = {key: (float(v) * k if ("bias" in key or "loa" in key) else v)
+           for key, v in lim.items()}
+    r = pd.to_numeric(df[ref], errors="coerce").to_numpy(dtype=float) * k
+    p = pd.to_numeric(df[pro], errors="coerce").to_numpy(dtype=float) * k
     ok = np.isfinite(r) & np.isfinite(p)
     mean, diff = (r[ok] + p[ok]) / 2, p[ok] - r[ok]
-    fig, ax = plt.subplots(figsize=(6, 4.2))
+    fig, ax = plt.subplots(figsize=(6.4, 5.6))
     if subject is not None:
         subs = df[subject].astype(str).to_numpy()[ok]
         order = _subject_order(subs)
@@ -199,7 +218,8 @@ def bland_altman_figure(df: pd.DataFrame, ref: str, pro: str, path: str | Path,
     else:
         ax.scatter(mean, diff, s=9, color="k", alpha=point_alpha(len(mean)), linewidths=0)
     _pooled_lines(ax, lim)
-    pub = dict(published or {})
+    pub = {key: (float(v) * k if key != "label" else v)
+           for key, v in dict(published or {}).items()}
     for key, style in (("bias", "-."), ("loa_low", "-."), ("loa_high", "-.")):
         if np.isfinite(pub.get(key, np.nan)):
             ax.axhline(pub[key], color="tab:green", ls=style, lw=1.2,
@@ -208,32 +228,46 @@ def bland_altman_figure(df: pd.DataFrame, ref: str, pro: str, path: str | Path,
     has_rm = subject is not None and np.isfinite(lim.get("loa_low_rm", np.nan))
     if has_rm:
         _repeated_lines(ax, lim, mean)
-    u = f" ({unit})" if unit and unit != "-" else ""
-    ax.set_xlabel(f"mean of reference and system{u}")
-    ax.set_ylabel(f"system - reference{u}")
-    text = (f"pooled: bias {lim['bias']:.3g}, LoA [{lim['loa_low']:.3g}, "
-            f"{lim['loa_high']:.3g}]")
+    un = f" ({unit})" if unit and unit != "-" else ""
+    ax.set_xlabel(f"mean of reference and system{un}")
+    ax.set_ylabel(f"system - reference{un}")
+    u = f" {unit}" if unit and unit != "-" else ""
+
+    def f(x):
+        return fixed(float(x), dec)
+    text = f"pooled: bias {f(lim['bias'])}{u}, LoA [{f(lim['loa_low'])}, {f(lim['loa_high'])}]{u}"
     if has_rm:
-        text += (f"\nrepeated measures: bias {lim['bias_rm']:.3g}, LoA "
-                 f"[{lim['loa_low_rm']:.3g}, {lim['loa_high_rm']:.3g}]")
+        text += (f"\nrepeated measures: bias {f(lim['bias_rm'])}{u}, LoA "
+                 f"[{f(lim['loa_low_rm'])}, {f(lim['loa_high_rm'])}]{u}")
     if not np.isfinite(pub.get("loa_low", np.nan)):
         text += "\nno published limits of agreement"
     ax.set_title((title + "\n" if title else "") + text, fontsize=8)
-    leg = ax.legend(fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.5),
-                    frameon=False)
-    for h in getattr(leg, "legend_handles", []):
-        h.set_alpha(1.0)                             # subjects legible in the legend
+    # two legends below the plot, full width: the lines, then the subjects
+    handles, labels = ax.get_legend_handles_labels()
+    subj = set(_subject_order(df[subject].astype(str))) if subject is not None else set()
+    lines = [(h, lb) for h, lb in zip(handles, labels) if lb not in subj]
+    points = [(h, lb) for h, lb in zip(handles, labels) if lb in subj]
+    leg1 = ax.legend([h for h, _ in lines], [lb for _, lb in lines], fontsize=6.5,
+                     loc="upper left", bbox_to_anchor=(0.0, -0.16), ncol=2, frameon=False)
+    if points:
+        ax.add_artist(leg1)
+        leg2 = ax.legend([h for h, _ in points], [lb for _, lb in points], fontsize=6.5,
+                         loc="upper left", bbox_to_anchor=(0.0, -0.40),
+                         ncol=min(len(points), 10), frameon=False, title="subjects",
+                         title_fontsize=6.5, handletextpad=0.2, columnspacing=0.8)
+        for h in getattr(leg2, "legend_handles", []):
+            h.set_alpha(1.0)                         # subjects legible in the legend
     fig.tight_layout()
     return save_figure(fig, path)
 
 
 def _pooled_lines(ax, lim: dict) -> None:
     """Pooled bias (thin) and limits (dashed) in grey, their 95% CIs as grey bands."""
-    for key, style, label in (("bias", "-", "pooled bias"),
+    for key, style, label in (("bias", ":", "pooled bias (strides independent)"),
                               ("loa_low", "--", "pooled limits (strides independent)"),
                               ("loa_high", "--", None)):
         if np.isfinite(lim.get(key, np.nan)):
-            ax.axhline(lim[key], color="0.5", ls=style, lw=1, label=label)
+            ax.axhline(lim[key], color="0.45", ls=style, lw=1.3, label=label, zorder=3)
     for lo, hi in (("bias_ci_low", "bias_ci_high"), ("loa_low_ci_low", "loa_low_ci_high"),
                    ("loa_high_ci_low", "loa_high_ci_high")):
         if np.isfinite(lim.get(lo, np.nan)) and np.isfinite(lim.get(hi, np.nan)):
@@ -246,10 +280,11 @@ def _repeated_lines(ax, lim: dict, mean: np.ndarray) -> None:
     The bars stand beside the points (bias, lower limit, upper limit from left to right)
     and are cut by the axes when, with few subjects, they are far wider than the data.
     """
-    ax.axhline(lim["bias_rm"], color="k", lw=1, label="repeated-measures bias")
-    ax.axhline(lim["loa_low_rm"], color="k", lw=1.6,
+    # solid black under the grey dashed pooled lines: where both coincide, both show
+    ax.axhline(lim["bias_rm"], color="k", lw=1.0, label="repeated-measures bias", zorder=2)
+    ax.axhline(lim["loa_low_rm"], color="k", lw=2.2, alpha=0.8, zorder=2,
                label="repeated-measures limits (subjects random)")
-    ax.axhline(lim["loa_high_rm"], color="k", lw=1.6)
+    ax.axhline(lim["loa_high_rm"], color="k", lw=2.2, alpha=0.8, zorder=2)
     ylo, yhi = ax.get_ylim()
     ylo, yhi = min(ylo, lim["loa_low_rm"]), max(yhi, lim["loa_high_rm"])
     span = float(np.ptp(mean)) if mean.size > 1 and np.ptp(mean) > 0 else 1.0
@@ -284,7 +319,8 @@ def write_ultrasonic_figures(gait_params: pd.DataFrame, out_dir: str | Path,
             continue
         paths.append(bland_altman_figure(
             sub, "reference", "system", out_dir / f"ultrasonic_bland_altman_{p}.png",
-            title=f"Bland-Altman: {_label(p)}, {speed} speed", unit=PARAM_INFO[p][2],
+            title=f"Bland-Altman: {p.replace('_', ' ')} {PARAM_INFO[p][0]}, {speed} speed",
+            unit=PARAM_INFO[p][2],
             subject="subject", limits=limits[limits["parameter"] == p].iloc[0],
             published=published_bias(p) if speed == "normal" else None))
     return paths

@@ -1,19 +1,34 @@
-"""The verdict page: one row per published comparison, reproduced or not.
+"""The verdict page: one row per published comparison — reproduced, not reproduced or not
+comparable — with the data it rests on and why.
 
-Each row states a comparison one of the seed papers makes — a ranking of methods, the
-direction of an effect, or a value with its published spread — the published numbers, the
-reproduced numbers, whether the reproduction goes the same way (``yes``/``no``; ``not run``
-when the study's tables are absent) and the report anchor of the table whose notes explain
-a difference.  Everything is read from the tables' CSVs (``<reports>/tables/*.csv``), which
-already carry the published values beside the reproduced ones, so no number here is typed
-by hand and a rerun updates the page.
+Each row states a comparison one of the seed papers makes (a ranking of methods, the
+direction of an effect, or a value with its published spread), the published numbers, the
+reproduced numbers *with the numbers the criterion used* (the 95 % interval when the
+criterion is an interval), the outcome and, in ``why``, the cause in one sentence taken
+from the table's own evidence.  Everything is read from the tables' CSVs and notes
+(``<reports>/tables/*.csv``, ``*.md``), which carry the published values beside the
+reproduced ones, so no number here is typed by hand and a rerun updates the page.
 
-Criteria (column ``criterion``):
+Outcomes (column ``outcome``):
 
-* ranking — the reproduced order of the methods equals the published order;
-* direction — the sign of the published difference holds in the reproduction;
-* value with spread — the reproduced value lies within the published mean ± 1 SD (or, for
-  a published proportion, inside the Wilson 95% interval of the reproduced proportion).
+* ``reproduced`` / ``not reproduced`` — the criterion holds / fails;
+* ``not comparable`` — the comparison cannot be scored, and ``why`` says why: the table
+  itself says its numbers are not comparable with the paper's (ultrasonic Table 7's test
+  of another hypothesis, Table C1's grouping, NS/NV's definition of n — recognised by the
+  table's note, so a table that stops saying so is scored again), or the study is too
+  small for the comparison (a statistic undefined, or a 95 % interval wider than half
+  the range: too wide to test a published value with);
+* ``not run`` — the run has no study with the paper's protocol.
+
+One primary reading per comparison.  TUG's Methods run under two readings of seed 000
+eq. (3)–(4) (:mod:`gaitval.gait.phases`); the primary one is gaitval's default
+(``swing_first``: the reading that gives Table 2's v_sw_th and the "unlikely" Phase 5 of
+the paper's text a role, docs/tracking.md); the other is shown beside it in
+``alternative`` with its own outcome and is not counted.
+
+Criteria (column ``criterion``): ranking — every pair the paper ranks strictly is ranked
+the same way; direction — the sign of the published difference holds; published inside
+the reproduced 95% CI (Wilson) — for a proportion; value inside published mean ± SD.
 
 References
 ----------
@@ -30,9 +45,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from gaitval.tables.numbers import number, p_value
+
 #: Columns of :func:`build_verdicts`.
-VERDICT_COLUMNS = ("study", "comparison", "source", "published", "reproduced", "criterion",
-                   "reproduced_in_direction", "note")
+VERDICT_COLUMNS = ("study", "data", "comparison", "source", "table", "published",
+                   "reproduced", "criterion", "outcome", "why", "alternative")
+OUTCOMES = ("reproduced", "not reproduced", "not comparable", "not run")
 STUDIES = {"tug": "TUG leg tracking (seed 000)", "mtst": "MTST (seed 001)",
            "rollator": "Robotic rollator (seed 002)", "ultrasonic": "Ultrasonic (seed 003)"}
 #: The table each study's verdicts need; absent → one ``not run`` row.
@@ -40,12 +58,21 @@ REQUIRED = {"tug": "tug_table3", "mtst": "mtst_table3", "rollator": "rollator_ta
             "ultrasonic": "ultrasonic_table8"}
 SHORT = {"tug_m1": "M1", "tug_m2": "M2", "tug_m3": "M3", "mtst_m1": "M1", "mtst_m2": "M2",
          "mtst_m3": "M3", "mtst_proposed": "proposed"}
-
-
-def _yn(ok) -> str:
-    if ok is None or (isinstance(ok, float) and math.isnan(ok)):
-        return "undecided"
-    return "yes" if bool(ok) else "no"
+#: TUG: the primary reading of seed000 eq. (3)-(4) (module notes).
+PRIMARY_READING = "swing_first"
+#: A 95 % interval wider than this (as a proportion) is too wide to test a published
+#: value with: the comparison is "not comparable: too small".
+MAX_CI_WIDTH = 0.5
+#: Fewer tracking-success trials than this: an RMSE compares single walks (TUG Tables 4-5).
+MIN_SUCCESS_TRIALS = 2
+#: Fewer subjects than this: a paired t-test (ultrasonic Table 8) has under 2 degrees of
+#: freedom, a "most subject × scenario cells" majority (rollator Table I) is one subject's.
+MIN_SUBJECTS_T = 3
+MIN_SUBJECTS_CELLS = 2
+#: What a table's notes say when its numbers are not comparable with the paper's.
+NOT_COMPARABLE_NOTE = {"ultrasonic_table7": "not comparable",
+                       "ultrasonic_tableC1": "by design",
+                       "ultrasonic_table8": "definitions of n"}
 
 
 def wilson(k: float, n: float, z: float = 1.959964) -> tuple[float, float]:
@@ -59,10 +86,40 @@ def wilson(k: float, n: float, z: float = 1.959964) -> tuple[float, float]:
     return (c - h, c + h)
 
 
-def _row(study, comparison, source, published, reproduced, criterion, ok, note=None) -> dict:
-    return {"study": study, "comparison": comparison, "source": source,
+def _row(study, comparison, source, published, reproduced, criterion, ok, why, table,
+         not_comparable: str | None = None) -> dict:
+    """One verdict; ``ok`` None or ``not_comparable`` set → ``not comparable``."""
+    if not_comparable:
+        outcome, why = "not comparable", not_comparable
+    elif ok is None or (isinstance(ok, float) and math.isnan(ok)):
+        outcome = "not comparable"
+    else:
+        outcome = "reproduced" if bool(ok) else "not reproduced"
+    return {"study": study, "data": "", "comparison": comparison, "source": source,
             "published": published, "reproduced": reproduced, "criterion": criterion,
-            "reproduced_in_direction": _yn(ok), "note": note or source}
+            "outcome": outcome, "why": why, "alternative": "", "table": table}
+
+
+def _pct(x: float) -> str:
+    return f"{100 * x:.1f}%"
+
+
+def _ci(lo: float, hi: float) -> str:
+    return f"95% CI {100 * lo:.1f}–{100 * hi:.1f}%"
+
+
+def _proportion_verdict(k, n, published_frac):
+    """(reproduced text, ok or None, too-small reason or None) of a proportion ``k/n``
+    against a published proportion, by the Wilson interval."""
+    lo, hi = wilson(k, n)
+    if not n:
+        return "no trials", None, "too small: no trials to compare"
+    text = f"{_pct(k / n)} ({int(k)}/{int(n)}); {_ci(lo, hi)}"
+    if hi - lo > MAX_CI_WIDTH:
+        return text, None, (f"too small: with {int(n)} trial{'s' * (int(n) != 1)} the 95% "
+                            f"CI spans {100 * (hi - lo):.0f} percentage points, too wide "
+                            "to test the paper's value")
+    return text, lo <= published_frac <= hi, None
 
 
 def _order(values: dict[str, float], higher_first: bool = True) -> list[str]:
@@ -71,15 +128,15 @@ def _order(values: dict[str, float], higher_first: bool = True) -> list[str]:
                                        keys.index(m)))
 
 
-def _ranking(values: dict[str, float], fmt: str, higher_first=True) -> str:
-    """``"M3 0.96 > M2 0.89 = M1 0.89"`` (ties, at the printed precision, as ``=``)."""
+def _ranking(values: dict[str, float], fmt, higher_first=True) -> str:
+    """``"M3 96.4 % > M2 89.3 % = M1 89.3 %"`` (ties, at the printed precision, as ``=``)."""
     order = _order(values, higher_first)
     out = ""
     for i, m in enumerate(order):
         if i:
-            tie = format(values[m], fmt) == format(values[order[i - 1]], fmt)
+            tie = fmt(values[m]) == fmt(values[order[i - 1]])
             out += " = " if tie else (" > " if higher_first else " < ")
-        out += f"{SHORT.get(m, m)} {format(values[m], fmt)}"
+        out += f"{SHORT.get(m, m)} {fmt(values[m])}"
     return out
 
 
@@ -90,60 +147,164 @@ def _same_ranking(pub: dict[str, float], rep: dict[str, float]) -> bool:
                for i, a in enumerate(ms) for b in ms[i + 1:] if pub[a] != pub[b])
 
 
-def tug_verdicts(t: dict[str, pd.DataFrame]) -> list[dict]:
-    """Seed 000: success ranking and per-method success (Table 3, each reading of
-    eq. (3)–(4)); Method 3 below Method 2 in turning-phase (Table 4) and unobservable
-    (Table 5) RMSE."""
+def _broken_pairs(pub: dict[str, float], rep: dict[str, float], fmt) -> str:
+    ms = [m for m in pub if m in rep]
+    bad = [(a, b) for i, a in enumerate(ms) for b in ms[i + 1:] if pub[a] != pub[b]
+           and np.sign(pub[a] - pub[b]) != np.sign(rep[a] - rep[b])]
+    out = []
+    for a, b in bad:
+        hi, lo = (a, b) if pub[a] > pub[b] else (b, a)
+        out.append(f"{SHORT.get(hi, hi)} {fmt(rep[hi])} is not above "
+                   f"{SHORT.get(lo, lo)} {fmt(rep[lo])}")
+    return "; ".join(out)
+
+
+# -- TUG (seed 000) ------------------------------------------------------------------------
+_TUG_FAIL = (("ft_turning", "false tracking in turning"), ("ft_return",
+             "false tracking on return"), ("ft_forward", "false tracking forward"),
+             ("sf_turning", "stance failures in turning"), ("sf_other", "other stance failures"))
+
+
+def _tug_failures(r) -> str:
+    parts = [f"{label} {int(r[c])}" for c, label in _TUG_FAIL
+             if c in r and np.isfinite(r[c]) and int(r[c])]
+    return ", ".join(parts) if parts else "none"
+
+
+def _tug_reading_rows(g: pd.DataFrame) -> dict[str, dict]:
+    """The Table 3 verdicts of one reading, keyed by comparison."""
+    st, out = "tug", {}
+    g = g.set_index("base_method")
+    pub = {m: float(g.loc[m, "success_rate_published"]) for m in g.index}
+    rep = {m: float(g.loc[m, "success_rate"]) for m in g.index}
+    n = {m: float(g.loc[m, "n_trials"]) for m in g.index}
+    small = [m for m in g.index if (lambda lo_hi: lo_hi[1] - lo_hi[0])(
+        wilson(g.loc[m, "n_success"], n[m])) > MAX_CI_WIDTH or not n[m]]
+    ok = _same_ranking(pub, rep)
+    if small:
+        why = (f"too small: {int(max(n.values()))} trials per method; the 95% CIs of the "
+               "success rates overlap almost entirely")
+        ok = None
+    elif ok:
+        why = "same order as the paper's: " + _ranking(rep, _pct) + "."
+    else:
+        worst = max(g.index, key=lambda m: pub[m] - rep[m])
+        why = (_broken_pairs(pub, rep, _pct) + f"; {SHORT.get(worst, worst)}'s failures: "
+               + _tug_failures(g.loc[worst]) + " (tug_failures: the first failure of each).")
+    out["ranking"] = _row(st, "Tracking success ranking of Methods 1-3", "Table 3",
+                          _ranking(pub, _pct), _ranking(rep, _pct), "ranking", ok, why,
+                          "tug_table3")
+    for m in g.index:
+        r = g.loc[m]
+        text, ok, small = _proportion_verdict(r["n_success"], r["n_trials"],
+                                              r["success_rate_published"])
+        pub_text = (f"{_pct(r['success_rate_published'])} ({int(r['n_success_published'])}/"
+                    f"{int(r['n_trials_published'])})")
+        if small:
+            why = small
+        elif ok:
+            why = f"the paper's {_pct(r['success_rate_published'])} lies inside the interval."
+        else:
+            side = "below" if r["success_rate"] < r["success_rate_published"] else "above"
+            why = (f"{int(r['n_success'])} of {int(r['n_trials'])} trials tracked, {side} "
+                   f"the paper's {int(r['n_success_published'])}; failures: "
+                   + _tug_failures(r) + ".")
+        out[m] = _row(st, f"Success rate {SHORT.get(m, m)}", "Table 3", pub_text, text,
+                      "paper inside our 95% CI", ok, why, "tug_table3",
+                      not_comparable=small)
+    return out
+
+
+def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
+    """Seed 000: success ranking and per-method success (Table 3; primary reading of
+    eq. (3)–(4), the other beside); Method 3 below Method 2 in turning-phase (Table 4) and
+    unobservable (Table 5) RMSE."""
     st = "tug"
-    rows = []
     t3 = t["tug_table3"]
     if "phase_reading" not in t3:
-        t3 = t3.assign(phase_reading="swing_first", base_method=t3["method"])
-    for reading, g in t3.groupby("phase_reading", sort=False):
-        g = g.set_index("base_method")
-        pub = {m: float(g.loc[m, "success_rate_published"]) for m in g.index}
-        rep = {m: float(g.loc[m, "success_rate"]) for m in g.index}
-        rows.append(_row(st, f"Tracking success ranking, reading {reading} of eq. (3)-(4)",
-                         "Table 3", _ranking(pub, ".2f"), _ranking(rep, ".2f"),
-                         "ranking", _same_ranking(pub, rep), "tug_table3"))
-        for m in g.index:
-            r = g.loc[m]
-            lo, hi = wilson(r["n_success"], r["n_trials"])
-            rows.append(_row(
-                st, f"Success rate {SHORT.get(m, m)}, reading {reading}", "Table 3",
-                f"{int(r['n_success_published'])}/{int(r['n_trials_published'])} = "
-                f"{r['success_rate_published']:.2f}",
-                f"{int(r['n_success'])}/{int(r['n_trials'])} = {r['success_rate']:.2f} "
-                f"(95% CI {lo:.2f}-{hi:.2f})", "published inside reproduced 95% CI",
-                lo <= r["success_rate_published"] <= hi, "tug_table3"))
+        t3 = t3.assign(phase_reading=PRIMARY_READING, base_method=t3["method"])
+    readings = {r: _tug_reading_rows(g) for r, g in t3.groupby("phase_reading", sort=False)}
+    primary = PRIMARY_READING if PRIMARY_READING in readings else next(iter(readings))
+    rows = []
+    for key, row in readings[primary].items():
+        row["comparison"] += f" (reading {primary})"
+        row["alternative"] = "; ".join(
+            f"reading {r}: {rr[key]['reproduced']} ({rr[key]['outcome']})"
+            for r, rr in readings.items() if r != primary and key in rr)
+        rows.append(row)
     for name, key, val, label in (("tug_table4", "tug_phase", "turning",
-                                   "Turning-phase RMSE M3 < M2 (x, y)"),
+                                   "Turning-phase RMSE M3 < M2 (x and y)"),
                                   ("tug_table5", "observation_state", "unobservable",
-                                   "Unobservable-step RMSE M3 < M2 (x, y)")):
+                                   "Unobservable-step RMSE M3 < M2 (x and y)")):
         d = t.get(name)
         if d is None:
             continue
-        d = d[(d[key] == val) & (d.get("phase_reading", "swing_first") == "swing_first")]
+        d = d[(d[key] == val) & (d.get("phase_reading", PRIMARY_READING) == primary)]
         d = d.set_index("method")
         if not {"tug_m2", "tug_m3"} <= set(d.index):
             continue
         a, b = d.loc["tug_m3"], d.loc["tug_m2"]
-        fmt = ("x {:.3f} vs {:.3f}, y {:.3f} vs {:.3f} m").format
-        ok = (a.rmse_x_m < b.rmse_x_m and a.rmse_y_m < b.rmse_y_m
-              if np.isfinite([a.rmse_x_m, b.rmse_x_m]).all() else None)
-        rows.append(_row(st, label, f"Table {name[-1]}",
+
+        def fmt(x3, x2, y3, y2):
+            return f"x {x3:.3f} vs {x2:.3f} m, y {y3:.3f} vs {y2:.3f} m"
+        finite = np.isfinite([a.rmse_x_m, b.rmse_x_m, a.rmse_y_m, b.rmse_y_m]).all()
+        g3 = t3[t3["phase_reading"] == primary].set_index("base_method")
+        n_ok = {m: int(g3.loc[m, "n_success"]) for m in ("tug_m2", "tug_m3") if m in g3.index}
+        if finite and n_ok and min(n_ok.values()) < MIN_SUCCESS_TRIALS:
+            ok, rep = None, fmt(a.rmse_x_m, b.rmse_x_m, a.rmse_y_m, b.rmse_y_m)
+            why = (f"too small: an RMSE over {min(n_ok.values())} tracking-success trial(s) "
+                   f"(M2 {n_ok.get('tug_m2', 0)}, M3 {n_ok.get('tug_m3', 0)}; the paper: 25 "
+                   "and 27) compares single walks, not the methods")
+        elif finite:
+            ok = bool(a.rmse_x_m < b.rmse_x_m and a.rmse_y_m < b.rmse_y_m)
+            lower = [ax for ax in ("x", "y") if a[f"rmse_{ax}_m"] < b[f"rmse_{ax}_m"]]
+            n_steps = ("time_steps" if "time_steps" in d else "n_steps")
+            steps = (f" over {int(a[n_steps])} (M3) and {int(b[n_steps])} (M2) time steps"
+                     if n_steps in d else "")
+            why = (f"M3 lower in {' and '.join(lower) or 'neither axis'}{steps}"
+                   + ("." if ok else f"; not in {' and '.join(ax for ax in ('x', 'y') if ax not in lower)}."))
+            rep = fmt(a.rmse_x_m, b.rmse_x_m, a.rmse_y_m, b.rmse_y_m)
+        else:
+            ok, rep = None, "no successful trial of M2 or M3"
+            why = "too small: no tracking-success trial of M2 or M3 to compute an RMSE"
+        rows.append(_row(st, f"{label} (reading {primary})", f"Table {name[-1]}",
                          fmt(a.rmse_x_m_published, b.rmse_x_m_published,
-                             a.rmse_y_m_published, b.rmse_y_m_published),
-                         fmt(a.rmse_x_m, b.rmse_x_m, a.rmse_y_m, b.rmse_y_m)
-                         if ok is not None else "no successful trial", "direction", ok,
-                         name))
+                             a.rmse_y_m_published, b.rmse_y_m_published), rep,
+                         "direction", ok, why, name))
     return rows
 
 
-def mtst_verdicts(t: dict[str, pd.DataFrame]) -> list[dict]:
+# -- MTST (seed 001) -----------------------------------------------------------------------
+def _k_n(s: str) -> tuple[float, float] | None:
+    """``(k, n)`` of a ``"x% (k/n)"`` string."""
+    try:
+        k, n = s.split("(")[1].split(")")[0].split("/")
+        return float(k), float(n)
+    except (IndexError, ValueError):
+        return None
+
+
+def _pct_of(s: str) -> float:
+    try:
+        return float(s.split("%")[0])
+    except ValueError:
+        return np.nan
+
+
+def _mtst_failures(r) -> str:
+    parts = []
+    for col, label in (("lost_no_stick", "lost"), ("false_no_stick", "false")):
+        if col in r and np.isfinite(r[col]):
+            pub = r.get(f"{col}_published", np.nan)
+            parts.append(f"{label} {int(r[col])}/{int(r['n_trials_no_stick'])} without a "
+                         f"stick" + (f" (paper {int(pub)})" if np.isfinite(pub) else ""))
+    return ", ".join(parts)
+
+
+def mtst_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
     """Seed 001: success ranking of Methods 1-3 and the proposed method (Table 3, mocap
-    reference; the rater events' where no trial has mocap), and target-step judgement
-    success (Table 4)."""
+    reference; the rater events' where no trial has mocap), each method's success and
+    target-step judgement success (Table 4), each with its 95 % interval."""
     st = "mtst"
     rows = []
     t3 = t["mtst_table3"]
@@ -155,96 +316,149 @@ def mtst_verdicts(t: dict[str, pd.DataFrame]) -> list[dict]:
         else:
             t3 = t3[t3["reference"] == "mocap"]
     t3 = t3.drop_duplicates("method").set_index("method")
-    pub = {m: float(t3.loc[m, "success_pct_published"]) for m in t3.index}
-    rep = {m: float(t3.loc[m, "success_pct"]) for m in t3.index}
-    if not rep:
+    pub = {m: float(t3.loc[m, "success_pct_published"]) / 100 for m in t3.index}
+    rep = {m: float(t3.loc[m, "success_pct"]) / 100 for m in t3.index}
+    kn = {m: _k_n(str(t3.loc[m, "success"])) for m in t3.index}
+    if not rep or not all(kn.values()):
         rows.append(_row(st, "Tracking success ranking", "Table 3", "see the paper",
-                         "no evaluated trials", "ranking", None, "mtst_table3"))
+                         "no evaluated trials", "ranking", None,
+                         "too small: no evaluated trials", "mtst_table3"))
     else:
+        small = any(wilson(*kn[m])[1] - wilson(*kn[m])[0] > MAX_CI_WIDTH for m in kn)
+        ok = None if small else _same_ranking(pub, rep)
+        why = ("too small: the 95% CIs of the success rates span more than half the range"
+               if small else "same order as the paper's." if ok else
+               _broken_pairs(pub, rep, _pct) + ".")
         rows.append(_row(st, f"Tracking success ranking ({ref})", "Table 3",
-                         _ranking(pub, ".1f") + " %", _ranking(rep, ".1f") + " %", "ranking",
-                         _same_ranking(pub, rep), "mtst_table3"))
+                         _ranking(pub, _pct), _ranking(rep, _pct), "ranking", ok, why,
+                         "mtst_table3"))
     for m in t3.index:
         r = t3.loc[m]
-        rows.append(_row(st, f"Success {SHORT.get(m, m)}", "Table 3",
-                         str(r["success_published"]), str(r["success"]),
-                         "published inside reproduced 95% CI",
-                         _pct_inside(str(r["success"]), pub[m]), "mtst_table3"))
+        k, n = kn[m] or (0, 0)
+        text, ok, small = _proportion_verdict(k, n, pub[m])
+        why = small or (f"the paper's {_pct(pub[m])} lies inside the interval." if ok else
+                        f"{int(k)} of {int(n)} trials tracked; " + _mtst_failures(r)
+                        + " (mtst_table3 notes: where the failures began).")
+        rows.append(_row(st, f"Success {SHORT.get(m, m)} ({ref.split(';')[0]})", "Table 3",
+                         str(r["success_published"]), text,
+                         "paper inside our 95% CI", ok, why, "mtst_table3",
+                         not_comparable=small))
     t4 = t.get("mtst_table4")
     if t4 is not None:
         for r in t4.itertuples(index=False):
-            pp = _pct_of(str(r.success_published))
+            pp = _pct_of(str(r.success_published)) / 100
+            got = _k_n(str(r.success))
+            if got is None:
+                rows.append(_row(st, f"{r.row.replace('_', ' ')} judged correctly", "Table 4",
+                                 str(r.success_published), "no steps",
+                                 "paper inside our 95% CI", None,
+                                 "too small: no steps on tracked trials", "mtst_table4"))
+                continue
+            text, ok, small = _proportion_verdict(*got, pp)
+            why = small or (f"the paper's {_pct(pp)} lies inside the interval." if ok else
+                            f"{int(got[0])} of {int(got[1])} judged correctly; "
+                            f"non-judgements {int(r.non_no_stick + r.non_stick)}, "
+                            f"misjudgements {int(r.mis_or_false_no_stick + r.mis_or_false_stick)}"
+                            " (mtst_table4 notes).")
             rows.append(_row(st, f"{r.row.replace('_', ' ')} judged correctly", "Table 4",
-                             str(r.success_published), str(r.success) if str(r.success)
-                             not in ("", "nan") else "no steps", "published inside "
-                             "reproduced 95% CI", _pct_inside(str(r.success), pp),
-                             "mtst_table4"))
+                             str(r.success_published), text,
+                             "paper inside our 95% CI", ok, why, "mtst_table4",
+                             not_comparable=small))
     return rows
 
 
-def _pct_of(s: str) -> float:
-    try:
-        return float(s.split("%")[0])
-    except ValueError:
-        return np.nan
-
-
-def _pct_inside(s: str, published_pct: float):
-    """Is ``published_pct`` inside the Wilson interval of a ``"x% (k/n)"`` string?"""
-    try:
-        k, n = s.split("(")[1].split(")")[0].split("/")
-        lo, hi = wilson(float(k), float(n))
-    except (IndexError, ValueError):
-        return None
-    return lo * 100 <= published_pct <= hi * 100
-
-
-def rollator_verdicts(t: dict[str, pd.DataFrame]) -> list[dict]:
-    """Seed 002: the PF beats the KF — lower RMSE and MAD per quantity (Table I, count of
-    subject × scenario cells) and fewer error frames (Table II)."""
+# -- Rollator (seed 002) -------------------------------------------------------------------
+def rollator_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
+    """Seed 002: the PF beats the KF — lower RMSE and MAD per quantity in most subject ×
+    scenario cells (Table I, in the paper's cm and cm/s) and fewer error frames
+    (Table II)."""
     st = "rollator"
     rows = []
     t1 = t["rollator_table1"]
     for p in dict.fromkeys(t1["parameter"]):
         d = t1[t1["parameter"] == p]
+        unit = {"m": "cm", "m/s": "cm/s"}.get(str(d["unit"].iloc[0]), str(d["unit"].iloc[0]))
         for stat in ("rmse", "mad"):
-            pk, pp = d[f"{stat}_kf_published"], d[f"{stat}_pf_published"]
-            rk, rp = d[f"{stat}_kf"], d[f"{stat}_pf"]
+            pk, pp = d[f"{stat}_kf_published"] * 100, d[f"{stat}_pf_published"] * 100
+            rk, rp = d[f"{stat}_kf"] * 100, d[f"{stat}_pf"] * 100
             mp, mr = pk.notna() & pp.notna(), rk.notna() & rp.notna()
             n_pub, n_rep = int((pp < pk)[mp].sum()), int((rp < rk)[mr].sum())
+            nr = int(mr.sum())
+            ok = ((n_rep * 2 > nr) == (n_pub * 2 > int(mp.sum()))) if nr else None
+            n_subj = int(d.loc[mr, "subject_no"].nunique())
+            if not nr:
+                why = "too small: no cell with both trackers' errors"
+            elif n_subj < MIN_SUBJECTS_CELLS:
+                ok = None
+                why = (f"too small: {nr} cell(s) of {n_subj} subject; the paper's majority "
+                       "is over 4 subjects × 2 scenarios")
+            else:
+                worse = d[mr & (rp >= rk)]
+                why = (f"PF lower in {n_rep} of {nr} cells (paper {n_pub} of {int(mp.sum())})"
+                       + ("; PF not lower for subject/scenario "
+                          + ", ".join(f"{int(a)}/{int(b)}" for a, b in
+                                      zip(worse["subject_no"], worse["scenario_no"].fillna(0)))
+                          if len(worse) and not ok else "") + ".")
             rows.append(_row(
                 st, f"PF {stat.upper()} < KF {stat.upper()}, {p}", "Table I",
-                f"{n_pub}/{int(mp.sum())} cells; mean KF {pk[mp].mean():.3f}, PF "
-                f"{pp[mp].mean():.3f}", f"{n_rep}/{int(mr.sum())} cells; mean KF "
-                f"{rk[mr].mean():.3f}, PF {rp[mr].mean():.3f}",
-                "direction (PF lower in most cells)",
-                (n_rep * 2 > int(mr.sum())) == (n_pub * 2 > int(mp.sum())) if mr.any()
-                else None, "rollator_table1"))
+                f"{n_pub}/{int(mp.sum())} cells; mean KF {pk[mp].mean():.2f}, PF "
+                f"{pp[mp].mean():.2f} {unit}", f"{n_rep}/{nr} cells; mean KF "
+                f"{rk[mr].mean():.2f}, PF {rp[mr].mean():.2f} {unit}" if nr else "no cells",
+                "direction (PF lower in most cells)", ok, why, "rollator_table1"))
     t2 = t.get("rollator_table2")
     if t2 is not None:
-        s = t2.groupby("tracker")[["error_frames", "error_frames_published"]].sum()
+        s = t2.groupby("tracker")[["error_frames", "error_frames_published",
+                                   "evaluated_frames"]].sum()
         if {"KF", "PF"} <= set(s.index):
             pub_ok = s.loc["PF", "error_frames_published"] < s.loc["KF", "error_frames_published"]
             rep_ok = s.loc["PF", "error_frames"] < s.loc["KF", "error_frames"]
+            why = (f"PF {int(s.loc['PF', 'error_frames'])} of "
+                   f"{int(s.loc['PF', 'evaluated_frames'])} evaluated frames, KF "
+                   f"{int(s.loc['KF', 'error_frames'])} of {int(s.loc['KF', 'evaluated_frames'])}"
+                   " (rollator_table2 notes: the error-frame rule).")
             rows.append(_row(st, "PF fewer error frames than KF (all cells)", "Table II",
                              f"KF {int(s.loc['KF', 'error_frames_published'])}, PF "
                              f"{int(s.loc['PF', 'error_frames_published'])}",
                              f"KF {int(s.loc['KF', 'error_frames'])}, PF "
                              f"{int(s.loc['PF', 'error_frames'])}", "direction",
-                             rep_ok == pub_ok, "rollator_table2"))
+                             rep_ok == pub_ok, why, "rollator_table2"))
     return rows
 
 
+# -- Ultrasonic (seed 003) -----------------------------------------------------------------
 _SPEED_ORDER = ("slow", "normal", "fast")
 
 
-def _p(p: float) -> str:
-    if not np.isfinite(p):
-        return "n/a"
-    return "< 0.001" if p < 0.001 else f"{p:.3f}"
+def _says(notes: dict | None, table: str) -> bool:
+    """Does ``table``'s notes call its numbers not comparable (:data:`NOT_COMPARABLE_NOTE`)?"""
+    phrase = NOT_COMPARABLE_NOTE[table]
+    return any(phrase in n for n in (notes or {}).get(table, []))
 
 
-def ultrasonic_verdicts(t: dict[str, pd.DataFrame]) -> list[dict]:
+def _pm(mean: float, sd: float, unit: str = "") -> str:
+    """``mean ± sd`` with decimals that give the SD two significant figures (at least the
+    paper's three), never e-notation."""
+    dec = 3
+    if np.isfinite(sd) and sd > 0:
+        dec = min(max(3, 1 - math.floor(math.log10(abs(sd)))), 8)
+    u = f" {unit}" if unit and unit != "-" else ""
+    return f"{mean:.{dec}f} ± {sd:.{dec}f}{u}".replace("-0.000 ", "0.000 ")
+
+
+def _ns_nv_reason(t8: pd.DataFrame, sym: str) -> str:
+    """NS, NV divide S, V by the number of strides n: the n each side implies."""
+    base = {"NS": "S", "NV": "V"}[sym]
+    pro = t8[t8["quantity"] == "pro"].set_index("symbol")
+    if base not in pro.index or sym not in pro.index:
+        return "NS and NV compare definitions of n, not accuracy (Table 8 note)."
+    n_rep = pro.loc[base, "normal_mean"] / pro.loc[sym, "normal_mean"]
+    n_pub = pro.loc[base, "normal_mean_published"] / pro.loc[sym, "normal_mean_published"]
+    return (f"{sym} = {base}/n: gaitval's n is every stride of the trial ({n_rep:.0f} at normal "
+            f"speed), the paper's values imply n ≈ {n_pub:.0f}; the rows compare definitions "
+            "of n, not accuracy (Table 8 note).")
+
+
+def ultrasonic_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
     """Seed 003: pendulum bias within its spread (Table 1); the system's stride parameters
     at normal speed within the published mean ± SD (Table 8); the direction of the speed
     effects (Table 8); normality (Table 7) and no subject effect (Table C1)."""
@@ -253,55 +467,95 @@ def ultrasonic_verdicts(t: dict[str, pd.DataFrame]) -> list[dict]:
     t1 = t.get("ultrasonic_table1")
     if t1 is not None:
         for r in t1.itertuples(index=False):
-            rows.append(_row(st, f"Pendulum error, {r.axis} axis: mean within ± SD",
-                             "Table 1", f"{r.mean_mm_published:.2f} ± "
+            ok = abs(r.mean_mm - r.mean_mm_published) <= r.std_mm_published
+            rows.append(_row(st, f"Pendulum error, {r.axis} axis: mean within the paper's "
+                             "± SD", "Table 1", f"{r.mean_mm_published:.2f} ± "
                              f"{r.std_mm_published:.2f} mm", f"{r.mean_mm:.2f} ± "
-                             f"{r.std_mm:.2f} mm", "value inside published mean ± SD",
-                             abs(r.mean_mm - r.mean_mm_published) <= r.std_mm_published,
-                             "ultrasonic_table1"))
+                             f"{r.std_mm:.2f} mm", "value inside published mean ± SD", ok,
+                             f"mean differs from the paper's by "
+                             f"{abs(r.mean_mm - r.mean_mm_published):.2f} mm, "
+                             f"{'within' if ok else 'more than'} its SD "
+                             f"{r.std_mm_published:.2f} mm.", "ultrasonic_table1"))
     t8 = t["ultrasonic_table8"]
+    ns_nv = _says(notes, "ultrasonic_table8")
     pro = t8[t8["quantity"] == "pro"]
     for r in pro.itertuples(index=False):
-        unit = "" if r.unit == "-" else f" {r.unit}"
+        unit = str(r.unit)
+        nc = _ns_nv_reason(t8, r.symbol) if ns_nv and r.symbol in ("NS", "NV") else None
+        small = None if np.isfinite(r.normal_std) else \
+            "too small: fewer than two subjects, no standard deviation"
+        dev = abs(r.normal_mean - r.normal_mean_published)
+        ok = dev <= r.normal_std_published
         rows.append(_row(st, f"{r.symbol} ({r.parameter}) at normal speed", "Table 8",
-                         f"{r.normal_mean_published:.3f} ± {r.normal_std_published:.3f}"
-                         f"{unit}", f"{r.normal_mean:.3f} ± {r.normal_std:.3f}{unit}",
-                         "value inside published mean ± SD",
-                         abs(r.normal_mean - r.normal_mean_published)
-                         <= r.normal_std_published, "ultrasonic_table8"))
+                         _pm(r.normal_mean_published, r.normal_std_published, unit),
+                         _pm(r.normal_mean, r.normal_std, unit),
+                         "value inside published mean ± SD", ok,
+                         f"mean differs from the paper's by {number(dev)}"
+                         f"{'' if unit == '-' else ' ' + unit}, "
+                         f"{'within' if ok else 'more than'} its SD "
+                         f"{number(r.normal_std_published)}.", "ultrasonic_table8",
+                         not_comparable=nc or small))
         pub = {s: getattr(r, f"{s}_mean_published") for s in _SPEED_ORDER}
         rep = {s: getattr(r, f"{s}_mean") for s in _SPEED_ORDER}
-        sig_pub = [getattr(r, f"{s}_p_published") < 0.05 for s in ("slow", "fast")]
-        sig_rep = [getattr(r, f"{s}_p") < 0.05 for s in ("slow", "fast")]
+        p_pub = {s: getattr(r, f"{s}_p_published") for s in ("slow", "fast")}
+        p_rep = {s: getattr(r, f"{s}_p") for s in ("slow", "fast")}
 
-        def trend(v, sig):
-            out = []
-            for s, ok in zip(("slow", "fast"), sig):
-                rel = "<" if v[s] < v["normal"] else ">"
-                out.append(f"{s} {rel} normal{'*' if ok else ''}")
-            return ", ".join(out)
+        def trend(v, p):
+            return ", ".join(f"{s} {'<' if v[s] < v['normal'] else '>'} normal"
+                             f"{'*' if p[s] < 0.05 else ''} (p {p_value(p[s])})"
+                             for s in ("slow", "fast"))
         same = all((np.sign(pub[s] - pub["normal"]) == np.sign(rep[s] - rep["normal"]))
-                   and (a == b) for s, a, b in zip(("slow", "fast"), sig_pub, sig_rep))
+                   and ((p_pub[s] < 0.05) == (p_rep[s] < 0.05)) for s in ("slow", "fast"))
+        n_subj = int(getattr(r, "n_subjects", MIN_SUBJECTS_T))
+        small_t = (None if np.isfinite(list(p_rep.values())).all()
+                   and n_subj >= MIN_SUBJECTS_T else
+                   f"too small: a paired t-test on {n_subj} subject(s) has "
+                   f"{max(n_subj - 1, 0)} degree(s) of freedom (the paper: 10 subjects)")
+        differ = [s for s in ("slow", "fast")
+                  if not ((np.sign(pub[s] - pub["normal"]) == np.sign(rep[s] - rep["normal"]))
+                          and ((p_pub[s] < 0.05) == (p_rep[s] < 0.05)))]
+        why = ("direction and significance as the paper's at both speeds." if same else
+               "differs at " + " and ".join(differ) + " speed: "
+               + "; ".join(f"{s} {number(rep[s])} vs normal {number(rep['normal'])}, "
+                           f"p {p_value(p_rep[s])} (paper {number(pub[s])} vs "
+                           f"{number(pub['normal'])}, p {p_value(p_pub[s])})"
+                           for s in differ) + ".")
         rows.append(_row(st, f"{r.symbol}: effect of speed (* p < 0.05)", "Table 8",
-                         trend(pub, sig_pub), trend(rep, sig_rep),
-                         "direction and significance", same, "ultrasonic_table8"))
+                         trend(pub, p_pub), trend(rep, p_rep), "direction and significance",
+                         same, why, "ultrasonic_table8", not_comparable=nc or small_t))
     t7 = t.get("ultrasonic_table7")
     if t7 is not None:
+        nc7 = _says(notes, "ultrasonic_table7")
         for r in t7.itertuples(index=False):
             known = np.isfinite([r.H, r.H_published]).all()
+            reason = (f"the paper's H = {r.H_published:.0f}, p = {r.p_published:.3f} test "
+                      "'mean is zero', not normality; gaitval's Lilliefors test gives "
+                      f"H = {r.H:.0f}, p {p_value(r.p)} (Table 7 note)." if nc7 and known
+                      else None if known else "too small: too few strides for the test")
             rows.append(_row(st, f"{r.symbol} normally distributed (Lilliefors)", "Table 7",
-                             f"H = {r.H_published:.0f}", f"H = {r.H:.0f} (p {_p(r.p)})"
+                             f"H = {r.H_published:.0f}", f"H = {r.H:.0f} (p {p_value(r.p)})"
                              if known else "too few strides", "same test decision",
                              int(r.H) == int(r.H_published) if known else None,
-                             "ultrasonic_table7"))
+                             f"H = {r.H:.0f} against the paper's {r.H_published:.0f}."
+                             if known else "", "ultrasonic_table7", not_comparable=reason))
     c1 = t.get("ultrasonic_tableC1")
     if c1 is not None:
+        ncc = _says(notes, "ultrasonic_tableC1")
         for r in c1[c1["source"] == "between"].itertuples(index=False):
+            known = np.isfinite(r.p) and np.isfinite(r.F)
+            reason = (f"gaitval groups strides by subject (F {r.F:.2f}, df {int(r.df)}); the "
+                      "paper's table matches grouping by stride index (F "
+                      f"{r.F_published:.2f}, df {int(r.df_published)}), so they differ by "
+                      "design (Table C1 note)." if ncc and known else None if known else
+                      f"too small: F is undefined with {int(r.df) + 1 if np.isfinite(r.df) else 'too few'} "
+                      "subject group(s)")
+            ok = (r.p < 0.05) == (r.p_published < 0.05) if known else None
             rows.append(_row(st, f"{r.symbol}: no difference between subjects (ANOVA)",
-                             "Table C1", f"F {r.F_published:.2f}, p {r.p_published:.3f}",
-                             f"F {r.F:.2f}, p {_p(r.p)}", "same test decision at 0.05",
-                             (r.p < 0.05) == (r.p_published < 0.05) if np.isfinite(r.p) else None,
-                             "ultrasonic_tableC1"))
+                             "Table C1", f"F {r.F_published:.2f}, p {p_value(r.p_published)}",
+                             f"F {r.F:.2f}, p {p_value(r.p)}" if known else "F undefined",
+                             "same test decision at 0.05", ok,
+                             f"p {p_value(r.p)} against the paper's {p_value(r.p_published)}.",
+                             "ultrasonic_tableC1", not_comparable=reason))
     return rows
 
 
@@ -309,37 +563,66 @@ BUILDERS = {"tug": tug_verdicts, "mtst": mtst_verdicts, "rollator": rollator_ver
             "ultrasonic": ultrasonic_verdicts}
 
 
-def build_verdicts(tables_dir: str | Path) -> pd.DataFrame:
+def _notes(md: Path) -> list[str]:
+    if not md.is_file():
+        return []
+    return [ln[2:] for ln in md.read_text(encoding="utf-8").splitlines()[1:]
+            if ln.startswith("- ")]
+
+
+def build_verdicts(tables_dir: str | Path, data: dict[str, str] | None = None
+                   ) -> pd.DataFrame:
     """Every verdict of the studies whose tables are in ``tables_dir`` (see module notes).
+
+    Parameters
+    ----------
+    tables_dir : path
+        ``<reports>/tables``.
+    data : mapping, optional
+        Paper (``tug``, ``mtst``, ``rollator``, ``ultrasonic``) → what its data are
+        (:func:`gaitval.report.datakind.paper_data`); the ``data`` column.
 
     Returns
     -------
     DataFrame
-        Columns :data:`VERDICT_COLUMNS`; ``note`` is the stem of the table whose notes
+        Columns :data:`VERDICT_COLUMNS`; ``table`` is the stem of the table whose notes
         explain a difference (its anchor in the report).  A study whose tables are absent
-        has one row with ``reproduced = "not run"``.
+        has one row with outcome ``not run``.
     """
     td = Path(tables_dir)
     tables = {p.stem: pd.read_csv(p) for p in sorted(td.glob("*.csv"))}
+    notes = {stem: _notes(td / f"{stem}.md") for stem in NOT_COMPARABLE_NOTE}
     rows = []
     for study, need in REQUIRED.items():
         if need not in tables:
             rows.append(_row(study, "all comparisons of the paper", need, "see the paper",
-                             "not run", "study not in `run`", None, ""))
-            rows[-1]["reproduced_in_direction"] = "not run"
+                             "not run", "study not in `run`", None,
+                             "no study of the run has this protocol", ""))
+            rows[-1]["outcome"] = "not run"
             continue
-        rows += BUILDERS[study](tables)
+        got = BUILDERS[study](tables, notes)
+        for r in got:
+            r["data"] = (data or {}).get(study, "")
+        rows += got
     return pd.DataFrame(rows, columns=list(VERDICT_COLUMNS))
 
 
 def summary_lines(v: pd.DataFrame) -> list[str]:
-    """One sentence per study: how many comparisons were reproduced."""
+    """One sentence per study: reproduced of the comparable comparisons, and how many were
+    not comparable (never counted as not reproduced)."""
     out = []
     for study, g in v.groupby("study", sort=False):
-        if (g["reproduced_in_direction"] == "not run").all():
-            out.append(f"{STUDIES.get(study, study)}: not run.")
+        name = STUDIES.get(study, study)
+        if (g["outcome"] == "not run").all():
+            out.append(f"{name}: not run.")
             continue
-        yes = int((g["reproduced_in_direction"] == "yes").sum())
-        n = int(g["reproduced_in_direction"].isin(["yes", "no"]).sum())
-        out.append(f"{STUDIES.get(study, study)}: {yes} of {n} comparisons reproduced.")
+        c = g["outcome"].value_counts()
+        yes, no, nc = (int(c.get(k, 0)) for k in ("reproduced", "not reproduced",
+                                                   "not comparable"))
+        data = str(g["data"].iloc[0])
+        line = (f"{name}: {yes} of {yes + no} comparable comparisons reproduced"
+                if yes + no else f"{name}: no comparison could be scored")
+        line += f"; {nc} not comparable" if nc else ""
+        line += f" — on {data}." if data else "."
+        out.append(line)
     return out

@@ -3,37 +3,31 @@
 Every paper table goes through :func:`write_table`, so all three files always say the same
 thing: the CSV is the tidy source (units in column names), the Markdown carries the caption
 and notes for the report, the LaTeX (:mod:`gaitval.tables.latex`, pandas' Styler with
-booktabs) is ready for a manuscript.  Floats are formatted with a fixed number of decimals
-so the outputs are byte-identical for the same input.
+booktabs) is ready for a manuscript.  The Markdown and the LaTeX get the table in its
+display units (:func:`gaitval.tables.numbers.to_display`: per cent for rates, mm for
+registration residuals, cm for the rollator's Table I) and every Markdown cell is printed by
+:func:`gaitval.tables.numbers.format_value`, the format the HTML report uses too: fixed
+decimals per quantity, ``< 0.001`` for p-values, never e-notation.  The CSV keeps full
+precision in SI units.  Same input, same bytes.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from gaitval.io.atomic import write_text
+from gaitval.tables.numbers import format_value, to_display
 
 
-def _fmt(v, digits: int) -> str:
-    if v is None or (isinstance(v, float) and np.isnan(v)):
-        return ""
-    if isinstance(v, (bool, np.bool_)):
-        return "yes" if v else "no"
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    if isinstance(v, (float, np.floating)):
-        return f"{float(v):.{digits}f}"
-    return str(v)
-
-
-def to_markdown(df: pd.DataFrame, digits: int = 3) -> str:
+def to_markdown(df: pd.DataFrame, table: str | None = None) -> str:
+    """``df`` (in display units, :func:`gaitval.tables.numbers.to_display`) as a Markdown
+    table, each cell by :func:`gaitval.tables.numbers.format_value`."""
     cols = [str(c) for c in df.columns]
     lines = ["| " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
-    for row in df.itertuples(index=False):
-        lines.append("| " + " | ".join(_fmt(v, digits).replace("|", "\\|") for v in row)
-                     + " |")
+    for row in df.itertuples(index=False, name=None):
+        lines.append("| " + " | ".join(format_value(v, c, table).replace("|", "\\|")
+                                       for c, v in zip(cols, row)) + " |")
     return "\n".join(lines)
 
 
@@ -53,7 +47,9 @@ def write_table(df: pd.DataFrame, stem: str | Path, *, caption: str,
     notes : list of str
         Deviations from the paper, disagreements and their likely causes.
     digits : int
-        Decimals for floats in Markdown and LaTeX (the CSV keeps ``csv_float_format``).
+        Passed on to the LaTeX renderer; the Markdown's decimals are those of each
+        column's quantity (:mod:`gaitval.tables.numbers`; the CSV keeps
+        ``csv_float_format``).
 
     Returns
     -------
@@ -62,12 +58,13 @@ def write_table(df: pd.DataFrame, stem: str | Path, *, caption: str,
     """
     stem = Path(stem)
     csv_text = df.to_csv(index=False, float_format=csv_float_format, lineterminator="\n")
-    md = [f"**{caption}**", "", to_markdown(df, digits)]
+    shown = to_display(df, stem.name)
+    md = [f"**{caption}**", "", to_markdown(shown, stem.name)]
     if notes:
         md += [""] + [f"- {n}" for n in notes]
     from gaitval.tables.latex import to_latex   # lazily: `python -m gaitval.tables.latex`
 
-    tex = to_latex(df, caption=caption, notes=notes, label=stem.name, digits=digits)
+    tex = to_latex(shown, caption=caption, notes=notes, label=stem.name, digits=digits)
     paths = [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".tex")]
     write_text(paths[0], csv_text)
     write_text(paths[1], "\n".join(md) + "\n")

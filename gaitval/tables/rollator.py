@@ -187,12 +187,12 @@ def write_rollator_tables(frames: pd.DataFrame, summary: pd.DataFrame, tables_di
     t1 = rollator_table1(frames, summary, kf, pf)
     t2 = rollator_table2(summary, kf, pf)
     imp = improvement(t1)
-    paths = write_table(t1, td / "rollator_table1", digits=4, notes=table1_notes(
+    paths = write_table(t1, td / "rollator_table1", digits=2, notes=table1_notes(
         t1, imp, model_sources), caption=(
         "Seed 002 Table I (tracking accuracy): RMSE and MAD of the mean position (x lateral, "
         "y forward) and mean velocity of both legs, KF (§II) vs PF (§III), per scenario and "
-        "subject (repetitions pooled), in the moving laser frame; published values (cm, "
-        "cm/s) converted to m, m/s beside."))
+        "subject (repetitions pooled), in the moving laser frame; shown in the paper's cm "
+        "and cm/s, published values beside (the CSV holds m and m/s)."))
     paths += write_table(t2, td / "rollator_table2", digits=2, notes=table2_notes(
         t2, error_m), caption=(
         "Seed 002 Table II (tracking robustness): time of correct tracking, error frames and "

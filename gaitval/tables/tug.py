@@ -175,10 +175,11 @@ def tug_table3(summaries, definitions: Mapping | None = None) -> pd.DataFrame:
     Returns
     -------
     DataFrame
-        One row per method: ``method, base_method, phase_reading, label,
-        gait_phase_association, catmull_rom_interpolation, n_trials, ft_turning,
-        ft_return, ft_forward, sf_turning, sf_other, n_success, success_rate`` and the
-        ``*_published`` columns.
+        One row per method, results first and the method's definition last:
+        ``method, label, phase_reading, success_rate, n_success, n_trials, ft_turning,
+        ft_return, ft_forward, sf_turning, sf_other, base_method, gait_phase_association,
+        catmull_rom_interpolation`` and the ``*_published`` columns (each after its
+        quantity).
     """
     s = _concat(summaries)
     rows = []
@@ -209,9 +210,15 @@ def tug_table3(summaries, definitions: Mapping | None = None) -> pd.DataFrame:
             "success_rate": ns / n if n else np.nan,
             "success_rate_published": (pub["n_success"] / pub["n_trials"]) if pub else np.nan,
         })
-    return _tidy_counts(pd.DataFrame(rows), ["ft_turning_published", "ft_return_published",
-                                             "sf_turning_published", "n_success_published",
-                                             "n_trials_published"])
+    order = ["method", "label", "phase_reading", "success_rate", "success_rate_published",
+             "n_success", "n_success_published", "n_trials", "n_trials_published",
+             "ft_turning", "ft_turning_published", "ft_return", "ft_return_published",
+             "ft_forward", "sf_turning", "sf_turning_published", "sf_other", "base_method",
+             "gait_phase_association", "catmull_rom_interpolation"]
+    return _tidy_counts(pd.DataFrame(rows, columns=order),
+                        ["ft_turning_published", "ft_return_published",
+                         "sf_turning_published", "n_success_published",
+                         "n_trials_published"])
 
 
 def _success_frames(frames: pd.DataFrame, summaries: pd.DataFrame) -> pd.DataFrame:
@@ -230,8 +237,9 @@ def tug_table4(frames, summaries, definitions: Mapping | None = None) -> pd.Data
     -------
     DataFrame
         One row per method and TUG phase (forward, turning, return, total):
-        ``method, base_method, phase_reading, label, tug_phase, n_success_trials, n_uo,
-        n_steps, occlusion_rate, rmse_x_m, rmse_y_m`` and the ``*_published`` columns.
+        ``method, phase_reading, label, tug_phase, n_success_trials, n_uo, n_steps,
+        occlusion_rate, rmse_x_m, rmse_y_m``, the ``*_published`` columns and
+        ``base_method`` last.
     """
     f, s = _concat(frames), _concat(summaries)
     good = _success_frames(f, s)
@@ -256,8 +264,10 @@ def tug_table4(frames, summaries, definitions: Mapping | None = None) -> pd.Data
                 "rmse_x_m": _rmse(e["err_x_m"]), "rmse_x_m_published": pub[2] if pub else np.nan,
                 "rmse_y_m": _rmse(e["err_y_m"]), "rmse_y_m_published": pub[3] if pub else np.nan,
             })
-    return _tidy_counts(pd.DataFrame(rows), ["n_success_trials_published", "n_uo_published",
-                                             "n_steps_published"])
+    t = _tidy_counts(pd.DataFrame(rows), ["n_success_trials_published", "n_uo_published",
+                                          "n_steps_published"])
+    # results first, the method's base (a definition) last
+    return t[[c for c in t.columns if c != "base_method"] + ["base_method"]]
 
 
 def tug_table5(frames, summaries, definitions: Mapping | None = None) -> pd.DataFrame:
@@ -285,6 +295,15 @@ def tug_table5(frames, summaries, definitions: Mapping | None = None) -> pd.Data
                 "rmse_y_m": _rmse(e["err_y_m"]), "rmse_y_m_published": pub[2] if pub else np.nan,
             })
     return _tidy_counts(pd.DataFrame(rows), ["time_steps_published"])
+
+
+#: The legend of the leg-pattern and gait-phase codes of the evidence sentences.
+PATTERN_LEGEND = ("Codes: leg patterns (seed 001 §2.3, gaitval.detect.legpatterns) SL one leg "
+                  "alone, LT two legs together, FS_O a leg partly hidden but observable, "
+                  "FS_U only a sliver of a leg visible, UO unobservable (no observation); "
+                  "`SL×6 → LT×2` reads 6 scans SL, then 2 scans LT. Gait phases (seed 000 "
+                  "Fig. 6) 0 both legs in stance, 1/2 left leg swinging (accelerating/"
+                  "decelerating), 3/4 right leg swinging, 5 both swinging.")
 
 
 def _ordering_notes(t3: pd.DataFrame, t4: pd.DataFrame, t5: pd.DataFrame) -> list[str]:
@@ -360,6 +379,7 @@ def write_tug_tables(frames, summaries, out_dir: str | Path, *,
     t2 = tug_table2(methods, dt_measured_s)
     t3, t4, t5 = tug_table3(s, defs), tug_table4(f, s, defs), tug_table5(f, s, defs)
     ev = failure_evidence(f, s, defs, evaluation)
+    legend = [PATTERN_LEGEND]
     common = [f"Source: {CITATION}.",
               "Reproduced values from gaitval's evaluation of each trial; *_published "
               "columns transcribed from the paper."]
@@ -376,7 +396,7 @@ def write_tug_tables(frames, summaries, out_dir: str | Path, *,
                          "definitions and tracking results per method (seed 000 Table 3). "
                          "Each failed trial counted once, in the TUG phase of its first "
                          "failure; ft_forward and sf_other have no published counterpart.",
-                         notes=common + [readings] + notes + _evidence_notes(ev, t3))
+                         notes=common + [readings] + notes + _evidence_notes(ev, t3) + legend)
     paths += write_table(t4, out / "tug_table4", caption="TUG leg tracking: occlusion rate "
                          "and RMSE of the leg trajectory per TUG phase over tracking-success "
                          "trials (seed 000 Table 4; sensor frame x/y).",
@@ -387,5 +407,6 @@ def write_tug_tables(frames, summaries, out_dir: str | Path, *,
     paths += write_table(ev, out / "tug_failures", caption="TUG leg tracking: the first "
                          "failure of every trial a method did not track, with what the "
                          "tracker saw in the 0.5 s before (leg patterns, unobservable scans, "
-                         "gait phases of eq. (3)–(5)); evidence for Table 3.", notes=common)
+                         "gait phases of eq. (3)–(5)); evidence for Table 3.",
+                         notes=common + legend)
     return paths

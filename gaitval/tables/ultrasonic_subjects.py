@@ -15,6 +15,7 @@ from scipy import stats as sps
 
 from gaitval.stats import error_summary
 from gaitval.tables import _published_qi2014 as pub
+from gaitval.tables.numbers import format_value
 from gaitval.tables.ultrasonic_agreement import agreement_row
 from gaitval.tables.ultrasonic_params import (PARAM_INFO, check_gait_params, select,
                                               subject_order)
@@ -149,9 +150,14 @@ def agreement_note(table: pd.DataFrame, parameter: str) -> str:
         return text + (" The repeated-measures limits need two subjects and a subject "
                        "with two strides; they are empty here.")
     n_sub = len(table) - 2                                # rows: subjects, average, peak
-    return text + (f" Here the repeated-measures limits [{avg['loa_low_rm' + u]:.3g}, "
-                   f"{avg['loa_high_rm' + u]:.3g}] are {ratio:.2f} times as wide as the "
-                   f"pooled [{avg['loa_low' + u]:.3g}, {avg['loa_high' + u]:.3g}] and the "
+    unit = PARAM_INFO[parameter][2]
+    unit = "" if unit == "-" else f" {unit}"
+
+    def f(col):                         # as the table's cells print it (one format)
+        return format_value(avg[col + u], col + u, "ultrasonic_table2")
+    return text + (f" Here the repeated-measures limits [{f('loa_low_rm')}, "
+                   f"{f('loa_high_rm')}]{unit} are {ratio:.2f} times as wide as the "
+                   f"pooled [{f('loa_low')}, {f('loa_high')}]{unit} and the "
                    f"95% CI of the upper limit {ci:.1f} times as long ({n_sub} subjects, "
                    f"{int(avg['n_strides'])} strides): the subject, not the stride, is the "
                    "unit of replication.")

@@ -1,0 +1,145 @@
+"""What the data of a report are: simulated replica, replay of real mocap, or real recordings.
+
+Read from the report's resolved configuration (``provenance/config.yaml``, written by the
+workflow's ``report_config`` rule) and each study's trial sheet:
+
+* a study with a ``simulate:`` block whose preset (``config/studies/<preset>.yaml``) has a
+  ``replay:`` section is a **replay of real mocap** (real leg motion, simulated laser);
+* any other ``simulate:`` study is a **simulated replica** of the papers' protocols;
+* a study given by its own trial sheet is **real recordings**.
+
+Each study's trial sheet says which protocols it has and how many subjects and trials; a
+study smaller than the paper it is compared with is called so (the ``tiny`` preset has one
+subject per protocol: it tests the pipeline, not the papers).  Nothing here imports the
+simulator (import contract ``analysis-not-simulate``): presets are read as YAML.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+import yaml
+
+#: The protocols (trial sheet ``protocol``) behind each paper's tables.
+PAPER_PROTOCOLS = {"tug": ("tug",), "mtst": ("mtst",), "rollator": ("rollator",),
+                   "ultrasonic": ("treadmill", "pendulum")}
+#: Subjects and trials of each paper (seed README): what "smaller than the paper" means.
+PAPER_SIZE = {"tug": (7, 28), "mtst": (16, 48), "rollator": (4, 16), "ultrasonic": (10, 30)}
+#: The sentences a report's reader needs before any verdict, per data kind.
+MEANING = {
+    "simulated": ("A verdict on simulated data shows whether gaitval's implementation of a "
+                  "paper's method, run on a replica of its protocol, orders and sizes its "
+                  "results as the paper did; it cannot confirm or refute the paper's "
+                  "findings about real people and sensors, and how hard the data are is set "
+                  "by the simulator's assumptions (docs/simulator.md)."),
+    "replay": ("A replay drives a simulated laser with real mocap walks: it tests the "
+               "trackers on real gait kinematics, not on real sensor noise or occluders."),
+    "real": ("Real recordings test the methods on real sensors and people; their subjects "
+             "and setups still differ from the papers'."),
+}
+REPO = Path(__file__).resolve().parents[2]
+
+
+@dataclass
+class StudyData:
+    """One study of the run: its name, kind, a label and its size per protocol."""
+    name: str
+    kind: str                          # simulated | replay | real | unknown
+    label: str                         # "simulated replica (default, seed 20150904)"
+    sizes: dict[str, tuple[int, int]] = field(default_factory=dict)   # protocol -> (subj, trials)
+
+
+def _load_yaml(path: Path) -> dict:
+    try:
+        with open(path, encoding="utf-8") as fh:
+            return yaml.safe_load(fh) or {}
+    except (OSError, yaml.YAMLError):
+        return {}
+
+
+def _sizes(sheet: Path) -> dict[str, tuple[int, int]]:
+    try:
+        df = pd.read_csv(sheet, usecols=["protocol", "subject", "trial"], dtype=str)
+    except (OSError, ValueError):
+        return {}
+    return {p: (int(g["subject"].nunique()), int(g["trial"].nunique()))
+            for p, g in df.groupby("protocol", sort=True)}
+
+
+def study_data(name: str, config: dict, base: Path = Path(".")) -> StudyData:
+    """The :class:`StudyData` of study ``name`` under the resolved ``config``; paths
+    relative to ``base`` (the workflow's working directory)."""
+    entry = (config.get("studies") or {}).get(name) or {}
+    sim = entry.get("simulate")
+    if sim:
+        preset = str(sim.get("preset", name))
+        seed = sim.get("seed", _load_yaml(REPO / "config" / "studies" / f"{preset}.yaml")
+                       .get("seed", "?"))
+        pcfg = _load_yaml(REPO / "config" / "studies" / f"{preset}.yaml")
+        sheet = base / config.get("data_dir", "data") / name / "trials.csv"
+        if pcfg.get("replay"):
+            return StudyData(name, "replay", f"replay of real mocap ({preset}, seed {seed})",
+                             _sizes(sheet))
+        return StudyData(name, "simulated", f"simulated replica ({preset}, seed {seed})",
+                         _sizes(sheet))
+    if entry.get("trial_sheet"):
+        sheet = Path(entry["trial_sheet"])
+        return StudyData(name, "real", f"real recordings ({name})",
+                         _sizes(sheet if sheet.is_absolute() else base / sheet))
+    return StudyData(name, "unknown", f"{name} (data kind unknown)")
+
+
+def run_data(reports_dir: str | Path, study_names: list[str] | None,
+             base: Path = Path(".")) -> list[StudyData]:
+    """Every study of the run, from ``<reports_dir>/provenance/config.yaml``; studies
+    without it are ``unknown`` (an index built outside the workflow)."""
+    config = _load_yaml(Path(reports_dir) / "provenance" / "config.yaml")
+    names = list(study_names or config.get("run") or [])
+    if not config:
+        return [StudyData(n, "unknown", f"{n} (data kind unknown: no provenance/config.yaml)")
+                for n in names]
+    return [study_data(n, config, base) for n in names]
+
+
+def paper_data(studies: list[StudyData], paper: str) -> str:
+    """The data a paper's verdicts rest on: the studies with its protocols, each with its
+    size where it is smaller than the paper's (``toy size: 1 subject, 2 trials; paper 7,
+    28``)."""
+    protos = PAPER_PROTOCOLS.get(paper, (paper,))
+    parts = []
+    for s in studies:
+        have = {p: s.sizes[p] for p in protos if p in s.sizes}
+        if s.sizes and not have:
+            continue
+        text = s.label
+        if have:
+            subj = max(v[0] for v in have.values())
+            trials = sum(v[1] for v in have.values())
+            ps, pt = PAPER_SIZE.get(paper, (0, 0))
+            if subj < ps:
+                text += (f"; smaller than the paper: {subj} subject{'s' * (subj != 1)}, "
+                         f"{trials} trial{'s' * (trials != 1)} (paper {ps}, {pt})")
+        parts.append(text)
+    return " + ".join(parts) if parts else "no study of the run has this protocol"
+
+
+def headline(studies: list[StudyData]) -> list[str]:
+    """The lines at the top of the report: what the data are and what a verdict means."""
+    if not studies:
+        return ["Data: no study named (an index built outside the workflow)."]
+    out = ["Data: " + "; ".join(f"**{s.name}**: {s.label}" for s in studies) + "."]
+    for s in studies:
+        small = [paper for paper, protos in PAPER_PROTOCOLS.items()
+                 if any(p in s.sizes for p in protos) and max(
+                     s.sizes[p][0] for p in protos if p in s.sizes) < PAPER_SIZE[paper][0]]
+        if small:
+            out.append(f"**{s.name}** has fewer subjects than the paper for "
+                       f"{', '.join(small)}: a comparison it is too small for is reported "
+                       "as _not comparable (too small)_, and the others rest on few walks.")
+    kinds = dict.fromkeys(s.kind for s in studies)
+    out += [MEANING[k] for k in kinds if k in MEANING]
+    if any(k == "unknown" for k in kinds):
+        out.append("The kind of some data is unknown (no resolved configuration beside the "
+                   "report): read the verdicts as about data of unknown origin.")
+    return out
