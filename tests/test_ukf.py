@@ -365,7 +365,7 @@ def test_checked_trilateration_refuses_what_no_anchor_set_supports():
 def test_filter_starts_at_the_heel_despite_a_late_echo_at_sample_0():
     t, pos, d = _late_echo_ranges()
     r = run_toa_ukf(t, d, ANCHORS, W_sigma=W, V=SIG ** 2, init_guess=GUESS)
-    assert r.reinit[0]
+    assert r.reinit[0] and r.used[0].tolist() == [True, True, False, True]
     assert np.linalg.norm(r.x[0, :3] - pos[0]) < 1e-6
     assert np.linalg.norm(r.x[:, :3] - pos, axis=1).max() < 0.02
 

@@ -41,8 +41,10 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     for k in range(n_s):
         if x is None or starved >= reinit_after:
             # from the guess: its side of the array (issue 34: checked, as the kernel's caller)
-            p0 = trilaterate_checked(d[k], anchors, guess).p
+            fix = trilaterate_checked(d[k], anchors, guess)
+            p0 = fix.p
             if np.all(np.isfinite(p0)):
+                res.used[k] = fix.used
                 x, P, starved = np.concatenate([p0, np.zeros(3)]), P0.copy(), 0
                 res.reinit[k] = True
                 res.x[k], res.P_diag[k] = x, P.diagonal()

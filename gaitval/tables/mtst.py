@@ -128,7 +128,12 @@ def table3(summary: pd.DataFrame, methods: list[str]) -> pd.DataFrame:
                 "success_pct_published": 100.0 * pub[4] / P.N_TRIALS["total"] if pub else None,
                 "success_published": pub[5] if pub else "",
                 **_persistent_columns(d, ref)})
-    return pd.DataFrame(rows)
+    out = pd.DataFrame(rows)
+    for c in PERSISTENT[:4]:                  # counts: "12", blank where there is no rule
+        if c + PS in out:
+            out[c + PS] = pd.Series([None if pd.isna(v) else int(v) for v in out[c + PS]],
+                                    dtype=object)
+    return out
 
 
 def judging_rules_note(t3: pd.DataFrame) -> str:

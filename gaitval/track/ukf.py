@@ -307,9 +307,11 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     while k < n_s:
         # here the filter has no state yet, or has starved for reinit_after samples
         # from the guess: its side of the array; a fix the ranges do not support is refused
-        p0 = trilaterate_checked(d[k], anchors, guess, max_residual_m=init_max_residual_m,
-                                 max_range_m=max_range_m).p
+        fix = trilaterate_checked(d[k], anchors, guess, max_residual_m=init_max_residual_m,
+                                  max_range_m=max_range_m)
+        p0 = fix.p
         if np.all(np.isfinite(p0)):
+            res.used[k] = fix.used                  # the anchors of the fix
             # the kernel keeps P row-major and flat (36,)
             x, P, starved[0] = np.concatenate([p0, np.zeros(3)]), P0.flatten(), 0
             res.reinit[k] = True
