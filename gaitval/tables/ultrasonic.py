@@ -83,12 +83,10 @@ def _captions() -> dict[str, tuple[str, list[str]]]:
         "Reproduces Table 7 of Qi et al. 2014: normality of the ultrasonic estimates of "
         "S, T, V, hS, vS (the sampled strides at normal speed pooled over subjects) with "
         "mean, std and t-based 95% confidence interval of the mean. " + common,
-        [TABLE7_NOT_COMPARABLE[:1].upper() + TABLE7_NOT_COMPARABLE[1:] + " (column "
-         "comparability). The published table is not a normality test: the paper reports "
-         "H = 0 and p = 1.000 for a null hypothesis of 'mean is zero'; gaitval applies "
-         "the Lilliefors test (MATLAB lillietest default, alpha = 0.05; H = 1 rejects "
-         "normality), so its p and H are not comparable with the published ones. The "
-         "mean, std and CI columns are.",
+        [TABLE7_NOT_COMPARABLE[:1].upper() + TABLE7_NOT_COMPARABLE[1:] + " (MATLAB "
+         "lillietest default, alpha = 0.05; H = 1 rejects normality); column "
+         "comparability says so on every row. The mean, std and CI columns are "
+         "comparable.",
          "Pooling strides of different subjects mixes subject means, so normality may "
          "be rejected even when each subject's strides are normal. T (eq. 19) is a "
          "difference of sample indices at 50 Hz, so it takes few distinct values and "
