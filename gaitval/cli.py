@@ -155,7 +155,7 @@ def cmd_gait_parameters(a) -> int:
 def cmd_ultrasonic_tables(a) -> int:
     from gaitval.steps import ultrasonic_tables_step
     ultrasonic_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir,
-                           a.config_hash)
+                           a.config_hash, config_json=a.config)
     return 0
 
 
@@ -309,6 +309,8 @@ def _add_ultrasonic_verbs(sub) -> None:
     s.add_argument("--figures-dir", required=True)
     s.add_argument("--reports-dir", default="reports")
     s.add_argument("--config-hash", default="")
+    s.add_argument("--config", default=None,
+                   help="config (view) JSON: ultrasonic.tables, the strides the tables use")
     s.set_defaults(func=cmd_ultrasonic_tables)
 
 

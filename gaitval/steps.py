@@ -429,14 +429,17 @@ def gait_parameters_step(track_parquet, ingest_dir, sheet, subjects, trial: str,
 
 
 def ultrasonic_tables_step(inputs: list[str | Path], tables_dir, figures_dir, reports_dir,
-                           config_hash: str = "") -> list[Path]:
-    """Seed 003 Tables 2-8, C1 and the figures from the per-trial gait parameters."""
+                           config_hash: str = "", config_json=None) -> list[Path]:
+    """Seed 003 Tables 2-8, C1 and the figures from the per-trial gait parameters; the
+    tables on the strides ``ultrasonic.tables`` of ``config_json`` selects (default: the
+    paper's 10 per subject), the figures on every stride."""
     from gaitval.report.provenance import stamp
     from gaitval.report.stats_figures import write_ultrasonic_figures
     from gaitval.tables.ultrasonic import write_ultrasonic_tables
 
     gp = pd.concat([read_parquet(p) for p in inputs], ignore_index=True)
-    paths = write_ultrasonic_tables(gp, tables_dir)
+    cfg = (load_json(config_json).get("ultrasonic") or {}) if config_json else {}
+    paths = write_ultrasonic_tables(gp, tables_dir, cfg)
     stamp("ultrasonic_tables", paths, reports_dir, config_hash_=config_hash)
     figs = write_ultrasonic_figures(gp, figures_dir)
     stamp("ultrasonic_figures", figs, reports_dir, config_hash_=config_hash)

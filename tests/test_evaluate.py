@@ -157,3 +157,44 @@ def test_a_prediction_running_off_by_more_than_a_stride_is_lost():
     f.loc[run, "x_m"] = 2.5                          # 1.5 m off: the leg is lost
     _, ev = false_tracking(f)
     assert ev["kind"].tolist() == ["lost"]
+
+
+# -- two judging rules side by side (issue 34) -----------------------------------------
+def test_a_short_swap_fails_the_paper_rule_but_not_the_persistent_swap_rule():
+    from gaitval.evaluate.tug import judged_false
+
+    f = static_frames()
+    f.loc[(f["side"] == "L") & f["k"].between(30, 45), "y_m"] = -0.1   # 16 scans = 0.40 s
+    _, ev = false_tracking(f)
+    assert ev["duration_s"].tolist() == [pytest.approx(0.40)]
+    assert len(judged_false(ev, "paper")) == 1
+    assert judged_false(ev, "persistent_swap").empty
+    # 21 scans = 0.525 s > 0.5 s: false tracking under both rules
+    f.loc[(f["side"] == "L") & f["k"].between(30, 50), "y_m"] = -0.1
+    _, ev = false_tracking(f)
+    assert len(judged_false(ev, "persistent_swap")) == 1
+    # a lost event counts under both rules, however short
+    g = static_frames()
+    g["observed"] = True
+    g.loc[(g["side"] == "R") & g["k"].between(60, 69), "x_m"] = 1.5     # 0.25 s
+    _, ev = false_tracking(g)
+    assert ev["kind"].tolist() == ["lost"]
+    assert len(judged_false(ev, "persistent_swap")) == 1
+    with pytest.raises(GaitvalError, match="judging rule"):
+        judged_false(ev, "majority")
+
+
+def test_the_summary_carries_both_rules(synthetic):
+    scans, truth = synthetic
+    track = track_trial(scans, "tug_m3", 0.1)
+    b = tug_phase_bounds(truth)
+    # the labels are swapped for 0.3 s in the return phase, then right again
+    t0 = b["t_turn_end_s"] + 0.5
+    brief = track["t_sensor_s"].between(t0, t0 + 0.3)
+    sw = track.copy()
+    sw.loc[brief, "side"] = sw.loc[brief, "side"].map({"L": "R", "R": "L"})
+    sw = sw.sort_values(["k", "side"], kind="stable").reset_index(drop=True)
+    s = evaluate_tug_trial(sw, truth, trial="syn", method="tug_m3")["summary"].iloc[0]
+    assert s.category == "false_tracking_return" and not s.success
+    assert s.category_persistent_swap == "success" and s.success_persistent_swap
+    assert s.n_ft_events >= 1 and s.n_ft_events_persistent_swap == 0

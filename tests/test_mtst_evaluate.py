@@ -161,3 +161,21 @@ def test_gate_usage_reports_the_table1_cell_of_every_scan():
     r = g[(g.side == "R") & (g.k == 23)].iloc[0]
     assert r["cell"].endswith("_unobservable")              # H = 3 up to k−1 = 22
     assert (g["radius_leg_widths"] >= 0.75).all()
+
+
+def test_a_brief_swap_is_forgiven_only_by_the_persistent_swap_rule():
+    """Issue 34: the labels swap for 0.3 s and swap back; the paper rule (mocap) calls it
+    a false track, the persistent-swap rule (> 0.5 s) does not; a lasting swap fails both."""
+    tr = walk(STEPS)
+
+    def swapped(t0, t1):
+        track = as_track(tr)
+        w = track["t_sensor_s"].between(t0, t1)
+        track.loc[w, "side"] = track.loc[w, "side"].map({"L": "R", "R": "L"})
+        return track.sort_values(["k", "side"]).reset_index(drop=True)
+
+    s = evaluate(swapped(2.0, 2.3), as_truth(tr), annotations_of(tr))["summary"].iloc[0]
+    assert s["category_mocap"] == "false_swap"
+    assert s["category_mocap_persistent_swap"] == "success"
+    s = evaluate(swapped(2.0, 10.0), as_truth(tr), annotations_of(tr))["summary"].iloc[0]
+    assert s["category_mocap"] == s["category_mocap_persistent_swap"] == "false_swap"

@@ -188,3 +188,20 @@ def test_published_table3_matches_the_seed_text():
         pub = PUBLISHED_T3[m]
         assert [pub[k] for k in rows] == [rows[k][i] for k in rows]
         assert (pub["n_success"], pub["n_trials"]) == tuple(int(v) for v in succ[i])
+
+
+def test_table3_has_the_persistent_swap_rule_after_the_papers():
+    s = pd.DataFrame([summary("a", "tug_m1", "false_tracking_turning"),
+                      summary("b", "tug_m1", "false_tracking_return"),
+                      summary("c", "tug_m1", "success")])
+    s["category_persistent_swap"] = ["success", "stance_failure_turning", "success"]
+    t = tug_table3(s).set_index("method")
+    assert t.loc["tug_m1", "n_success"] == 1
+    assert t.loc["tug_m1", "n_success_persistent_swap"] == 2
+    assert t.loc["tug_m1", "sf_turning_persistent_swap"] == 1
+    assert t.loc["tug_m1", "success_rate_persistent_swap"] == pytest.approx(2 / 3)
+    cols = list(t.columns)
+    assert cols.index("success_rate_published") < cols.index("ft_turning_persistent_swap")
+    # summaries without the second rule: its columns are there and empty
+    old = tug_table3(s.drop(columns="category_persistent_swap"))
+    assert old["success_rate_persistent_swap"].isna().all()

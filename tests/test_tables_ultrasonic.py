@@ -99,18 +99,77 @@ def test_table8_paired_tests_over_subjects():
 def test_tableC1_is_anova_across_subjects(gait_params):
     t = tableC1(gait_params)
     assert list(t["source"][:3]) == ["between", "within", "total"]
+    assert list(t["grouping"][:6]) == ["subject"] * 3 + ["stride_index"] * 3
     sub = gait_params[(gait_params.parameter == "stride_velocity")
                       & (gait_params.speed == "normal")]
     ref = anova_oneway(sub, "system", "subject")
-    got = t[t.parameter == "stride_velocity"].set_index("source")
+    got = t[(t.parameter == "stride_velocity")
+            & (t.grouping == "subject")].set_index("source")
     np.testing.assert_allclose(got.loc[["between", "within", "total"], "SS"], ref["SS"])
     np.testing.assert_allclose(got.loc["total", "SS"],
                                (len(sub) - 1) * sub["system"].var(ddof=1))
     assert got.loc["between", "df"] == N_SUBJECTS - 1
     assert got.loc["within", "SS_published"] == 0.23895
     t10 = tableC1(gait_params, max_strides_per_subject=10)
-    assert t10[t10.parameter == "stride_length"].set_index("source").loc["total", "df"] \
-        == N_SUBJECTS * 10 - 1
+    assert t10[(t10.parameter == "stride_length") & (t10.grouping == "subject")].set_index(
+        "source").loc["total", "df"] == N_SUBJECTS * 10 - 1
+    # the other reading: groups = stride position within each subject (12 strides each)
+    by_k = t[(t.parameter == "stride_velocity")
+             & (t.grouping == "stride_index")].set_index("source")
+    ref_k = anova_oneway(sub.assign(k=sub["stride"]), "system", "k")
+    np.testing.assert_allclose(by_k.loc[["between", "within", "total"], "SS"], ref_k["SS"])
+    assert by_k.loc["between", "df"] == N_STRIDES - 1
+    assert by_k.loc["within", "SS_published"] == 0.23895
+
+
+def test_sample_strides_draws_the_papers_n_reproducibly(gait_params):
+    from gaitval.tables.ultrasonic import sample_strides
+
+    a = sample_strides(gait_params, 10, seed=7)
+    assert a.equals(sample_strides(gait_params, 10, seed=7))
+    assert not a.equals(sample_strides(gait_params, 10, seed=8))
+    per = a.groupby(["subject", "speed", "parameter"]).size()
+    assert (per == 10).all()
+    assert sorted(a["stride_index"].unique()) == list(range(10))
+    # the per-stride parameters share their strides (one draw for S, NS, T, V, NV, C)
+    s_idx = a[a.parameter == "stride_length"].set_index(["trial", "stride"]).index
+    t_idx = a[a.parameter == "stride_duration"].set_index(["trial", "stride"]).index
+    assert s_idx.equals(t_idx)
+    # NS = S / n and NV = V / n with n = 10 (seed003 eq. (18), (21))
+    s = a[a.parameter == "stride_length"].set_index(["trial", "stride"])
+    ns = a[a.parameter == "stride_length_norm"].set_index(["trial", "stride"])
+    np.testing.assert_allclose(ns["system"], s.loc[ns.index, "system"] / 10)
+    # "all": every stride, NS with n = all strides (the gait table's own n)
+    every = sample_strides(gait_params, "all")
+    assert len(every) == len(gait_params)
+    s = every[every.parameter == "stride_length"].set_index(["trial", "stride"])
+    ns = every[every.parameter == "stride_length_norm"].set_index(["trial", "stride"])
+    np.testing.assert_allclose(ns["reference"], s.loc[ns.index, "reference"] / N_STRIDES)
+    # more than a subject has: all of them
+    assert (sample_strides(gait_params, 50).groupby(["subject", "speed", "parameter"])
+            .size() == N_STRIDES).all()
+    with pytest.raises(GaitvalError, match="strides_per_subject"):
+        sample_strides(gait_params, 0)
+
+
+def test_table8_gives_n_beside_ns_and_nv(gait_params):
+    tabs = build_ultrasonic_tables(gait_params, 10)
+    t8 = tabs["table8"].set_index(["parameter", "quantity"])
+    assert t8.loc[("stride_length_norm", "pro"), "normal_n"] == "10"
+    assert t8.loc[("stride_velocity_norm", "rmse"), "slow_n"] == "10"
+    assert t8.loc[("stride_length", "pro"), "normal_n"] == ""
+    t8all = build_ultrasonic_tables(gait_params, "all")["table8"].set_index(
+        ["parameter", "quantity"])
+    assert t8all.loc[("stride_length_norm", "pro"), "fast_n"] == str(N_STRIDES)
+    cols = list(tabs["table8"].columns)
+    assert cols.index("normal_std") + 1 == cols.index("normal_n")
+
+
+def test_table7_is_marked_not_comparable(gait_params):
+    t = build_ultrasonic_tables(gait_params)["table7"]
+    assert t["comparability"].str.startswith("not comparable: ").all()
+    assert "not a normality test" in t["comparability"].iloc[0]
+    assert (t["n"] == N_SUBJECTS * 10).all()            # the paper's 10 per subject
 
 
 def test_table7_normality_columns(gait_params):

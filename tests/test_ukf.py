@@ -295,3 +295,84 @@ def test_kernel_without_the_blas_symbols_runs_its_loops(monkeypatch):
     assert ukf_kernel.blas_pointers().shape == (5,)
     monkeypatch.setattr(ukf_kernel, "NUMPY_SYMBOLS", ("no_such_cblas_dgemm",) * 3)
     assert not ukf_kernel.blas_pointers().any()
+
+
+# -- checked (re-)initialisation (issue 34) ---------------------------------------------
+def _late_echo_ranges():
+    """The issue's case: at sample 0 anchor 3's echo arrives late (about 0.46 m of extra
+    path), from sample 1 on every range is direct."""
+    t, pos = _path(200)
+    d = toa_ranges(pos, ANCHORS)
+    d[0, 2] += 0.46
+    return t, pos, d
+
+
+#: Sample 0 and 1 of the default study's us_US04_slow (issue 34): anchor 3's time of
+#: flight 2.333 ms at sample 0 against 1.003 ms at sample 1 (ranges in m).
+US04_SLOW_D = np.array([[0.4054554, 0.30581542, 0.80436007, 0.43614037],
+                        [0.40446506, 0.30826237, 0.34584694, 0.44204963]])
+
+
+def test_unchecked_trilateration_of_a_late_echo_runs_away():
+    # the bug the check guards against: Gauss-Newton on inconsistent ranges lands far off
+    p = trilaterate(US04_SLOW_D[0], ANCHORS, GUESS)
+    assert not np.all(np.isfinite(p)) or np.linalg.norm(p - ANCHORS.mean(axis=0)) > 1e3
+    _, pos, d = _late_echo_ranges()
+    assert np.linalg.norm(trilaterate(d[0], ANCHORS, GUESS) - pos[0]) > 0.2
+
+
+def test_checked_trilateration_of_the_issue_sample():
+    from gaitval.track.ukf import trilaterate_checked
+
+    fix0 = trilaterate_checked(US04_SLOW_D[0], ANCHORS, GUESS)
+    fix1 = trilaterate_checked(US04_SLOW_D[1], ANCHORS, GUESS)
+    assert fix0.used.tolist() == [True, True, False, True] and fix1.used.all()
+    # 20 ms apart: the heel moved millimetres, not kilometres
+    assert np.linalg.norm(fix0.p - fix1.p) < 0.01
+
+
+def test_checked_trilateration_drops_the_late_anchor():
+    from gaitval.track.ukf import trilaterate_checked
+
+    _, pos, d = _late_echo_ranges()
+    fix = trilaterate_checked(d[0], ANCHORS, GUESS)
+    assert fix.reason == ""
+    assert fix.used.tolist() == [True, True, False, True]
+    assert fix.p == pytest.approx(pos[0], abs=1e-6)
+    # consistent ranges: all anchors, the unchecked result bit for bit
+    full = trilaterate_checked(d[1], ANCHORS, GUESS)
+    assert full.used.all() and np.array_equal(full.p, trilaterate(d[1], ANCHORS, GUESS))
+
+
+def test_checked_trilateration_refuses_what_no_anchor_set_supports():
+    from gaitval.track.ukf import trilaterate_checked
+
+    _, pos, d = _late_echo_ranges()
+    two_late = d[1].copy()
+    two_late[[1, 2]] += [0.4, 0.7]                    # two late echoes: no 3 ranges agree
+    fix = trilaterate_checked(two_late, ANCHORS, GUESS)
+    assert fix.reason != "" and np.isnan(fix.p).all() and not fix.used.any()
+    three = d[1].copy()
+    three[3] = np.nan
+    three[2] += 0.5                                   # 3 ranges, inconsistent: no subset
+    assert np.isnan(trilaterate_checked(three, ANCHORS, GUESS).p).all()
+    far = toa_ranges(np.array([30.0, 0.1, -0.3]), ANCHORS)   # beyond the 20 m range
+    assert trilaterate_checked(far, ANCHORS, GUESS).reason == "fewer than 3 ranges"
+    assert np.isfinite(trilaterate_checked(far, ANCHORS, GUESS,
+                                           max_range_m=50.0).p).all()
+
+
+def test_filter_starts_at_the_heel_despite_a_late_echo_at_sample_0():
+    t, pos, d = _late_echo_ranges()
+    r = run_toa_ukf(t, d, ANCHORS, W_sigma=W, V=SIG ** 2, init_guess=GUESS)
+    assert r.reinit[0] and r.used[0].tolist() == [True, True, False, True]
+    assert np.linalg.norm(r.x[0, :3] - pos[0]) < 1e-6
+    assert np.linalg.norm(r.x[:, :3] - pos, axis=1).max() < 0.02
+
+
+def test_filter_waits_for_a_sample_with_a_fix():
+    t, pos, d = _late_echo_ranges()
+    d[0, 1] += 0.4                                    # sample 0: two late echoes
+    r = run_toa_ukf(t, d, ANCHORS, W_sigma=W, V=SIG ** 2, init_guess=GUESS)
+    assert r.refused[0] and not r.reinit[0] and np.isnan(r.x[0]).all()
+    assert r.reinit[1] and np.linalg.norm(r.x[1, :3] - pos[1]) < 1e-6

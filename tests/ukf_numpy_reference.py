@@ -4,13 +4,14 @@
 per-sample cycle moved into numba (:mod:`gaitval.track.ukf_kernel`), verbatim: each product
 is numpy's ``@`` (OpenBLAS), the factorisations scipy's LAPACK.  tests/test_ukf.py runs both
 on the same ranges and requires the same bits (the kernel calls the same routines in the
-same order), or agreement to round-off where the kernel runs its loops.
+same order), or agreement to round-off where the kernel runs its loops.  One change since:
+the (re-)initialisation is the checked trilateration both use (issue 34).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from gaitval.track.ukf import (N_STATE, ToaUkfResult, _mirror_plane, trilaterate,
+from gaitval.track.ukf import (N_STATE, ToaUkfResult, _mirror_plane, trilaterate_checked,
                                ukf_weights)
 
 _NO_ANCHOR = np.zeros(0, dtype=np.intp)
@@ -39,8 +40,11 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     starved = 0
     for k in range(n_s):
         if x is None or starved >= reinit_after:
-            p0 = trilaterate(d[k], anchors, guess)   # from the guess: its side of the array
+            # from the guess: its side of the array (issue 34: checked, as the kernel's caller)
+            fix = trilaterate_checked(d[k], anchors, guess)
+            p0 = fix.p
             if np.all(np.isfinite(p0)):
+                res.used[k] = fix.used
                 x, P, starved = np.concatenate([p0, np.zeros(3)]), P0.copy(), 0
                 res.reinit[k] = True
                 res.x[k], res.P_diag[k] = x, P.diagonal()

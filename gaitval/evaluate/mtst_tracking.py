@@ -34,6 +34,14 @@ Rater events (the paper's reference; a study without mocap)
 The first event of a trial names its category: ``success``, ``lost``, ``false_swap``,
 ``false_other``.
 
+Two judging rules, side by side (issue 34; neither picked by its outcome)
+    The **paper** rule (primary) is the above.  The **persistent-swap** rule, mocap truth
+    only, forgives a ``false_swap`` event of ``persistent_swap_s`` (0.5 s) or less — a
+    swap that recovers within half a second, which a video check of the tracked legs would
+    likely not call a switch; ``lost`` and ``false_other`` events count as under the paper
+    rule.  The rater rule needs ``min_run`` consecutive contacts of one leg, about a stride
+    (> 0.5 s), so it is persistent already and has no second reading.
+
 References
 ----------
 Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (seed 001), §3.2, Table 1, Table 3.
@@ -50,8 +58,8 @@ from gaitval.track.gate import GateContext, VariableValidationRegion
 from gaitval.track.tracker import step_durations
 
 DEFAULTS = {"lost_m": 0.30, "swap_margin_m": 0.05, "swap_min_m": 0.10, "min_bad_s": 0.20,
-            "drift_max_m": math.inf, "min_run": 2}
-EVENT_COLUMNS = ("side", "kind", "t_start_s", "t_end_s", "reference")
+            "drift_max_m": math.inf, "min_run": 2, "persistent_swap_s": 0.5}
+EVENT_COLUMNS = ("side", "kind", "t_start_s", "t_end_s", "duration_s", "reference")
 CATEGORIES = ("success", "lost", "false_swap", "false_other")
 
 
@@ -83,7 +91,8 @@ def tracking_vs_truth(track: pd.DataFrame, truth: pd.DataFrame, cfg: dict | None
     category : str
         One of :data:`CATEGORIES`.
     events : DataFrame
-        :data:`EVENT_COLUMNS` (``reference = "mocap"``).
+        :data:`EVENT_COLUMNS` (``reference = "mocap"``); ``duration_s`` is the event's
+        scans over the scan rate.
     """
     c = _cfg(cfg)
     fr = align_truth(track, truth)
@@ -93,8 +102,17 @@ def tracking_vs_truth(track: pd.DataFrame, truth: pd.DataFrame, cfg: dict | None
     kinds = {"swap": "false_swap", "lost": "false_other", "drift": "lost"}
     out = pd.DataFrame({"side": ev["side"], "kind": ev["kind"].map(kinds),
                         "t_start_s": ev["t_start_s"], "t_end_s": ev["t_end_s"],
-                        "reference": "mocap"}, columns=list(EVENT_COLUMNS))
+                        "duration_s": ev["duration_s"], "reference": "mocap"},
+                       columns=list(EVENT_COLUMNS))
     return _verdict(out), out
+
+
+def persistent_swap_verdict(events: pd.DataFrame, cfg: dict | None = None) -> str:
+    """The trial's category under the persistent-swap rule (module notes), from the
+    mocap events of :func:`tracking_vs_truth`."""
+    ev = events[events["reference"] == "mocap"]
+    short = (ev["kind"] == "false_swap") & (ev["duration_s"] <= _cfg(cfg)["persistent_swap_s"])
+    return _verdict(ev[~short])
 
 
 def _run_starts(flags: np.ndarray, n: int) -> list[int]:
@@ -143,7 +161,8 @@ def tracking_vs_annotations(steps: pd.DataFrame, contacts: pd.DataFrame,
         foreign = ~c["matched"].to_numpy(bool) & ~np.isin(c.index.to_numpy(), swapped)
         for i in _run_starts(foreign, n):
             rows.append((side, "false_other", float(tc[i]), float(tc[min(i + n, len(tc)) - 1])))
-    out = pd.DataFrame([r + ("annotations",) for r in rows], columns=list(EVENT_COLUMNS))
+    out = pd.DataFrame([r + (r[3] - r[2], "annotations") for r in rows],
+                       columns=list(EVENT_COLUMNS))
     return _verdict(out), out.sort_values("t_start_s", kind="stable").reset_index(drop=True)
 
 

@@ -40,8 +40,18 @@ False tracking
       is not counted as such.  A prediction that runs off farther has lost its leg
       (``lost``) even if it later finds it again.
 
-    Its TUG phase is the phase at its first scan.  Brief crossings (the legs pass each
-    other every step) stay below these limits.
+    Its TUG phase is the phase at its first scan; its duration is its number of scans
+    over the scan rate.  Brief crossings (the legs pass each other every step) stay below
+    these limits.
+Two judging rules, reported side by side (issue 34; neither is picked by its outcome)
+    * **paper** (primary): every ``swap`` and ``lost`` event above is false tracking — the
+      paper's "tracking both legs without false tracking" with gaitval's event rule.
+    * **persistent swap**: a ``swap`` counts only when it lasts longer than
+      ``persistent_swap_s`` = 0.5 s; shorter swaps that recover are forgiven (what a
+      rater who watches the tracked legs, not every scan, would likely not call a switch).
+      ``lost`` events count as under the paper rule; stance failures are unchanged.
+    The summary carries each rule's verdict: the paper rule's columns without suffix,
+    the persistent-swap rule's with ``_persistent_swap``.
 Stance-phase identification
     Ground-truth stance: the truth leg speed (central differences of the 0.05 s-smoothed
     track) is below ``stance_speed_mps`` = 0.70 m/s (between the tracker's thresholds
@@ -81,13 +91,40 @@ from gaitval.evaluate.tug_truth import (DEFAULTS, TRUTH_COLUMNS, TUG_PHASES, _cf
                                         _runs, align_truth, truth_stance_intervals,
                                         tug_phase_bounds, tug_phase_of)
 
-__all__ = ["DEFAULTS", "FRAME_COLUMNS", "TRUTH_COLUMNS", "TUG_PHASES", "align_truth",
-           "evaluate_tug_trial", "false_tracking", "stance_failures",
+__all__ = ["DEFAULTS", "FRAME_COLUMNS", "JUDGING_RULES", "SUMMARY_COLUMNS", "TRUTH_COLUMNS", "TUG_PHASES",
+           "align_truth", "evaluate_tug_trial", "false_tracking", "judged_false",
+           "stance_failures",
            "truth_phases_of", "truth_stance_intervals", "tug_phase_bounds", "tug_phase_of"]
 
 FRAME_COLUMNS = (C.TRIAL, C.METHOD, "k", C.T_SENSOR, C.SIDE, C.X, C.Y, C.XS, C.YS,
                  C.VALID, "err_x_m", "err_y_m", "observed", "interpolated", "pattern",
                  "phase", "swing", "tug_phase", "bad")
+#: Columns of the summary row of :func:`evaluate_tug_trial`.
+SUMMARY_COLUMNS = (C.TRIAL, C.METHOD, "n_scans", "n_leg_steps", "n_uo", "false_tracking",
+                   "ft_phase", "n_ft_events", "n_drift_events", "stance_failure",
+                   "sf_phase", "n_stance_true", "n_stance_failures", "success", "category",
+                   "t_turn_start_s", "t_turn_end_s", "false_tracking_persistent_swap",
+                   "ft_phase_persistent_swap", "n_ft_events_persistent_swap",
+                   "success_persistent_swap", "category_persistent_swap")
+#: The judging rules of false tracking (module notes), primary first, and the suffix of
+#: each one's summary columns.
+JUDGING_RULES = {"paper": "", "persistent_swap": "_persistent_swap"}
+
+
+def judged_false(events: pd.DataFrame, rule: str = "paper", cfg: dict | None = None
+                 ) -> pd.DataFrame:
+    """The events of :func:`false_tracking` that are false tracking under ``rule``.
+
+    ``"paper"``: every ``swap`` and ``lost`` event.  ``"persistent_swap"``: ``lost``
+    events and the ``swap`` events longer than ``persistent_swap_s`` (module notes).
+    """
+    if rule not in JUDGING_RULES:
+        raise GaitvalError(f"unknown judging rule {rule!r}; known: {', '.join(JUDGING_RULES)}")
+    ft = events[events["kind"].isin(["swap", "lost"])]
+    if rule == "persistent_swap":
+        keep = (ft["kind"] != "swap") | (ft["duration_s"] > _cfg(cfg)["persistent_swap_s"])
+        ft = ft[keep]
+    return ft
 
 
 def false_tracking(frames: pd.DataFrame, cfg: dict | None = None
@@ -103,8 +140,8 @@ def false_tracking(frames: pd.DataFrame, cfg: dict | None = None
     -------
     bad : ndarray of bool, aligned with ``frames`` rows
     events : DataFrame
-        ``side, kind (swap|lost|drift), k_start, k_end, t_start_s, t_end_s, tug_phase,
-        max_error_m``.
+        ``side, kind (swap|lost|drift), k_start, k_end, t_start_s, t_end_s, duration_s,
+        tug_phase, max_error_m``.
     """
     c = _cfg(cfg)
     bad = np.zeros(len(frames), bool)
@@ -140,10 +177,11 @@ def false_tracking(frames: pd.DataFrame, cfg: dict | None = None
             rows.append({C.SIDE: s, "kind": kind,
                          "k_start": int(f["k"].iloc[a[i0]]), "k_end": int(f["k"].iloc[a[i1 - 1]]),
                          "t_start_s": float(t_all[a[i0]]), "t_end_s": float(t_all[a[i1 - 1]]),
+                         "duration_s": (i1 - i0) / rate,
                          "tug_phase": str(f["tug_phase"].iloc[a[i0]]),
                          "max_error_m": float(np.nanmax(e_own[i0:i1]))})
     ev = pd.DataFrame(rows, columns=[C.SIDE, "kind", "k_start", "k_end", "t_start_s",
-                                     "t_end_s", "tug_phase", "max_error_m"])
+                                     "t_end_s", "duration_s", "tug_phase", "max_error_m"])
     return bad, ev.sort_values(["t_start_s", C.SIDE], kind="stable").reset_index(drop=True)
 
 
@@ -218,7 +256,9 @@ def evaluate_tug_trial(track: pd.DataFrame, truth: pd.DataFrame, *, trial: str =
         ``stance`` (see :func:`stance_failures`, plus trial/method) and ``summary`` (one
         row: ``trial, method, n_scans, n_leg_steps, n_uo, false_tracking, ft_phase,
         n_ft_events (swap + lost), n_drift_events, stance_failure, sf_phase, n_stance_true,
-        n_stance_failures, success, category, t_turn_start_s, t_turn_end_s``).
+        n_stance_failures, success, category, t_turn_start_s, t_turn_end_s``, then the
+        persistent-swap rule's ``false_tracking, ft_phase, n_ft_events, success,
+        category`` with the suffix ``_persistent_swap``: :data:`SUMMARY_COLUMNS`).
     """
     bounds, truth_stance = truth_phases if truth_phases is not None else \
         truth_phases_of(truth, cfg)
@@ -236,23 +276,28 @@ def evaluate_tug_trial(track: pd.DataFrame, truth: pd.DataFrame, *, trial: str =
     for d in (events, stance):
         d.insert(0, C.METHOD, method)
         d.insert(0, C.TRIAL, trial)
-    ftev = events[events["kind"].isin(["swap", "lost"])]
-    ft = len(ftev) > 0
     failed = stance[~stance["identified"]] if len(stance) else stance
     sf = len(failed) > 0
-    ft_phase = str(ftev["tug_phase"].iloc[0]) if ft else ""
     sf_phase = str(failed.sort_values("t_start_s")["tug_phase"].iloc[0]) if sf else ""
-    category = (f"false_tracking_{ft_phase}" if ft else
-                f"stance_failure_{sf_phase}" if sf else "success")
     v = fr[fr[C.VALID]]
-    summary = pd.DataFrame([{
-        C.TRIAL: trial, C.METHOD: method, "n_scans": int(fr["k"].nunique()),
-        "n_leg_steps": int(len(v)), "n_uo": int((v["pattern"] == "UO").sum()),
-        "false_tracking": ft, "ft_phase": ft_phase, "n_ft_events": int(len(ftev)),
-        "n_drift_events": int((events["kind"] == "drift").sum()),
-        "stance_failure": sf, "sf_phase": sf_phase, "n_stance_true": int(len(stance)),
-        "n_stance_failures": int(len(failed)), "success": not ft and not sf,
-        "category": category, "t_turn_start_s": bounds["t_turn_start_s"],
-        "t_turn_end_s": bounds["t_turn_end_s"]}])
+    row = {C.TRIAL: trial, C.METHOD: method, "n_scans": int(fr["k"].nunique()),
+           "n_leg_steps": int(len(v)), "n_uo": int((v["pattern"] == "UO").sum())}
+    for rule, sfx in JUDGING_RULES.items():
+        ftev = judged_false(events, rule, cfg)
+        ft = len(ftev) > 0
+        ft_phase = str(ftev["tug_phase"].iloc[0]) if ft else ""
+        row.update({f"false_tracking{sfx}": ft, f"ft_phase{sfx}": ft_phase,
+                    f"n_ft_events{sfx}": int(len(ftev))})
+        if not sfx:
+            row.update({"n_drift_events": int((events["kind"] == "drift").sum()),
+                        "stance_failure": sf, "sf_phase": sf_phase,
+                        "n_stance_true": int(len(stance)),
+                        "n_stance_failures": int(len(failed))})
+        row.update({f"success{sfx}": not ft and not sf, f"category{sfx}": (
+            f"false_tracking_{ft_phase}" if ft else
+            f"stance_failure_{sf_phase}" if sf else "success")})
+    row.update({"t_turn_start_s": bounds["t_turn_start_s"],
+                "t_turn_end_s": bounds["t_turn_end_s"]})
+    summary = pd.DataFrame([row], columns=list(SUMMARY_COLUMNS))
     return {"frames": fr.reset_index(drop=True), "events": events, "stance": stance,
             "summary": summary}

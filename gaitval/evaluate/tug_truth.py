@@ -38,6 +38,8 @@ DEFAULTS: dict[str, Any] = {
     "stance_smooth_s": 0.05,
     "min_stance_s": 0.10,
     "min_stance_scans": 2,
+    # the second judging rule (issue 34), reported beside the first, never instead of it
+    "persistent_swap_s": 0.5,
 }
 
 TUG_PHASES = ("forward", "turning", "return")

@@ -5,8 +5,9 @@ Every stage of the study reads its keys from here: the camera reference
 ``reference.max_gap_s``), the tracker role (``ukf``: the parameters of
 :class:`gaitval.track.ukf.ToaUkf`, built by :func:`build_tracker`), alignment and gait
 parameters (:mod:`gaitval.evaluate.ultrasonic`: ``resample_hz``, ``lowpass``, ``align``,
-``strides``, ``symmetry``) and the pendulum noise identification
-(:mod:`gaitval.stats.noise`: ``noise_id``).  ``workflow/schemas/config.schema.yaml``
+``strides``, ``symmetry``), the pendulum noise identification
+(:mod:`gaitval.stats.noise`: ``noise_id``) and the strides the tables use
+(:mod:`gaitval.tables.ultrasonic`: ``tables``).  ``workflow/schemas/config.schema.yaml``
 documents each key; its defaults are these.
 """
 from __future__ import annotations
@@ -32,6 +33,8 @@ DEFAULT_CFG: dict = {
     "symmetry": {"window_strides": 5},
     "noise_id": {"W_grid_mps2": [1.0, 2.0, 5.0, 10.0, 20.0, 30.0, 50.0, 100.0, 200.0],
                  "outlier_mad": 5.0, "skip_start_s": 0.5},
+    # Tables 2-8, C1 on the paper's sample size (gaitval.tables.ultrasonic_params)
+    "tables": {"strides_per_subject": 10, "sample_seed": 2014},
 }
 
 

@@ -164,6 +164,32 @@ def tug_table2(methods=("tug_m1", "tug_m2", "tug_m3"), dt_measured_s: float | No
     return pd.DataFrame(rows)
 
 
+#: Table 3's counts repeated under the persistent-swap rule, after the paper rule's.
+PS = "_persistent_swap"
+PERSISTENT_COUNTS = ("ft_turning", "ft_return", "ft_forward", "sf_turning", "sf_other",
+                     "n_success")
+
+
+def _counts(cat: pd.Series) -> dict:
+    """Failed trials per first-failure category and successes (Table 3 cells)."""
+    return {"ft_turning": int((cat == "false_tracking_turning").sum()),
+            "ft_return": int((cat == "false_tracking_return").sum()),
+            "ft_forward": int((cat == "false_tracking_forward").sum()),
+            "sf_turning": int((cat == "stance_failure_turning").sum()),
+            "sf_other": int(cat.isin(["stance_failure_forward",
+                                      "stance_failure_return"]).sum()),
+            "n_success": int((cat == "success").sum())}
+
+
+def _persistent_columns(d: pd.DataFrame) -> dict:
+    """The persistent-swap rule's Table 3 cells of one method's summaries."""
+    if "category" + PS not in d or d["category" + PS].isna().any():
+        return {**{c + PS: np.nan for c in PERSISTENT_COUNTS}, "success_rate" + PS: np.nan}
+    c = _counts(d["category" + PS].astype(str))
+    return {**{k + PS: c[k] for k in PERSISTENT_COUNTS},
+            "success_rate" + PS: c["n_success"] / len(d) if len(d) else np.nan}
+
+
 def tug_table3(summaries, definitions: Mapping | None = None) -> pd.DataFrame:
     """Table 3: method definitions, false tracking, stance failures, success rate.
 
@@ -179,7 +205,10 @@ def tug_table3(summaries, definitions: Mapping | None = None) -> pd.DataFrame:
         ``method, label, phase_reading, success_rate, n_success, n_trials, ft_turning,
         ft_return, ft_forward, sf_turning, sf_other, base_method, gait_phase_association,
         catmull_rom_interpolation`` and the ``*_published`` columns (each after its
-        quantity).
+        quantity, the paper's judging rule), then the same counts under the
+        persistent-swap rule (a swap is false tracking only when it lasts > 0.5 s;
+        :mod:`gaitval.evaluate.tug`): ``ft_turning_persistent_swap`` …
+        ``success_rate_persistent_swap`` (NaN when the summaries predate it).
     """
     s = _concat(summaries)
     rows = []
@@ -190,35 +219,38 @@ def tug_table3(summaries, definitions: Mapping | None = None) -> pd.DataFrame:
         pub = PUBLISHED_T3.get(base, {})
         defs = METHOD_DEFINITIONS.get(base, {})
         n = len(d)
-        ns = int((cat == "success").sum())
+        c = _counts(cat)
+        ns = c["n_success"]
         rows.append({
             "method": m, "base_method": base, "phase_reading": reading,
             "label": _label(m, definitions),
             "gait_phase_association": defs.get("gait_phase_association"),
             "catmull_rom_interpolation": defs.get("catmull_rom_interpolation"),
             "n_trials": n,
-            "ft_turning": int((cat == "false_tracking_turning").sum()),
+            "ft_turning": c["ft_turning"],
             "ft_turning_published": pub.get("ft_turning", np.nan),
-            "ft_return": int((cat == "false_tracking_return").sum()),
+            "ft_return": c["ft_return"],
             "ft_return_published": pub.get("ft_return", np.nan),
-            "ft_forward": int((cat == "false_tracking_forward").sum()),
-            "sf_turning": int((cat == "stance_failure_turning").sum()),
+            "ft_forward": c["ft_forward"],
+            "sf_turning": c["sf_turning"],
             "sf_turning_published": pub.get("sf_turning", np.nan),
-            "sf_other": int(cat.isin(["stance_failure_forward", "stance_failure_return"]).sum()),
+            "sf_other": c["sf_other"],
             "n_success": ns, "n_success_published": pub.get("n_success", np.nan),
             "n_trials_published": pub.get("n_trials", np.nan),
             "success_rate": ns / n if n else np.nan,
             "success_rate_published": (pub["n_success"] / pub["n_trials"]) if pub else np.nan,
+            **_persistent_columns(d),
         })
     order = ["method", "label", "phase_reading", "success_rate", "success_rate_published",
              "n_success", "n_success_published", "n_trials", "n_trials_published",
              "ft_turning", "ft_turning_published", "ft_return", "ft_return_published",
-             "ft_forward", "sf_turning", "sf_turning_published", "sf_other", "base_method",
-             "gait_phase_association", "catmull_rom_interpolation"]
+             "ft_forward", "sf_turning", "sf_turning_published", "sf_other"]
+    order += [c + PS for c in ("success_rate",) + PERSISTENT_COUNTS]
+    order += ["base_method", "gait_phase_association", "catmull_rom_interpolation"]
     return _tidy_counts(pd.DataFrame(rows, columns=order),
                         ["ft_turning_published", "ft_return_published",
                          "sf_turning_published", "n_success_published",
-                         "n_trials_published"])
+                         "n_trials_published"] + [c + PS for c in PERSISTENT_COUNTS])
 
 
 def _success_frames(frames: pd.DataFrame, summaries: pd.DataFrame) -> pd.DataFrame:
@@ -383,6 +415,17 @@ def write_tug_tables(frames, summaries, out_dir: str | Path, *,
     common = [f"Source: {CITATION}.",
               "Reproduced values from gaitval's evaluation of each trial; *_published "
               "columns transcribed from the paper."]
+    rules = ("Two judging rules side by side, fixed before the results (issue 34): the "
+             "columns without suffix use the paper's rule (every swap or lost event of >= "
+             "0.20 s is false tracking; primary, compared with the published values); the "
+             "*_persistent_swap columns count a left/right swap only when it lasts > 0.5 s "
+             "(shorter swaps that recover are forgiven; lost events and stance failures "
+             "as before).")
+    if "success_rate" + PS in t3 and t3["success_rate" + PS].notna().any():
+        rules += " Successes, paper rule -> persistent-swap rule: " + "; ".join(
+            f"{r.method} {int(r.n_success)} -> {int(getattr(r, 'n_success' + PS))} of "
+            f"{int(r.n_trials)}" for r in t3.itertuples(index=False)
+            if pd.notna(getattr(r, "n_success" + PS))) + "."
     readings = ("Rows with phase_reading stance_first ran the same method with seed000 "
                 "eq. (3) tested before eq. (4) (the slower leg is in stance first; "
                 "gaitval.gait.phases); the paper's text allows both readings, its "
@@ -396,7 +439,8 @@ def write_tug_tables(frames, summaries, out_dir: str | Path, *,
                          "definitions and tracking results per method (seed 000 Table 3). "
                          "Each failed trial counted once, in the TUG phase of its first "
                          "failure; ft_forward and sf_other have no published counterpart.",
-                         notes=common + [readings] + notes + _evidence_notes(ev, t3) + legend)
+                         notes=common + [rules, readings] + notes
+                         + _evidence_notes(ev, t3) + legend)
     paths += write_table(t4, out / "tug_table4", caption="TUG leg tracking: occlusion rate "
                          "and RMSE of the leg trajectory per TUG phase over tracking-success "
                          "trials (seed 000 Table 4; sensor frame x/y).",

@@ -16,7 +16,17 @@ from gaitval.stats import anova_oneway, normality, paired_ttest
 from gaitval.stats.summary import summarize_errors
 from gaitval.tables import _published_qi2014 as pub
 from gaitval.tables.ultrasonic_params import (PARAM_INFO, PARAMETERS, SPEEDS,
-                                              SUMMARY_PARAMETERS, check_gait_params, select)
+                                              SUMMARY_PARAMETERS, check_gait_params, n_text,
+                                              select, strides_per_subject_of)
+
+#: Table 7's comparability with the published table (issue 34): the verdict page reads
+#: the fixed prefix "not comparable: ".
+TABLE7_NOT_COMPARABLE = (
+    "not comparable: the published Table 7 is not a normality test - its H and p test the "
+    "null hypothesis 'mean is zero' (H = 0, p = 1.000 for every parameter, seed 003 "
+    "§4.4.2), while gaitval's H and p are a Lilliefors test of normality")
+#: Table C1's two readings of "between groups" (issue 34).
+C1_GROUPINGS = ("subject", "stride_index")
 
 
 def table7(gait_params: pd.DataFrame, speed: str = "normal", column: str = "system",
@@ -41,7 +51,9 @@ def table7(gait_params: pd.DataFrame, speed: str = "normal", column: str = "syst
         ``mean``, ``std``, ``ci95_low``, ``ci95_high``, ``method``, ``statistic``, ``p``,
         ``H`` (1 = normality rejected at 5%), and the published ``mean_published``,
         ``std_published``, ``H_published``, ``p_published``, ``ci95_low_published``,
-        ``ci95_high_published``.
+        ``ci95_high_published``, and ``comparability``: :data:`TABLE7_NOT_COMPARABLE`
+        (the paper's H and p answer another question; its mean, std and CI are
+        comparable).
 
     Notes
     -----
@@ -63,6 +75,7 @@ def table7(gait_params: pd.DataFrame, speed: str = "normal", column: str = "syst
     for i, name in enumerate(names):
         nt[name + "_published"] = [pub.TABLE_7[p][i] if published else np.nan
                                    for p in nt["parameter"]]
+    nt["comparability"] = TABLE7_NOT_COMPARABLE
     return nt
 
 
@@ -91,11 +104,14 @@ def table8(gait_params: pd.DataFrame, alpha: float = 0.05) -> pd.DataFrame:
     -------
     DataFrame
         One row per (parameter, quantity): ``parameter``, ``symbol``, ``unit``,
-        ``quantity``, ``slow_mean``, ``slow_std``, ``slow_p``, ``slow_significant``,
-        ``normal_mean``, ``normal_std``, ``fast_mean``, ``fast_std``, ``fast_p``,
-        ``fast_significant``, ``n_subjects``, and ``*_published`` beside each numeric
+        ``quantity``, ``slow_mean``, ``slow_std``, ``slow_n``, ``slow_p``,
+        ``slow_significant``, ``normal_mean``, ``normal_std``, ``normal_n``, ``fast_mean``,
+        ``fast_std``, ``fast_n``, ``fast_p``, ``fast_significant``, ``n_subjects``, and
+        ``*_published`` beside each numeric
         column the paper prints.  ``p`` is NaN when all paired differences are equal
-        (the paper prints "NaN" for cadence RMSE).
+        (the paper prints "NaN" for cadence RMSE).  ``<speed>_n`` is, on the NS and NV
+    rows, the ``n`` of eq. (18), (21) — the strides per subject at that speed (``"10"``,
+    or the range over subjects such as ``"231-264"``); empty on the other rows.
 
     Notes
     -----
@@ -116,6 +132,8 @@ def table8(gait_params: pd.DataFrame, alpha: float = 0.05) -> pd.DataFrame:
                 v = v[np.isfinite(v)]
                 row[f"{sp}_mean"] = float(np.mean(v)) if v.size else np.nan
                 row[f"{sp}_std"] = float(np.std(v, ddof=1)) if v.size > 1 else np.nan
+                row[f"{sp}_n"] = (n_text(strides_per_subject_of(df, sp))   # eq. (18), (21)
+                                  if param.endswith("_norm") else "")
                 if sp != "normal":
                     t = paired_ttest(sub, "value", "subject", "speed", sp, "normal",
                                      alpha=alpha).iloc[0]
@@ -128,40 +146,52 @@ def table8(gait_params: pd.DataFrame, alpha: float = 0.05) -> pd.DataFrame:
             for i, c in enumerate(cols):
                 row[c + "_published"] = published[i] if published else np.nan
             rows.append(row)
-    order = ["parameter", "symbol", "unit", "quantity", "slow_mean", "slow_std", "slow_p",
-             "slow_significant", "normal_mean", "normal_std", "fast_mean", "fast_std",
-             "fast_p", "fast_significant", "n_subjects"]
+    order = ["parameter", "symbol", "unit", "quantity", "slow_mean", "slow_std", "slow_n",
+             "slow_p", "slow_significant", "normal_mean", "normal_std", "normal_n",
+             "fast_mean", "fast_std", "fast_n", "fast_p", "fast_significant", "n_subjects"]
     out = pd.DataFrame(rows)
     return out[order + [c for c in out.columns if c.endswith("_published")]]
 
 
 def tableC1(gait_params: pd.DataFrame, speed: str = "normal", column: str = "system",
-            max_strides_per_subject: int | None = None) -> pd.DataFrame:
-    """One-way ANOVA across subjects for S, T, V, hS, vS (seed 003 Table C1).
+            max_strides_per_subject: int | None = None,
+            groupings: tuple[str, ...] = C1_GROUPINGS) -> pd.DataFrame:
+    """One-way ANOVA of S, T, V, hS, vS (seed 003 Table C1), in both readings of its groups.
 
     Parameters
     ----------
     gait_params : DataFrame
-        The gait parameter table.
+        The gait parameter table; the tables use the strides drawn by
+        :func:`gaitval.tables.ultrasonic_params.sample_strides` (its ``stride_index``).
     speed : str
         Speed analysed (the paper's tables are at normal speed).
     column : {"system", "reference"}
         Which system's estimates are analysed.
     max_strides_per_subject : int, optional
-        Use only the first ``m`` strides (by ``stride`` number) of each subject; the
-        paper's Table C1 has 100 observations (10 subjects × 10 strides).
+        Use only the first ``m`` strides (by ``stride`` number) of each subject.
+    groupings : tuple of str
+        ``"subject"``: the groups are the subjects (what the paper's text says: "differences
+        in the means of the ten subjects").  ``"stride_index"``: the groups are the
+        position of a stride in its subject's sample (the columns of a subjects × strides
+        matrix given to MATLAB's ``anova1``), what the paper's numbers imply: its
+        within-group mean square (0.0144 m² for S) equals the between- plus
+        within-subject variance of its Tables 2–6.  Without a ``stride_index`` column it
+        is the stride's order within its subject and speed.
 
     Returns
     -------
     DataFrame
-        One row per (parameter, source) with ``source`` in ``between``, ``within``,
-        ``total``: ``parameter``, ``symbol``, ``source``, ``SS``, ``df``, ``MS``, ``F``,
-        ``p`` (from :func:`gaitval.stats.anova_oneway` with ``group="subject"``), and
-        ``SS_published``, ``df_published``, ``MS_published``, ``F_published``,
-        ``p_published``.
+        One row per (parameter, grouping, source) with ``source`` in ``between``,
+        ``within``, ``total``: ``parameter``, ``symbol``, ``grouping``, ``source``, ``SS``,
+        ``df``, ``MS``, ``F``, ``p`` (:func:`gaitval.stats.anova_oneway`), and
+        ``SS_published`` … ``p_published`` (the one published table, beside both
+        readings).
     """
     if column not in ("system", "reference"):
         raise GaitvalError(f"tableC1: column must be 'system' or 'reference', not {column!r}")
+    bad = [g for g in groupings if g not in C1_GROUPINGS]
+    if bad:
+        raise GaitvalError(f"tableC1: unknown grouping(s) {bad}; known: {list(C1_GROUPINGS)}")
     df = check_gait_params(gait_params)
     frames = []
     for param in SUMMARY_PARAMETERS:
@@ -169,17 +199,22 @@ def tableC1(gait_params: pd.DataFrame, speed: str = "normal", column: str = "sys
         if max_strides_per_subject is not None:
             sub = (sub.sort_values(["subject", "trial", "stride"])
                    .groupby("subject", sort=True).head(max_strides_per_subject))
-        try:
-            a = anova_oneway(sub, column, "subject").reset_index()
-        except GaitvalError:
-            # fewer than two subjects with data: the ANOVA is undefined, say so by NaN
-            a = pd.DataFrame({"source": ["between", "within", "total"],
-                              **{c: np.nan for c in ("SS", "df", "MS", "F", "p")}})
-        a.insert(0, "parameter", param)
-        a.insert(1, "symbol", PARAM_INFO[param][0])
-        published = pub.TABLE_C1[param] if speed == "normal" else None
-        for i, c in enumerate(["SS", "df", "MS", "F", "p"]):
-            a[c + "_published"] = [published[s][i] if published else np.nan
-                                   for s in a["source"]]
-        frames.append(a)
+        if "stride_index" not in sub:
+            sub = sub.sort_values(["subject", "trial", "stride"], kind="stable")
+            sub = sub.assign(stride_index=sub.groupby("subject").cumcount())
+        for grouping in groupings:
+            try:
+                a = anova_oneway(sub, column, grouping).reset_index()
+            except GaitvalError:
+                # fewer than two groups with data: the ANOVA is undefined, say so by NaN
+                a = pd.DataFrame({"source": ["between", "within", "total"],
+                                  **{c: np.nan for c in ("SS", "df", "MS", "F", "p")}})
+            a.insert(0, "parameter", param)
+            a.insert(1, "symbol", PARAM_INFO[param][0])
+            a.insert(2, "grouping", grouping)
+            published = pub.TABLE_C1[param] if speed == "normal" else None
+            for i, c in enumerate(["SS", "df", "MS", "F", "p"]):
+                a[c + "_published"] = [published[s][i] if published else np.nan
+                                       for s in a["source"]]
+            frames.append(a)
     return pd.concat(frames, ignore_index=True)

@@ -8,7 +8,7 @@ and a-posteriori statistics (eq. 11).  :class:`ToaUkf` is the filter as a tracke
 (``toa_ukf`` in :data:`UKF_TRACKERS`), built from config ``ultrasonic.ukf``; its
 :meth:`ToaUkf.track` turns one ultrasonic log into a track table.
 
-Two things the paper leaves open are made explicit here:
+What the paper leaves open is made explicit here:
 
 * **Per-anchor outlier handling (multipath).**  A late echo (a reflected path) makes one
   receiver's range too long while the others stay good.  Before the update, each anchor's
@@ -28,6 +28,13 @@ Two things the paper leaves open are made explicit here:
   coplanar, the side of ``init_guess`` is taken as the physical side (the transmitter faces
   the receivers) and a state that ends an update on the other side is reflected back
   (position and velocity); this is counted in ``reflected``.
+* **Checked (re-)initialisation.**  The paper's filter starts from a known position;
+  gaitval starts (and restarts a lost filter) from a trilateration of one sample's ranges.
+  A late echo in that sample makes the ranges inconsistent, and an unchecked Gauss–Newton
+  can land anywhere (issue 34: 490 km from the board at sample 0 of a simulated trial).
+  :func:`trilaterate_checked` accepts a fix only when its range residual is small, it lies
+  within the sensor's range (20 m, §5), and, failing that with all anchors, tries the
+  subsets that leave one anchor out; no fix means the filter waits for the next sample.
 * **The a-priori step for a linear model.**  Passing sigma points through the linear
   transition ``A`` (eq. 8) gives exactly ``A P A^T`` (the unscented transform is exact for
   linear maps), so eq. (8) is evaluated in that closed form, which is cheaper and free of
@@ -109,22 +116,99 @@ def trilaterate(d: np.ndarray, anchors: np.ndarray, guess: np.ndarray,
 
     With a planar receiver array there are two mirror solutions; Gauss–Newton converges to
     the one on the side of ``guess``.  NaN ranges are ignored.  Returns NaN positions when
-    fewer than three ranges are finite.
+    fewer than three ranges are finite.  No check of the result: ranges that no point fits
+    (a late echo) can send the iteration anywhere; :func:`trilaterate_checked` is the one
+    the filter uses.
     """
     ok = np.isfinite(d)
     if ok.sum() < 3:
         return np.full(3, np.nan)
     a, r = anchors[ok], d[ok]
     p = np.asarray(guess, dtype=float).copy()
-    for _ in range(n_iter):
-        diff = p - a
-        rng = np.linalg.norm(diff, axis=1)
-        J = diff / np.maximum(rng, 1e-9)[:, None]
-        step, *_ = np.linalg.lstsq(J, r - rng, rcond=None)
-        p = p + step
-        if np.linalg.norm(step) < 1e-10:
-            break
+    with np.errstate(over="ignore", invalid="ignore"):
+        for _ in range(n_iter):
+            diff = p - a
+            rng = np.linalg.norm(diff, axis=1)
+            J = diff / np.maximum(rng, 1e-9)[:, None]
+            if not np.all(np.isfinite(J)):
+                return np.full(3, np.nan)           # diverged (inconsistent ranges)
+            step, *_ = np.linalg.lstsq(J, r - rng, rcond=None)
+            p = p + step
+            if np.linalg.norm(step) < 1e-10:
+                break
     return p
+
+
+@dataclass(frozen=True)
+class Fix:
+    """What :func:`trilaterate_checked` returns.
+
+    ``p`` (3,): the position, NaN when refused; ``used`` (m,): the anchors of the fix;
+    ``residual_m``: RMS of measured minus fitted range over ``used`` (NaN when refused);
+    ``reason``: ``""`` for a fix, else why it was refused (``"fewer than 3 ranges"``,
+    ``"no consistent anchor set"``, ``"ambiguous"``).
+    """
+
+    p: np.ndarray
+    used: np.ndarray
+    residual_m: float
+    reason: str = ""
+
+
+def trilaterate_checked(d: np.ndarray, anchors: np.ndarray, guess: np.ndarray, *,
+                        max_residual_m: float = 0.05, max_range_m: float = 20.0) -> Fix:
+    """A position from ranges that the ranges support, or none (issue 34).
+
+    1. Ranges beyond ``max_range_m`` (the sensor's range, seed 003 §5: 20 m) or not finite
+       are not used.
+    2. All usable ranges are fitted (:func:`trilaterate`, from ``guess``).  The fix is
+       accepted when the RMS residual (measured − fitted range) is at most
+       ``max_residual_m`` and the point lies within ``max_range_m`` of the anchor centroid.
+    3. Otherwise, with four or more usable ranges, every subset that leaves one anchor
+       out is fitted.  A subset's fix is a candidate when it passes the same two checks
+       and the anchor left out is not *early*: a reflected path is longer than the direct
+       one, so a left-out range may exceed its fitted range (a late echo) but not fall
+       short of it by more than ``max_residual_m``.  One candidate, or several within
+       ``max_residual_m`` of each other, give the fix (the smallest residual); candidates
+       that disagree leave the sample without a fix (``"ambiguous"``).
+
+    The same checks run at every (re)initialisation of :func:`run_toa_ukf`.  Seed 003
+    gives no initialisation (its UKF starts from a known position); the rule is gaitval's.
+    """
+    d = np.asarray(d, dtype=float)
+    anchors = np.asarray(anchors, dtype=float)
+    centre = anchors.mean(axis=0)
+    ok = np.isfinite(d) & (d <= max_range_m)
+    none = np.zeros(len(d), dtype=bool)
+    if ok.sum() < 3:
+        return Fix(np.full(3, np.nan), none, float("nan"), "fewer than 3 ranges")
+
+    def fit(use: np.ndarray):
+        p = trilaterate(np.where(use, d, np.nan), anchors, guess)
+        if not np.all(np.isfinite(p)) or np.linalg.norm(p - centre) > max_range_m:
+            return None
+        res = d - np.linalg.norm(anchors - p, axis=1)
+        rms = float(np.sqrt(np.mean(res[use] ** 2)))
+        return (p, rms, res) if rms <= max_residual_m else None
+
+    full = fit(ok)
+    if full is not None:
+        return Fix(full[0], ok.copy(), full[1])
+    cands = []
+    if ok.sum() >= 4:
+        for j in np.flatnonzero(ok):
+            use = ok.copy()
+            use[j] = False
+            f = fit(use)
+            if f is not None and f[2][j] >= -max_residual_m:   # left out: late, not early
+                cands.append((f[1], int(j), f[0], use))
+    if not cands:
+        return Fix(np.full(3, np.nan), none, float("nan"), "no consistent anchor set")
+    pts = np.array([c[2] for c in cands])
+    if np.max(np.linalg.norm(pts[:, None] - pts[None], axis=2)) > max_residual_m:
+        return Fix(np.full(3, np.nan), none, float("nan"), "ambiguous")
+    rms, _, p, use = min(cands, key=lambda c: (c[0], c[1]))
+    return Fix(p, use, rms)
 
 
 @dataclass
@@ -136,7 +220,8 @@ class ToaUkfResult:
     the update; ``rejected`` (n, m): anchors dropped by the innovation gate (finite range
     judged an outlier); ``reinit`` (n,): samples at which the filter was (re-)initialised
     by trilateration; ``reflected`` (n,): samples at which the state was reflected back to
-    the physical side of a planar receiver array (module notes).
+    the physical side of a planar receiver array (module notes); ``refused`` (n,): samples
+    at which a (re-)initialisation was due but :func:`trilaterate_checked` gave no fix.
     """
 
     x: np.ndarray
@@ -145,6 +230,7 @@ class ToaUkfResult:
     rejected: np.ndarray
     reinit: np.ndarray
     reflected: np.ndarray
+    refused: np.ndarray
 
     @classmethod
     def start(cls, finite: np.ndarray) -> "ToaUkfResult":
@@ -152,7 +238,8 @@ class ToaUkfResult:
         n, m = finite.shape
         return cls(x=np.full((n, N_STATE), np.nan), P_diag=np.full((n, N_STATE), np.nan),
                    used=finite.copy(), rejected=np.zeros((n, m), dtype=bool),
-                   reinit=np.zeros(n, dtype=bool), reflected=np.zeros(n, dtype=bool))
+                   reinit=np.zeros(n, dtype=bool), reflected=np.zeros(n, dtype=bool),
+                   refused=np.zeros(n, dtype=bool))
 
 
 def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
@@ -160,7 +247,8 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
                 kappa: float = 0.0, init_guess: np.ndarray | None = None,
                 init_sigma_pos: float = 0.05, init_sigma_vel: float = 1.0,
                 gate_sigma: float = 4.0, max_reject: int = 2, min_anchors: int = 3,
-                reinit_after: int = 10, mirror_guard: bool = True) -> ToaUkfResult:
+                reinit_after: int = 10, mirror_guard: bool = True,
+                init_max_residual_m: float = 0.05, max_range_m: float = 20.0) -> ToaUkfResult:
     """Track one transmitter from its ranges to fixed receivers with a UKF.
 
     Parameters
@@ -186,6 +274,9 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
         Fewer usable anchors than ``min_anchors`` for ``reinit_after`` steps re-initialises.
     mirror_guard : bool
         Keep the state on the ``init_guess`` side of a planar array (module notes).
+    init_max_residual_m, max_range_m : float
+        Checks of every (re-)initialisation (:func:`trilaterate_checked`): the largest RMS
+        range residual of a fix and the sensor's range (seed 003 §5: 20 m).
 
     Returns
     -------
@@ -193,7 +284,7 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
 
     Notes
     -----
-    Per sample: (re-)initialise by trilateration when needed, predict (eq. 8, closed form),
+    Per sample: (re-)initialise by a checked trilateration when needed, predict (eq. 8, closed form),
     update from the anchors that pass the gate (eq. 9–11), reflect a mirror state back;
     all but the trilateration in :func:`gaitval.track.ukf_kernel.ukf_steps`.
     """
@@ -215,8 +306,12 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     k = 0
     while k < n_s:
         # here the filter has no state yet, or has starved for reinit_after samples
-        p0 = trilaterate(d[k], anchors, guess)       # from the guess: its side of the array
+        # from the guess: its side of the array; a fix the ranges do not support is refused
+        fix = trilaterate_checked(d[k], anchors, guess, max_residual_m=init_max_residual_m,
+                                  max_range_m=max_range_m)
+        p0 = fix.p
         if np.all(np.isfinite(p0)):
+            res.used[k] = fix.used                  # the anchors of the fix
             # the kernel keeps P row-major and flat (36,)
             x, P, starved[0] = np.concatenate([p0, np.zeros(3)]), P0.flatten(), 0
             res.reinit[k] = True
@@ -225,9 +320,11 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
             force = False
         elif x is None:
             res.used[k] = False
+            res.refused[k] = n_finite[k] >= 3       # ranges there, but no consistent fix
             k += 1                                  # wait for a sample with >= 3 ranges
             continue
         else:
+            res.refused[k] = n_finite[k] >= 3
             force = True                            # still lost: predict and update anyway
         if k < n_s:
             # per sample: predict (eq. 8), update (eq. 9-11), reflect (module notes)
@@ -312,7 +409,10 @@ class ToaUkf:
 
     Defaults: seed 003 §3.2 and §4.3.  §4.3.1 gives W as 30, 25, 10 "mm/s"; with G of
     eq. (5) w is an acceleration, and a heel needs tens of m/s^2, so the numbers are read
-    as m/s^2.  V is §4.3.2's diag(11, 9.3, 9, 9) mm^2.
+    as m/s^2.  V is §4.3.2's diag(11, 9.3, 9, 9) mm^2.  ``max_range_m`` is §5's maximum
+    propagation distance (20 m); ``init_max_residual_m`` is gaitval's (issue 34,
+    :func:`trilaterate_checked`): 0.05 m, about 15 times the ~3 mm range noise of §4.3.2,
+    so noise alone never refuses a fix, and chosen before looking at any track.
     """
 
     alpha: float = 1e-3
@@ -327,6 +427,8 @@ class ToaUkf:
     init_guess_m: list = field(default_factory=lambda: [0.16, 0.10, -0.30])
     init_sigma_pos_m: float = 0.05
     init_sigma_vel_mps: float = 1.0
+    init_max_residual_m: float = 0.05
+    max_range_m: float = 20.0
     mirror_guard: bool = True
 
     def track(self, log: UltrasonicLog, *, trial: str | None = None) -> pd.DataFrame:
@@ -336,7 +438,8 @@ class ToaUkf:
         ``t_s`` (ultrasonic clock), ``x_m, y_m, z_m`` (ultrasonic frame), ``vx_mps, vy_mps,
         vz_mps``, ``used_anchors`` (ranges that entered the update), ``rejected_anchors``
         (finite ranges the multipath gate dropped); ``attrs``: ``anchors`` (the anchor
-        table, records), ``n_reinit``, ``n_reflected``.
+        table, records), ``n_reinit``, ``n_reflected``, ``n_init_refused`` (samples where a
+        (re-)initialisation found no fix the ranges support).
         """
         t = np.asarray(log.t, dtype=float)
         if t.size < 2 or np.any(np.diff(t) <= 0):
@@ -357,7 +460,9 @@ class ToaUkf:
             init_sigma_pos=self.init_sigma_pos_m, init_sigma_vel=self.init_sigma_vel_mps,
             gate_sigma=self.gate_sigma, max_reject=int(self.max_reject),
             min_anchors=int(self.min_anchors), reinit_after=int(self.reinit_after),
-            mirror_guard=self.mirror_guard)
+            mirror_guard=self.mirror_guard,
+            init_max_residual_m=float(self.init_max_residual_m),
+            max_range_m=float(self.max_range_m))
         df = pd.DataFrame({"t_s": t, "x_m": r.x[:, 0], "y_m": r.x[:, 1], "z_m": r.x[:, 2],
                            "vx_mps": r.x[:, 3], "vy_mps": r.x[:, 4], "vz_mps": r.x[:, 5],
                            "used_anchors": r.used.sum(axis=1).astype(np.int64),
@@ -365,5 +470,6 @@ class ToaUkf:
         df.attrs["anchors"] = log.anchors.to_dict("records")
         df.attrs["n_reinit"] = int(r.reinit.sum())
         df.attrs["n_reflected"] = int(r.reflected.sum())
+        df.attrs["n_init_refused"] = int(r.refused.sum())
         return df
 

@@ -73,9 +73,11 @@ rule ultrasonic_track:
 
 rule ultrasonic_tables:
     input:
-        lambda w: [
+        gait=lambda w: [
             f"{RESULTS}/{s}/ultrasonic/gait/{t}.parquet" for s, t in treadmill_trials()
         ],
+        # ultrasonic.tables: the strides the tables use (the study view, as the noise rule)
+        config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/ultrasonic/{STUDY_VIEW}.json",
     output:
         t2=report(
             f"{REPORTS}/tables/ultrasonic_table2.csv",
@@ -99,9 +101,10 @@ rule ultrasonic_tables:
     log:
         "logs/ultrasonic_tables.log",
     shell:
-        "{params.gv} ultrasonic-tables {input:q} --tables-dir {params.tables:q}"
+        "{params.gv} ultrasonic-tables {input.gait:q} --tables-dir {params.tables:q}"
         " --figures-dir {params.figures:q} --reports-dir {params.reports:q}"
-        " --config-hash {params.chash:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+        " --config {input.config:q} --config-hash {params.chash:q}"
+        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
 REPORT_ITEM_FUNCS.append(
