@@ -187,3 +187,33 @@ def test_html_top_says_what_the_data_are_then_verdicts_with_reasons(tmp_path):
     names = [c for c, _ in header]
     assert names.index("success_pct_published") == names.index("success_pct") + 1
     assert rows[0][names.index("success_pct")] == "25.0"            # a rate in per cent
+
+
+def test_table_c1_primary_reading_is_the_papers_words_and_stride_index_stands_beside():
+    """Issue 34/35: Table C1 in both readings of its groups; the verdict scores grouping by
+    subject (the paper's words) and shows the stride-index reading beside it, uncounted.
+    When C1's note finds the published numbers inconsistent with subject groups, the
+    primary row is not comparable."""
+    from gaitval.report.verdicts import ultrasonic_verdicts
+    c1 = pd.DataFrame({"symbol": ["S", "S"], "source": ["between", "between"],
+                       "grouping": ["subject", "stride_index"], "df": [9.0, 9.0],
+                       "F": [15.9, 0.27], "p": [1e-6, 0.98], "df_published": [9, 9],
+                       "F_published": [0.14, 0.14], "p_published": [0.998, 0.998]})
+    t8 = pd.DataFrame(columns=["quantity"])
+    rows = ultrasonic_verdicts({"ultrasonic_table8": t8, "ultrasonic_tableC1": c1}, {})
+    assert len(rows) == 1 and rows[0]["outcome"] == "not reproduced"
+    assert rows[0]["alternative"].startswith("groups = stride index: F 0.27")
+    assert "reproduced, not counted" in rows[0]["alternative"]
+    note = {"ultrasonic_tableC1": ["Finding: the published table is not consistent with "
+                                   "subjects as groups."]}
+    rows = ultrasonic_verdicts({"ultrasonic_table8": t8, "ultrasonic_tableC1": c1}, note)
+    assert rows[0]["outcome"] == "not comparable" and "stride index" in rows[0]["why"]
+
+
+def test_table7_marked_not_comparable_by_its_own_column(tmp_path):
+    from gaitval.report.verdicts import ultrasonic_verdicts
+    t7 = _table7().assign(comparability="not comparable: the published Table 7 is not a "
+                                        "normality test")
+    rows = ultrasonic_verdicts({"ultrasonic_table8": pd.DataFrame(columns=["quantity"]),
+                                "ultrasonic_table7": t7}, {})
+    assert [r["outcome"] for r in rows] == ["not comparable"] * 2

@@ -71,8 +71,8 @@ MIN_SUBJECTS_T = 3
 MIN_SUBJECTS_CELLS = 2
 #: What a table's notes say when its numbers are not comparable with the paper's.
 NOT_COMPARABLE_NOTE = {"ultrasonic_table7": "not comparable",
-                       "ultrasonic_tableC1": "by design",
-                       "ultrasonic_table8": "definitions of n"}
+                       "ultrasonic_tableC1": "not consistent with subjects as groups",
+                       "ultrasonic_table8": "divide by the number of strides n"}
 
 
 def wilson(k: float, n: float, z: float = 1.959964) -> tuple[float, float]:
@@ -431,8 +431,8 @@ _SPEED_ORDER = ("slow", "normal", "fast")
 
 def _says(notes: dict | None, table: str) -> bool:
     """Does ``table``'s notes call its numbers not comparable (:data:`NOT_COMPARABLE_NOTE`)?"""
-    phrase = NOT_COMPARABLE_NOTE[table]
-    return any(phrase in n for n in (notes or {}).get(table, []))
+    phrase = NOT_COMPARABLE_NOTE[table].lower()
+    return any(phrase in n.lower() for n in (notes or {}).get(table, []))
 
 
 def _pm(mean: float, sd: float, unit: str = "") -> str:
@@ -452,10 +452,13 @@ def _ns_nv_reason(t8: pd.DataFrame, sym: str) -> str:
     if base not in pro.index or sym not in pro.index:
         return "NS and NV compare definitions of n, not accuracy (Table 8 note)."
     n_rep = pro.loc[base, "normal_mean"] / pro.loc[sym, "normal_mean"]
+    if "normal_n" in pro.columns and np.isfinite(pro.loc[sym, "normal_n"]):
+        n_rep = float(pro.loc[sym, "normal_n"])
     n_pub = pro.loc[base, "normal_mean_published"] / pro.loc[sym, "normal_mean_published"]
-    return (f"{sym} = {base}/n: gaitval's n is every stride of the trial ({n_rep:.0f} at normal "
-            f"speed), the paper's values imply n ≈ {n_pub:.0f}; the rows compare definitions "
-            "of n, not accuracy (Table 8 note).")
+    return (f"{sym} = {base}/n: gaitval divides by the {n_rep:.0f} strides per subject it "
+            f"samples (the paper's Tables 2-6 sample size), the paper's values imply "
+            f"n ≈ {n_pub:.0f} at normal speed; the rows compare definitions of n, not "
+            "accuracy (Table 8 note).")
 
 
 def ultrasonic_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
@@ -528,6 +531,9 @@ def ultrasonic_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -
         nc7 = _says(notes, "ultrasonic_table7")
         for r in t7.itertuples(index=False):
             known = np.isfinite([r.H, r.H_published]).all()
+            said = str(getattr(r, "comparability", "") or "")
+            if said.lower().startswith("not comparable"):         # the table's own word
+                nc7 = True
             reason = (f"the paper's H = {r.H_published:.0f}, p = {r.p_published:.3f} test "
                       "'mean is zero', not normality; gaitval's Lilliefors test gives "
                       f"H = {r.H:.0f}, p {p_value(r.p)} (Table 7 note)." if nc7 and known
@@ -541,21 +547,35 @@ def ultrasonic_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -
     c1 = t.get("ultrasonic_tableC1")
     if c1 is not None:
         ncc = _says(notes, "ultrasonic_tableC1")
-        for r in c1[c1["source"] == "between"].itertuples(index=False):
+        between = c1[c1["source"] == "between"]
+        if "grouping" not in between.columns:
+            between = between.assign(grouping="subject")
+        # one primary reading, the paper's words ("between subjects"); the other reading of
+        # its groups (the stride index, which its numbers imply) beside it, not counted
+        alt = {r.symbol: r for r in between[between["grouping"] != "subject"]
+               .itertuples(index=False)}
+        for r in between[between["grouping"] == "subject"].itertuples(index=False):
             known = np.isfinite(r.p) and np.isfinite(r.F)
-            reason = (f"gaitval groups strides by subject (F {r.F:.2f}, df {int(r.df)}); the "
-                      "paper's table matches grouping by stride index (F "
-                      f"{r.F_published:.2f}, df {int(r.df_published)}), so they differ by "
-                      "design (Table C1 note)." if ncc and known else None if known else
+            reason = (f"the paper says it groups by subject, but its numbers cannot come "
+                      f"from that grouping (its own Tables 2-4 imply F >> 1; gaitval: F "
+                      f"{r.F:.2f}); they match grouping by stride index (Table C1 note)."
+                      if ncc and known else None if known else
                       f"too small: F is undefined with {int(r.df) + 1 if np.isfinite(r.df) else 'too few'} "
                       "subject group(s)")
             ok = (r.p < 0.05) == (r.p_published < 0.05) if known else None
-            rows.append(_row(st, f"{r.symbol}: no difference between subjects (ANOVA)",
-                             "Table C1", f"F {r.F_published:.2f}, p {p_value(r.p_published)}",
-                             f"F {r.F:.2f}, p {p_value(r.p)}" if known else "F undefined",
-                             "same test decision at 0.05", ok,
-                             f"p {p_value(r.p)} against the paper's {p_value(r.p_published)}.",
-                             "ultrasonic_tableC1", not_comparable=reason))
+            row = _row(st, f"{r.symbol}: no difference between subjects (ANOVA)",
+                       "Table C1", f"F {r.F_published:.2f}, p {p_value(r.p_published)}",
+                       f"F {r.F:.2f}, p {p_value(r.p)}" if known else "F undefined",
+                       "same test decision at 0.05", ok,
+                       f"p {p_value(r.p)} against the paper's {p_value(r.p_published)}.",
+                       "ultrasonic_tableC1", not_comparable=reason)
+            a = alt.get(r.symbol)
+            if a is not None and np.isfinite(a.p) and np.isfinite(a.F):
+                a_ok = (a.p < 0.05) == (a.p_published < 0.05)
+                row["alternative"] = (f"groups = stride index: F {a.F:.2f}, p {p_value(a.p)} "
+                                      f"({'reproduced' if a_ok else 'not reproduced'}, "
+                                      "not counted)")
+            rows.append(row)
     return rows
 
 
