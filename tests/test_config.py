@@ -498,3 +498,14 @@ def test_tug_tables_verb_hands_the_configs_it_is_given_to_the_step(monkeypatch):
     assert seen["configs"] == ["v/tug_m1.json", "v/tug_m2.json"]
     assert main(["tug-tables", "e1", "--tables-dir", "t", "--figures-dir", "f"]) == 0
     assert seen["configs"] is None                                # config.json convention
+
+
+def test_tables_steps_name_a_method_with_its_overrides_from_its_view(tmp_path):
+    """Issue 35: the MTST tables step reads each method's view beside its study view."""
+    from gaitval.steps import method_display_names, method_view
+
+    cfg = {"tracking": {"methods": {}, "overrides": {"mtst_m3": {"gate__radius_leg_widths": 1.2}}}}
+    for m in ("mtst_m1", "mtst_m3"):
+        (tmp_path / f"{m}.json").write_text(json.dumps(method_view(cfg, m, "mtst")))
+    assert method_display_names(tmp_path, ["mtst_m1", "mtst_m3", "mtst_proposed"]) == {
+        "mtst_m1": "mtst_m1", "mtst_m3": "mtst_m3 (gate.radius_leg_widths = 1.2)"}
