@@ -89,8 +89,9 @@ def test_input_list_is_relative_to_the_working_folder(tmp_path, monkeypatch):
     work = tmp_path / "checkout"
     (work / "data").mkdir(parents=True)
     (work / "data" / "trials.csv").write_text("trial\n")
-    (tmp_path / "shared").mkdir()
-    (tmp_path / "shared" / "peer.parquet").write_bytes(b"x")
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "elsewhere" / "peer.parquet").write_bytes(b"x")
+    (tmp_path / "shared").symlink_to(tmp_path / "elsewhere")    # a link stays a link
     monkeypatch.chdir(work)
     prov = work / "reports" / "tiny" / "provenance"
     out = SimpleNamespace(config=prov / "config.yaml", inputs=prov / "inputs.txt",

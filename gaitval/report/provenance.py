@@ -130,9 +130,10 @@ def input_manifest(paths: list[str | Path]) -> tuple[str, int, int]:
 
 def relative_path(path: str | Path, start: str | Path | None = None) -> str:
     """``path`` relative to ``start`` (default: the working folder), ``../`` where it is
-    outside, so that a manifest checks on another machine with the same layout."""
-    return Path(os.path.relpath(Path(path).resolve(),
-                                Path(start or Path.cwd()).resolve())).as_posix()
+    outside, so that a manifest checks on another machine with the same layout.  Symbolic
+    links are kept (``../shared`` stays ``../shared`` when it links elsewhere)."""
+    return Path(os.path.relpath(os.path.abspath(path),
+                                os.path.abspath(start or os.getcwd()))).as_posix()
 
 
 #: Distributions a plain ``pip install -r`` does not take from a lock: the project itself
