@@ -509,3 +509,31 @@ def test_tables_steps_name_a_method_with_its_overrides_from_its_view(tmp_path):
         (tmp_path / f"{m}.json").write_text(json.dumps(method_view(cfg, m, "mtst")))
     assert method_display_names(tmp_path, ["mtst_m1", "mtst_m3", "mtst_proposed"]) == {
         "mtst_m1": "mtst_m1", "mtst_m3": "mtst_m3 (gate.radius_leg_widths = 1.2)"}
+
+
+def test_a_modified_rollator_method_is_named_in_a_note_of_every_rollator_table(
+        tmp_path, monkeypatch):
+    """Issue 35: the rollator tables keep their _kf/_pf columns; a note names a KF or PF
+    run with overrides (the table bodies are stubbed: only the notes are under test)."""
+    import gaitval.tables.rollator as rollator
+    import gaitval.tables.rollator_notes as notes
+
+    one = pd.DataFrame({"scenario": ["straight"], "rmse_kf": [0.01]})
+    for name in ("rollator_table1", "rollator_table2"):
+        monkeypatch.setattr(rollator, name, lambda *a, **k: one)
+    monkeypatch.setattr(rollator, "improvement", lambda t1: one)
+    monkeypatch.setattr(notes, "table1_notes", lambda *a, **k: [])
+    monkeypatch.setattr(notes, "table2_notes", lambda *a, **k: [])
+    paths = rollator.write_rollator_tables(
+        pd.DataFrame(), pd.DataFrame(), tmp_path, kf="rollator_kf", pf="rollator_pf",
+        shown={"rollator_kf": "rollator_kf (filter.r_sd_m = 0.03)",
+               "rollator_pf": "rollator_pf"})
+    mds = [p for p in paths if p.suffix == ".md"]
+    assert len(mds) == 3
+    for p in mds:
+        text = p.read_text()
+        assert "KF ran as rollator_kf (filter.r_sd_m = 0.03)" in text, p.name
+        assert "PF ran as" not in text
+    plain = rollator.write_rollator_tables(pd.DataFrame(), pd.DataFrame(), tmp_path / "b",
+                                           kf="rollator_kf", pf="rollator_pf")
+    assert not any("KF ran as" in p.read_text() for p in plain if p.suffix == ".md")
