@@ -4,8 +4,10 @@
     python3 run.py report   # generate the default study (first time), build reports/default/index.html
     python3 run.py test     # run the test suite
 
-Each creates ``.venv`` and installs gaitval into it (``pip install -e .[test]``) on first
-use, and again only when ``pyproject.toml`` changes.  Extra arguments go to Snakemake
+Each creates ``.venv`` and installs into it, on first use and again only when
+``pyproject.toml`` or ``requirements.lock`` changes, the exact versions of
+``requirements.lock`` (hashed, ``pip install --require-hashes``; made with pip-tools, see
+the file's head) and then gaitval itself (``pip install --no-deps -e .``).  Extra arguments go to Snakemake
 (``report``) or pytest (``test``), e.g. ``python3 run.py report --config 'run=["tiny"]'``.
 Also: ``python3 run.py bench benchmarks/NAME.py`` (installs the benchmark-only extras).
 
@@ -33,21 +35,37 @@ BIN = VENV / ("Scripts" if os.name == "nt" else "bin")
 PY = BIN / ("python.exe" if os.name == "nt" else "python")
 
 
+#: The exact, hashed versions of gaitval's dependencies and its test extra
+#: (``pip-compile --generate-hashes --extra test``; the file's head has the command).
+LOCK = ROOT / "requirements.lock"
+
+
 def ensure_env(extras: str) -> None:
     if sys.version_info < (3, 11):
         sys.exit(f"gaitval needs Python 3.11 or newer (this is {sys.version.split()[0]})")
-    key = hashlib.sha256((ROOT / "pyproject.toml").read_bytes() + extras.encode()).hexdigest()
+    lock = LOCK.read_bytes() if LOCK.is_file() else b""
+    key = hashlib.sha256((ROOT / "pyproject.toml").read_bytes() + lock
+                         + extras.encode()).hexdigest()
     stamp = VENV / f".gaitval-installed-{extras or 'base'}"
     if PY.exists() and stamp.exists() and stamp.read_text() == key:
         return
     if not PY.exists():
         print(f"[run.py] creating {VENV} ...", flush=True)
         venv.EnvBuilder(with_pip=True).create(VENV)
-    print(f"[run.py] installing gaitval[{extras}] into {VENV} (first run only) ...", flush=True)
-    subprocess.run([str(PY), "-m", "pip", "install", "--quiet", "--upgrade", "pip"],
-                   check=True)
-    subprocess.run([str(PY), "-m", "pip", "install", "--quiet", "-e",
-                    f"{ROOT}[{extras}]" if extras else str(ROOT)], check=True)
+    pip = [str(PY), "-m", "pip", "install", "--quiet"]
+    if lock:
+        # the locked versions, each file checked against its hash, then gaitval itself
+        print(f"[run.py] installing {LOCK.name} into {VENV} (first run only) ...", flush=True)
+        subprocess.run([*pip, "--require-hashes", "--no-deps", "-r", str(LOCK)], check=True)
+        subprocess.run([*pip, "--no-deps", "-e", str(ROOT)], check=True)
+        rest = [e for e in extras.split(",") if e and e != "test"]   # test is locked
+        if rest:                                  # e.g. bench: on top, not locked
+            subprocess.run([*pip, "-e", f"{ROOT}[{','.join(rest)}]"], check=True)
+    else:
+        print(f"[run.py] installing gaitval[{extras}] into {VENV} (first run only) ...",
+              flush=True)
+        subprocess.run([*pip, "-e", f"{ROOT}[{extras}]" if extras else str(ROOT)],
+                       check=True)
     # the particle filter's and the UKF's numba kernels, compiled into their cache now
     # (~15 s CPU) rather than by each worker of the first report (warm_up in
     # gaitval/track/pf.py and gaitval/track/ukf.py)

@@ -247,7 +247,29 @@ def check_config(config: Mapping, layers: Sequence[tuple[str, Any]] | None = Non
     schema = schema or load_schema()
     layers = list(layers) if layers else [("config/config.yaml", config)]
     probs = find_problems(dict(config), schema)
-    raise_problems([Problem(p.path, p.message, _source(p.path, layers)) for p in probs])
+    raise_problems(with_sources(probs, layers))
+
+
+def run_problems(config: Mapping) -> list[Problem]:
+    """Each name in ``run`` that is no key of ``studies`` (with the nearest one)."""
+    studies = list((config.get("studies") or {}) if isinstance(config, Mapping) else {})
+    out = []
+    for i, name in enumerate(config.get("run") or []):
+        if name in studies:
+            continue
+        close = difflib.get_close_matches(str(name), studies, n=1, cutoff=0.6)
+        tip = f" — did you mean {close[0]}?" if close else ""
+        out.append(Problem(("run", i), f"run[{i}]: no study {name!r} under studies:{tip} "
+                                       f"(studies: {', '.join(sorted(studies))})"))
+    return out
+
+
+def with_sources(problems: list[Problem], layers: Sequence[tuple[str, Any]]
+                 ) -> list[Problem]:
+    """``problems`` each naming the config layer that sets its key (for
+    :func:`raise_problems`)."""
+    return [Problem(p.path, p.message, p.source or _source(p.path, layers))
+            for p in problems]
 
 
 def check_study_file(study: Any, path: str | Path, *, schema: dict | None = None) -> None:

@@ -220,6 +220,23 @@ def registration_summary(inputs: list[str | Path], study: str, out_csv, out_stem
 
 
 # -- tracking (LRS) ------------------------------------------------------------------------
+def method_display_names(view_dir: str | Path, methods) -> dict[str, str]:
+    """method -> its name in the tables (``tug_m3 (occlusion.max_n = 10)`` when run with
+    overrides), from the method views ``<view_dir>/<method>.json`` beside a tables step's
+    study view (the views its tracks ran with); a method without a view keeps its name."""
+    from gaitval.methods import display_name, get_method, set_params
+
+    out = {}
+    for m in methods:
+        p = Path(view_dir) / f"{m}.json"
+        if p.is_file():
+            cfg = load_json(p)
+            d = set_params(get_method(method_definition(cfg, m)),
+                           ((cfg.get("tracking") or {}).get("overrides") or {}).get(m))
+            out[m] = display_name(m, d)
+    return out
+
+
 def method_definition(cfg: dict, method: str):
     """A method's definition: ``tracking.methods.<name>`` from config, else the built-in."""
     custom = (cfg.get("tracking") or {}).get("methods") or {}

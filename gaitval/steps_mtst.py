@@ -38,7 +38,8 @@ from gaitval.errors import ConfigError, FileFormatError, GaitvalError
 from gaitval.io.atomic import write_parquet
 from gaitval.io.filememo import FileMemo
 from gaitval.io.parquet import read_parquet
-from gaitval.steps import load_json, method_definition, trial_and_subject
+from gaitval.steps import (load_json, method_definition, method_display_names,
+                           trial_and_subject)
 
 TARGET_COLUMNS = ("target", "x_m", "y_m", "color", "assigned")
 EVAL_TABLES = ("contacts", "steps", "events", "gates", "track_field", "summary", "targets")
@@ -294,7 +295,8 @@ def mtst_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, repor
     s = mtst_config(config_json)[1] if config_json else None
     methods = list(methods or (s or {}).get("methods") or
                    ["mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed"])
-    paths = write_mtst_tables(data, tables_dir, methods=methods)
+    shown = method_display_names(Path(config_json).parent, methods) if config_json else {}
+    paths = write_mtst_tables(data, tables_dir, methods=methods, shown=shown)
     stamp("mtst_tables", paths, reports_dir, config_hash_=config_hash)
     figs = write_mtst_figure(data, figures_dir, trial=(s or {}).get("figure_trial"),
                              methods=methods)

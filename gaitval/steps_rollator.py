@@ -31,7 +31,8 @@ from gaitval.errors import GaitvalError
 from gaitval.io.atomic import write_parquet, write_text
 from gaitval.io.filememo import FileMemo, file_identity
 from gaitval.io.parquet import read_parquet
-from gaitval.steps import load_json, method_definition, trial_and_subject
+from gaitval.steps import (load_json, method_definition, method_display_names,
+                           trial_and_subject)
 
 #: defaults of the ``rollator:`` keys read here
 DEFAULTS = {"kf_method": "rollator_kf", "pf_method": "rollator_pf", "pf_seed": 2017,
@@ -223,9 +224,11 @@ def rollator_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, r
     cfg = load_json(config_json) if config_json else {}
     rc = rollator_cfg(cfg)
     sources = sorted({load_json(m).get("source", "") for m in models})
+    shown = (method_display_names(Path(config_json).parent, [kf_method, pf_method])
+             if config_json else {})
     paths = write_rollator_tables(frames_df, summary, tables_dir, kf=kf_method,
                                   pf=pf_method, error_m=float(rc["error_m"]),
-                                  model_sources=sources)
+                                  model_sources=sources, shown=shown)
     stamp("rollator_tables", paths, reports_dir, config_hash_=config_hash)
     figs = write_rollator_figure(frames_df, figures_dir, kf=kf_method, pf=pf_method,
                                  trial=rc["figure_trial"],

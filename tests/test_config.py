@@ -202,6 +202,51 @@ def dry_run(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run(cmd, capture_output=True, text=True, timeout=300, cwd=ROOT)
 
 
+def test_override_keys_are_checked_against_the_methods_parameters():
+    """Issue 35: a typo'd override names the key and the nearest valid one."""
+    from gaitval.methods import METHODS, check_overrides, override_problems
+
+    defs = {m: m for m in METHODS}
+    ok = {"tug_m3": {"occlusion__max_n": 10, "gate__g": 9.21, "tracker__dt_s": 0.025,
+                     "detector__background": {"name": "percentile", "q": 90.0}},
+          "rollator_pf": {"kind__n_particles": 100},
+          "tug_m1": {"occlusion__name": "catmull_rom", "occlusion__max_n": 5}}
+    assert override_problems(ok, defs) == []
+    msgs = [p.message for p in override_problems(
+        {"tug_m3": {"occlusion__maxn": 10, "occlusoin__max_n": 1, "tracker__dt": 0.1,
+                    "occlusion__name": "catmul_rom"},
+         "tug_m33": {"gate__g": 1}, "tug_m1": {"occlusion__max_n": 5}}, defs)]
+    text = "\n".join(msgs)
+    assert ("tracking.overrides.tug_m33: no method 'tug_m33' — did you mean "
+            "tracking.overrides.tug_m3?") in text
+    assert "tug_m3 has no role 'occlusoin' — did you mean occlusion__max_n?" in text
+    assert "tracker__dt: the tracker loop of tug_m3 has no parameter 'dt' — did you " \
+           "mean tracker__dt_s?" in text
+    assert "no occlusion handler 'catmul_rom' — did you mean catmull_rom?" in text
+    # tug_m1's occlusion handler (predict only) has no max_n
+    assert "tug_m1.occlusion__max_n: the occlusion handler 'predict_only' of tug_m1 " \
+           "has no parameter 'max_n'" in text
+    with pytest.raises(ConfigError, match="did you mean occlusion__max_n"):
+        check_overrides({"tug_m3": {"occlusion__maxn": 10}}, defs)
+
+
+@pytest.mark.slow
+def test_a_typo_in_an_override_or_run_stops_the_dry_run_with_the_message_only():
+    res = dry_run("--config", 'run=["tiny"]',
+                  'tracking={"overrides": {"tug_m3": {"occlusion__maxn": 10}}}')
+    assert res.returncode != 0
+    assert ("--config: tracking.overrides.tug_m3.occlusion__maxn: the occlusion handler "
+            "'catmull_rom' of tug_m3 has no parameter 'maxn' — did you mean "
+            "occlusion__max_n?") in res.stderr
+    res2 = dry_run("--config", 'run=["tinyy"]')
+    assert res2.returncode != 0
+    assert "--config: run[0]: no study 'tinyy' under studies: — did you mean tiny?" \
+        in res2.stderr
+    for r in (res, res2):
+        assert "Traceback" not in r.stderr and "File \"" not in r.stderr
+        assert "Exception" not in r.stderr
+
+
 @pytest.mark.slow
 def test_snakemake_stops_with_the_message_only(tmp_path):
     res = dry_run("--config", 'run=["tiny"]', 'groundtruth={"lowpas_hz": 6}')
@@ -351,9 +396,46 @@ def test_table2_shows_overrides(tmp_path, table2_of):
     t2 = table2_of(study_results(tmp_path / "res", "s", cfg, ["tug_m3", "my_m3"]),
                    ["tug_m3", "my_m3"])
     v = t2.set_index(["method", "symbol"])["value"]
-    assert v["my_m3", "G"] == "5.99" and v["tug_m3", "G"] == "13.82"
-    assert v["tug_m3", "N_bo"] == "5" and v["tug_m3", "N_ao"] == "match"
-    assert v["tug_m3", "√R"] == "0.03" and v["my_m3", "√R"] == "0.04"
+    # a built-in method run with overrides is named with them (issue 35); a config-defined
+    # method is its own definition
+    m3 = "tug_m3 (filter.r_sd_m = 0.03, occlusion.n_bo = 5)"
+    assert list(dict.fromkeys(t2.method)) == [m3, "my_m3"]
+    assert v["my_m3", "G"] == "5.99" and v[m3, "G"] == "13.82"
+    assert v[m3, "N_bo"] == "5" and v[m3, "N_ao"] == "match"
+    assert v[m3, "√R"] == "0.03" and v["my_m3", "√R"] == "0.04"
+    pub = t2.set_index(["method", "symbol"])["value_published"]
+    assert pub[m3, "√R"] == "0.04"                    # the paper's value beside the run one
+
+
+def test_table2_has_a_row_for_an_overridden_parameter_it_does_not_list(tmp_path, table2_of):
+    """Issue 35: occlusion.max_n is no row of Table 2; overridden, it gets one."""
+    cfg = {"tracking": {"overrides": {"tug_m3": {"occlusion__max_n": 10}}}}
+    t2 = table2_of(study_results(tmp_path / "res", "s", cfg, ["tug_m1", "tug_m3"]),
+                   ["tug_m1", "tug_m3"])
+    m3 = "tug_m3 (occlusion.max_n = 10)"
+    assert list(dict.fromkeys(t2.method)) == ["tug_m1", m3]
+    row = t2[t2.parameter.str.startswith("occlusion.max_n")]
+    assert list(row.method) == [m3] and list(row.value) == ["10"]
+    assert row.parameter.iloc[0] == "occlusion.max_n (changed; built in: 20)"
+
+
+def test_a_modified_method_is_named_with_its_changes_in_every_tug_table(tmp_path):
+    from gaitval.evaluate.tug import FRAME_COLUMNS
+    from gaitval.methods import get_method, set_params
+    from gaitval.tables.tug import write_tug_tables
+
+    frames = pd.DataFrame(columns=list(FRAME_COLUMNS))
+    summaries = pd.DataFrame([{"trial": "t1", "method": m, "success": False,
+                               "category": "false_tracking_turning"}
+                              for m in ("tug_m1", "tug_m3")])
+    defs = {"tug_m1": get_method("tug_m1"),
+            "tug_m3": set_params(get_method("tug_m3"), {"occlusion__max_n": 10})}
+    write_tug_tables(frames, summaries, tmp_path, methods=defs)
+    for name in ("tug_table2", "tug_table3", "tug_table4", "tug_table5"):
+        t = pd.read_csv(tmp_path / f"{name}.csv")
+        shown = set(t["method"].dropna())
+        assert "tug_m3 (occlusion.max_n = 10)" in shown, (name, shown)
+        assert "tug_m3" not in shown and "tug_m1" in shown, (name, shown)
 
 
 def test_table2_without_config_changes_is_the_builtin_table(tmp_path, table2_of):
@@ -371,8 +453,9 @@ def test_table2_studies_that_ran_a_method_differently(tmp_path, table2_of):
     dirs = (study_results(tmp_path / "res", "a", a, ["tug_m1", "tug_m3"])
             + study_results(tmp_path / "res", "b", b, ["tug_m1", "tug_m3"]))
     t2 = table2_of(dirs, ["tug_m1", "tug_m3"])
-    assert list(dict.fromkeys(t2.method)) == ["tug_m1", "tug_m3 (a)", "tug_m3 (b)"]
-    assert g_of(t2, "tug_m3 (a)") == "9.21" and g_of(t2, "tug_m3 (b)") == "13.82"
+    a3 = "tug_m3 (a) (gate.g = 9.21)"
+    assert list(dict.fromkeys(t2.method)) == ["tug_m1", a3, "tug_m3 (b)"]
+    assert g_of(t2, a3) == "9.21" and g_of(t2, "tug_m3 (b)") == "13.82"
 
 
 def test_table2_from_the_method_views_is_the_table_from_config_json(tmp_path, table2_of):
@@ -397,7 +480,8 @@ def test_table2_from_the_method_views_is_the_table_from_config_json(tmp_path, ta
             views[-1].write_text(json.dumps(method_view(cfg, m, "tug")))
     from_views = table2_of(dirs, names, configs=views)
     assert from_views.equals(whole)
-    assert {"tug_m3 (a)", "tug_m3 (b)", "my_m3 (a)", "my_m3 (b)"} <= set(from_views.method)
+    assert {"tug_m3 (a) (occlusion.n_bo = 5)", "tug_m3 (b)", "my_m3 (a)", "my_m3 (b)"} \
+        <= set(from_views.method)
 
 
 def test_tug_tables_verb_hands_the_configs_it_is_given_to_the_step(monkeypatch):
@@ -414,3 +498,42 @@ def test_tug_tables_verb_hands_the_configs_it_is_given_to_the_step(monkeypatch):
     assert seen["configs"] == ["v/tug_m1.json", "v/tug_m2.json"]
     assert main(["tug-tables", "e1", "--tables-dir", "t", "--figures-dir", "f"]) == 0
     assert seen["configs"] is None                                # config.json convention
+
+
+def test_tables_steps_name_a_method_with_its_overrides_from_its_view(tmp_path):
+    """Issue 35: the MTST tables step reads each method's view beside its study view."""
+    from gaitval.steps import method_display_names, method_view
+
+    cfg = {"tracking": {"methods": {}, "overrides": {"mtst_m3": {"gate__radius_leg_widths": 1.2}}}}
+    for m in ("mtst_m1", "mtst_m3"):
+        (tmp_path / f"{m}.json").write_text(json.dumps(method_view(cfg, m, "mtst")))
+    assert method_display_names(tmp_path, ["mtst_m1", "mtst_m3", "mtst_proposed"]) == {
+        "mtst_m1": "mtst_m1", "mtst_m3": "mtst_m3 (gate.radius_leg_widths = 1.2)"}
+
+
+def test_a_modified_rollator_method_is_named_in_a_note_of_every_rollator_table(
+        tmp_path, monkeypatch):
+    """Issue 35: the rollator tables keep their _kf/_pf columns; a note names a KF or PF
+    run with overrides (the table bodies are stubbed: only the notes are under test)."""
+    import gaitval.tables.rollator as rollator
+    import gaitval.tables.rollator_notes as notes
+
+    one = pd.DataFrame({"scenario": ["straight"], "rmse_kf": [0.01]})
+    for name in ("rollator_table1", "rollator_table2"):
+        monkeypatch.setattr(rollator, name, lambda *a, **k: one)
+    monkeypatch.setattr(rollator, "improvement", lambda t1: one)
+    monkeypatch.setattr(notes, "table1_notes", lambda *a, **k: [])
+    monkeypatch.setattr(notes, "table2_notes", lambda *a, **k: [])
+    paths = rollator.write_rollator_tables(
+        pd.DataFrame(), pd.DataFrame(), tmp_path, kf="rollator_kf", pf="rollator_pf",
+        shown={"rollator_kf": "rollator_kf (filter.r_sd_m = 0.03)",
+               "rollator_pf": "rollator_pf"})
+    mds = [p for p in paths if p.suffix == ".md"]
+    assert len(mds) == 3
+    for p in mds:
+        text = p.read_text()
+        assert "KF ran as rollator_kf (filter.r_sd_m = 0.03)" in text, p.name
+        assert "PF ran as" not in text
+    plain = rollator.write_rollator_tables(pd.DataFrame(), pd.DataFrame(), tmp_path / "b",
+                                           kf="rollator_kf", pf="rollator_pf")
+    assert not any("KF ran as" in p.read_text() for p in plain if p.suffix == ".md")

@@ -76,3 +76,86 @@ def test_study_inputs_and_rebuild_command(tmp_path):
                           repo=tmp_path)
     assert cmd == "python3 run.py report --config 'run=[\"tiny\", \"default\"]' 'data_dir=/d x'"
     assert "--directory" in rebuild_command([], {}, tmp_path / "w", repo=tmp_path)
+
+
+# -- portable provenance (issue 35, scope 6) ---------------------------------------------
+def test_input_list_is_relative_to_the_working_folder(tmp_path, monkeypatch):
+    """inputs.txt (so inputs.sha256) names files relative to the working folder, ../ for
+    a file beside it: `sha256sum -c` works in another checkout with the same layout."""
+    from types import SimpleNamespace
+
+    from gaitval.report.provenance import write_workflow_record
+
+    work = tmp_path / "checkout"
+    (work / "data").mkdir(parents=True)
+    (work / "data" / "trials.csv").write_text("trial\n")
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "elsewhere" / "peer.parquet").write_bytes(b"x")
+    (tmp_path / "shared").symlink_to(tmp_path / "elsewhere")    # a link stays a link
+    monkeypatch.chdir(work)
+    prov = work / "reports" / "tiny" / "provenance"
+    out = SimpleNamespace(config=prov / "config.yaml", inputs=prov / "inputs.txt",
+                          rebuild=prov / "rebuild.json")
+    write_workflow_record({"run": ["tiny"]}, [str(work / "data" / "trials.csv"),
+                                              "../shared/peer.parquet"], out,
+                          str(tmp_path / "log"), command="python3 run.py report",
+                          chash="abc")
+    assert (prov / "inputs.txt").read_text() == "data/trials.csv\n../shared/peer.parquet\n"
+    text, n, _ = input_manifest((prov / "inputs.txt").read_text().split())
+    assert n == 2 and "  data/trials.csv\n" in text and str(tmp_path) not in text
+
+
+def test_report_provenance_has_the_lock_the_tables_and_a_reproduce_script(tmp_path):
+    import shutil
+    import subprocess
+
+    from gaitval.report.provenance import REPO, lock_versions
+
+    rd, _, _ = _report(tmp_path)
+    build_index(rd, study_names=["tiny"])
+    prov = rd / "provenance"
+    rec = json.loads((prov / "report.json").read_text())
+    lock = (prov / "requirements.lock").read_text()
+    assert lock == (REPO / "requirements.lock").read_text()
+    assert rec["lock_sha256"] == hashlib.sha256(lock.encode()).hexdigest()
+    env = (prov / "environment.txt").read_text().splitlines()
+    assert not any(ln.lower().startswith(("gaitval==", "pip==")) for ln in env)
+    # the environment the tests run in is the lock's (run.py installs it)
+    assert rec["environment_vs_lock"]["differ"] == [], rec["environment_vs_lock"]
+    assert lock_versions(lock)["pandas"] == version("pandas")
+    # tables.sha256 checks from the report folder
+    tables = (prov / "tables.sha256").read_text().splitlines()
+    assert tables and all(ln.split("  ", 1)[1].startswith("tables/") for ln in tables)
+    if shutil.which("sha256sum"):
+        assert subprocess.run(["sha256sum", "-c", "--quiet", "provenance/tables.sha256"],
+                              cwd=rd).returncode == 0
+    script = (prov / "reproduce.sh").read_text()
+    commit = rec["git_commit"].removesuffix("+dirty")
+    assert f"COMMIT={commit}" in script and 'git clone --quiet "$REPO" "$DEST"' in script
+    assert 'cmp -s requirements.lock "$PROV/requirements.lock"' in script
+    assert "\npython3 run.py report --config 'run=[\"tiny\"]'\n" in script
+    assert 'sha256sum -c --quiet "$PROV/inputs.sha256"' in script
+    assert 'sha256sum -c --quiet "$PROV/tables.sha256"' in script
+    if shutil.which("bash"):
+        assert subprocess.run(["bash", "-n", str(prov / "reproduce.sh")]).returncode == 0
+    text = (rd / "index.md").read_text()
+    assert "bash provenance/reproduce.sh" in text and "(absolute paths)" not in text
+
+
+def test_the_lock_pins_every_dependency_of_pyproject_with_hashes():
+    """requirements.lock covers pyproject.toml's dependencies and test extra (a new
+    dependency without a new lock fails here: rerun the command in its head)."""
+    import re
+    import tomllib
+
+    from gaitval.report.provenance import REPO, lock_versions
+
+    project = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]
+    wanted = project["dependencies"] + project["optional-dependencies"]["test"]
+    text = (REPO / "requirements.lock").read_text()
+    locked = lock_versions(text)
+    for req in wanted:
+        name = re.split(r"[<>=!~ \[;]", req, maxsplit=1)[0].lower().replace("_", "-")
+        assert name in locked, (req, "not in requirements.lock")
+    pins = [ln for ln in text.splitlines() if "==" in ln and not ln.startswith(("#", " "))]
+    assert len(pins) == len(locked) and all(ln.rstrip().endswith("\\") for ln in pins)

@@ -88,7 +88,8 @@ def test_table2_from_definitions_blank_where_a_method_has_no_such_part():
     pf = {"label": "PF", "kind": {"name": "my_particle_filter", "n": 500}}
     t = tug_table2({"tug_m3": m3, "pf": pf}, dt_measured_s=0.025).set_index(
         ["method", "symbol"])["value"]
-    assert t["tug_m3", "v_st_th"] == "0.4" and t["tug_m3", "Δt"] == "0.05"
+    m = "tug_m3 (phase.v_st_th = 0.4, tracker.dt_s = 0.05)"    # modified: says so (issue 35)
+    assert t[m, "v_st_th"] == "0.4" and t[m, "Δt"] == "0.05"
     assert t["pf", "Δt"] == "0.025" and t["pf", "G"] == "" and t["pf", "v_st_th"] == ""
     assert t["pf", "N_bo"] == "" and t["pf", "√Q"] == ""
 

@@ -125,7 +125,7 @@ def test_one_methods_parameter_reruns_only_that_methods_trials(tiny_run):
     other method's track, no ultrasonic noise identification or track, no other study
     section's tables or summaries."""
     res = run_workflow(tiny_run, tiny_run / "data",   # a --config item, then the dry run
-                       'tracking={"overrides": {"tug_m1": {"occlusion__max_n": 7}}}', "-n")
+                       'tracking={"overrides": {"tug_m1": {"gate__g": 9.21}}}', "-n")
     assert res.returncode == 0, res.stderr[-3000:]
     planned = _planned(res)
     n_tug = len(list((tiny_run / "results" / "tiny" / "track" / "tug_m1").glob("*.parquet")))

@@ -28,7 +28,7 @@ import pandas as pd
 
 from gaitval import __version__
 from gaitval.io.atomic import write_text
-from gaitval.report.provenance import load_all
+from gaitval.report.provenance import load_all, relative_path
 from gaitval.report.datakind import PAPER_PROTOCOLS, headline, paper_data, run_data
 from gaitval.report.verdicts import VERDICT_COLUMNS, build_verdicts, summary_lines
 from gaitval.tables.numbers import format_value, to_display
@@ -144,8 +144,13 @@ def _provenance(rd: Path, rec: dict | None) -> list[str]:
     if rec.get("inputs"):
         out.append(f"Input files: [{rec['inputs']}]({rec['inputs']}), SHA-256 of "
                    f"{rec['n_input_files']} files ({rec['input_bytes'] / 1e6:.1f} MB); "
-                   f"check with `sha256sum -c {rec['inputs']}` in the report folder "
-                   "(absolute paths)")
+                   f"check with `sha256sum -c {relative_path(rd)}/{rec['inputs']}` in the "
+                   "working folder (paths relative to it)")
+    if rec.get("reproduce"):
+        out.append(f"Rebuild it elsewhere: `bash {rec['reproduce']}` clones commit "
+                   f"`{str(rec['git_commit'])[:12]}`, builds the environment from "
+                   f"[{rec.get('lock', 'the lock')}]({rec.get('lock', '')}) and checks "
+                   f"the inputs and [tables]({rec['tables']}) against the report's")
     deps = _dependency_versions(rd / rec["environment"])
     out.append(f"Environment: [{rec['environment']}]({rec['environment']}), "
                f"{rec['n_distributions']} distributions at exact versions"

@@ -5,19 +5,31 @@ record ``<report>/provenance/<step>.json`` listing the items it produced and how
 report index (:mod:`gaitval.report.index`) names that record beside every item.
 
 Once per report (:func:`write_report_provenance`, called when the index is built) the
-folder ``<report>/provenance/`` also gets what a reviewer needs to rerun it:
-``config.yaml`` (the resolved configuration, written by the workflow),
-``inputs.sha256`` (``sha256sum -c`` format: every raw input file of the pooled studies,
-listed by the workflow in ``inputs.txt``), ``environment.txt`` (``pip freeze`` style exact
-versions of the installed distributions, from :mod:`importlib.metadata`) and
-``report.json`` (git commit, gaitval and Python versions, and the one command that
-rebuilds the report, from the workflow's ``rebuild.json``).  No wall-clock time is
-recorded, so reruns with the same inputs stay byte-identical.
+folder ``<report>/provenance/`` also gets what a reviewer needs to rerun it elsewhere:
+
+* ``config.yaml``: the resolved configuration (written by the workflow); its hash is
+  ``report.json``'s ``config_hash``.  Each ``<step>.json`` has the hash of the part of it
+  that step read (its config view, ``results/<study>/config_views/``), so the two differ.
+* ``inputs.sha256``: every raw input file of the pooled studies (the workflow lists them
+  in ``inputs.txt``), paths relative to the working folder (the checkout), so
+  ``sha256sum -c reports/<run>/provenance/inputs.sha256`` there works on any machine.
+* ``requirements.lock``: the repository's hashed lock file the environment was built
+  from (``python3 run.py`` installs it), and ``environment.txt``: the versions actually
+  installed (gaitval itself left out), with ``report.json`` saying whether they are the
+  lock's.
+* ``tables.sha256``: the tables (``tables/``), relative to the report folder.
+* ``reproduce.sh``: clones the repository at the commit, builds the environment from the
+  lock, reruns the report's command and checks the inputs and tables against the two
+  manifests.
+* ``report.json``: git commit, repository, versions, and the command that rebuilt it.
+
+No wall-clock time is recorded, so reruns with the same inputs stay byte-identical.
 """
 from __future__ import annotations
 
 import hashlib
 import json
+import os
 import shlex
 import subprocess
 import sys
@@ -116,16 +128,131 @@ def input_manifest(paths: list[str | Path]) -> tuple[str, int, int]:
                                                              for f in files)
 
 
+def relative_path(path: str | Path, start: str | Path | None = None) -> str:
+    """``path`` relative to ``start`` (default: the working folder), ``../`` where it is
+    outside, so that a manifest checks on another machine with the same layout.  Symbolic
+    links are kept (``../shared`` stays ``../shared`` when it links elsewhere)."""
+    return Path(os.path.relpath(os.path.abspath(path),
+                                os.path.abspath(start or os.getcwd()))).as_posix()
+
+
+#: Distributions a plain ``pip install -r`` does not take from a lock: the project itself
+#: and pip's own tools.
+_NOT_LOCKED = {"gaitval", "pip", "setuptools", "wheel"}
+
+
+def _norm(name: str) -> str:
+    return name.lower().replace("_", "-").replace(".", "-")
+
+
 def environment_lines() -> list[str]:
-    """``name==version`` of every installed distribution (``pip freeze`` without pip)."""
+    """``name==version`` of every installed distribution but gaitval and pip's tools
+    (``pip freeze`` style: installable with ``pip install -r``)."""
     from importlib.metadata import distributions
 
     seen = {}
     for d in distributions():
         name = (d.metadata["Name"] or "").strip()
-        if name:
+        if name and _norm(name) not in _NOT_LOCKED:
             seen.setdefault(name.lower(), f"{name}=={d.version}")
     return [seen[k] for k in sorted(seen)]
+
+
+def lock_versions(text: str) -> dict[str, str]:
+    """``{normalised name: version}`` of a pip-compile lock file."""
+    out = {}
+    for ln in text.splitlines():
+        if "==" in ln and not ln.startswith((" ", "#", "-")):
+            name, ver = ln.split("==", 1)
+            out[_norm(name.strip())] = ver.split()[0].rstrip("\\").strip().split(";")[0]
+    return out
+
+
+def environment_vs_lock(env: list[str], lock_text: str) -> dict:
+    """What of the installed ``env`` (``name==version`` lines) differs from the lock."""
+    locked = lock_versions(lock_text)
+    have = {_norm(n): v for n, v in (ln.split("==", 1) for ln in env)}
+    return {"differ": sorted(f"{n}=={have[n]} (lock {locked[n]})" for n in have
+                             if n in locked and have[n] != locked[n]),
+            "not_in_lock": sorted(f"{n}=={have[n]}" for n in have if n not in locked),
+            "missing": sorted(f"{n}=={locked[n]}" for n in locked if n not in have)}
+
+
+def tables_manifest(reports_dir: str | Path) -> str:
+    """``sha256sum`` lines of every file under ``<reports_dir>/tables``, relative to the
+    report folder."""
+    rd = Path(reports_dir)
+    files = sorted(p for p in (rd / "tables").rglob("*") if p.is_file())
+    return "".join(f"{sha256_file(p)}  {p.relative_to(rd).as_posix()}\n" for p in files)
+
+
+def git_origin(repo: Path = REPO) -> str:
+    """The repository the checkout was cloned from (``remote.origin.url``), else its own
+    folder."""
+    try:
+        url = subprocess.run(["git", "-C", str(repo), "remote", "get-url", "origin"],
+                             capture_output=True, text=True, timeout=10).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        url = ""
+    return url or str(repo)
+
+
+def reproduce_script(rec: dict, reports_rel: str) -> str:
+    """``reproduce.sh``: a new checkout of the commit, the environment from the lock,
+    the report's command, then its inputs and tables checked against the manifests."""
+    commit = str(rec.get("git_commit", "unknown"))
+    plain = commit.removesuffix("+dirty")
+    args = shlex.split(rec.get("command") or "python3 run.py report")
+    keep, skip = [], False
+    for a in args:                        # the new checkout is the working folder
+        if skip:
+            skip = False
+        elif a == "--directory":
+            skip = True
+        elif not a.startswith("--directory="):
+            keep.append(a)
+    command = " ".join(shlex.quote(a) for a in keep)
+    q = shlex.quote
+    lines = [
+        "#!/usr/bin/env bash",
+        f"# Rebuild the gaitval report {reports_rel} from nothing and check that its inputs",
+        "# and tables are identical: a new checkout of the commit, the environment built",
+        "# from the hashed lock, the report's own command.  Written by gaitval",
+        "# (gaitval/report/provenance.py).",
+        "#",
+        "#   bash reproduce.sh [REPOSITORY] [FOLDER]",
+        "#",
+        "# REPOSITORY  gaitval's git repository, a URL or a folder (default: the one the",
+        "#             report was made from)",
+        "# FOLDER      a new folder for the checkout (default: ./gaitval-<commit>); data the",
+        "#             studies read from outside the checkout (../shared/...) must sit",
+        "#             beside it as they did beside the original",
+        "set -euo pipefail",
+        'PROV=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)',
+        f"COMMIT={q(plain)}",
+        f"REPO=${{1:-{q(rec.get('repository') or str(REPO))}}}",
+        f'DEST=${{2:-gaitval-{plain[:12]}}}',
+        'if [ -e "$DEST" ]; then echo "reproduce.sh: $DEST exists; name a new folder" >&2;'
+        " exit 2; fi",
+    ]
+    if commit.endswith("+dirty"):
+        lines.append('echo "reproduce.sh: the report was made from a checkout with '
+                     'uncommitted changes; the commit alone may not rebuild it" >&2')
+    lines += [
+        'git clone --quiet "$REPO" "$DEST"',
+        'cd "$DEST"',
+        'git -c advice.detachedHead=false checkout --quiet "$COMMIT"',
+        "# the environment: run.py builds .venv from requirements.lock, the report's lock",
+        'cmp -s requirements.lock "$PROV/requirements.lock" || '
+        '{ echo "reproduce.sh: requirements.lock at $COMMIT is not the one the report '
+        'was made with" >&2; exit 1; }',
+        command,
+        'sha256sum -c --quiet "$PROV/inputs.sha256"',
+        f'(cd {q(reports_rel)} && sha256sum -c --quiet "$PROV/tables.sha256")',
+        'echo "reproduce.sh: inputs and tables identical to the report\'s ($DEST/'
+        + reports_rel + ')"',
+    ]
+    return "\n".join(lines) + "\n"
 
 
 def write_report_provenance(reports_dir: str | Path) -> dict | None:
@@ -150,12 +277,35 @@ def write_report_provenance(reports_dir: str | Path) -> dict | None:
     write_text(prov / "environment.txt", "".join(ln + "\n" for ln in env))
     if (prov / "config.yaml").is_file():
         rec["config"] = "provenance/config.yaml"
+        rec["config_hash_note"] = (
+            "config_hash: the whole resolved configuration (provenance/config.yaml); a "
+            "step record's config_hash: the part of it that step read (its config view)")
+    lock = REPO / "requirements.lock"
+    if lock.is_file():
+        text = lock.read_text(encoding="utf-8")
+        write_text(prov / "requirements.lock", text)
+        diff = environment_vs_lock(env, text)
+        rec.update(lock="provenance/requirements.lock",
+                   lock_sha256=hashlib.sha256(text.encode()).hexdigest(),
+                   environment_is_lock=not (diff["differ"] or diff["missing"]),
+                   environment_vs_lock=diff)
+    write_text(prov / "tables.sha256", tables_manifest(reports_dir))
     rec.update(environment="provenance/environment.txt", n_distributions=len(env),
-               git_commit=git_commit(), gaitval_version=__version__,
-               python=platform.python_version(),
-               platform=f"{platform.system()} {platform.machine()}")
+               git_commit=git_commit(), repository=git_origin(),
+               gaitval_version=__version__, python=platform.python_version(),
+               platform=f"{platform.system()} {platform.machine()}",
+               tables="provenance/tables.sha256", reproduce="provenance/reproduce.sh")
+    rel = relative_path(reports_dir)
+    write_text(prov / "reproduce.sh", reproduce_script(rec, rel))
+    os.chmod(prov / "reproduce.sh", 0o755 & ~_umask())
     write_text(prov / "report.json", json.dumps(rec, indent=1, sort_keys=True) + "\n")
     return rec
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 # -- what the workflow hands over -------------------------------------------------------
@@ -198,7 +348,7 @@ def write_workflow_record(config: dict, inputs, output, log: str, *, command: st
 
     resolved = json.loads(json.dumps(config, default=str))
     write_text(output.config, yaml.safe_dump(resolved, sort_keys=True))
-    write_text(output.inputs, "".join(f"{Path(p).resolve()}\n" for p in inputs))
+    write_text(output.inputs, "".join(f"{relative_path(p)}\n" for p in inputs))
     write_text(output.rebuild, json.dumps(
         {"command": command, "studies": list(config.get("run", [])),
          "config_hash": chash}, indent=1, sort_keys=True) + "\n")

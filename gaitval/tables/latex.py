@@ -1,7 +1,7 @@
 """LaTeX of one table through pandas' ``Styler.to_latex``: booktabs, escaping, page fit.
 
 Every ``.tex`` gaitval writes compiles with pdflatex inside :data:`PREAMBLE` (the packages
-``booktabs``, ``longtable``, ``pdflscape`` and ``[T1]{fontenc}``; Debian:
+``booktabs``, ``longtable``, ``pdflscape``, ``array`` and ``[T1]{fontenc}``; Debian:
 texlive-latex-base, texlive-latex-recommended, texlive-latex-extra).  What the renderer
 does so that it does:
 
@@ -18,13 +18,23 @@ does so that it does:
   as maths minus; numeric columns right-aligned.
 * **Published beside reproduced.** ``<q>_published`` moves right after ``<q>`` under one
   header ``<q>`` with sub-columns *ours* and *paper* (``\\multicolumn`` + ``\\cmidrule``).
-* **Page fit.** Column widths are estimated from their longest entry and header (0.6 em a
-  character).  A table that fits a portrait article text width is a ``table`` float in
-  ``\\footnotesize``; a wider one is set in landscape (``pdflscape``) in ``\\scriptsize``.
-  Long text columns share the width left by the others as ``p{..}`` paragraphs; a table
-  with numbers that still does not fit is split into parts that repeat its first column.
-  Tables of more than :data:`LONG_ROWS` rows are ``longtable`` (page breaks, repeated
-  header).  Notes follow the table as a small paragraph inside its float.
+* **Page fit.**  Column widths are estimated from their longest entry and header (0.6 em a
+  character).  A table that fits a portrait article text width is set in
+  ``\\footnotesize``; a wider one in landscape (``pdflscape``) in ``\\scriptsize``.  Long
+  text columns share the width left by the others as ragged-right ``p{..}`` paragraphs
+  (a justified narrow column is all underfull lines); a long header over short entries
+  breaks after its underscores.  A table that still does not fit is split into parts
+  that each repeat its *key columns* (:func:`key_columns`: the leading columns that tell
+  the rows apart, e.g. ``method`` and ``tug_phase``), results first and descriptive text
+  last.  A text column of sentences (entries over :data:`PROSE_CHARS` characters) is a
+  full-width line under its row.  The parts are one ``table`` float when their estimated
+  height fits the page, else longtables (page breaks, repeated header) with the
+  notes after them as a paragraph that may break; tables of more than :data:`LONG_ROWS`
+  rows are always longtables.
+* **Checked as pages.**  :func:`compile_tables` (``python -m gaitval.tables.latex``)
+  compiles each file inside :data:`PREAMBLE`, after a paragraph of an article page, and
+  fails it on a pdflatex error, "Float too large", an overfull or underfull box, a
+  runaway argument, or a listing of fewer than :data:`MIN_LINES_PER_PAGE` lines a page.
 
 Same input, same bytes: nothing here depends on time or the machine.
 """
@@ -45,14 +55,25 @@ PREAMBLE = "\n".join([
     r"\usepackage{booktabs}",
     r"\usepackage{longtable}",
     r"\usepackage{pdflscape}",
+    r"\usepackage{array}",
 ])
+#: Text set before the table in the checker's document (a table is checked as it would
+#: sit in a manuscript, after a paragraph).
+PAGE_TEXT = r"Text before the table.\par"
 #: Rows above which a table is a longtable.
 LONG_ROWS = 40
 #: Page fit (article class): text width in pt and font size in pt of a portrait table
 #: (\footnotesize) and a landscape one (\scriptsize, \tabcolsep 4pt); a character is taken
 #: as 0.6 em wide (measured: 0.56 em for letters, 0.6 em with \\_).
-PORTRAIT = {"width_pt": 345.0, "size_pt": 8.0, "tabcolsep_pt": 6.0}
-LANDSCAPE = {"width_pt": 540.0, "size_pt": 7.0, "tabcolsep_pt": 4.0}
+PORTRAIT = {"width_pt": 345.0, "height_pt": 550.0, "size_pt": 8.0, "baseline_pt": 9.5,
+            "tabcolsep_pt": 6.0}
+LANDSCAPE = {"width_pt": 540.0, "height_pt": 345.0, "size_pt": 7.0, "baseline_pt": 8.0,
+             "tabcolsep_pt": 4.0}
+#: A text column whose entries average more characters than this is prose (a sentence
+#: per row): it is set as a full-width line under its row, not as a column.
+PROSE_CHARS = 120
+#: A part taller than this fraction of the page's height is a longtable, not a float.
+FLOAT_FRACTION = 0.8
 
 _SPECIALS = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#",
              "_": r"\_", "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}",
@@ -198,16 +219,23 @@ def _col_info(df: pd.DataFrame, col: str, digits: int) -> dict:
     return {"num": num, "chars": max(cells, len(col)), "cells": cells,
             "min": max([8, min(max(words + [0]), 17)]
                        + [len(w) for w in re.split(r"[_ ]", col)]),
+            "head": max(len(w) for w in re.split(r"(?<=_)", col)),
             "shrink": not num and cells > 12}
+
+
+def _p(width_pt: float) -> str:
+    """A paragraph column, set ragged right (a justified narrow column is all underfull
+    lines)."""
+    return rf">{{\raggedright\arraybackslash}}p{{{width_pt:.1f}pt}}"
 
 
 def _layout(groups, info, page) -> tuple[dict[str, str], bool]:
     """Column formats for one page kind and whether the table fits its width.
 
     Numbers and short text keep their natural width (``r``/``l``); long text columns
-    share what is left as ``p{..pt}`` paragraphs (water-filling: a column narrower than
-    its share keeps its natural width); a pair (``ours``/``paper``) is at least as wide
-    as its header."""
+    share what is left as ragged-right ``p{..pt}`` paragraphs (water-filling: a column
+    narrower than its share keeps its natural width); a pair (``ours``/``paper``) is at
+    least as wide as its header."""
     cw, pad = 0.6 * page["size_pt"], 2 * page["tabcolsep_pt"]
     specs, fixed, flex = {}, 0.0, []
     for g in groups:
@@ -215,10 +243,19 @@ def _layout(groups, info, page) -> tuple[dict[str, str], bool]:
             flex.append(g[0])
             continue
         inner = sum(max(info[c]["cells"], 5) * cw + pad for c in g)
-        head = (len(g[0]) * cw + pad) if len(g) == 2 else info[g[0]]["chars"] * cw + pad
-        fixed += max(inner, head)
         for c in g:
             specs[c] = "r" if info[c]["num"] else "l"
+        if len(g) == 2:                           # a header over ours/paper: no break
+            head = (len(g[0]) + 3) * cw + pad
+        elif info[g[0]]["chars"] > max(info[g[0]]["cells"], info[g[0]]["head"]):
+            # a long header over short entries breaks after its underscores
+            w = max(info[g[0]]["cells"], info[g[0]]["head"] + 2, 5) * cw
+            align = r"\raggedleft" if info[g[0]]["num"] else r"\raggedright"
+            specs[g[0]] = rf">{{{align}\arraybackslash}}p{{{w:.1f}pt}}"
+            head = w + pad
+        else:
+            head = info[g[0]]["chars"] * cw + pad
+        fixed += max(inner, head)
     avail = page["width_pt"] - fixed - pad * len(flex)
     left = sorted(flex, key=lambda c: (info[c]["chars"], c))
     while left:
@@ -230,28 +267,100 @@ def _layout(groups, info, page) -> tuple[dict[str, str], bool]:
             continue
         for c in left:
             w = max(share, info[c]["min"] * cw)
-            specs[c] = f"p{{{w:.1f}pt}}"
+            specs[c] = _p(w)
             avail -= w
         break
     return specs, avail >= -0.5
 
 
-def _split(groups, info) -> list[list[list[str]]]:
-    """Parts that fit a landscape page, each repeating the first column (the label)."""
-    key, rest = groups[:1], groups[1:]
+def _is_float_col(col: pd.Series) -> bool:
+    vals = [v for v in col if not _is_missing(v)]
+    return any(isinstance(v, (float, np.floating)) and not float(v).is_integer()
+               for v in vals)
+
+
+def _determined(df: pd.DataFrame, by: list[str], col: str) -> bool:
+    """Whether ``by`` determines ``col`` (one value of ``col`` per combination)."""
+    keyed = df[by + [col]].astype(str)
+    return bool((keyed.groupby(by, dropna=False)[col].nunique() <= 1).all())
+
+
+def key_columns(df: pd.DataFrame) -> list[str]:
+    """The columns that say what a row is, repeated in every part of a split table.
+
+    Candidates are the leading columns before the first column with fractional numbers
+    (or the first ``*_published``): names, labels, numbers of scenario or subject.  Of
+    them a column is kept unless the kept ones already determine it (``label`` beside
+    ``method``, ``subject`` beside ``subject_no``), until the kept ones tell the rows
+    apart.  Of two columns that determine each other the text one is kept (``scenario``
+    rather than ``scenario_no``).  At least the first column.
+    """
+    cols = [str(c) for c in df.columns]
+    if df.empty or not cols:
+        return cols[:1]
+    cand = []
+    for c in cols:
+        if c.endswith("_published") or _is_float_col(df[c]):
+            break
+        cand.append(c)
+    kept: list[str] = []
+    for c in cand:
+        if kept and _determined(df, kept, c):
+            last = kept[-1]
+            if (_numeric(df[last]) and not _numeric(df[c])
+                    and _determined(df, [c], last)):
+                kept[-1] = c                      # the same key, in words
+            continue
+        kept.append(c)
+        if not df.duplicated(subset=kept).any():
+            break
+    return kept or cols[:1]
+
+
+def _split(keys, rest, info, page) -> list[list[list[str]]]:
+    """Parts that fit ``page``, each repeating the key columns ``keys`` (groups)."""
     parts, cur = [], []
     for g in rest:
-        if cur and not _layout(key + cur + [g], info, LANDSCAPE)[1]:
-            parts.append(key + cur)
+        if cur and not _layout(keys + cur + [g], info, page)[1]:
+            parts.append(keys + cur)
             cur = []
         cur.append(g)
-    parts.append(key + cur)
+    parts.append(keys + cur)
     return parts
 
 
 def _head(name: str) -> str:
     """A column header; it may break after an underscore in a paragraph column."""
     return latex_text(name).replace(r"\_", r"\_\allowbreak{}")
+
+
+def _col_width_pt(spec: str, info: dict, page: dict) -> float:
+    m = re.search(r"p\{([0-9.]+)pt\}", spec)
+    return float(m.group(1)) if m else info["chars"] * 0.6 * page["size_pt"]
+
+
+def _height_pt(df: pd.DataFrame, groups, specs, info, page, *, digits: int,
+               caption: str, notes: list[str]) -> float:
+    """A generous estimate of a part's height as a float: caption, header, rows (a row
+    is as tall as its tallest paragraph cell) and notes."""
+    cw, line = 0.6 * page["size_pt"], page["baseline_pt"]
+    cols = [c for g in groups for c in g]
+    widths = {c: max(_col_width_pt(specs[c], info[c], page), 1.0) for c in cols}
+    para = [c for c in cols if "p{" in specs[c]]
+
+    def lines(text_len: float, width: float) -> int:
+        return max(1, math.ceil(1.15 * text_len * cw / width))
+
+    rows = 0.0
+    for _, row in df[cols].iterrows():
+        n = max([lines(_plain_len(row[c], digits), widths[c]) for c in para] + [1])
+        rows += n * line
+    head = max([lines(len(c), widths[c]) for c in para] + [1]) * line
+    head += line if any(len(g) == 2 for g in groups) else 0
+    text_w = page["width_pt"]
+    cap = math.ceil(1.15 * (len(caption) + 12) * 5.0 / text_w) * 12.0 + 10
+    note = sum(math.ceil(1.15 * len(n) * cw / text_w) for n in notes) * line + 6
+    return cap + head + rows + note + 3 * 4
 
 
 def _render_part(df: pd.DataFrame, groups: list[list[str]], specs: dict[str, str], *,
@@ -285,59 +394,167 @@ def _render_part(df: pd.DataFrame, groups: list[list[str]], specs: dict[str, str
     return tex
 
 
+def _with_prose(tex: str, df: pd.DataFrame, prose: list[str], ncols: int, page: dict, *,
+                long: bool) -> str:
+    """Each row of ``tex`` followed by its prose columns as one full-width line."""
+    head, body = tex.rsplit("\\endlastfoot\n" if long else "\\midrule\n", 1)
+    rows, tail = body.split("\\bottomrule", 1) if not long else (body, "")
+    lines = rows.split(" \\\\\n")
+    width = page["width_pt"] - 2 * page["tabcolsep_pt"]
+    out = []
+    for k, ln in enumerate(lines[:len(df)]):
+        text = "; ".join(rf"\textit{{{latex_text(c)}}}: {format_cell(df[c].iloc[k], 3)}"
+                         for c in prose if not _is_missing(df[c].iloc[k]))
+        out.append(ln + " \\\\\n" + rf"\multicolumn{{{ncols}}}"
+                   rf"{{>{{\raggedright\arraybackslash}}p{{{width:.1f}pt}}}}"
+                   rf"{{\quad {text}}} \\[2pt]" + "\n")
+    rest = " \\\\\n".join(lines[len(df):])
+    sep = "\\endlastfoot\n" if long else "\\midrule\n"
+    return head + sep + "".join(out) + rest + ("\\bottomrule" + tail if not long else "")
+
+
 def to_latex(df: pd.DataFrame, *, caption: str, label: str, notes: list[str] | None = None,
-             digits: int = 3) -> str:
-    """The table as LaTeX (``table`` or ``longtable``, portrait, landscape or split),
-    compiling inside :data:`PREAMBLE`."""
+             digits: int = 3, keys: list[str] | None = None) -> str:
+    """The table as LaTeX that fits a page, compiling inside :data:`PREAMBLE`.
+
+    Portrait if it fits the text width, else landscape, else split into landscape parts
+    that each repeat the key columns (``keys``, default :func:`key_columns`).  A part is a
+    ``table`` float when its estimated height fits the page with room to spare, else a
+    ``longtable`` (page breaks, repeated header) with the notes after it as a paragraph.
+    """
     df = df.reset_index(drop=True)
     df.columns = [str(c) for c in df.columns]
-    groups = _groups(df)
+    notes = list(notes or [])
     info = {c: _col_info(df, c, digits) for c in df.columns}
-    specs, fits = _layout(groups, info, PORTRAIT)
-    landscape = not fits
+    prose = [c for c in df.columns if not info[c]["num"] and len(df.columns) > 1
+             and np.mean([_plain_len(v, digits) for v in df[c]] or [0]) > PROSE_CHARS]
+    groups = [g for g in _groups(df) if g[0] not in prose]
+    keys = [k for k in (keys if keys is not None else key_columns(df.drop(columns=prose)))
+            if k in df.columns]
+    page = PORTRAIT
+    specs, fits = _layout(groups, info, page)
     parts = [groups]
-    if landscape:
-        specs, fits = _layout(groups, info, LANDSCAPE)
-        if not fits and len(groups) > 2 and any(info[g[0]]["num"] for g in groups):
-            parts = _split(groups, info)
-    part_specs = [specs] if len(parts) == 1 else [_layout(p, info, LANDSCAPE)[0]
-                                                  for p in parts]
-    long = len(df) > LONG_ROWS
+    if not fits:
+        page = LANDSCAPE
+        specs, fits = _layout(groups, info, page)
+        key_groups = [g for g in groups if g[0] in keys] or groups[:1]
+        rest = [g for g in groups if g not in key_groups]
+        if not fits and len(rest) > 1:
+            # results first, descriptions (text, yes/no) in the last part(s)
+            text = [g for g in rest if not any(info[c]["num"] for c in g)]
+            parts = _split(key_groups, [g for g in rest if g not in text] + text, info,
+                           page)
+    part_specs = [specs] if len(parts) == 1 else [_layout(p, info, page)[0] for p in parts]
     cap = md_to_latex(caption)
-    out = [f"% gaitval table {label}: pdflatex with booktabs, longtable, pdflscape, "
-           "[T1]{fontenc} (gaitval.tables.latex.PREAMBLE)."]
+    caps = [cap if len(parts) == 1 else f"{cap} (part {i + 1} of {len(parts)})"
+            for i in range(len(parts))]
+    # a float must fit the page (the text height, or the text width in landscape) with
+    # room for the text around it; anything taller, or long, is a longtable
+    prose_lines = sum(math.ceil(1.15 * _plain_len(v, digits) * 0.6 * page["size_pt"]
+                                / page["width_pt"]) for c in prose for v in df[c])
+    long = len(df) > LONG_ROWS or sum(
+        _height_pt(df, p, part_specs[i], info, page, digits=digits, caption=caps[i],
+                   notes=notes if i == len(parts) - 1 else []) + 12
+        for i, p in enumerate(parts)) + prose_lines * page["baseline_pt"] \
+        > FLOAT_FRACTION * page["height_pt"]
+    landscape = page is LANDSCAPE
+    lines = len(df) * len(parts) + sum(math.ceil(len(n) / 100) for n in notes)
+    out = [f"% gaitval table {label}: {lines} lines; pdflatex with booktabs, "
+           "longtable, pdflscape, array, [T1]{fontenc} (gaitval.tables.latex.PREAMBLE)."]
     if landscape:
         out.append(r"\begin{landscape}")
     # A float resets the font to \normalsize, so the size goes inside it (after
     # \centering); a longtable is no float and takes it from the enclosing group.
     size = r"\scriptsize\setlength{\tabcolsep}{4pt}" if landscape else r"\footnotesize"
     out.append("{" + size if long else "{")
-    note_block = "\n".join(
-        [r"\par\smallskip\noindent\begin{minipage}{\linewidth}\raggedright"]
-        + [md_to_latex(n) + r"\par" for n in notes or []] + [r"\end{minipage}"])
+    if not long:                 # one float holds every part, so they stay together
+        out += [r"\begin{table}[htbp]", r"\centering", size]
+    note_lines = [md_to_latex(n) + r"\par" for n in notes]
     for i, part in enumerate(parts):
-        pcap = cap if len(parts) == 1 else f"{cap} (part {i + 1} of {len(parts)})"
         plabel = label if i == 0 else f"{label}-{i + 1}"
-        tex = _render_part(df, part, part_specs[i], caption=pcap, label=plabel, digits=digits,
-                           long=long).rstrip("\n")
+        tex = _render_part(df, part, part_specs[i], caption=caps[i], label=plabel,
+                           digits=digits, long=long).rstrip("\n")
+        if prose and i == len(parts) - 1:
+            tex = _with_prose(tex, df, prose, len([c for g in part for c in g]), page,
+                              long=long)
         if not long:
-            tex = tex.replace("\\centering\n", "\\centering\n" + size + "\n", 1)
-        if notes and i == len(parts) - 1:         # the notes stay with their table
-            tex = (tex + "\n" + note_block if long else
-                   tex.replace("\\end{table}", note_block + "\n\\end{table}"))
+            tex = tex.replace("\\begin{table}[htbp]\n\\centering\n", "", 1)
+            tex = tex.replace("\n\\end{table}", "")
+            if i:
+                out.append(r"\par\bigskip")
         out.append(tex)
+    if notes and long:                            # a paragraph that may break pages
+        out.append("\n".join([r"{\raggedright"] + note_lines + ["}"]))
+    elif notes:                                   # the notes stay with their table
+        out.append("\n".join([r"\par\smallskip\noindent\begin{minipage}{\linewidth}"
+                              r"\raggedright"] + note_lines + [r"\end{minipage}"]))
+    if not long:
+        out.append(r"\end{table}")
     out.append("}")
     if landscape:
         out.append(r"\end{landscape}")
     return "\n".join(out) + "\n"
 
 
-def compile_tables(paths, workdir, *, pdflatex: str = "pdflatex",
-                   timeout: float = 120) -> dict[str, tuple[bool, str, int]]:
-    """Compile each ``.tex`` table on its own inside :data:`PREAMBLE` with pdflatex.
+#: What the page-fit check counts in pdflatex's log (:func:`compile_tables`).
+LOG_PROBLEMS = {"float too large": re.compile(r"Float too large for page by ([0-9.]+)pt"),
+                "overfull hbox": re.compile(r"^Overfull \\hbox", re.M),
+                "overfull vbox": re.compile(r"^Overfull \\vbox", re.M),
+                "underfull hbox": re.compile(r"^Underfull \\hbox", re.M),
+                "underfull vbox": re.compile(r"^Underfull \\vbox", re.M),
+                "runaway": re.compile(r"^Runaway (argument|definition|text|preamble)",
+                                      re.M)}
+#: A table of more than two pages must carry at least this many lines (rows, notes) a
+#: page: fewer is a listing of paragraphs, not a table (the check fails it).
+MIN_LINES_PER_PAGE = 6
 
-    Returns ``{path: (ok, first error line or '', overfull hbox count)}``.  ``workdir``
-    receives the wrapper documents and logs.
+
+class Compiled(tuple):
+    """``(ok, problem, n_box_problems)`` of one table, plus ``.counts`` and ``.pages``."""
+
+    counts: dict
+    pages: int
+
+    def __new__(cls, ok: bool, problem: str, n_boxes: int, counts: dict, pages: int):
+        self = super().__new__(cls, (ok, problem, n_boxes))
+        self.counts, self.pages = counts, pages
+        return self
+
+
+def check_log(log: str, *, lines: int | None = None) -> tuple[str, dict, int]:
+    """The page-fit problems a pdflatex log shows: ``(first problem or '', counts,
+    pages)``.  Every count in :data:`LOG_PROBLEMS` must be 0, and a table of ``lines``
+    lines (rows of every part, and its notes at 100 characters a line) on more than two
+    pages must have :data:`MIN_LINES_PER_PAGE` lines a page."""
+    counts = {k: len(rx.findall(log)) for k, rx in LOG_PROBLEMS.items()}
+    first = re.search(r"GAITVAL-FIRST-PAGE (\d+)", log)
+    nxt = re.search(r"GAITVAL-NEXT-PAGE (\d+)", log)
+    pages = int(nxt.group(1)) - int(first.group(1)) if first and nxt else 0
+    err = next((ln for ln in log.splitlines() if ln.startswith("!")), "")
+    if err:
+        return err, counts, pages
+    too_large = LOG_PROBLEMS["float too large"].search(log)
+    if too_large:
+        return f"Float too large for page by {too_large.group(1)}pt", counts, pages
+    bad = [f"{n} {k}" for k, n in counts.items() if n]
+    if bad:
+        return ", ".join(bad), counts, pages
+    if lines is not None and pages > 2 and lines < MIN_LINES_PER_PAGE * pages:
+        return (f"{pages} pages for {lines} lines of rows and notes (fewer than "
+                f"{MIN_LINES_PER_PAGE} a page)", counts, pages)
+    return "", counts, pages
+
+
+def compile_tables(paths, workdir, *, pdflatex: str = "pdflatex", timeout: float = 120
+                   ) -> dict[str, Compiled]:
+    """Compile each ``.tex`` table on its own inside :data:`PREAMBLE`, as a page of an
+    article, with pdflatex, and check that it fits the page.
+
+    Returns ``{path: (ok, problem, n_box_problems)}`` (a :class:`Compiled` that also has
+    ``.counts`` and ``.pages``).  ``ok`` is False when pdflatex fails or its log shows a
+    float too large for the page, an overfull or underfull box, a runaway argument, or
+    (for a gaitval table, whose first line gives its lines) more than two pages with
+    fewer than :data:`MIN_LINES_PER_PAGE` lines a page.  ``workdir`` receives the wrapper documents and logs.
     """
     import subprocess
     from pathlib import Path
@@ -347,8 +564,11 @@ def compile_tables(paths, workdir, *, pdflatex: str = "pdflatex",
     out = {}
     for i, p in enumerate(sorted(Path(x).resolve() for x in paths)):
         doc = workdir / f"t{i:03d}_{p.stem}.tex"
-        doc.write_text(PREAMBLE + "\n\\begin{document}\n\\input{" + p.as_posix()
-                       + "}\n\\end{document}\n", encoding="utf-8")
+        doc.write_text(PREAMBLE + "\n\\begin{document}\n" + PAGE_TEXT
+                       + "\n\\clearpage\\typeout{GAITVAL-FIRST-PAGE \\thepage}\n\\input{"
+                       + p.as_posix() + "}"
+                       + "\n\\clearpage\\typeout{GAITVAL-NEXT-PAGE \\thepage}\n"
+                       "\\end{document}\n", encoding="utf-8")
         try:
             res = subprocess.run([pdflatex, "-interaction=nonstopmode", "-halt-on-error",
                                   "-output-directory", str(workdir), doc.name],
@@ -358,24 +578,30 @@ def compile_tables(paths, workdir, *, pdflatex: str = "pdflatex",
             ok = res.returncode == 0 and doc.with_suffix(".pdf").is_file()
         except subprocess.TimeoutExpired:
             ok, log = False, "! pdflatex timed out"
-        err = next((ln for ln in log.splitlines() if ln.startswith("!")), "")
-        out[str(p)] = (ok, err, log.count("Overfull \\hbox"))
+        m = re.match(r"% gaitval table \S+: (\d+) lines", p.read_text(errors="replace"))
+        problem, counts, pages = check_log(log, lines=int(m.group(1)) if m else None)
+        if not ok and not problem:
+            problem = "pdflatex failed"
+        n_boxes = sum(n for k, n in counts.items() if k != "float too large")
+        out[str(p)] = Compiled(ok and not problem, problem, n_boxes, counts, pages)
     return out
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m gaitval.tables.latex FILE.tex ...``: compile each, one line per file."""
+    """``python -m gaitval.tables.latex FILE.tex ...``: compile each in a page, one line
+    per file (pages and every problem)."""
     import sys
     import tempfile
 
     paths = list(sys.argv[1:] if argv is None else argv)
     with tempfile.TemporaryDirectory() as tmp:
         res = compile_tables(paths, tmp)
-    for p, (ok, err, overfull) in res.items():
-        print(f"{'ok  ' if ok else 'FAIL'} {p}  overfull hboxes: {overfull}"
-              + (f"  {err}" if err else ""))
-    print(f"{sum(ok for ok, _, _ in res.values())}/{len(res)} compiled")
-    return 0 if all(ok for ok, _, _ in res.values()) else 1
+    for p, r in res.items():
+        ok, problem, _ = r
+        print(f"{'ok  ' if ok else 'FAIL'} {p}  {r.pages} page(s)"
+              + (f"  {problem}" if problem else ""))
+    print(f"{sum(r[0] for r in res.values())}/{len(res)} fit their pages")
+    return 0 if all(r[0] for r in res.values()) else 1
 
 
 if __name__ == "__main__":

@@ -218,9 +218,11 @@ def mocap_notes(summary: pd.DataFrame) -> list[str]:
 
 
 def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
-                      methods: list[str]) -> list[Path]:
+                      methods: list[str], shown: dict[str, str] | None = None) -> list[Path]:
     """Write ``mtst_table1``, ``mtst_table3``, ``mtst_table4`` (csv, md, tex) from the
-    concatenated per-trial tables ``data`` (``summary``, ``gates``)."""
+    concatenated per-trial tables ``data`` (``summary``, ``gates``).  ``shown``: method ->
+    the name the tables print (a method run with overrides,
+    :func:`gaitval.methods.display_name`)."""
     td = Path(tables_dir)
     summary = data.get("summary", pd.DataFrame())
     if summary.empty:
@@ -230,6 +232,11 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
     t1 = table1(data.get("gates", pd.DataFrame()))
     t3 = table3(summary, methods)
     t4 = table4(summary)
+    notes3 = mocap_notes(summary) + [judging_rules_note(t3)] + table3_notes(
+        t3, data.get("events"), data.get("track_field"))
+    if shown:                                  # a method run with overrides says so
+        t1, t3 = (t.assign(method=t["method"].map(lambda m: shown.get(m, m)))
+                  for t in (t1, t3))
     paths = write_table(t1, td / "mtst_table1", digits=3, caption=(
         "Seed 001 Table 1: radius r_val of the variable validation region by the leg's gait "
         "phase at k-1 and whether it was observable (H = consecutive unobservable scans; "
@@ -244,8 +251,7 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
         "and the tracking success rate; published values beside. Reference 'mocap': the "
         "track against the mocap leg points (stands in for the paper's video check); "
         "'rater events': from the rater's contacts only (what a study without mocap "
-        "has)."), notes=mocap_notes(summary) + [judging_rules_note(t3)]
-        + table3_notes(t3, data.get("events"), data.get("track_field")))
+        "has)."), notes=notes3)
     paths += write_table(t4, td / "mtst_table4", digits=1, caption=(
         "Seed 001 Table 4: target-step judgement and cross-step detection against the "
         "rater annotations on the trials the proposed method tracked successfully; "

@@ -19,7 +19,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from gaitval.methods import METHOD_DEFINITIONS, METHODS, get_method
+from gaitval.methods import (METHOD_DEFINITIONS, METHODS, changed_parameters, display_name,
+                             get_method)
 from gaitval.stats.summary import rmse
 from gaitval.tables.render import write_table
 from gaitval.tables.tug_evidence import DEFAULT_READING, failure_evidence, method_reading
@@ -157,8 +158,16 @@ def tug_table2(methods=("tug_m1", "tug_m2", "tug_m3"), dt_measured_s: float | No
             ("background percentile", "", "%", bg.get("q"), None),
             ("background margin", "", "m", bg.get("margin_m"), None),
         ]
+        # a parameter changed by tracking.overrides that has no row above gets one
+        shown = {"tracker.dt_s", "filter.q_accel_sd_mps2", "filter.r_sd_m", "phase.v_st_th",
+                 "phase.v_sw_th", "gate.g", "motion.n_ac", "occlusion.n_bo",
+                 "occlusion.n_ao", "detector.background.q", "detector.background.margin_m"}
+        base = method_reading(name.split(" (")[0], {name.split(" (")[0]: m})[0]
+        items += [(f"{k} (changed; built in: {_builtin(base, k)})", "", "", v, None)
+                  for k, v in changed_parameters(m, base).items() if k not in shown]
         for p, sym, unit, v, pub in items:
-            rows.append({"parameter": p, "symbol": sym, "unit": unit, "method": name,
+            rows.append({"parameter": p, "symbol": sym, "unit": unit,
+                         "method": display_name(name, m, base),
                          "value": "" if v is None else str(v),
                          "value_published": "" if pub is None else str(pub)})
     return pd.DataFrame(rows)
@@ -188,6 +197,14 @@ def _persistent_columns(d: pd.DataFrame) -> dict:
     c = _counts(d["category" + PS].astype(str))
     return {**{k + PS: c[k] for k in PERSISTENT_COUNTS},
             "success_rate" + PS: c["n_success"] / len(d) if len(d) else np.nan}
+
+
+def _builtin(base: str, key: str):
+    """The built-in method's value of ``role.param`` (``—`` when it has none)."""
+    v = METHODS.get(base, {})
+    for k in key.split("."):
+        v = v.get(k) if isinstance(v, dict) else None
+    return "—" if v is None else v
 
 
 def tug_table3(summaries, definitions: Mapping | None = None) -> pd.DataFrame:
@@ -431,6 +448,11 @@ def write_tug_tables(frames, summaries, out_dir: str | Path, *,
                 "gaitval.gait.phases); the paper's text allows both readings, its "
                 "published values are shown beside both.")
     notes = _ordering_notes(t3, t4, t5)
+    if defs:                          # a method run with overrides is named with them
+        shown = {m: display_name(m, d, method_reading(m, defs)[0]) for m, d in defs.items()}
+        for t in (t3, t4, t5, ev):
+            if "method" in t:
+                t["method"] = t["method"].map(lambda m: shown.get(m, m))
     paths = []
     paths += write_table(t2, out / "tug_table2", caption="TUG leg tracking: parameters used "
                          "(seed 000 Table 2). N_bo, N_ao, the background model and the reading "

@@ -8,11 +8,12 @@ from snakemake.common.configfile import load_configfile
 from snakemake.utils import update_config
 
 from gaitval.configcheck import (check_config, check_study_file, display_path,
-                                 load_schema, retype_command_line)
+                                 load_schema, raise_problems, retype_command_line,
+                                 run_problems, with_sources)
 from gaitval.errors import ConfigError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash
-from gaitval.methods import get_method, set_params
+from gaitval.methods import METHODS, get_method, override_problems, set_params
 from gaitval.steps import (ALL_SCOPE, ANALYSIS_SECTIONS, PROTOCOL_SCOPE, SCOPES, STUDY_VIEW,
                            method_definition, method_view)
 from gaitval.tables.tug_evidence import method_reading
@@ -36,15 +37,34 @@ def _command_line_config():
     return retype_command_line(dict(getattr(settings, "config", None) or {}))
 
 
+def _method_definitions(cfg):
+    """Every method an override may name: the built-in ones, tracking.methods, and the
+    TUG reading variants <method>_<reading> (made from their base, _reading_variants)."""
+    defs = {m: m for m in METHODS}
+    defs.update((cfg.get("tracking") or {}).get("methods") or {})
+    for m in (cfg.get("tug") or {}).get("methods") or []:
+        for r in (cfg.get("tug") or {}).get("phase_readings") or []:
+            defs.setdefault(f"{m}_{r}", defs.get(m, m))
+    return defs
+
+
 def _check_study_files(schema):
     """study.yaml of each study in `run` whose trial sheet is already there (a simulated
-    study's is checked again when its config is built, rule study_config)."""
+    study's is checked again when its config is built, rule study_config), its
+    tracking.overrides too."""
     for study in config["run"]:
         entry = config["studies"].get(study) or {}
         sheet = Path(entry.get("trial_sheet") or Path(DATA) / study / "trials.csv")
         cal = sheet.parent / "study.yaml"
         if cal.is_file():
-            check_study_file(load_configfile(str(cal)), cal, schema=schema)
+            own = load_configfile(str(cal))
+            check_study_file(own, cal, schema=schema)
+            merged = {k: {**(config.get(k) or {}), **((own or {}).get(k) or {})}
+                      for k in ("tracking", "tug")}
+            raise_problems(with_sources(
+                override_problems((own.get("tracking") or {}).get("overrides"),
+                                  _method_definitions(merged)),
+                [(display_path(cal), own)]))
 
 
 DATA = config.get("data_dir", "data")
@@ -56,6 +76,11 @@ update_config(config, _command_line_config())
 try:
     _SCHEMA = load_schema(Path(workflow.basedir) / "workflow/schemas/config.schema.yaml")
     check_config(config, _config_layers(), schema=_SCHEMA)
+    raise_problems(with_sources(run_problems(config), _config_layers()))   # run: [studies]
+    # tracking.overrides: each key a role and parameter of its method (gaitval.methods)
+    raise_problems(with_sources(
+        override_problems((config.get("tracking") or {}).get("overrides"),
+                          _method_definitions(config)), _config_layers()))
     _check_study_files(_SCHEMA)
 except ConfigError as exc:
     sys.exit(f"ConfigError: {exc}")
