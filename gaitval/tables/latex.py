@@ -152,12 +152,19 @@ def _is_missing(v) -> bool:
     return isinstance(v, (float, np.floating)) and math.isnan(v)
 
 
-def format_cell(v, digits: int) -> str:
-    """One cell as LaTeX at ``digits`` decimals (see the module docstring)."""
+def format_cell(v, digits: int, column: str | None = None, table: str | None = None) -> str:
+    """One cell as LaTeX.  With its ``column`` (display name) a number takes the report's
+    one number format (:func:`gaitval.tables.numbers.format_value`: the same text as the
+    Markdown and HTML, never e-notation); without, ``digits`` decimals (module docstring)."""
     if _is_missing(v):
         return ""
     if isinstance(v, (bool, np.bool_)):
         return "yes" if v else "no"
+    if column is not None and isinstance(v, (int, float, np.integer, np.floating)) \
+            and math.isfinite(float(v)):
+        from gaitval.tables.numbers import format_value
+        text = latex_text(format_value(v, column, table))
+        return text.replace("-", r"\ensuremath{-}", 1) if text.startswith("-") else text
     if isinstance(v, (int, np.integer)):
         return str(int(v)).replace("-", r"\ensuremath{-}")
     if isinstance(v, (float, np.floating)):
@@ -375,7 +382,8 @@ def _render_part(df: pd.DataFrame, groups: list[list[str]], specs: dict[str, str
         columns = pd.MultiIndex.from_tuples(tuples)
     else:
         columns = pd.Index([_head(c) for c in cols])
-    body = pd.DataFrame([[format_cell(v, digits) for v in row]
+    table = re.sub(r"-\d+$", "", label)                # a part's label: its table's
+    body = pd.DataFrame([[format_cell(v, digits, c, table) for c, v in zip(cols, row)]
                          for row in df[cols].itertuples(index=False)], columns=columns)
     styler = body.style.hide(axis="index").format(lambda v: v)
     tex = styler.to_latex(
@@ -403,7 +411,7 @@ def _with_prose(tex: str, df: pd.DataFrame, prose: list[str], ncols: int, page: 
     width = page["width_pt"] - 2 * page["tabcolsep_pt"]
     out = []
     for k, ln in enumerate(lines[:len(df)]):
-        text = "; ".join(rf"\textit{{{latex_text(c)}}}: {format_cell(df[c].iloc[k], 3)}"
+        text = "; ".join(rf"\textit{{{latex_text(c)}}}: {format_cell(df[c].iloc[k], 3, c)}"
                          for c in prose if not _is_missing(df[c].iloc[k]))
         out.append(ln + " \\\\\n" + rf"\multicolumn{{{ncols}}}"
                    rf"{{>{{\raggedright\arraybackslash}}p{{{width:.1f}pt}}}}"
