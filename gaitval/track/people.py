@@ -87,7 +87,7 @@ class Person:
     """One person hypothesis: two legs' filter states and its life-cycle state."""
 
     __slots__ = ("pid", "status", "post", "prior", "seen", "pattern", "obs_j", "phase",
-                 "windows", "t_last_seen", "confirm_memory", "n_unobs", "k_born")
+                 "windows", "t_last_seen", "confirm_memory", "n_unobs", "k_born", "n_obs")
 
     def __init__(self, pid, filter, zl, zr, pl, pr, jl, jr, k, t, windows, memory,
                  status=TENTATIVE):
@@ -104,6 +104,7 @@ class Person:
         self.t_last_seen = t
         self.confirm_memory = memory
         self.n_unobs = [0, 0]
+        self.n_obs = [1, 1]
         self.k_born = k
 
     def pos(self, f: int) -> tuple[float, float]:
@@ -222,8 +223,14 @@ class PeopleTracker(TrackerKind):
                     ctx = None
                     if ctx_needed:
                         s = p.post[f]
-                        ctx = GateContext(leg_width_m, dt, math.hypot(s[2], s[3]),
-                                          _SWING[p.phase][f], p.n_unobs[f])
+                        if p.n_obs[f] < 2:
+                            # a leg seen once has no measured speed: seed 001 Table 1's
+                            # "unobservable swing" cell (assumed swing speed v_sw)
+                            ctx = GateContext(leg_width_m, dt, math.hypot(s[2], s[3]), True,
+                                              max(1, p.n_unobs[f]))
+                        else:
+                            ctx = GateContext(leg_width_m, dt, math.hypot(s[2], s[3]),
+                                              _SWING[p.phase][f], p.n_unobs[f])
                     ox, oy = p.prior[1 - f][0], p.prior[1 - f][1]
                     for j, lam2 in gate.candidates(F, p.prior[f], obs, ctx):  # eq. (11)-(13)
                         zx, zy = obs[j - 1]
@@ -259,6 +266,7 @@ class PeopleTracker(TrackerKind):
                         p.pattern[f] = pats[k][j]
                         p.obs_j[f] = j
                         p.n_unobs[f] = 0
+                        p.n_obs[f] += 1
                 if p.seen[0] or p.seen[1]:
                     p.t_last_seen = tk
                 p.phase = identify(p.post[0], p.post[1])
