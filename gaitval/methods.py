@@ -286,10 +286,17 @@ METHODS["people"] = {
              "birth": {"name": "unexplained_pairs", "max_pair_m": 0.8,
                        "min_leg_widths": 0.7},
              "confirmer": {"name": "m_of_n_moving", "window_s": 1.4, "m_fraction": 0.5,
-                           "min_relative_travel_m": 0.5, "pass_leg_widths": 1.0},
+                           "min_relative_travel_m": 0.5, "pass_leg_widths": 1.0,
+                           "min_travel_m": 0.5},
              "deleter": {"name": "unsupported_time", "max_unsupported_s": 3.0,
                          "tentative_unsupported_s": 0.2},
              "area": {"name": "field_of_view", "margin_m": 0.25},
+             # no odometry in the recordings: the sensor's motion from its scans, and a map
+             # of what stays put (leg_tracker's local occupancy grid), both online
+             "ego_motion": {"name": "scan_matching", "max_pair_m": 0.5, "trim": 0.8,
+                            "iterations": 20, "beam_step": 2, "min_pairs": 20},
+             "static_map": {"name": "recent_hits", "cell_m": 0.1, "min_static_s": 1.4,
+                            "tau_s": 5.0, "neighbourhood": 1},
              "init": None, "max_leg_separation_m": 0.8, "dt_s": None,
              "sides": "walking_direction"},
 }

@@ -19,9 +19,13 @@ holds none of their rules (Stone Soup's initiator/deleter split, docs/STYLE §13
         confirmed  ⇔  |{k'∈W : both legs observed}| ≥ M                         (M of N)
                       ∧  min_W r·û ≤ −c  ∧  max_W r·û ≥ c     (the legs pass each other)
                       ∧  max_{i,j∈W} |r_i − r_j| ≥ d_c                 (r spans d_c)
+                      ∧  |v̂| (t_last − t_first) ≥ d_w ∧ RMS(c − ĉ) ≤ w_l   (the body walked)
+                         with no gap in the scans with both legs longer than N/3
 
     with r = p_L − p_R over the scans of the window W (the last N) that saw both legs, û
-    the direction of the longest r in W and c one leg width.  The *relative* vector is used because a
+    the direction of the longest r in W, c one leg width, and ĉ(t) = ĉ₀ + v̂ t the
+    least-squares line through the body centres c of those scans in the world frame (the
+    ego-motion role of :mod:`gaitval.track.staticmap`).  The *relative* vector is used because a
     walker's legs swing past each other (one stands while the other swings) whatever the
     sensor does, whereas a pair of static objects seen from a moving robot moves as one
     rigid pair (r constant up to the robot's turn), and a pair whose observations flicker
@@ -201,29 +205,37 @@ class MOfNMoving(Confirmer):
         The legs pass each other: along the direction of the longest r in the window, r
         reaches at least ``pass_leg_widths`` · w_l on both sides of zero (1.0: each leg gets
         a leg's width ahead of the other).
+    min_travel_m : float
+        d_w: the body centre moved steadily at least this far in the world frame over the
+        window (a line fit, module notes; ``person.world_centre``, set by the tracker from
+        its ego-motion role; 0 = not asked).  leg_tracker's 0.5 m of travel in the odometry
+        frame; over 1.4 s it asks for at least 0.36 m/s, a slow walk.
     """
 
     def __init__(self, window_s: float = 1.4, m_fraction: float = 0.5,
-                 min_relative_travel_m: float = 0.5, pass_leg_widths: float = 1.0):
+                 min_relative_travel_m: float = 0.5, pass_leg_widths: float = 1.0,
+                 min_travel_m: float = 0.0):
         self.window_s = window_s
         self.m_fraction = m_fraction
         self.min_relative_travel_m = min_relative_travel_m
         self.pass_leg_widths = pass_leg_widths
+        self.min_travel_m = min_travel_m
         self.n = 1
         self.m = 1
         self.leg_width_m = 0.10
 
     def bind(self, dt, leg_width_m: float = 0.10):
         out = MOfNMoving(self.window_s, self.m_fraction, self.min_relative_travel_m,
-                         self.pass_leg_widths)
+                         self.pass_leg_widths, self.min_travel_m)
         out.n = max(1, int(round(self.window_s / dt)))
         out.m = max(1, math.ceil(self.m_fraction * out.n))
         out.leg_width_m = leg_width_m
         return out
 
     def new_memory(self):
-        # per scan of the window: r = p_L - p_R when both legs were observed, else None
-        return {"win": deque(maxlen=self.n), "age": 0}
+        # per scan of the window: r = p_L - p_R when both legs were observed, else None;
+        # and the body centre in the world frame
+        return {"win": deque(maxlen=self.n), "world": deque(maxlen=self.n), "age": 0}
 
     def step(self, person, k):
         mem = person.confirm_memory
@@ -231,8 +243,10 @@ class MOfNMoving(Confirmer):
         if both:
             (xl, yl), (xr, yr) = person.pos(0), person.pos(1)
             mem["win"].append((xl - xr, yl - yr))
+            mem["world"].append(person.world_centre)
         else:
             mem["win"].append(None)
+            mem["world"].append(None)
         mem["age"] += 1
         win = mem["win"]
         if len(win) < self.n:
@@ -249,6 +263,32 @@ class MOfNMoving(Confirmer):
         w = self.pass_leg_widths * self.leg_width_m
         if min(proj) > -w or max(proj) < w:
             return False
+        # ... the body walked d_w in the world, steadily: a straight-line fit c(t) = c0 + v t
+        # to the world centres of the window's scans with both legs spans d_w, with an RMS
+        # residual below one leg width (a pair flickering between objects jumps instead)
+        if self.min_travel_m > 0:
+            idx = [i for i, c in enumerate(mem["world"]) if c is not None]
+            # the walk is seen throughout: no gap between scans with both legs longer than a
+            # third of the window (across a gap, two clusters of a flickering pair would
+            # fit a line)
+            if max(b - a - 1 for a, b in zip(idx[:-1], idx[1:])) > len(mem["world"]) // 3:
+                return False
+            cs = [mem["world"][i] for i in idx]
+            ti = [float(i) for i in idx]
+            tm = sum(ti) / len(ti)
+            stt = sum((x - tm) ** 2 for x in ti)
+            if stt <= 0:
+                return False
+            res2 = 0.0
+            span2 = 0.0
+            for ax in (0, 1):
+                v = [c[ax] for c in cs]
+                vm = sum(v) / len(v)
+                slope = sum((x - tm) * (y - vm) for x, y in zip(ti, v)) / stt
+                res2 += sum((y - vm - slope * (x - tm)) ** 2 for x, y in zip(ti, v))
+                span2 += (slope * (ti[-1] - ti[0])) ** 2
+            if span2 < self.min_travel_m ** 2 or res2 / len(cs) > self.leg_width_m ** 2:
+                return False
         # ... and r spans d_c (the diameter of the set of r)
         d2 = self.min_relative_travel_m ** 2
         return any((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 >= d2

@@ -61,6 +61,7 @@ from gaitval.track.lifecycle import (AREAS, BIRTHS, COASTING, CONFIRMED, CONFIRM
 from gaitval.track.motion import MOTION_MODELS
 from gaitval.track.observations import DetectionSeries
 from gaitval.track.phase import PHASE_MODELS
+from gaitval.track.staticmap import EGO_MOTIONS, STATIC_MAPS, scan_points, to_world
 from gaitval.track.tracker import _SWING, step_durations
 
 #: columns of :attr:`PeopleResult.people` (one row per scan, reported person and leg)
@@ -87,7 +88,8 @@ class Person:
     """One person hypothesis: two legs' filter states and its life-cycle state."""
 
     __slots__ = ("pid", "status", "post", "prior", "seen", "pattern", "obs_j", "phase",
-                 "windows", "t_last_seen", "confirm_memory", "n_unobs", "k_born", "n_obs")
+                 "windows", "t_last_seen", "confirm_memory", "n_unobs", "k_born", "n_obs",
+                 "world_centre")
 
     def __init__(self, pid, filter, zl, zr, pl, pr, jl, jr, k, t, windows, memory,
                  status=TENTATIVE):
@@ -106,6 +108,7 @@ class Person:
         self.n_unobs = [0, 0]
         self.n_obs = [1, 1]
         self.k_born = k
+        self.world_centre = (0.0, 0.0)
 
     def pos(self, f: int) -> tuple[float, float]:
         s = self.post[f]
@@ -132,6 +135,10 @@ class PeopleTracker(TrackerKind):
         The gate of tentative persons' legs (None: ``gate``).
     birth, confirmer, deleter, area : spec
         The life-cycle roles (:mod:`gaitval.track.lifecycle`).
+    ego_motion, static_map : spec
+        The sensor's motion and the map of what never moves (:mod:`gaitval.track.staticmap`):
+        an observation on a static cell starts no person, and a tentative person with
+        both legs on static cells is not confirmed (leg_tracker's "in free space").
     init : spec or None
         An initialiser whose pair starts a confirmed person (module notes).
     max_leg_separation_m : float
@@ -146,7 +153,8 @@ class PeopleTracker(TrackerKind):
     def __init__(self, detector="leg_patterns", filter="kf", motion="constant_velocity",
                  phase="speed_thresholds", gate="chi2", birth="unexplained_pairs",
                  confirmer="m_of_n_moving", deleter="unsupported_time",
-                 area="field_of_view", init=None, tentative_gate=None,
+                 area="field_of_view", ego_motion="none", static_map="none",
+                 init=None, tentative_gate=None,
                  max_leg_separation_m: float = 0.8,
                  dt_s: float | None = None, sides: str = "walking_direction"):
         self.detector = DETECTORS.build(detector)
@@ -159,6 +167,8 @@ class PeopleTracker(TrackerKind):
         self.confirmer = CONFIRMERS.build(confirmer)
         self.deleter = DELETERS.build(deleter)
         self.area = AREAS.build(area)
+        self.ego_motion = EGO_MOTIONS.build(ego_motion)
+        self.static_map = STATIC_MAPS.build(static_map)
         self.init = INITIALISERS.build(init) if init else None
         self.max_leg_separation_m = max_leg_separation_m
         self.dt_s = dt_s
@@ -170,9 +180,13 @@ class PeopleTracker(TrackerKind):
         xy, pats = split_observations(obs_df, scans.n_scans)
         return self.run(scans, xy, pats, leg_width_m)
 
-    def run(self, scans, xy, pats, leg_width_m: float) -> PeopleResult:
+    def run(self, scans, xy, pats, leg_width_m: float, profile: bool = False
+            ) -> PeopleResult:
         """Track every person through precomputed per-scan observations (``xy[k]``: (J, 2)
-        array, ``pats[k]``: their patterns)."""
+        array, ``pats[k]``: their patterns).  ``profile``: also return ``scan_seconds`` and
+        ``scan_hypotheses`` (per scan: time spent, person hypotheses alive) as attributes of
+        the result (benchmarks/people_tracker.py)."""
+        from time import perf_counter
         t = np.asarray(scans.t, dtype=float)
         n = len(t)
         if n == 0:
@@ -184,6 +198,8 @@ class PeopleTracker(TrackerKind):
                  (self.tentative_gate or self.gate).for_leg_width(leg_width_m))
         confirmer = self.confirmer.bind(dt0, leg_width_m)
         area = self.area.bind(scans)
+        poses = self.ego_motion.poses(scans)
+        smap = self.static_map.start(scans, poses)
         seeded = None
         if self.init is not None:
             seeded = self.init.find(DetectionSeries(xy, pats), leg_width_m)
@@ -195,10 +211,17 @@ class PeopleTracker(TrackerKind):
         inputs = self.motion.inputs
         sep2 = self.max_leg_separation_m ** 2
         dts = dts.tolist()
+        cost, alive = ([], []) if profile else (None, None)
         for k in range(n):
+            if profile:
+                t_start = perf_counter()
             dt, tk = dts[k], float(t[k])
             obs = [(float(p[0]), float(p[1])) for p in xy[k]]
             J = len(obs)
+            pose = poses[k]
+            smap.update(k, to_world(pose, scan_points(scans, k)))
+            static = [smap.is_static(*w) for w in
+                      to_world(pose, np.asarray(obs).reshape(-1, 2)).tolist()]
             # predict (seed000 eq. (7)-(8); input u of the motion role, eq. (18)-(20))
             for p in persons:
                 a, b = p.post
@@ -279,7 +302,8 @@ class PeopleTracker(TrackerKind):
             # life cycle
             for p in persons:
                 if p.status == TENTATIVE:
-                    if confirmer.step(p, k):
+                    p.world_centre = tuple(to_world(pose, np.array([p.centre()]))[0].tolist())
+                    if confirmer.step(p, k) and not _on_static(p, pose, smap):
                         p.status = CONFIRMED
                         n_conf += 1
                     elif confirmer.failed(p):
@@ -294,7 +318,7 @@ class PeopleTracker(TrackerKind):
                     p.status = CONFIRMED if (p.seen[0] or p.seen[1]) else COASTING
             persons = [p for p in persons if p.status != ENDED]
             # birth from the observations nobody explains
-            free = [not (taken[j] or explained[j]) for j in range(J)]
+            free = [not (taken[j] or explained[j] or static[j]) for j in range(J)]
             pairs = self.birth.propose(obs, free, leg_width_m)
             if seeded is not None and k == seeded[0]:
                 il, ir = seeded[1], seeded[2]
@@ -313,6 +337,7 @@ class PeopleTracker(TrackerKind):
                 n_born += 1
                 n_conf += start == CONFIRMED
                 if start == TENTATIVE:
+                    p.world_centre = tuple(to_world(pose, np.array([p.centre()]))[0].tolist())
                     confirmer.step(p, k)
                 persons.append(p)
             # record the reported persons
@@ -322,10 +347,17 @@ class PeopleTracker(TrackerKind):
                         s = p.post[f]
                         rows.append((k, tk, p.pid, p.status, "LR"[f], s[0], s[1], s[2], s[3],
                                      p.seen[f], p.pattern[f], p.phase))
+            if profile:
+                cost.append(perf_counter() - t_start)
+                alive.append(len(persons))
         people = pd.DataFrame.from_records(rows, columns=list(PEOPLE_COLUMNS))
         people = people.astype({"k": np.int64, "person_id": np.int64, "phase": np.int64,
                                 "observed": bool})
-        return self._result(t, people, n_born, n_conf)
+        res = self._result(t, people, n_born, n_conf)
+        if profile:
+            res.scan_seconds = np.asarray(cost)
+            res.scan_hypotheses = np.asarray(alive, dtype=np.int64)
+        return res
 
     # -- output ------------------------------------------------------------------------------
     def _result(self, t, people: pd.DataFrame, n_born: int, n_conf: int) -> PeopleResult:
@@ -355,6 +387,12 @@ class PeopleTracker(TrackerKind):
         if self.sides == "walking_direction" and handedness(res) < 0:
             swap_sides(res)
         return res
+
+
+def _on_static(p: Person, pose, smap) -> bool:
+    """Both legs of ``p`` lie on static cells of the map (not in free space)."""
+    w = to_world(pose, np.array([p.pos(0), p.pos(1)]))
+    return smap.is_static(*w[0]) or smap.is_static(*w[1])
 
 
 def _empty(t) -> PeopleResult:
