@@ -216,3 +216,17 @@ def test_empty_room_gives_no_confirmed_person(realdata):
         res = build_method("people").track(read_rosbag_scans(bag, topic), 0.10)
         confirmed[topic] = res.n_confirmed
     assert confirmed and not any(confirmed.values()), confirmed
+
+
+def test_an_initialiser_seeds_a_confirmed_person():
+    """legbench's ``--init annotation``: the pair the initialiser finds is a person from its
+    scan on, even one who stands (which the confirmer alone would never confirm)."""
+    n = 30
+    legs = [np.array([[2.0, 0.15], [2.0, -0.15]]) for _ in range(n)]
+    xy, pats = _observations(legs, np.random.default_rng(6))
+    alone = _tracker().run(_scans(n), xy, pats, 0.10)
+    assert alone.n_confirmed == 0
+    seeded = _tracker(init={"name": "annotated_pair", "k": 5, "x_m": 2.0, "y_m": 0.0}).run(
+        _scans(n), xy, pats, 0.10)
+    assert seeded.n_confirmed == 1 and seeded.k_init == 5
+    assert seeded.people["k"].min() == 5 and seeded.people["k"].max() == n - 1
