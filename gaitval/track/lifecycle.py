@@ -207,8 +207,10 @@ class MOfNMoving(Confirmer):
         a leg's width ahead of the other).
     min_travel_m : float
         d_w: the body centre moved steadily at least this far in the world frame over the
-        window (a line fit, module notes; ``person.world_centre``, set by the tracker from
-        its ego-motion role; 0 = not asked).  leg_tracker's 0.5 m of travel in the odometry
+        window (a line fit, module notes; ``person.world_centre`` = (segment, x, y), set by
+        the tracker from its ego-motion role; 0 = not asked).  Where the sensor's motion
+        was lost inside the window (more than one segment) the world frame is unknown and
+        this test is not made.  leg_tracker's 0.5 m of travel in the odometry
         frame; over 1.4 s it asks for at least 0.36 m/s, a slow walk.
     """
 
@@ -266,14 +268,15 @@ class MOfNMoving(Confirmer):
         # ... the body walked d_w in the world, steadily: a straight-line fit c(t) = c0 + v t
         # to the world centres of the window's scans with both legs spans d_w, with an RMS
         # residual below one leg width (a pair flickering between objects jumps instead)
-        if self.min_travel_m > 0:
+        world_known = len({c[0] for c in mem["world"] if c is not None}) == 1
+        if self.min_travel_m > 0 and world_known:
             idx = [i for i, c in enumerate(mem["world"]) if c is not None]
             # the walk is seen throughout: no gap between scans with both legs longer than a
             # third of the window (across a gap, two clusters of a flickering pair would
             # fit a line)
             if max(b - a - 1 for a, b in zip(idx[:-1], idx[1:])) > len(mem["world"]) // 3:
                 return False
-            cs = [mem["world"][i] for i in idx]
+            cs = [mem["world"][i][1:] for i in idx]
             ti = [float(i) for i in idx]
             tm = sum(ti) / len(ti)
             stt = sum((x - tm) ** 2 for x in ti)

@@ -108,7 +108,7 @@ class Person:
         self.n_unobs = [0, 0]
         self.n_obs = [1, 1]
         self.k_born = k
-        self.world_centre = (0.0, 0.0)
+        self.world_centre = (0, 0.0, 0.0)      # (ego-motion segment, x, y)
 
     def pos(self, f: int) -> tuple[float, float]:
         s = self.post[f]
@@ -198,8 +198,8 @@ class PeopleTracker(TrackerKind):
                  (self.tentative_gate or self.gate).for_leg_width(leg_width_m))
         confirmer = self.confirmer.bind(dt0, leg_width_m)
         area = self.area.bind(scans)
-        poses = self.ego_motion.poses(scans)
-        smap = self.static_map.start(scans, poses)
+        poses, segment = self.ego_motion.poses(scans)
+        smap, seg = None, None
         seeded = None
         if self.init is not None:
             seeded = self.init.find(DetectionSeries(xy, pats), leg_width_m)
@@ -219,6 +219,9 @@ class PeopleTracker(TrackerKind):
             obs = [(float(p[0]), float(p[1])) for p in xy[k]]
             J = len(obs)
             pose = poses[k]
+            if segment[k] != seg:          # the sensor's motion was lost: a new map
+                seg = int(segment[k])
+                smap = self.static_map.start(scans, poses)
             smap.update(k, to_world(pose, scan_points(scans, k)))
             static = [smap.is_static(*w) for w in
                       to_world(pose, np.asarray(obs).reshape(-1, 2)).tolist()]
@@ -302,7 +305,7 @@ class PeopleTracker(TrackerKind):
             # life cycle
             for p in persons:
                 if p.status == TENTATIVE:
-                    p.world_centre = tuple(to_world(pose, np.array([p.centre()]))[0].tolist())
+                    p.world_centre = (seg, *to_world(pose, np.array([p.centre()]))[0].tolist())
                     if confirmer.step(p, k) and not _on_static(p, pose, smap):
                         p.status = CONFIRMED
                         n_conf += 1
@@ -337,7 +340,7 @@ class PeopleTracker(TrackerKind):
                 n_born += 1
                 n_conf += start == CONFIRMED
                 if start == TENTATIVE:
-                    p.world_centre = tuple(to_world(pose, np.array([p.centre()]))[0].tolist())
+                    p.world_centre = (seg, *to_world(pose, np.array([p.centre()]))[0].tolist())
                     confirmer.step(p, k)
                 persons.append(p)
             # record the reported persons

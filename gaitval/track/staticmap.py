@@ -6,12 +6,15 @@ a local occupancy grid ("in free space"); gaitval's recordings carry no odometry
 roles stand in for it:
 
 ``ego_motion`` (:data:`EGO_MOTIONS`)
-    ``poses(scans) -> (n, 3)``: the sensor's pose (x, y, θ) per scan in the frame of the
-    first scan.  ``none``: a sensor that stands still (identity).  ``scan_matching``: each
+    ``poses(scans) -> (poses (n, 3), segment (n,))``: the sensor's pose (x, y, θ) per scan
+    in a world frame, and the *segment* of scans whose poses share that frame: where the
+    motion from one scan to the next cannot be measured, a new segment starts (its poses
+    are not comparable with the previous segment's — the motion is unknown, not zero).  ``none``: a sensor that stands still (identity).  ``scan_matching``: each
     scan's points aligned to the previous scan's by iterative closest point (Besl & McKay
     1992) with the closed-form 2-D rigid fit of each iteration (Arun et al. 1987, Kabsch):
     pairs from :class:`scipy.spatial.cKDTree`, the closest ``trim`` fraction of pairs kept
-    (people and new returns do not pull the fit), starting from the previous step's motion.
+    (people and new returns do not pull the fit), starting from the previous step's motion;
+    fewer than ``min_pairs`` usable pairs: the step is unknown (a new segment).
 ``static_map`` (:data:`STATIC_MAPS`)
     ``start(scans, poses)`` then per scan ``update(k, points)`` and ``is_static(x, y)``
     (world frame).  ``recent_hits``: a grid of ``cell_m`` cells, each with a hit score that
@@ -58,14 +61,14 @@ def to_world(pose, pts: np.ndarray) -> np.ndarray:
 class EgoMotion:
     """Role base."""
 
-    def poses(self, scans) -> np.ndarray:
+    def poses(self, scans) -> tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError
 
 
 @EGO_MOTIONS.register("none")
 class StandingSensor(EgoMotion):
     def poses(self, scans):
-        return np.zeros((scans.n_scans, 3))
+        return np.zeros((scans.n_scans, 3)), np.zeros(scans.n_scans, dtype=np.int64)
 
 
 @EGO_MOTIONS.register("scan_matching")
@@ -84,7 +87,7 @@ class ScanMatching(EgoMotion):
     beam_step : int
         Every n-th beam is used (speed).
     min_pairs : int
-        Fewer usable pairs: the step is taken as no motion.
+        Fewer usable pairs: the step is unknown (module notes).
     """
 
     def __init__(self, max_pair_m: float = 0.5, trim: float = 0.8, iterations: int = 20,
@@ -95,10 +98,10 @@ class ScanMatching(EgoMotion):
         self.beam_step = beam_step
         self.min_pairs = min_pairs
 
-    def step(self, prev: np.ndarray, cur: np.ndarray, guess) -> tuple[float, float, float]:
-        """(x, y, θ) of the current scan in the previous scan's frame."""
+    def step(self, prev: np.ndarray, cur: np.ndarray, guess):
+        """(x, y, θ) of the current scan in the previous scan's frame; None: unknown."""
         if len(prev) < self.min_pairs or len(cur) < self.min_pairs:
-            return 0.0, 0.0, 0.0
+            return None
         tree = cKDTree(prev)
         x, y, th = guess
         for _ in range(self.iterations):
@@ -106,7 +109,7 @@ class ScanMatching(EgoMotion):
             d, i = tree.query(moved, distance_upper_bound=self.max_pair_m)
             ok = np.isfinite(d)
             if ok.sum() < self.min_pairs:
-                return 0.0, 0.0, 0.0
+                return None
             d, src, dst = d[ok], moved[ok], prev[i[ok]]
             keep = np.argsort(d, kind="stable")[:max(self.min_pairs, int(self.trim * len(d)))]
             src, dst = src[keep], dst[keep]
@@ -128,16 +131,23 @@ class ScanMatching(EgoMotion):
     def poses(self, scans):
         n = scans.n_scans
         out = np.zeros((n, 3))
+        seg = np.zeros(n, dtype=np.int64)
         prev = scan_points(scans, 0, self.beam_step) if n else None
         rel = (0.0, 0.0, 0.0)
         for k in range(1, n):
             cur = scan_points(scans, k, self.beam_step)
-            rel = self.step(prev, cur, rel)
+            step = self.step(prev, cur, rel)
+            prev = cur
+            if step is None:                 # unknown motion: a new frame from here on
+                seg[k] = seg[k - 1] + 1
+                rel = (0.0, 0.0, 0.0)
+                continue
+            seg[k] = seg[k - 1]
+            rel = step
             x0, y0, t0 = out[k - 1]
             c, s = math.cos(t0), math.sin(t0)
             out[k] = (x0 + c * rel[0] - s * rel[1], y0 + s * rel[0] + c * rel[1], t0 + rel[2])
-            prev = cur
-        return out
+        return out, seg
 
 
 class StaticMap:
