@@ -406,7 +406,8 @@ def _empty(t) -> PeopleResult:
 def people_frame_for_scoring(res: PeopleResult) -> pd.DataFrame:
     """The legbench track of a people result: :data:`~gaitval.track.leg.TRACK_COLUMNS` plus
     ``person_id``, one row per scan, reported person and side; a scan with nobody reported
-    has two rows with ``person_id`` −1 and no position, so that every scan's time is kept."""
+    has two rows with ``person_id`` −1 and no position, so that every scan's time is kept.
+    ``swing`` and ``interpolated`` are False (not kept per person)."""
     n = len(res.t)
     p = res.people
     cols = ["k", "t_sensor_s", "side", "x_m", "y_m", "vx_mps", "vy_mps", "observed",

@@ -9,9 +9,10 @@ roles stand in for it:
     ``poses(scans) -> (poses (n, 3), segment (n,))``: the sensor's pose (x, y, θ) per scan
     in a world frame, and the *segment* of scans whose poses share that frame: where the
     motion from one scan to the next cannot be measured, a new segment starts (its poses
-    are not comparable with the previous segment's — the motion is unknown, not zero).  ``none``: a sensor that stands still (identity).  ``scan_matching``: each
-    scan's points aligned to the previous scan's by iterative closest point (Besl & McKay
-    1992) with the closed-form 2-D rigid fit of each iteration (Arun et al. 1987, Kabsch):
+    are not comparable with the previous segment's — the motion is unknown, not zero).
+    ``none``: a sensor that stands still (identity).  ``scan_matching``: each scan's points
+    aligned to the previous scan's by iterative closest point (Besl & McKay 1992) with the
+    closed-form 2-D rigid fit of each iteration (Arun et al. 1987, Kabsch):
     pairs from :class:`scipy.spatial.cKDTree`, the closest ``trim`` fraction of pairs kept
     (people and new returns do not pull the fit), starting from the previous step's motion;
     fewer than ``min_pairs`` usable pairs: the step is unknown (a new segment).
@@ -78,8 +79,8 @@ class ScanMatching(EgoMotion):
     Parameters
     ----------
     max_pair_m : float
-        Pairs further apart are not used (0.5 m: what a robot at ≤ 2 m/s moves, or turns a
-        point 2.5 m away at 1.5 rad/s, in one scan period of 0.1–0.13 s... plus margin).
+        Pairs further apart are not used (0.5 m: more than a robot at 2 m/s moves, or
+        turns a point 2.5 m away at 1.5 rad/s, in one scan period of 0.1–0.13 s).
     trim : float
         Fraction of the closest pairs kept per iteration.
     iterations : int
