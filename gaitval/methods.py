@@ -405,3 +405,39 @@ def track_trial(scans: ScanSeries, method: str | dict[str, Any], leg_width_m: fl
     """
     cfg = cfg or {}
     return build_method(method, cfg.get("overrides")).track(scans, leg_width_m).to_frame()
+
+# -- issue 36: a people tracker (several persons, two legs each, with a life cycle) -------
+# Not a paper's method: the seed papers' leg model (seed 000's KF and χ² gate, Table 2;
+# seed 001's constant-velocity input and GNN assignment) inside a tracker that starts,
+# confirms, coasts and ends person hypotheses (gaitval/track/people.py, lifecycle.py;
+# docs/people.md says where every value comes from).
+METHODS["people"] = {
+    "label": "People tracker (life cycle, several persons)",
+    "paper": "gaitval (issue 36); leg model of seeds 000/001, life cycle after Leigh et al. "
+             "ICRA 2015",
+    "kind": {"name": "people",
+             "detector": copy.deepcopy(_TUG_COMMON["detector"]),
+             "filter": {"name": "kf", "q_accel_sd_mps2": 15.0, "r_sd_m": 0.04,
+                        "p0_pos_sd_m": 0.04, "p0_vel_sd_mps": 0.5},
+             "motion": {"name": "constant_velocity"},
+             "phase": {"name": "speed_thresholds", "v_st_th": 0.47, "v_sw_th": 0.93},
+             "gate": {"name": "chi2", "g": 13.82},
+             # seed 001's variable validation region (Table 1) while a person is tentative
+             "tentative_gate": {"name": "variable_region", "v_sw": 1.1, "v_st": 0.55},
+             "birth": {"name": "unexplained_pairs", "max_pair_m": 0.8,
+                       "min_leg_widths": 0.7},
+             "confirmer": {"name": "m_of_n_moving", "window_s": 1.4, "m_fraction": 0.5,
+                           "min_relative_travel_m": 0.5, "pass_leg_widths": 1.0,
+                           "min_travel_m": 0.5},
+             "deleter": {"name": "unsupported_time", "max_unsupported_s": 3.0,
+                         "tentative_unsupported_s": 0.2},
+             "area": {"name": "field_of_view", "margin_m": 0.25},
+             # no odometry in the recordings: the sensor's motion from its scans, and a map
+             # of what stays put (leg_tracker's local occupancy grid), both online
+             "ego_motion": {"name": "scan_matching", "max_pair_m": 0.5, "trim": 0.8,
+                            "iterations": 20, "beam_step": 2, "min_pairs": 20},
+             "static_map": {"name": "recent_hits", "cell_m": 0.1, "min_static_s": 1.4,
+                            "tau_s": 5.0, "neighbourhood": 1},
+             "init": None, "max_leg_separation_m": 0.8, "dt_s": None,
+             "sides": "walking_direction"},
+}

@@ -121,7 +121,11 @@ def legbench_track_step(sensor, method: str, out_parquet, *, init: str = "own",
             scans, float(leg_width_m))
     except GaitvalError as exc:
         raise exc.with_context(path=sensor, trial=trial) from None
-    track = res.to_frame()
+    if getattr(res, "people", None) is not None:     # a people tracker: every person (issue 36)
+        from gaitval.track.people import people_frame_for_scoring
+        track = people_frame_for_scoring(res)
+    else:
+        track = res.to_frame()
     k_init = getattr(res, "k_init", None)
     if k_init is None or k_init < 0:
         print(f"gaitval: warning: trial {trial}, method {method} ({init} init): the "
@@ -175,23 +179,34 @@ def legbench_evaluate_step(track_parquet, annotations, out_dir, *,
 
     track, meta = read_track(track_parquet)
     trial = trial or meta.get("trial")
-    t = track.loc[track["side"] == "L", "t_sensor_s"].to_numpy(float)
+    people = "person_id" in track.columns        # a people tracker's track (issue 36)
+    persons = _person_legs(track) if people else None
+    if people:
+        t = track.groupby("k", sort=True)["t_sensor_s"].first().to_numpy(float)
+    else:
+        t = track.loc[track["side"] == "L", "t_sensor_s"].to_numpy(float)
+        x = np.vstack([track.loc[track["side"] == s, "x_m"].to_numpy(float) for s in "LR"])
+        y = np.vstack([track.loc[track["side"] == s, "y_m"].to_numpy(float) for s in "LR"])
     n = len(t)
-    x = np.vstack([track.loc[track["side"] == s, "x_m"].to_numpy(float) for s in "LR"])
-    y = np.vstack([track.loc[track["side"] == s, "y_m"].to_numpy(float) for s in "LR"])
     positions, ameta = read_positions(annotations, annotation_topic, scan_topic, t, trial)
     if len(positions) and positions["k"].max() >= n:
         raise GaitvalError(f"annotations refer to scan {int(positions['k'].max())} but the "
                            f"track has {n} scans: not the same recording or scan topic",
                            path=annotations, trial=trial)
-    hyp = person_hypotheses(x, y, meta.get("restarts") or [])
+    if people:
+        hyp = _people_hypotheses(track)
+    else:
+        hyp = person_hypotheses(x, y, meta.get("restarts") or [])
     if sector_deg is not None:
         positions = positions[in_sector(positions["x_m"], positions["y_m"], sector_deg)]
         hyp = hyp[in_sector(hyp["x_m"], hyp["y_m"], sector_deg)]
         positions, hyp = positions.reset_index(drop=True), hyp.reset_index(drop=True)
     summary, events = clear_mot(positions, hyp, n, match_m=match_m)
     follow = following_counts(summary, events)
-    legs = false_leg_tracks(x, y, t, positions, match_m=match_m, min_false_s=min_false_s)
+    if people:            # every person's legs, summed (recording_min is the same for all)
+        legs = _people_false_legs(persons, t, positions, match_m, min_false_s)
+    else:
+        legs = false_leg_tracks(x, y, t, positions, match_m=match_m, min_false_s=min_false_s)
     k0 = meta.get("k_init")
     offset = float("nan")
     if k0 is not None:
@@ -220,6 +235,49 @@ def legbench_evaluate_step(track_parquet, annotations, out_dir, *,
     write_parquet(summary_df, out / SUMMARY_FILE)
     write_parquet(_frames(t, positions, hyp, events), out / FRAMES_FILE)
     return summary_df
+
+
+def _person_legs(track: pd.DataFrame) -> list:
+    """``[(person_id, x (2, n), y (2, n))]`` of a people tracker's track (``person_id`` ≥ 0;
+    NaN where the person is not reported)."""
+    n = int(track["k"].max()) + 1 if len(track) else 0
+    out = []
+    for pid, g in track[track["person_id"] >= 0].groupby("person_id", sort=True):
+        x, y = np.full((2, n), np.nan), np.full((2, n), np.nan)
+        for f, side in enumerate("LR"):
+            leg = g[g["side"] == side]
+            x[f, leg["k"].to_numpy()] = leg["x_m"].to_numpy(float)
+            y[f, leg["k"].to_numpy()] = leg["y_m"].to_numpy(float)
+        out.append((int(pid), x, y))
+    return out
+
+
+def _people_hypotheses(track: pd.DataFrame) -> pd.DataFrame:
+    """Every reported person's hypothesis: the midpoint of its two legs, ``hyp_id`` = its
+    person id (:data:`gaitval.evaluate.clearmot.HYP_COLUMNS`)."""
+    from gaitval.evaluate.clearmot import HYP_COLUMNS
+    tr = track[track["person_id"] >= 0]
+    mid = tr.groupby(["k", "person_id"], sort=True)[["x_m", "y_m"]].agg(["mean", "count"])
+    ok = (mid[("x_m", "count")] == 2) & (mid[("y_m", "count")] == 2)
+    mid = mid[ok]
+    return pd.DataFrame({"k": mid.index.get_level_values(0).astype(np.int64),
+                         "hyp_id": mid.index.get_level_values(1).astype(np.int64),
+                         "x_m": mid[("x_m", "mean")].to_numpy(float),
+                         "y_m": mid[("y_m", "mean")].to_numpy(float)})[HYP_COLUMNS]
+
+
+def _people_false_legs(persons, t, positions, match_m, min_false_s) -> dict:
+    """:func:`~gaitval.evaluate.clearmot.false_leg_tracks` summed over every person."""
+    from gaitval.evaluate.clearmot import false_leg_tracks
+    nan = np.full((2, len(t)), np.nan)
+    total = false_leg_tracks(nan, nan, t, positions, match_m=match_m, min_false_s=min_false_s)
+    for _, x, y in persons:
+        r = false_leg_tracks(x, y, t, positions, match_m=match_m, min_false_s=min_false_s)
+        for key in ("false_leg_tracks", "false_leg_time_s", "leg_time_s"):
+            total[key] += r[key]
+    m = total["recording_min"]
+    total["false_leg_tracks_per_min"] = total["false_leg_tracks"] / m if m > 0 else float("nan")
+    return total
 
 
 def _window_fraction(method: str, positions: pd.DataFrame) -> float:

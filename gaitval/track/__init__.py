@@ -27,3 +27,5 @@ ROLE_REGISTRIES = {"filter": FILTERS, "motion": MOTION_MODELS, "phase": PHASE_MO
 # seed 002: registers the "facing_pair" initialiser and the "reinit_after_lost" handler
 from gaitval.track import reinit  # noqa: F401,E402
 from gaitval.track import pf  # noqa: F401,E402  (registers the "rollator_pf" kind)
+# issue 36: the life-cycle roles and the "people" kind (several persons, two legs each)
+from gaitval.track import people  # noqa: F401,E402  (registers the "people" kind)

@@ -1,0 +1,232 @@
+"""The people tracker (issue 36): life-cycle roles, several persons, real recordings."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from gaitval.methods import METHODS, build_method, track_trial
+from gaitval.track import TRACK_COLUMNS
+from gaitval.track.lifecycle import (AREAS, BIRTHS, CONFIRMERS, DELETERS, FieldOfView,
+                                     UnexplainedPairs)
+from gaitval.track.people import PEOPLE_COLUMNS, PeopleTracker, people_frame_for_scoring
+from gaitval.types import ScanSeries
+
+DT = 0.1                                     # 10 Hz, like the leg_tracker benchmark bags
+
+
+def _scans(n, range_max=8.0):
+    """A ScanSeries frame for synthetic observations: 181 beams over −90°…+90°."""
+    return ScanSeries(t=np.arange(n) * DT, ranges=np.full((n, 181), np.nan),
+                      angle_min=-math.pi / 2, angle_increment=math.pi / 180,
+                      range_min=0.02, range_max=range_max)
+
+
+def _walker(c0, v, t, stride_s=1.1, step_m=0.5, half_width_m=0.1, phase=0.0):
+    """Two legs of a person whose body centre moves from c0 at velocity v: along the walking
+    direction the legs swing past each other (r = ±step_m), 2·half_width_m apart sideways."""
+    c0, v = np.asarray(c0, float), np.asarray(v, float)
+    u = v / np.linalg.norm(v)
+    nrm = np.array([-u[1], u[0]])
+    c = c0 + t[:, None] * v
+    s = 0.5 * step_m * np.sin(2 * np.pi * t / stride_s + phase)
+    left = c + s[:, None] * u + half_width_m * nrm
+    right = c - s[:, None] * u - half_width_m * nrm
+    return c, left, right
+
+
+def _observations(legs_per_scan, rng, sd=0.01):
+    xy = [np.array(p, float).reshape(-1, 2) + rng.normal(0, sd, (len(p), 2))
+          for p in legs_per_scan]
+    return xy, [["SL"] * len(o) for o in xy]
+
+
+def _tracker(**kw):
+    kind = dict(METHODS["people"]["kind"])
+    kind.pop("name")
+    kind["detector"] = {"name": "leg_patterns"}
+    kind.update(kw)
+    return PeopleTracker(**kind)
+
+
+def _owner(people, centres):
+    """Per reported (scan, person): index of the true person nearest its legs' midpoint."""
+    mid = people.groupby(["k", "person_id"])[["x_m", "y_m"]].mean().reset_index()
+    k = mid["k"].to_numpy()
+    d = np.stack([np.hypot(mid["x_m"] - c[k, 0], mid["y_m"] - c[k, 1]) for c in centres])
+    mid["owner"] = d.argmin(axis=0)
+    mid["d_m"] = d.min(axis=0)
+    return mid
+
+
+def test_role_registries_hold_the_life_cycle_parts():
+    assert "unexplained_pairs" in BIRTHS and "m_of_n_moving" in CONFIRMERS
+    assert "unsupported_time" in DELETERS and {"field_of_view", "rectangle"} <= set(AREAS.names())
+
+
+def test_births_pair_the_closest_unexplained_observations():
+    obs = [(1.0, 0.0), (1.0, 0.3), (3.0, 0.0), (1.2, 0.15), (5.0, 5.0)]
+    free = [True, True, True, False, True]
+    # 0–1 are 0.3 m apart; 2 and 4 have nobody within 0.8 m; 3 is explained
+    assert UnexplainedPairs().propose(obs, free, 0.10) == [(0, 1)]
+    # two legs cannot overlap: 0.05 m < 0.7 w_l
+    assert UnexplainedPairs().propose([(1, 0), (1, 0.05)], [True, True], 0.10) == []
+
+
+def test_field_of_view_area():
+    a = FieldOfView(margin_m=0.25).bind(_scans(2, range_max=5.0))
+    assert a.contains(2.0, 0.0)
+    assert not a.contains(4.9, 0.0)                 # within the margin of the range limit
+    assert not a.contains(-1.0, 0.0)                # behind the laser (−90°…+90°)
+
+
+def test_two_people_crossing_keep_their_identities():
+    """Two walkers cross on an X (B 0.9 m behind A where their paths cross): both are
+    confirmed, each person id stays on one walker, and each walker keeps one id."""
+    n = 90
+    t = np.arange(n) * DT
+    ca, la, ra = _walker((1.5, -2.0), (0.25, 1.0), t)
+    cb, lb, rb = _walker((3.8, -2.9), (-0.25, 1.0), t, phase=1.3)
+    rng = np.random.default_rng(0)
+    xy, pats = _observations([np.vstack([la[k], ra[k], lb[k], rb[k]]) for k in range(n)],
+                             rng)
+    res = _tracker().run(_scans(n), xy, pats, 0.10)
+    assert res.n_confirmed == 2
+    own = _owner(res.people, [ca, cb])
+    assert (own["d_m"] < 0.15).all()
+    assert own.groupby("person_id")["owner"].nunique().max() == 1    # an id stays on one walker
+    assert sorted(own.groupby("owner")["person_id"].nunique().tolist()) == [1, 1]
+    # the walkers' closest approach is in the run and both are reported through it
+    k_cross = int(np.argmin(np.hypot(*(ca - cb).T)))
+    assert set(own.loc[own["k"] == k_cross, "owner"]) == {0, 1}
+    assert list(res.people.columns) == list(PEOPLE_COLUMNS)
+
+
+def test_a_person_leaving_the_field_of_view_ends():
+    """A walker leaves through the range limit: the track ends when the body centre leaves
+    the measurement area; nothing is reported after that."""
+    n = 80
+    t = np.arange(n) * DT
+    c, left, right = _walker((1.0, 0.0), (1.0, 0.0), t)
+    rng = np.random.default_rng(1)
+    rmax = 5.0
+    legs = [np.array([p for p in (left[k], right[k]) if np.hypot(*p) < rmax])
+            for k in range(n)]
+    xy, pats = _observations(legs, rng)
+    res = _tracker().run(_scans(n, range_max=rmax), xy, pats, 0.10)
+    assert res.n_confirmed == 1
+    last = int(res.people["k"].max())
+    k_out = int(np.argmax(np.hypot(*c.T) > rmax - 0.25))
+    assert last < k_out                                  # ended on leaving, not coasted on
+    assert res.people["person_id"].nunique() == 1
+
+
+def test_a_person_who_is_no_longer_seen_ends_after_the_stated_time():
+    n = 100
+    t = np.arange(n) * DT
+    c, left, right = _walker((1.5, -1.5), (0.0, 1.0), t)
+    k_gone = 40
+    legs = [np.vstack([left[k], right[k]]) if k < k_gone else np.zeros((0, 2))
+            for k in range(n)]
+    xy, pats = _observations(legs, np.random.default_rng(2))
+    res = _tracker().run(_scans(n), xy, pats, 0.10)
+    assert res.n_confirmed == 1
+    p = res.people
+    assert set(p.loc[p["k"] >= k_gone, "status"]) == {"coasting"}
+    t_last = p["t_sensor_s"].max()
+    # ended after 3.0 s without support (the deleter's max_unsupported_s)
+    assert t_last - t[k_gone - 1] == pytest.approx(3.0, abs=DT + 1e-9)
+
+
+def test_a_slow_walker_is_confirmed():
+    """0.5 m/s: a newborn leg's gate assumes seed 001's swing speed until it is seen twice."""
+    n = 100
+    t = np.arange(n) * DT
+    _, left, right = _walker((1.5, -1.0), (0.0, 0.5), t)
+    xy, pats = _observations([np.vstack([left[k], right[k]]) for k in range(n)],
+                             np.random.default_rng(2))
+    assert _tracker().run(_scans(n), xy, pats, 0.10).n_confirmed == 1
+
+
+def test_static_leg_pairs_are_never_confirmed():
+    """Chair legs (static pairs, flickering detections) stay tentative: no person."""
+    rng = np.random.default_rng(3)
+    pairs = np.array([[1.5, 0.3], [1.5, -0.1], [2.2, 0.8], [2.6, 0.8], [3.0, -1.0],
+                      [3.4, -1.0]])
+    legs = [pairs[rng.random(len(pairs)) > 0.2] for _ in range(200)]
+    xy, pats = _observations(legs, rng)
+    res = _tracker().run(_scans(200), xy, pats, 0.10)
+    assert res.n_confirmed == 0 and res.people.empty and res.k_init == -1
+
+
+def test_people_method_keeps_the_study_track_contract():
+    """Every study reads the subject's two legs in the usual table (TRACK_COLUMNS)."""
+    from gaitval.track.kinds import TRACKER_KINDS
+    assert "people" in TRACKER_KINDS
+    n = 60
+    t = np.arange(n) * DT
+    _, left, right = _walker((1.5, -1.5), (0.0, 1.0), t)
+    xy, pats = _observations([np.vstack([left[k], right[k]]) for k in range(n)],
+                             np.random.default_rng(4))
+    res = _tracker().run(_scans(n), xy, pats, 0.10)
+    df = res.to_frame()
+    assert list(df.columns) == list(TRACK_COLUMNS) and len(df) == 2 * n
+    assert res.subject_id == int(res.people["person_id"].iloc[0])
+    scored = people_frame_for_scoring(res)
+    assert sorted(scored["k"].unique()) == list(range(n))      # every scan keeps its time
+    assert (scored.loc[scored["person_id"] < 0, "x_m"].isna()).all()
+
+
+def test_people_tracker_is_deterministic():
+    n = 60
+    t = np.arange(n) * DT
+    _, left, right = _walker((1.5, -1.5), (0.0, 1.0), t)
+    xy, pats = _observations([np.vstack([left[k], right[k]]) for k in range(n)],
+                             np.random.default_rng(5))
+    a = _tracker().run(_scans(n), xy, pats, 0.10).people
+    b = _tracker().run(_scans(n), xy, pats, 0.10).people
+    assert a.equals(b)
+
+
+# -- real recordings ------------------------------------------------------------------------
+@pytest.mark.realdata
+def test_a_walker_in_positive_1_is_found(realdata):
+    from gaitval.io.rosbag import read_rosbag_scans
+    scans = read_rosbag_scans(realdata / "lrs" / "positive_1.bag")
+    res = build_method("people").track(scans, 0.10)
+    p = res.people
+    assert res.n_confirmed >= 1
+    # the subject is reported for more than 10 s of the 53 s recording
+    sub = p[p["person_id"] == res.subject_id]
+    assert sub["k"].nunique() * float(np.median(np.diff(scans.t))) > 10.0
+    assert len(track_trial(scans, "people", 0.10)) == 2 * scans.n_scans
+
+
+@pytest.mark.realdata
+def test_empty_room_gives_no_confirmed_person(realdata):
+    """negative_2: a robot driving through a furnished room with nobody in it, three lasers
+    with ~36 leg-like detections a scan: no person is confirmed on any of them."""
+    from gaitval.io.rosbag import describe_rosbag, read_rosbag_scans
+    bag = realdata / "lrs" / "negative_2.bag"
+    if not bag.exists():
+        pytest.skip(f"{bag} is absent")
+    confirmed = {}
+    for topic in describe_rosbag(bag)["scans"]:
+        res = build_method("people").track(read_rosbag_scans(bag, topic), 0.10)
+        confirmed[topic] = res.n_confirmed
+    assert confirmed and not any(confirmed.values()), confirmed
+
+
+def test_an_initialiser_seeds_a_confirmed_person():
+    """legbench's ``--init annotation``: the pair the initialiser finds is a person from its
+    scan on, even one who stands (which the confirmer alone would never confirm)."""
+    n = 30
+    legs = [np.array([[2.0, 0.15], [2.0, -0.15]]) for _ in range(n)]
+    xy, pats = _observations(legs, np.random.default_rng(6))
+    alone = _tracker().run(_scans(n), xy, pats, 0.10)
+    assert alone.n_confirmed == 0
+    seeded = _tracker(init={"name": "annotated_pair", "k": 5, "x_m": 2.0, "y_m": 0.0}).run(
+        _scans(n), xy, pats, 0.10)
+    assert seeded.n_confirmed == 1 and seeded.k_init == 5
+    assert seeded.people["k"].min() == 5 and seeded.people["k"].max() == n - 1
