@@ -82,7 +82,8 @@ def describe_c3d(path: str | Path, *, trial: str | None = None) -> dict[str, Any
     ``{context, label, t_s}``), ``prefixes``, ``prefix_stripped`` (bool),
     ``duplicates``, ``n_zero_gaps``, ``n_analogs``, ``analog_rate_hz``, ``manufacturer``,
     ``vertical_axis`` (the stored axis that points up; see :mod:`gaitval.io.c3d_axes`),
-    ``text_encodings`` (parameter -> encoding, for text that is not UTF-8).
+    ``text_encodings`` (parameter -> encoding, for text that is not UTF-8), ``warnings``
+    (what the reader logged as a warning).
     """
     tr = read_c3d(path, trial=trial)
     miss = np.isnan(tr.xyz[:, :, 0])
@@ -116,4 +117,5 @@ def describe_c3d(path: str | Path, *, trial: str | None = None) -> dict[str, Any
         "manufacturer": tr.meta["manufacturer"],
         "vertical_axis": tr.meta["vertical_axis"],
         "text_encodings": dict(tr.meta.get("text_encodings", {})),
+        "warnings": list(tr.meta.get("warnings", [])),
     }

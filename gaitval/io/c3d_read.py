@@ -254,6 +254,13 @@ def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "s
         "vertical_axis": up,
         # parameters whose text is not UTF-8 -> the encoding it was read with
         "text_encodings": dict(pre.get("encodings", {})),
+        # what was logged as a warning while reading (gaitval inspect lists it)
+        "warnings": ([f"duplicate marker labels kept with suffixes: "
+                      + "; ".join(f"{k} -> {', '.join(v)}" for k, v in dups.items())]
+                     if dups else [])
+        + ([f"the markers say {up} points up; rotated to gaitval's z-up field frame"]
+           if vertical == "auto" and up not in (None, "+z") and not up.startswith("+z")
+           else []),
     }
     return MocapTrial(path=str(path), rate_hz=rate, first_frame=int(ff), labels=labels,
                       xyz=xyz, events=events, units=units, meta=meta)
