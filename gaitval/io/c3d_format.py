@@ -224,9 +224,9 @@ def _check_size(hdr: dict, params: Parameters, size: int, path: Path,
                 trial: str | None) -> tuple[int, int]:
     """The data section must hold the frames the header announces (POINT:FRAMES where the
     header's 16-bit last-frame word is saturated), no whole frame more beyond two 512-byte
-    blocks of padding (ezc3d's writer adds a block), and at most :data:`MAX_DATA_BYTES`.  Returns the larger of
-    the two frame counts, which the reader compares with what ezc3d read, and the bytes
-    the announced frames take."""
+    blocks of padding (ezc3d's writer adds a block), and at most :data:`MAX_DATA_BYTES`.
+    Returns the larger of the two frame counts, which the reader compares with what ezc3d
+    read, and the bytes the announced frames take."""
     n_header = hdr["last"] - hdr["first"] + 1 if hdr["last"] >= hdr["first"] else 0
     p_frames = params.count("POINT", "FRAMES")
     p_frames = 0 if p_frames is None else int(p_frames)

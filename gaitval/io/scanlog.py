@@ -193,7 +193,8 @@ def _meta_fields(meta: dict, path: Path, trial: str | None) -> dict:
     text_field(meta, "format", expected=FORMAT, **kw)
     version_field(meta, VERSION, **kw)
     g = {"model": text_field(meta, "sensor_model", **kw),
-         "scan_time": number(meta, "scan_time_s", above=0, optional=True, **kw),"n_beams": number(meta, "n_beams", above=0, integer=True, **kw),
+         "scan_time": number(meta, "scan_time_s", above=0, optional=True, **kw),
+         "n_beams": number(meta, "n_beams", above=0, integer=True, **kw),
          "amin": number(meta, "angle_min_rad", **kw),
          "ainc": number(meta, "angle_increment_rad", **kw),
          "rmin": number(meta, "range_min_m", minimum=0, **kw),

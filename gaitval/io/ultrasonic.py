@@ -202,7 +202,8 @@ def read_ultrasonic(path: str | Path, *, trial: str | None = None) -> Ultrasonic
     lo, hi = TEMPERATURE_RANGE_C
     bad = np.flatnonzero((cols["temperature_c"] < lo) | (cols["temperature_c"] > hi))
     if bad.size:
-        raise FileFormatError(f"column 'temperature_c' holds {float(cols['temperature_c'][bad[0]])!r}"
+        worst = float(cols["temperature_c"][bad[0]])
+        raise FileFormatError(f"column 'temperature_c' holds {worst!r}"
                               f" degC at row {int(bad[0])}; an air temperature lies within "
                               f"{lo:g} .. {hi:g} degC", path=path, trial=trial)
     data = np.column_stack([cols[c] for c in need[2:]]) if len(need) > 2 else \

@@ -11,8 +11,8 @@ bytes (Latin-1, control bytes); for ROS 1 bags also the bag header's ``chunk_cou
 infos' counts; for Parquet logs their JSON metadata (NaN, inf, huge integers, wrong types,
 missing keys), columns (odd values, other types: bool, timestamp, integer, text) and
 row counts (0, 1); for CSV files cells (NaN, inf, empty, 5,000 characters,
-``../../etc/passwd``), encodings (UTF-16, Latin-1) and structure.  Each mutant is one file (or a folder for a sheet) and a
-one-line description of what was done to it.
+``../../etc/passwd``), encodings (UTF-16, Latin-1) and structure.  Each mutant is one
+file (or a folder for a sheet) and a one-line description of what was done to it.
 """
 from __future__ import annotations
 
