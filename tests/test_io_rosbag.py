@@ -205,6 +205,7 @@ def _patch_u32(data: bytes, field: bytes, value: int, start: int = 0) -> bytes:
 @pytest.mark.realdata
 @pytest.mark.parametrize("patch, message", [
     ("chunk_count", "the bag header announces chunk_count=1, the file holds 6 chunk records"),
+    ("chunk_count=0", "the bag header announces chunk_count=0, the file holds 6 chunk records"),
     ("conn", r"list messages of connection\(s\) \[7\], which the bag does not define"),
     ("info", r"topic /left_scan \(connection 0\): the index records list 435 messages, the "
              "chunk infos 430, and 435 were read"),
@@ -224,8 +225,8 @@ def test_bag_whose_index_disagrees_is_refused_with_counts(realdata, tmp_path, pa
         dlen = struct.unpack_from("<I", data, pos + 4 + hlen)[0]
         records.append((pos, _fields(data[pos + 4:pos + 4 + hlen], pos), pos + 8 + hlen))
         pos += 8 + hlen + dlen
-    if patch == "chunk_count":
-        data = _patch_u32(data, b"chunk_count=", 1)
+    if patch.startswith("chunk_count"):                 # 0: a bag without any topic
+        data = _patch_u32(data, b"chunk_count=", 0 if patch.endswith("0") else 1)
     elif patch == "conn":                      # the first index record after a chunk
         at = next(r[0] for r in records if r[1]["op"] == b"\x04")
         data = _patch_u32(data, b"conn=", 7, at)

@@ -88,6 +88,13 @@ def _open(path: Path, trial: str | None):
     except Exception as exc:  # rosbags raises AnyReaderError / ReaderError / OSError
         raise FileFormatError(f"not a readable ROS bag: {type(exc).__name__}: {exc}",
                               path=path, trial=trial) from None
+    if path.is_file():                      # ROS 1: the index must agree with the records
+        from gaitval.io.rosbag_check import check_structure
+        try:
+            check_structure(path, trial)
+        except FileFormatError:
+            reader.close()
+            raise
     return reader
 
 

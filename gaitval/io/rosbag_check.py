@@ -6,8 +6,9 @@ list.  A bag whose ``chunk_count`` is 1 (of 6) therefore loaded 82 of 435 scans 
 without a word, and a corrupted connection id in an index record moved a topic's messages
 elsewhere.  :func:`walk_bag1` walks the file's top-level records (bag header, chunks, the
 index data after each chunk, connections and chunk infos of the index section) without
-decompressing anything, and :func:`check_counts` compares the counts found with each
-other and with the messages the reader delivered.
+decompressing anything; :func:`check_structure` compares the counts found with each
+other (whenever a bag is opened) and :func:`check_counts` also with the messages the
+reader delivered for a topic.
 
 ROS bag format 2.0 [2]_: after the line ``#ROSBAG V2.0``, records ``header_len (uint32),
 header (fields: field_len (uint32), name=value), data_len (uint32), data``; the header's
@@ -129,46 +130,58 @@ def walk_bag1(path: Path) -> dict[str, Any]:
     return out
 
 
-def check_counts(path: Path, trial: str | None, topic: str, read: dict[int, int],
-                 topic_conns: list[int]) -> None:
-    """Refuse a ROS 1 bag whose index and chunk records disagree with each other or with
-    the messages read (``read``: connection id -> messages delivered for ``topic``).
+def _refuse(path: Path, trial: str | None, problem: str):
+    raise FileFormatError(f"the bag's index disagrees with its contents: {problem}",
+                          path=path, trial=trial,
+                          hint="reindex it (`rosbag reindex`) or re-record it")
+
+
+def check_structure(path: Path, trial: str | None) -> dict[str, Any]:
+    """:func:`walk_bag1`, and the counts of the whole bag checked against each other; the
+    walk's result.
 
     Raises
     ------
     FileFormatError
-        Naming the counts: chunk records vs the header's ``chunk_count`` vs chunk infos,
-        connections vs ``conn_count``, index records naming an undefined connection, and
-        for each connection of ``topic`` the messages listed by the index records, by
-        the chunk infos, and read.
+        A broken record; chunk records, chunk infos and the header's ``chunk_count`` that
+        disagree; connection records and ``conn_count`` that disagree; index records or
+        chunk infos naming an undefined connection.  (A ``chunk_count`` of 0 used to give
+        a bag without topics, and 1 a bag of 82 of 435 scans per topic.)
     """
-    def refuse(problem: str):
-        raise FileFormatError(f"the bag's index disagrees with its contents: {problem}",
-                              path=path, trial=trial,
-                              hint="reindex it (`rosbag reindex`) or re-record it")
-
     try:
         s = walk_bag1(path)
     except (BagStructureError, OSError, struct.error) as exc:
         raise FileFormatError(f"the bag's record structure is broken: {exc}", path=path,
                               trial=trial, hint="`rosbag reindex` may repair it") from None
     if s["chunk_count"] is None:
-        refuse("it has no bag header record")
+        _refuse(path, trial, "it has no bag header record")
     if not s["chunk_count"] == s["chunks"] == s["chunk_infos"]:
-        refuse(f"the bag header announces chunk_count={s['chunk_count']}, the file holds "
-               f"{s['chunks']} chunk records and {s['chunk_infos']} chunk infos")
+        _refuse(path, trial, f"the bag header announces chunk_count={s['chunk_count']}, "
+                             f"the file holds {s['chunks']} chunk records and "
+                             f"{s['chunk_infos']} chunk infos")
     if s["conn_count"] != len(s["connections"]):
-        refuse(f"the bag header announces conn_count={s['conn_count']}, the index section "
-               f"defines {len(s['connections'])} connections")
+        _refuse(path, trial, f"the bag header announces conn_count={s['conn_count']}, the "
+                             f"index section defines {len(s['connections'])} connections")
     for where in ("index_counts", "info_counts"):
         stray = sorted(set(s[where]) - s["connections"])
         if stray:
-            refuse(f"the {'index records' if where == 'index_counts' else 'chunk infos'} "
-                   f"list messages of connection(s) {stray}, which the bag does not define "
-                   f"(defined: {sorted(s['connections'])})")
+            _refuse(path, trial,
+                    f"the {'index records' if where == 'index_counts' else 'chunk infos'} "
+                    f"list messages of connection(s) {stray}, which the bag does not define "
+                    f"(defined: {sorted(s['connections'])})")
+    return s
+
+
+def check_counts(path: Path, trial: str | None, topic: str, read: dict[int, int],
+                 topic_conns: list[int]) -> None:
+    """:func:`check_structure`, then for each connection of ``topic`` the messages listed
+    by the index records and by the chunk infos against those read (``read``: connection
+    id -> messages delivered)."""
+    s = check_structure(path, trial)
     for conn in topic_conns:
         idx, info, got = (s["index_counts"].get(conn, 0), s["info_counts"].get(conn, 0),
                           read.get(conn, 0))
         if not idx == info == got:
-            refuse(f"topic {topic} (connection {conn}): the index records list {idx} "
-                   f"messages, the chunk infos {info}, and {got} were read")
+            _refuse(path, trial, f"topic {topic} (connection {conn}): the index records "
+                                 f"list {idx} messages, the chunk infos {info}, and {got} "
+                                 "were read")
