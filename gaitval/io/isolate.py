@@ -120,16 +120,18 @@ def run_isolated(func: Callable[..., Any], *args: Any, path: str | Path, trial: 
 
 def _limit_memory(extra_bytes: int) -> None:
     """``RLIMIT_AS`` = this process's virtual size + ``extra_bytes`` (not above the
-    inherited hard limit)."""
+    inherited limit).  Without ``/proc`` (macOS, which does not enforce ``RLIMIT_AS``
+    anyway) the virtual size is unknown and nothing is limited."""
     import resource
 
-    vm = 0
     try:
         with open("/proc/self/status", encoding="ascii") as fh:
             vm = next((int(line.split()[1]) * 1024 for line in fh
                        if line.startswith("VmSize:")), 0)
-    except OSError:                                   # no /proc (macOS): the peak RSS
-        vm = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    except OSError:
+        return
+    if not vm:
+        return
     soft, hard = resource.getrlimit(resource.RLIMIT_AS)
     want = vm + int(extra_bytes)
     for lim in (soft, hard):
