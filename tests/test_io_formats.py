@@ -287,6 +287,10 @@ def _write_log(path, cols, key, meta):
     ("scanlog", "version", float("nan"), "'version' is nan"),
     ("scanlog", "version", 0.5, "'version' is 0.5"),
     ("scanlog", "format", None, "field 'format' is missing"),
+    ("scanlog", "time_increment_s", float("nan"), "'time_increment_s' is nan"),
+    ("scanlog", "time_increment_s", 0.5, "time_increment is 0.5 s; over 31 beams"),
+    ("scanlog", "angle_increment_rad", 1.0, "1 rad x 31 beams spans more than one turn"),
+    ("scanlog", "angle_min_rad", 10.0, "angle_min is 10 rad, more than one turn"),
 ])
 def test_non_finite_or_wrong_metadata_is_refused_naming_the_field(tmp_path, kind, field,
                                                                    value, message):

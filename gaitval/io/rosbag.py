@@ -56,7 +56,8 @@ import numpy as np
 
 from gaitval.errors import FileFormatError
 from gaitval.io.guard import loader
-from gaitval.io.scanlog import check_timestamps, clean_ranges
+from gaitval.io.scanlog import (MAX_SCAN_TIME_S, check_scan_geometry, check_timestamps,
+                                clean_ranges)
 from gaitval.types import ScanSeries
 
 LASERSCAN = "sensor_msgs/msg/LaserScan"
@@ -290,6 +291,13 @@ def _check_geometry(d: dict, topic: str, path: Path, trial: str | None) -> None:
                               trial=trial)
     if not np.all(np.isfinite(d["t"])):
         raise FileFormatError(f"{where}: timestamps are not finite", path=path, trial=trial)
+    check_scan_geometry(f"LaserScan topic {topic}", d["raw"].shape[1], d["angle_min"],
+                        d["angle_increment"], d["time_increment_s"], path, trial)
+    if not (np.isfinite(d["scan_time_s"]) and 0 <= d["scan_time_s"] <= MAX_SCAN_TIME_S):
+        raise FileFormatError(f"LaserScan topic {topic}: the median scan_time is "
+                              f"{d['scan_time_s']!r} s; it must be finite, >= 0 (0: not "
+                              f"stated) and at most {MAX_SCAN_TIME_S:g} s", path=path,
+                              trial=trial)
 
 
 def scan_summary(s: ScanSeries) -> dict[str, Any]:

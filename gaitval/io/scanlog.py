@@ -52,6 +52,30 @@ SUFFIX = ".scan.parquet"
 #: physical bounds of the metadata (a scan of a 2-D laser scanner: 5-100 Hz, <= 10k beams)
 MAX_SCAN_TIME_S = 10.0
 MAX_BEAMS = 100_000
+#: a scan spans at most one turn (radians, with a little slack for rounding)
+MAX_SPAN_RAD = 2 * np.pi + 1e-3
+#: the beams of one scan are taken within this many seconds (time_increment x n_beams)
+MAX_SWEEP_S = 1.0
+
+
+def check_scan_geometry(where: str, n_beams: int, angle_min: float, angle_increment: float,
+                        time_increment: float | None, path, trial: str | None) -> None:
+    """Angles and beam timing within physical bounds (shared with the bag reader): the
+    first beam within one turn of 0, the beams spanning at most one turn, and a sweep
+    (``time_increment`` x beams) of at most :data:`MAX_SWEEP_S`.  ``where`` names the
+    fields' place ("scan-log metadata", "LaserScan topic /scan, first message")."""
+    if abs(angle_min) > MAX_SPAN_RAD:
+        raise FileFormatError(f"{where}: angle_min is {angle_min:g} rad, more than one "
+                              "turn from 0", path=path, trial=trial)
+    if abs(angle_increment) * max(n_beams - 1, 1) > MAX_SPAN_RAD:
+        raise FileFormatError(f"{where}: angle_increment {angle_increment:g} rad x "
+                              f"{n_beams} beams spans more than one turn", path=path,
+                              trial=trial)
+    if time_increment is not None and not (np.isfinite(time_increment) and
+                                           abs(time_increment) * n_beams <= MAX_SWEEP_S):
+        raise FileFormatError(f"{where}: time_increment is {time_increment!r} s; over "
+                              f"{n_beams} beams a scan must take a finite time of at most "
+                              f"{MAX_SWEEP_S:g} s", path=path, trial=trial)
 #: Scan logs read in this process (a warm worker runs every method of a trial: seed 000's
 #: six tracks read the same log), by file identity; a caller gets its own copy.
 _READ = FileMemo(256 * 2 ** 20)
@@ -218,6 +242,9 @@ def _meta_fields(meta: dict, path: Path, trial: str | None) -> dict:
         raise FileFormatError(f"scan-log metadata field 'n_beams' is {g['n_beams']}; a "
                               f"laser scanner has at most {MAX_BEAMS} beams", path=path,
                               trial=trial)
+    inc = number(meta, "time_increment_s", optional=True, **kw)   # beam timing, if stated
+    check_scan_geometry("scan-log metadata", g["n_beams"], g["amin"], g["ainc"], inc, path,
+                        trial)
     return g
 
 
