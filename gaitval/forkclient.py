@@ -39,6 +39,29 @@ def _plain(args: list[str]) -> None:
     os.execv(sys.executable, [sys.executable, "-m", "gaitval", *args])
 
 
+def folder_problem(path: str) -> str | None:
+    """Why the folder of the socket ``path`` is not safe to use, or None.
+
+    The folder (``/tmp/gaitval-<uid>`` by default, workflow/rules/common.smk) lies in a
+    directory anyone can write to: another user who created it first could listen on the
+    socket and receive every job's environment and file descriptors.  So it must be a real
+    directory (not a symbolic link), owned by this user, with no access for group or
+    others (mode 0700).  Only ``os`` is used (this module's start-up budget)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    try:
+        st = os.lstat(folder)
+    except OSError as exc:
+        return f"cannot inspect it ({exc.strerror})"
+    if (st.st_mode & 0o170000) != 0o040000:
+        return "it is not a directory (a symbolic link or another file)"
+    if st.st_uid != os.getuid():
+        return f"it belongs to uid {st.st_uid}, not to this user (uid {os.getuid()})"
+    if st.st_mode & 0o077:
+        return (f"its mode is {st.st_mode & 0o777:04o}; group and others must have no "
+                "access (0700)")
+    return None
+
+
 def _recv_int(sock: _socket.socket) -> int | None:
     buf = b""
     while len(buf) < 4:
@@ -60,8 +83,16 @@ def submit(path: str, args: list[str], *, cwd: str, env: dict, fds: bytes = _FDS
     job.  A connection the server closes gives 1 with the reason on this process's standard
     error.  Used by :func:`main` (one job per process) and by the workflow's ``shell``
     (workflow/rules/common.smk), which calls it from Snakemake's own job thread, so a local
-    job starts no shell and no client.
+    job starts no shell and no client.  A socket whose folder is unsafe
+    (:func:`folder_problem`) is never connected to: a warning, then None.
     """
+    if not os.path.exists(path):
+        return None
+    why = folder_problem(path)
+    if why is not None:
+        sys.stderr.write(f"gaitval: warning: not using the fork server at {path}: its folder "
+                         f"is unsafe ({why}); running the plain command\n")
+        return None
     sock = _socket.socket(_socket.AF_UNIX, _socket.SOCK_STREAM)
     try:
         try:

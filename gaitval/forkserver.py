@@ -67,6 +67,8 @@ import time
 import traceback
 import warnings
 
+from gaitval.forkclient import folder_problem
+
 # Imported lazily by some verbs; warm them too (optional ones may be absent).
 THIRD_PARTY = ("numpy", "pandas", "pyarrow", "pyarrow.parquet", "pyarrow.csv", "scipy.signal",
                "scipy.stats", "scipy.optimize", "scipy.interpolate", "scipy.linalg",
@@ -306,6 +308,12 @@ def serve(path: str, owner: int | None, workers: int = 2, max_jobs: int = 2000,
     old = os.umask(0o077)
     try:
         os.makedirs(os.path.dirname(path), mode=0o700, exist_ok=True)
+        why = folder_problem(path)          # made by someone else before us, or loosened
+        if why is not None:
+            print(f"gaitval fork server: error: refusing the socket folder "
+                  f"{os.path.dirname(os.path.abspath(path))}: {why}; remove it (or fix it: "
+                  "chmod 700, owned by you) and start again", file=sys.stderr, flush=True)
+            return 1
         if os.path.exists(path):
             os.unlink(path)
         srv = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)

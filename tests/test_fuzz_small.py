@@ -27,3 +27,24 @@ def test_mutants_load_or_name_the_file(kind, realdata, tmp_path):
            if r["outcome"] in H.FAILURES]
     assert not bad, "\n".join(bad)
     assert {r["outcome"] for r in results} & {"load", "error"}
+
+
+def test_a_silently_short_or_non_finite_load_is_a_failure():
+    """The harness' own verdicts (issue 33): "loaded but short" is not a success."""
+    base = {"scans": {"/a": {"n_scans": 435, "rate_hz": 7.5, "duration_s": 58.0,
+                             "t_start_s": 1.0}}, "warnings": []}
+    short = {"scans": {"/a": {**base["scans"]["/a"], "n_scans": 82}}, "warnings": []}
+    assert H.judge_load("bag", short, base)["outcome"] == "short"
+    assert "n_scans 82 of 435" in H.judge_load("bag", short, base)["detail"]
+    gone = {"scans": {}, "warnings": []}
+    assert H.judge_load("bag", gone, base)["outcome"] == "short"
+    loud = {**short, "warnings": ["topic /a: 1 gap(s) longer than 5 x ..."]}
+    assert H.judge_load("bag", loud, base)["outcome"] == "warned"
+    assert H.judge_load("bag", base, base)["outcome"] == "load"
+    nan = {"scans": {"/a": {**base["scans"]["/a"], "rate_hz": None}}, "warnings": []}
+    assert H.judge_load("bag", nan, base)["outcome"] == "nonfinite"
+    c3d = {"rate_hz": 100.0, "n_frames": 94, "n_markers": 0, "t_start_s": 0.0,
+           "t_end_s": 0.93, "duration_s": 0.94, "warnings": ["duplicate marker labels"]}
+    seed = {**c3d, "n_markers": 137}
+    assert H.judge_load("c3d", c3d, seed)["outcome"] == "short"   # the seed's own warning
+    assert set(H.FAILURES) >= {"short", "nonfinite", "crash", "hang", "foreign", "unnamed"}

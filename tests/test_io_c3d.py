@@ -333,3 +333,118 @@ def test_describe_c3d_key_numbers(realdata):
     assert d4["prefix_stripped"] and d4["prefixes"] == ["Matt:"]
     dd = describe_c3d(realdata / "c3d" / "Gait_MotionAnalysis.c3d")
     assert dd["duplicates"]["LFOO"] == ["LFOO", "LFOO#2"]
+
+
+# -- issue 33: sizes, rates and counts checked before ezc3d reads; text encodings ------------
+
+def _set_param(data: bytes, group: str, name: str, value) -> bytes:
+    """``data`` with the first value of parameter ``group:name`` replaced (its own type)."""
+    import struct
+
+    from gaitval.io.c3d_params import parse_parameters
+    b = bytearray(data)
+    ps, ds = (b[0] - 1) * 512, (int.from_bytes(b[16:18], "little") - 1) * 512
+    p = parse_parameters(bytes(b[:ds]), ps, ds)[(group, name)]
+    struct.pack_into({4: "<f", 2: "<h", 1: "<b"}[p.type], b, p.offset, value)
+    return bytes(b)
+
+
+@pytest.mark.parametrize("group, name, value, message", [
+    ("ANALOG", "RATE", 3e9, "ANALOG:RATE is 3000000000.0 Hz; it must be at most 100,000 Hz"),
+    ("POINT", "RATE", 3e9, "POINT:RATE is 3000000000.0 Hz; it must be above 0"),
+    ("POINT", "RATE", 0.0, "POINT:RATE is 0.0"),
+    ("POINT", "USED", 0, r"no markers \(POINT:USED is 0\)"),
+    ("ANALOG", "RATE", 2000.0, "20 analog samples per frame, but the header says 10"),
+    ("ANALOG", "USED", 37, r"ANALOG:USED \(37 channels\) x 10 samples per frame = 370"),
+    ("POINT", "FRAMES", 40, "the header announces 94 frames"),
+])
+def test_issue33_reproducers_refused_quickly_naming_the_field(realdata, tmp_path, group, name,
+                                                               value, message):
+    """One parameter of a real PiG file changed: one clear error, before any allocation
+    (ANALOG:RATE 3e9 used to make ezc3d allocate 15.5 GB for 69 s)."""
+    import time
+
+    from gaitval.cli import main
+    src = realdata / "c3d" / "PiG_Calibration-FlatFoot-Full.c3d"
+    path = tmp_path / f"{group}_{name}.c3d"
+    path.write_bytes(_set_param(src.read_bytes(), group, name, value))
+    t0 = time.monotonic()
+    with pytest.raises(FileFormatError, match=message) as exc:
+        read_c3d(path, trial="S01_T1")
+    assert str(path) in str(exc.value) and "S01_T1" in str(exc.value)
+    assert time.monotonic() - t0 < 2.0
+    assert main(["inspect", str(path)]) == 1
+
+
+def test_header_frame_count_below_the_stored_frames_is_refused(realdata, tmp_path):
+    """A last-frame word cut to 4 used to load 4 of the 94 frames without a word."""
+    b = bytearray((realdata / "c3d" / "PiG_Calibration-FlatFoot-Full.c3d").read_bytes())
+    first = int.from_bytes(b[6:8], "little")
+    b[8:10] = (first + 3).to_bytes(2, "little")
+    b = bytearray(_set_param(bytes(b), "POINT", "FRAMES", 4))
+    (tmp_path / "short.c3d").write_bytes(bytes(b))
+    with pytest.raises(FileFormatError, match=r"announces 4 frames .* room for 94 frames"):
+        read_c3d(tmp_path / "short.c3d")
+
+
+def test_ezc3d_child_runs_under_an_address_space_limit():
+    from gaitval.io.isolate import ChildError, run_isolated
+
+    def hog(n):
+        return len(bytearray(n))
+    assert run_isolated(hog, 1 << 20, path="x.c3d", trial=None, what="t", timeout_s=30,
+                        memory_bytes=256 << 20) == 1 << 20
+    with pytest.raises(ChildError) as exc:
+        run_isolated(hog, 2 << 30, path="x.c3d", trial=None, what="t", timeout_s=30,
+                     memory_bytes=256 << 20)
+    assert exc.value.type_name == "MemoryError"
+
+
+def _analog_c3d(path: Path, units: str) -> None:
+    """A small C3D with one analog channel whose ANALOG:UNITS is ``units`` (5 ASCII bytes
+    that the caller patches)."""
+    import ezc3d
+    c = ezc3d.c3d()
+    c["parameters"]["POINT"]["RATE"]["value"] = [100]
+    c["parameters"]["POINT"]["LABELS"]["value"] = ["A", "B", "C"]
+    c["parameters"]["POINT"]["UNITS"]["value"] = ["mm"]
+    c["parameters"]["ANALOG"]["RATE"]["value"] = [200]
+    c["parameters"]["ANALOG"]["LABELS"]["value"] = ["acc"]
+    c["parameters"]["ANALOG"]["UNITS"]["value"] = [units]
+    rng = np.random.default_rng(0)
+    pts = np.ones((4, 3, 50))
+    pts[:3] = rng.normal(size=(3, 3, 50)) * 100 + np.array([0, 0, 1000])[:, None, None]
+    c["data"]["points"] = pts
+    c["data"]["analogs"] = rng.normal(size=(1, 1, 100))
+    c.write(str(path))
+
+
+def test_latin1_text_in_an_unused_parameter_loads(tmp_path):
+    """ANALOG:UNITS "mm/s²" with ² as Latin-1 byte 0xB2 (as a real file of another lab
+    holds it) used to be refused as "not UTF-8"; gaitval never reads analog channels."""
+    from gaitval.io.inspect import describe, format_description
+    _analog_c3d(tmp_path / "a.c3d", "mm/s2")
+    data = (tmp_path / "a.c3d").read_bytes()
+    assert data.count(b"mm/s2") == 1
+    (tmp_path / "latin1.c3d").write_bytes(data.replace(b"mm/s2", b"mm/s\xb2"))
+    tr = read_c3d(tmp_path / "latin1.c3d")
+    assert tr.xyz.shape == (50, 3, 3) and tr.labels == ["A", "B", "C"]
+    assert tr.meta["text_encodings"] == {"ANALOG:UNITS": "cp1252"}
+    assert read_c3d(tmp_path / "a.c3d").meta["text_encodings"] == {}
+    d = describe(tmp_path / "latin1.c3d")
+    assert d["text_encodings"] == {"ANALOG:UNITS": "cp1252"}
+    assert "ANALOG:UNITS cp1252" in format_description(d)
+
+
+def test_latin1_marker_label_is_decoded(tmp_path):
+    _analog_c3d(tmp_path / "a.c3d", "volts")
+    data = (tmp_path / "a.c3d").read_bytes()
+    tr = None
+    from gaitval.io.c3d_params import parse_parameters
+    ps, ds = (data[0] - 1) * 512, (int.from_bytes(data[16:18], "little") - 1) * 512
+    p = parse_parameters(data[:ds], ps, ds)[("POINT", "LABELS")]
+    b = bytearray(data)
+    b[p.offset] = 0xC9                                          # "A" -> Latin-1 "É"
+    (tmp_path / "label.c3d").write_bytes(bytes(b))
+    tr = read_c3d(tmp_path / "label.c3d")
+    assert tr.labels[0] == "É" and tr.meta["text_encodings"] == {"POINT:LABELS": "cp1252"}

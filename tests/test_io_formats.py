@@ -252,3 +252,125 @@ def test_a_bad_ingested_marker_table_is_an_error_naming_file_and_trial(tmp_path)
     pq.write_table(torn, tmp_path / "torn.parquet")
     with pytest.raises(FileFormatError, match="3 rows are not whole frames of 2 markers"):
         read_mocap_parquet(tmp_path / "torn.parquet", trial="T7")
+
+
+# -- issue 33: metadata and column types checked against each format's schema ---------------
+
+def _log_parts(kind: str):
+    """Columns, metadata key and metadata of a small valid log (the fuzz harness' seeds)."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parent / "fuzz"))
+    import fuzz_seeds
+    return fuzz_seeds.parquet_parts(kind)
+
+
+def _write_log(path, cols, key, meta):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    raw = json.dumps(meta).encode()               # NaN/inf as JSON's NaN/Infinity tokens
+    pq.write_table(pa.table(cols).replace_schema_metadata({key: raw}), path)
+    return path
+
+
+@pytest.mark.parametrize("kind, field, value, message", [
+    ("ultrasonic", "version", float("inf"), "'version' is inf"),
+    ("ultrasonic", "version", float("nan"), "'version' is nan"),
+    ("ultrasonic", "version", 2, "version 2 is newer"),
+    ("ultrasonic", "format", float("nan"), "'format' is nan, not text"),
+    ("ultrasonic", "format", "gaitval-scanlog", "'format' is 'gaitval-scanlog'"),
+    ("ultrasonic", "sensor_model", float("nan"), "'sensor_model' is nan, not text"),
+    ("scanlog", "scan_time_s", float("nan"), "'scan_time_s' is nan"),
+    ("scanlog", "scan_time_s", float("-inf"), "'scan_time_s' is -inf"),
+    ("scanlog", "scan_time_s", 3600.0, "a scan takes at most 10 s"),
+    ("scanlog", "sensor_model", float("nan"), "'sensor_model' is nan, not text"),
+    ("scanlog", "version", float("nan"), "'version' is nan"),
+    ("scanlog", "version", 0.5, "'version' is 0.5"),
+    ("scanlog", "format", None, "field 'format' is missing"),
+    ("scanlog", "time_increment_s", float("nan"), "'time_increment_s' is nan"),
+    ("scanlog", "time_increment_s", 0.5, "time_increment is 0.5 s; over 31 beams"),
+    ("scanlog", "angle_increment_rad", 1.0, "1 rad x 31 beams spans more than one turn"),
+    ("scanlog", "angle_min_rad", 10.0, "angle_min is 10 rad, more than one turn"),
+])
+def test_non_finite_or_wrong_metadata_is_refused_naming_the_field(tmp_path, kind, field,
+                                                                   value, message):
+    cols, key, meta = _log_parts(kind)
+    if value is None:
+        del meta[field]
+    else:
+        meta[field] = value
+    p = _write_log(tmp_path / f"x.{'scan' if kind == 'scanlog' else 'us'}.parquet", cols,
+                   key, meta)
+    read = read_scanlog if kind == "scanlog" else read_ultrasonic
+    with pytest.raises(FileFormatError, match=message) as exc:
+        read(p, trial="T9")
+    assert str(p) in str(exc.value) and "T9" in str(exc.value)
+    assert not getattr(exc.value, "unexpected", False)
+
+
+def _dtype_swap(cols, name, how):
+    import pyarrow as pa
+    n = len(cols["t_s"])
+    if how == "timestamp":
+        cols[name] = pa.array((np.asarray(cols[name]) * 1e9).astype("datetime64[ns]"))
+    elif how == "bool":
+        cols[name] = pa.array(np.ones(n, dtype=bool))
+    elif how == "int":
+        cols[name] = pa.array(np.arange(n, dtype=np.int64))
+    return cols
+
+
+@pytest.mark.parametrize("kind, column, how, message", [
+    ("ultrasonic", "temperature_c", "timestamp", "'temperature_c' holds timestamp"),
+    ("ultrasonic", "tof_R1_s", "bool", "'tof_R1_s' holds bool, not float numbers"),
+    ("ultrasonic", "tof_R2_s", "int", "'tof_R2_s' holds int64, not float numbers"),
+    ("ultrasonic", "t_s", "bool", "'t_s' holds bool"),
+    ("scanlog", "t_s", "bool", "'t_s' holds bool"),
+    ("scanlog", "t_s", "timestamp", "'t_s' holds timestamp"),
+])
+def test_wrong_column_types_are_refused(tmp_path, kind, column, how, message):
+    cols, key, meta = _log_parts(kind)
+    p = _write_log(tmp_path / f"x.{'scan' if kind == 'scanlog' else 'us'}.parquet",
+                   _dtype_swap(cols, column, how), key, meta)
+    read = read_scanlog if kind == "scanlog" else read_ultrasonic
+    with pytest.raises(FileFormatError, match=message) as exc:
+        read(p)
+    assert str(p) in str(exc.value)
+
+
+@pytest.mark.parametrize("kind, rows, message", [
+    ("scanlog", 0, "holds 0 scans; at least 2"),
+    ("scanlog", 1, "holds 1 scan; at least 2"),
+    ("ultrasonic", 0, "holds 0 samples; at least 2"),
+    ("ultrasonic", 1, "holds 1 sample; at least 2"),
+])
+def test_empty_and_one_row_logs_are_refused(tmp_path, kind, rows, message):
+    import pyarrow as pa
+    cols, key, meta = _log_parts(kind)
+    tab = pa.table(cols).slice(0, rows)
+    p = _write_log(tmp_path / f"x.{'scan' if kind == 'scanlog' else 'us'}.parquet",
+                   {c: tab[c] for c in tab.column_names}, key, meta)
+    read = read_scanlog if kind == "scanlog" else read_ultrasonic
+    with pytest.raises(FileFormatError, match=message):
+        read(p)
+
+
+def test_times_that_never_advance_and_hot_air_are_refused(tmp_path):
+    cols, key, meta = _log_parts("ultrasonic")
+    cols["t_s"] = np.full(len(cols["t_s"]), 5.0)
+    with pytest.raises(FileFormatError, match="never advances"):
+        read_ultrasonic(_write_log(tmp_path / "a.us.parquet", cols, key, meta))
+    cols, key, meta = _log_parts("ultrasonic")
+    cols["temperature_c"] = cols["temperature_c"].copy()
+    cols["temperature_c"][3] = 2.19e10
+    with pytest.raises(FileFormatError, match="'temperature_c' holds 21900000000.0 degC at "
+                                              "row 3"):
+        read_ultrasonic(_write_log(tmp_path / "b.us.parquet", cols, key, meta))
+
+
+def test_the_seed_logs_load(tmp_path):
+    for kind, read in (("scanlog", read_scanlog), ("ultrasonic", read_ultrasonic)):
+        cols, key, meta = _log_parts(kind)
+        p = _write_log(tmp_path / f"x.{'scan' if kind == 'scanlog' else 'us'}.parquet",
+                       cols, key, meta)
+        assert len(read(p).t) == 20

@@ -190,3 +190,97 @@ def test_describe_real_bag(realdata):
     assert s["n_no_return"] > 1265
     text = format_description(d)
     assert "1265" in text and "512" in text and "/scan" in text
+
+
+# -- issue 33: short loads are errors (index vs contents) or loud warnings (gaps) ----------
+
+def _patch_u32(data: bytes, field: bytes, value: int, start: int = 0) -> bytes:
+    import struct
+    b = bytearray(data)
+    i = b.find(field, start) + len(field)
+    struct.pack_into("<I", b, i, value)
+    return bytes(b)
+
+
+@pytest.mark.realdata
+@pytest.mark.parametrize("patch, message", [
+    ("chunk_count", "the bag header announces chunk_count=1, the file holds 6 chunk records"),
+    ("chunk_count=0", "the bag header announces chunk_count=0, the file holds 6 chunk records"),
+    ("conn", r"list messages of connection\(s\) \[7\], which the bag does not define"),
+    ("info", r"topic /left_scan \(connection 0\): the index records list 435 messages, the "
+             "chunk infos 430, and 435 were read"),
+])
+def test_bag_whose_index_disagrees_is_refused_with_counts(realdata, tmp_path, patch,
+                                                         message):
+    """The issue's reproducers: chunk_count=1 loaded 82 of 435 scans per topic, and a
+    corrupted connection id dropped a topic, both with rc 0 and "timestamps clean"."""
+    import struct
+
+    from gaitval.cli import main
+    from gaitval.io.rosbag_check import _fields
+    data = (realdata / "lrs" / "negative_2.bag").read_bytes()
+    records, pos = [], 13                      # (start, fields, data start) of each record
+    while pos < len(data):
+        hlen = struct.unpack_from("<I", data, pos)[0]
+        dlen = struct.unpack_from("<I", data, pos + 4 + hlen)[0]
+        records.append((pos, _fields(data[pos + 4:pos + 4 + hlen], pos), pos + 8 + hlen))
+        pos += 8 + hlen + dlen
+    if patch.startswith("chunk_count"):                 # 0: a bag without any topic
+        data = _patch_u32(data, b"chunk_count=", 0 if patch.endswith("0") else 1)
+    elif patch == "conn":                      # the first index record after a chunk
+        at = next(r[0] for r in records if r[1]["op"] == b"\x04")
+        data = _patch_u32(data, b"conn=", 7, at)
+    else:                                      # the first chunk info's count of conn 0
+        at = next(r for r in records if r[1]["op"] == b"\x06")
+        b = bytearray(data)
+        for k in range(struct.unpack("<I", at[1]["count"])[0]):
+            conn, n = struct.unpack_from("<II", b, at[2] + 8 * k)
+            if conn == 0:
+                struct.pack_into("<I", b, at[2] + 8 * k + 4, n - 5)
+        data = bytes(b)
+    path = tmp_path / "broken.bag"
+    path.write_bytes(data)
+    with pytest.raises(FileFormatError, match=message) as exc:
+        read_rosbag_scans(path, "/left_scan", trial="S03_T1")
+    assert str(path) in str(exc.value) and "S03_T1" in str(exc.value)
+    assert main(["inspect", str(path)]) == 1
+
+
+@pytest.mark.realdata
+def test_real_bags_pass_the_index_checks_without_warnings(realdata):
+    from gaitval.io.rosbag_check import walk_bag1
+    s = walk_bag1(realdata / "lrs" / "negative_2.bag")
+    assert (s["chunk_count"], s["chunks"], s["chunk_infos"]) == (6, 6, 6)
+    assert s["index_counts"] == s["info_counts"] == {0: 435, 1: 435, 2: 434}
+    for topic, n in (("/left_scan", 435), ("/right_scan", 434)):
+        got = read_rosbag_scans(realdata / "lrs" / "negative_2.bag", topic)
+        assert got.n_scans == n and got.meta["warnings"] == []
+
+
+def test_ros2_message_count_that_disagrees_is_refused(tmp_path):
+    p = write_ros2_bag(tmp_path / "mc", {"/scan": [(10**9 + k * 10**8, 1 + k, R5)
+                                                   for k in range(10)]})
+    meta = (p / "metadata.yaml").read_text()
+    assert "message_count: 10" in meta
+    (p / "metadata.yaml").write_text(meta.replace("message_count: 10", "message_count: 12"))
+    with pytest.raises(FileFormatError, match="lists 12 messages, 10 were read"):
+        read_rosbag_scans(p)
+
+
+def test_a_long_gap_is_a_loud_warning(tmp_path, caplog):
+    stamps = [10**9 + k * 25_000_000 for k in range(40)]
+    stamps = stamps[:20] + [s + 2 * 10**9 for s in stamps[20:]]      # a 2.025 s gap
+    p = write_ros2_bag(tmp_path / "gap", {"/scan": [(s, s, R5) for s in stamps]})
+    with caplog.at_level("WARNING", logger="gaitval.io.rosbag"):
+        s = read_rosbag_scans(p)
+    assert s.n_scans == 40
+    want = "1 gap(s) longer than 5 x the median scan period (0.025 s); the longest is " \
+           "2.02 s after scan 19 of 40"
+    assert s.meta["warnings"] == [f"topic /scan: {want}"]
+    assert want in caplog.text
+    d = describe(p)
+    assert d["warnings"] == [f"topic /scan: {want}"]
+    assert f"WARNING: topic /scan: {want}" in format_description(d)
+    q = write_ros2_bag(tmp_path / "even", {"/scan": [(s, s, R5) for s in stamps[:20]]})
+    assert read_rosbag_scans(q).meta["warnings"] == []
+    assert "warnings:     none" in format_description(describe(q))

@@ -246,3 +246,42 @@ def test_a_walking_subject_is_still_found(realdata):
     scans = read_rosbag_scans(realdata / "lrs" / "positive_1.bag")
     track = track_trial(scans, "tug_m1", 0.10)
     assert track["x_m"].notna().mean() > 0.9
+
+
+# -- issue 33: the fork server's socket folder must be ours and private -------------------
+def test_socket_folder_must_be_a_private_directory_of_this_user(tmp_path, capsys):
+    import socket
+
+    from gaitval.forkclient import folder_problem, submit
+    from gaitval.forkserver import serve
+    ok = tmp_path / "ok"
+    ok.mkdir(mode=0o700)
+    assert folder_problem(str(ok / "x.sock")) is None
+    loose = tmp_path / "loose"
+    loose.mkdir()
+    loose.chmod(0o777)
+    assert "mode is 0777" in folder_problem(str(loose / "x.sock"))
+    link = tmp_path / "link"
+    link.symlink_to(ok)
+    assert "not a directory" in folder_problem(str(link / "x.sock"))
+    if os.getuid() == 0:                     # only root can give a folder to someone else
+        other = tmp_path / "other"
+        other.mkdir(mode=0o700)
+        os.chown(other, 65534, -1)
+        assert "belongs to uid 65534" in folder_problem(str(other / "x.sock"))
+    # the server refuses the loose folder and leaves it alone
+    assert serve(str(loose / "x.sock"), owner=None, workers=1) == 1
+    assert "refusing the socket folder" in capsys.readouterr().err
+    assert not (loose / "x.sock").exists()
+    # a client never connects to a socket in it (someone else may be listening there)
+    srv = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    srv.bind(str(loose / "y.sock"))
+    srv.listen(1)
+    srv.settimeout(0.2)
+    try:
+        assert submit(str(loose / "y.sock"), ["--version"], cwd=str(tmp_path), env={}) is None
+        assert "its folder is unsafe (its mode is 0777" in capsys.readouterr().err
+        with pytest.raises(socket.timeout):
+            srv.accept()
+    finally:
+        srv.close()

@@ -81,7 +81,9 @@ def describe_c3d(path: str | Path, *, trial: str | None = None) -> dict[str, Any
     ``gap_fraction`` (missing samples / all samples), ``events`` (list of
     ``{context, label, t_s}``), ``prefixes``, ``prefix_stripped`` (bool),
     ``duplicates``, ``n_zero_gaps``, ``n_analogs``, ``analog_rate_hz``, ``manufacturer``,
-    ``vertical_axis`` (the stored axis that points up; see :mod:`gaitval.io.c3d_axes`).
+    ``vertical_axis`` (the stored axis that points up; see :mod:`gaitval.io.c3d_axes`),
+    ``text_encodings`` (parameter -> encoding, for text that is not UTF-8), ``warnings``
+    (what the reader logged as a warning).
     """
     tr = read_c3d(path, trial=trial)
     miss = np.isnan(tr.xyz[:, :, 0])
@@ -114,4 +116,6 @@ def describe_c3d(path: str | Path, *, trial: str | None = None) -> dict[str, Any
         "analog_rate_hz": float(tr.meta["analog_rate_hz"]),
         "manufacturer": tr.meta["manufacturer"],
         "vertical_axis": tr.meta["vertical_axis"],
+        "text_encodings": dict(tr.meta.get("text_encodings", {})),
+        "warnings": list(tr.meta.get("warnings", [])),
     }

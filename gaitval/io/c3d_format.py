@@ -25,6 +25,17 @@ from gaitval.io.c3d_params import ParameterProblem, Parameters, float_at, parse_
 UNIT_SCALE = {"mm": 1e-3, "cm": 1e-2, "m": 1.0}
 EVENT_COLUMNS = ["context", "label", "t_s"]
 _PROCESSORS = {84: "Intel", 85: "DEC", 86: "MIPS (SGI)"}
+#: highest point or analog rate accepted (Hz): motion capture runs at up to a few kHz and
+#: force plates at up to ~20 kHz; a rate above this is a corrupt parameter
+MAX_RATE_HZ = 100_000.0
+#: largest data section (bytes, as stored) gaitval hands to ezc3d, which needs ~10 times
+#: as much memory to hold it (a 60,000-frame, 100-marker capture with analogs is ~150 MB)
+MAX_DATA_BYTES = 512 * 2 ** 20
+#: address space the ezc3d child may add to its parent's: a fixed allowance plus this
+#: many bytes per stored byte (measured: ezc3d 1.7.2 holds 1.6 MB of data in ~16 MB, and
+#: the child copies the points to numpy and pickles them)
+EZC3D_MEMORY_BASE = 768 * 2 ** 20
+EZC3D_MEMORY_PER_BYTE = 32
 #: numeric parameters that must be finite and >= 0 (True) or > 0 (False) wherever present
 _FINITE = ((("POINT", "RATE"), False), (("POINT", "FRAMES"), True),
            (("ANALOG", "RATE"), True), (("TRIAL", "CAMERA_RATE"), True),
@@ -78,9 +89,12 @@ def _precheck(path: Path, trial: str | None) -> dict[str, Any]:
                                                 "software") from None
     if proc == "DEC":                                      # header floats in DEC format
         hdr.update(scale=float_at(head, 12, True), rate=float_at(head, 20, True))
-    expected = _check_layout(hdr, params, size, path, trial)
+    expected, data_bytes = _check_layout(hdr, params, size, path, trial)
     return {"processor": proc, "first_frame_word": hdr["first"],
             "last_frame_word": hdr["last"], "frames_expected": expected,
+            "data_bytes": data_bytes,
+            "encodings": {p.label: p.encoding for p in params.params.values()
+                          if p.type == -1 and p.encoding != "utf-8"},
             "frames_only": _frames_only_layout(hdr, params, proc, expected)}
 
 
@@ -123,10 +137,11 @@ def _processor(code: int, path: Path, trial: str | None) -> str:
 
 
 def _check_layout(hdr: dict, params: Parameters, size: int, path: Path,
-                  trial: str | None) -> int:
+                  trial: str | None) -> tuple[int, int]:
     """Finite, consistent header and parameters; a data section that holds every frame.
 
-    Returns the number of frames the file announces.
+    Returns the number of frames the file announces and the bytes its data section holds
+    by the header (:func:`_check_size`).
     """
     def refuse(problem: str):
         raise FileFormatError(problem, path=path, trial=trial,
@@ -142,6 +157,7 @@ def _check_layout(hdr: dict, params: Parameters, size: int, path: Path,
                        f"{'>= 0' if allow_zero else '> 0'}")
     if not math.isfinite(hdr["scale"]):
         refuse(f"the header's scale factor is {hdr['scale']!r}")
+    _check_rates_and_counts(hdr, params, refuse)
     for (group, name), want in ((("POINT", "USED"), hdr["n_points"]),
                                 (("POINT", "DATA_START"), hdr["data_start"])):
         got = params.count(group, name) if name == "USED" else params.first(group, name)
@@ -167,11 +183,50 @@ def _check_layout(hdr: dict, params: Parameters, size: int, path: Path,
     return _check_size(hdr, params, size, path, trial)
 
 
+def _check_rates_and_counts(hdr: dict, params: Parameters, refuse) -> None:
+    """Rates within (0, :data:`MAX_RATE_HZ`], at least one marker, and analog parameters
+    that agree with the header's analog words (ezc3d sizes its analog buffers from
+    ANALOG:RATE / POINT:RATE: a rate of 3e9 asked it for 15 GB)."""
+    p_rate = params.first("POINT", "RATE")
+    rate, field = (p_rate, "POINT:RATE") if p_rate is not None else \
+        (hdr["rate"], "the header's frame rate")
+    if not (math.isfinite(rate) and 0 < rate <= MAX_RATE_HZ):
+        refuse(f"{field} is {rate!r} Hz; it must be above 0 and at most "
+               f"{MAX_RATE_HZ:,.0f} Hz")
+    used = params.count("POINT", "USED")
+    if used == 0 or hdr["n_points"] == 0:
+        refuse("the file holds no markers (" + ("POINT:USED is 0" if used == 0 else
+                                                 "the header's point count is 0") + ")")
+    a_rate = params.first("ANALOG", "RATE")
+    if a_rate is not None and not (math.isfinite(a_rate) and 0 <= a_rate <= MAX_RATE_HZ):
+        refuse(f"ANALOG:RATE is {a_rate!r} Hz; it must be at most {MAX_RATE_HZ:,.0f} Hz")
+    a_used = params.count("ANALOG", "USED") or 0
+    if not (hdr["n_analog"] or a_used):
+        return
+    if not a_rate:
+        refuse(f"ANALOG:USED is {a_used:g} (header: {hdr['n_analog']} analog samples per "
+               f"frame) but ANALOG:RATE is {a_rate!r}")
+    per_frame = a_rate / rate                                      # samples per frame
+    if abs(per_frame - round(per_frame)) > 1e-3 or round(per_frame) < 1:
+        refuse(f"ANALOG:RATE ({a_rate:g} Hz) / {field} ({rate:g} Hz) = {per_frame:g} "
+               "analog samples per point frame, not a whole number")
+    per_frame = round(per_frame)
+    if hdr["n_analog"] and per_frame != hdr["analog_per_frame"]:
+        refuse(f"ANALOG:RATE / {field} = {a_rate:g} / {rate:g} Hz = {per_frame} analog "
+               f"samples per frame, but the header says {hdr['analog_per_frame']}")
+    if a_used * per_frame != hdr["n_analog"]:
+        refuse(f"ANALOG:USED ({a_used:g} channels) x {per_frame} samples per frame = "
+               f"{a_used * per_frame:g} analog values per frame, but the header says "
+               f"{hdr['n_analog']}")
+
+
 def _check_size(hdr: dict, params: Parameters, size: int, path: Path,
-                trial: str | None) -> int:
+                trial: str | None) -> tuple[int, int]:
     """The data section must hold the frames the header announces (POINT:FRAMES where the
-    header's 16-bit last-frame word is saturated); returns the larger of the two counts,
-    which the reader compares with what ezc3d read."""
+    header's 16-bit last-frame word is saturated), no whole frame more beyond two 512-byte
+    blocks of padding (ezc3d's writer adds a block), and at most :data:`MAX_DATA_BYTES`.
+    Returns the larger of the two frame counts, which the reader compares with what ezc3d
+    read, and the bytes the announced frames take."""
     n_header = hdr["last"] - hdr["first"] + 1 if hdr["last"] >= hdr["first"] else 0
     p_frames = params.count("POINT", "FRAMES")
     p_frames = 0 if p_frames is None else int(p_frames)
@@ -195,7 +250,23 @@ def _check_size(hdr: dict, params: Parameters, size: int, path: Path,
             f"at {expected}: ezc3d reads only those, and the rest would be lost without a "
             "word", path=path, trial=trial,
             hint="export the capture in parts of at most 65,535 frames")
-    return max(expected, p_frames if 0 < p_frames < 0xFFFF else 0)
+    frames = max(expected, p_frames if 0 < p_frames < 0xFFFF else 0)
+    data_bytes = frames * frame_bytes
+    if frame_bytes and room - expected * frame_bytes >= max(2 * 512, frame_bytes):
+        raise FileFormatError(
+            f"the header announces {expected} frames of {frame_bytes} bytes "
+            f"({expected * frame_bytes} bytes) but the data section holds {room} bytes, "
+            f"room for {room // frame_bytes} frames: the frame count (header words 4-5, "
+            "POINT:FRAMES) or the point/analog counts are wrong, and reading would lose "
+            "or misplace frames", path=path, trial=trial,
+            hint="re-export the file from the capture software")
+    if data_bytes > MAX_DATA_BYTES:
+        raise FileFormatError(
+            f"the data section holds {data_bytes / 2 ** 20:.0f} MiB ({frames} frames of "
+            f"{frame_bytes} bytes), more than gaitval reads at once "
+            f"({MAX_DATA_BYTES / 2 ** 20:.0f} MiB; ezc3d needs ~10 times that in memory)",
+            path=path, trial=trial, hint="export the capture in shorter parts")
+    return frames, data_bytes
 
 
 def _trial_frames(params: Parameters) -> int:
@@ -251,14 +322,23 @@ def _open_ezc3d(path: Path, trial: str | None, pre: dict | None = None) -> dict[
 
 
 def _ezc3d_child(target: Path, path: Path, trial: str | None) -> dict[str, Any]:
-    """:func:`_extract` of ``target`` in a child process; errors name ``path``."""
+    """:func:`_extract` of ``target`` in a child process under a time and an
+    address-space limit (:data:`EZC3D_MEMORY_BASE` + :data:`EZC3D_MEMORY_PER_BYTE` x the
+    file's size); errors name ``path``."""
     from gaitval.io.isolate import ChildError, run_isolated
 
-    timeout = 60.0 + 20.0 * target.stat().st_size / 1e6       # generous: ~1 s/MB is usual
+    n_bytes = target.stat().st_size
+    timeout = 60.0 + 20.0 * n_bytes / 1e6                     # generous: ~1 s/MB is usual
+    memory = EZC3D_MEMORY_BASE + EZC3D_MEMORY_PER_BYTE * n_bytes
     try:
         return run_isolated(_extract, str(target), path=path, trial=trial, what="ezc3d",
-                            timeout_s=timeout)
+                            timeout_s=timeout, memory_bytes=memory)
     except ChildError as exc:  # ezc3d raises OSError, RuntimeError, ValueError, IndexError
+        if exc.type_name == "MemoryError" or "bad_alloc" in str(exc):
+            raise FileFormatError(f"ezc3d needed more than {memory / 2 ** 20:.0f} MiB to read "
+                                  f"it (the limit for a {n_bytes / 2 ** 20:.1f} MiB file): "
+                                  "a size in the header or parameters is corrupt",
+                                  path=path, trial=trial) from None
         raise FileFormatError(_ezc3d_reason(exc), path=path, trial=trial) from None
 
 

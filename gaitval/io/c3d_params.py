@@ -2,12 +2,13 @@
 
 Part of :mod:`gaitval.io.c3d` (see :mod:`gaitval.io.c3d_format` for the header and data
 checks).  ezc3d 1.7.2 [1]_ trusts the section: a parameter whose type byte is wrong
-(``0xFF`` makes POINT:USED a character parameter), a description or text value that is not
-UTF-8, or a pointer out of the file crashes the interpreter (segmentation fault) or makes it
+(``0xFF`` makes POINT:USED a character parameter), a control byte in a text, or a pointer
+out of the file crashes the interpreter (segmentation fault) or makes it
 loop.  :func:`parse_parameters` walks the section's linked list once and raises
 :class:`ParameterProblem` naming the group, parameter and field for anything ezc3d could
 trip on; :class:`Parameters` then gives typed values of the parameters gaitval and ezc3d
-read.
+read.  Text (values and descriptions) is UTF-8 or, failing that, CP-1252 or Latin-1
+(:func:`text_encoding`): real files written on Windows hold "mm/s\u00b2" as byte 0xB2.
 
 C3D User Guide [2]_, parameter section: a 4-byte header (byte 3 = number of parameter
 blocks, byte 4 = processor type 83 + n), then records ``name length (int8, negative =
@@ -78,16 +79,40 @@ class Param:
         return f"{self.group}:{self.name}"
 
     @property
+    def encoding(self) -> str | None:
+        """The text encoding of a character parameter (:func:`text_encoding`), else None."""
+        return text_encoding(self.data) if self.type == -1 else None
+
+    @property
     def count(self) -> int:
         return math.prod(self.dims) // (self.dims[0] if self.type == -1 and self.dims else 1)
 
 
+#: text encodings tried in turn (C3D text written on Windows is often CP-1252 or Latin-1;
+#: Latin-1 decodes any byte, so it is the last resort)
+ENCODINGS = ("utf-8", "cp1252", "latin-1")
+
+
+def text_encoding(raw: bytes) -> str:
+    """The first of :data:`ENCODINGS` that decodes ``raw``."""
+    for enc in ENCODINGS[:-1]:
+        try:
+            raw.decode(enc)
+            return enc
+        except UnicodeDecodeError:
+            pass
+    return ENCODINGS[-1]
+
+
+def decode_text(raw: bytes) -> str:
+    """``raw`` decoded with :func:`text_encoding` (never fails)."""
+    return raw.decode(text_encoding(raw))
+
+
 def _text_problem(raw: bytes) -> str | None:
-    """Why ``raw`` is not safe text for ezc3d (UTF-8 without control characters), or None."""
-    try:
-        raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        return f"byte 0x{raw[exc.start]:02X} at position {exc.start} is not UTF-8 text"
+    """Why ``raw`` is not safe text for ezc3d (no control characters), or None.  Bytes
+    that are not UTF-8 are read as CP-1252/Latin-1 (:func:`text_encoding`); ezc3d passes
+    them through (as surrogates), and the reader decodes them the same way."""
     bad = next((c for c in raw if c in _TEXT_CONTROL), None)
     return None if bad is None else f"control byte 0x{bad:02X}"
 
@@ -99,7 +124,7 @@ def parse_parameters(b: bytes, start: int, end: int) -> dict[tuple[str, str], Pa
     ------
     ParameterProblem
         A record that leaves the section, an unreadable name, an unknown type, data that
-        overruns its record, a description or text value that is not UTF-8, a parameter
+        overruns its record, a description or text value with control bytes, a parameter
         of an unknown group, or a chain that does not end.
     """
     groups: dict[int, str] = {}

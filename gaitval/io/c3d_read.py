@@ -24,6 +24,7 @@ import pandas as pd
 from gaitval.errors import FileFormatError
 from gaitval.io.c3d_axes import detect_vertical, to_z_up
 from gaitval.io.c3d_format import EVENT_COLUMNS, UNIT_SCALE, _open_ezc3d, _precheck
+from gaitval.io.c3d_params import decode_text
 from gaitval.types import MocapTrial
 
 # the reader's messages keep the name of the module users import it from
@@ -36,12 +37,23 @@ def _param(c, group: str, name: str, default=None):
         return default
 
 
+def _text(s) -> str:
+    """A text value as ezc3d passes it (bytes that are not UTF-8 as lone surrogates),
+    decoded as the parameter check decoded it: UTF-8, else CP-1252, else Latin-1."""
+    s = str(s)
+    try:
+        s.encode("utf-8")
+    except UnicodeEncodeError:
+        s = decode_text(s.encode("utf-8", "surrogateescape"))
+    return s.strip("\x00 \t")
+
+
 def _strings(value) -> list[str]:
     if value is None:
         return []
     if isinstance(value, str):
-        return [value.strip("\x00 \t")]
-    return [str(v).strip("\x00 \t") for v in np.asarray(value, dtype=object).ravel()]
+        return [_text(value)]
+    return [_text(v) for v in np.asarray(value, dtype=object).ravel()]
 
 
 def _first_number(value, default=None):
@@ -240,6 +252,15 @@ def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "s
         "first_frame_header": header_ff,
         "subjects": _strings(_param(c, "SUBJECTS", "NAMES")),
         "vertical_axis": up,
+        # parameters whose text is not UTF-8 -> the encoding it was read with
+        "text_encodings": dict(pre.get("encodings", {})),
+        # what was logged as a warning while reading (gaitval inspect lists it)
+        "warnings": ([f"duplicate marker labels kept with suffixes: "
+                      + "; ".join(f"{k} -> {', '.join(v)}" for k, v in dups.items())]
+                     if dups else [])
+        + ([f"the markers say {up} points up; rotated to gaitval's z-up field frame"]
+           if vertical == "auto" and up not in (None, "+z") and not up.startswith("+z")
+           else []),
     }
     return MocapTrial(path=str(path), rate_hz=rate, first_frame=int(ff), labels=labels,
                       xyz=xyz, events=events, units=units, meta=meta)
@@ -255,6 +276,9 @@ def _point_data(c, pre: dict, path: Path, trial: str | None) -> np.ndarray:
     expected = pre["frames_expected"]          # header words and POINT:FRAMES, any processor
     if n_frames == 0:
         raise FileFormatError("C3D file holds no point frames (empty or truncated)",
+                              path=path, trial=trial)
+    if pts.shape[1] == 0:
+        raise FileFormatError(f"C3D file holds no markers over its {n_frames} frames",
                               path=path, trial=trial)
     if n_frames < expected:
         raise FileFormatError(f"C3D file is truncated: the header announces {expected} "

@@ -89,3 +89,66 @@ def column_names(table, path: Path, trial: str | None) -> list[str]:
     except UnicodeDecodeError:
         raise FileFormatError("the Parquet column names are not UTF-8 text", path=path,
                               trial=trial) from None
+
+
+def text_field(meta: dict, key: str, path: Path, trial: str | None, *,
+               what: str = "metadata", expected: str | None = None,
+               optional: bool = True) -> str | None:
+    """``meta[key]`` as text (``expected``: the one value allowed); FileFormatError naming
+    the field for a number (NaN stored as a sensor name), a list or anything else."""
+    v = meta.get(key)
+    if v is None:
+        if optional and expected is None:
+            return None
+        raise FileFormatError(f"{what} incomplete: field {key!r} is missing", path=path,
+                              trial=trial, hint="see docs/formats.md")
+    if not isinstance(v, str):
+        raise FileFormatError(f"{what} field {key!r} is {v!r}, not text", path=path,
+                              trial=trial)
+    if expected is not None and v != expected:
+        raise FileFormatError(f"{what} field {key!r} is {v!r}, expected {expected!r}",
+                              path=path, trial=trial, hint="see docs/formats.md")
+    return v
+
+
+def version_field(meta: dict, newest: int, path: Path, trial: str | None, *,
+                  what: str = "metadata") -> int:
+    """``meta["version"]``: a whole number from 1 to ``newest`` (NaN, inf, 0, 1.5 and
+    versions newer than this gaitval reads are refused, naming the field)."""
+    v = number(meta, "version", path, trial, what=what, minimum=1, integer=True)
+    if v > newest:
+        raise FileFormatError(f"{what}: version {v} is newer than this gaitval reads "
+                              f"({newest})", path=path, trial=trial,
+                              hint="update gaitval")
+    return int(v)
+
+
+def column_kind(table, name: str, kinds: tuple[str, ...], path: Path,
+                trial: str | None, *, what: str = "column") -> None:
+    """The Parquet column ``name`` holds one of ``kinds`` ("float", "integer"); a bool,
+    timestamp, text or any other type is a FileFormatError naming the column and type
+    (a timestamp read as float showed 2.19e10 degC; bools turned times into 0/1)."""
+    import pyarrow as pa
+
+    typ = table.schema.field(name).type
+    ok = (("float" in kinds and pa.types.is_floating(typ))
+          or ("integer" in kinds and pa.types.is_integer(typ)))
+    if not ok:
+        raise FileFormatError(f"{what} {name!r} holds {typ}, not "
+                              f"{' or '.join(k + ' numbers' for k in kinds)}", path=path,
+                              trial=trial, hint="see docs/formats.md")
+
+
+def enough_rows(t, minimum: int, path: Path, trial: str | None, *, what: str,
+                unit: str) -> None:
+    """At least ``minimum`` rows whose times advance at least once (a rate exists)."""
+    import numpy as np
+
+    n = len(t)
+    if n < minimum:
+        raise FileFormatError(f"{what} holds {n} {unit}{'s' if n != 1 else ''}; at least "
+                              f"{minimum} are needed (a rate and a duration)", path=path,
+                              trial=trial)
+    if n >= 2 and not np.any(np.diff(np.asarray(t, dtype=float)) > 0):
+        raise FileFormatError(f"{what}: the column 't_s' never advances over its {n} "
+                              f"{unit}s (no rate)", path=path, trial=trial)

@@ -252,6 +252,9 @@ def format_description(d: dict[str, Any]) -> str:
                         f"{_f(d['analog_rate_hz'], 'g')} Hz (not read)"))
         if d.get("manufacturer"):
             out.append(_row("written by", d["manufacturer"]))
+        enc = d.get("text_encodings") or {}
+        out.append(_row("text", "UTF-8" if not enc else "UTF-8, except " + ", ".join(
+            f"{k} {v}" for k, v in enc.items())))
     elif kind == "rosbag":
         out += [_row("ROS version", str(d["ros_version"])),
                 _row("duration", _f(d["duration_s"], ".2f", " s")),
@@ -293,5 +296,11 @@ def format_description(d: dict[str, Any]) -> str:
             out.append(_row("target steps", ", ".join(
                 f"{k} {v}" for k, v in d["target_steps"].items())))
     else:
-        out += [_row(str(k), str(v)) for k, v in d.items() if k not in ("kind", "path")]
+        out += [_row(str(k), str(v)) for k, v in d.items()
+                if k not in ("kind", "path", "warnings")]
+    warns = list(d.get("warnings") or [])
+    for s in (d.get("scans") or {}).values():
+        warns += [w for w in s.get("warnings") or [] if w not in warns]
+    out.append(_row("warnings", "none" if not warns else str(len(warns))))
+    out += [f"  WARNING: {w}" for w in warns]
     return "\n".join(out) + "\n"

@@ -56,7 +56,7 @@ def _signal_name(sig: int) -> str:
 
 
 def run_isolated(func: Callable[..., Any], *args: Any, path: str | Path, trial: str | None,
-                 what: str, timeout_s: float) -> Any:
+                 what: str, timeout_s: float, memory_bytes: int | None = None) -> Any:
     """``func(*args)`` in a forked child; its result, or an error naming ``path``.
 
     Parameters
@@ -69,6 +69,10 @@ def run_isolated(func: Callable[..., Any], *args: Any, path: str | Path, trial: 
         Who does the work, for the message (``"ezc3d"``).
     timeout_s : float
         Longest time the child may take.
+    memory_bytes : int, optional
+        Address space the child may add to the parent's (``RLIMIT_AS`` in the child, never
+        above an inherited limit): an allocation beyond it fails there (``MemoryError``,
+        ``std::bad_alloc``) instead of swapping the machine.
 
     Raises
     ------
@@ -84,7 +88,7 @@ def run_isolated(func: Callable[..., Any], *args: Any, path: str | Path, trial: 
     pid = os.fork()
     if pid == 0:                                                    # the child
         os.close(rfd)
-        _child(func, args, wfd)
+        _child(func, args, wfd, memory_bytes)
     os.close(wfd)
     try:
         data, timed_out = _collect(rfd, timeout_s)
@@ -114,7 +118,32 @@ def run_isolated(func: Callable[..., Any], *args: Any, path: str | Path, trial: 
     return payload
 
 
-def _child(func, args, wfd: int) -> None:
+def _limit_memory(extra_bytes: int) -> None:
+    """``RLIMIT_AS`` = this process's virtual size + ``extra_bytes`` (not above the
+    inherited limit).  Without ``/proc`` (macOS, which does not enforce ``RLIMIT_AS``
+    anyway) the virtual size is unknown and nothing is limited."""
+    import resource
+
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            vm = next((int(line.split()[1]) * 1024 for line in fh
+                       if line.startswith("VmSize:")), 0)
+    except OSError:
+        return
+    if not vm:
+        return
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    want = vm + int(extra_bytes)
+    for lim in (soft, hard):
+        if lim != resource.RLIM_INFINITY:
+            want = min(want, lim)
+    try:
+        resource.setrlimit(resource.RLIMIT_AS, (want, hard))
+    except (ValueError, OSError):                      # a platform without RLIMIT_AS
+        pass
+
+
+def _child(func, args, wfd: int, memory_bytes: int | None = None) -> None:
     """Body of the child: run, pickle, write, and leave without running parent clean-ups."""
     global _IN_CHILD
     _IN_CHILD = True
@@ -122,6 +151,8 @@ def _child(func, args, wfd: int) -> None:
     try:
         import faulthandler
         faulthandler.disable()          # the parent reports a crash; no dump on its stderr
+        if memory_bytes is not None:
+            _limit_memory(memory_bytes)
         try:
             out = ("ok", func(*args))
         except BaseException as exc:       # noqa: BLE001 - carried to the parent

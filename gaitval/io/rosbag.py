@@ -25,6 +25,19 @@ Ranges
 Geometry
     ``angle_min`` and ``angle_increment`` come from the first message; a change of beam
     count, ``angle_min`` or ``angle_increment`` within the topic is a FileFormatError.
+Short loads (errors)
+    The messages read must be the messages the bag's index lists: for every connection
+    of the topic, the connection's message count (ROS 1 chunk infos, ROS 2
+    ``metadata.yaml``) and, in a ROS 1 bag, the index records after the chunks
+    (:mod:`gaitval.io.rosbag_check`); a ROS 1 bag's ``chunk_count`` and ``conn_count`` must
+    match the chunk, chunk-info and connection records found.  Any disagreement is a
+    FileFormatError naming the counts: a bag that loads short is never used.
+Short loads (warnings)
+    Two things a recording can really do are warnings, logged and listed in
+    ``meta["warnings"]`` (``gaitval inspect`` prints them): a gap between two scans longer
+    than :data:`GAP_FACTOR` times the median scan period, and a topic whose receive times
+    cover less than :data:`COVERAGE` of the bag's span while other topics cover it (a
+    scan count that drops against its neighbours).
 
 References
 ----------
@@ -35,6 +48,7 @@ References
 """
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 from typing import Any
 
@@ -42,11 +56,19 @@ import numpy as np
 
 from gaitval.errors import FileFormatError
 from gaitval.io.guard import loader
-from gaitval.io.scanlog import check_timestamps, clean_ranges
+from gaitval.io.scanlog import (MAX_SCAN_TIME_S, check_scan_geometry, check_timestamps,
+                                clean_ranges)
 from gaitval.types import ScanSeries
 
 LASERSCAN = "sensor_msgs/msg/LaserScan"
 _ANGLE_TOL = 1e-6   # rad: tolerance for "the scan geometry changed"
+#: a gap longer than this many median scan periods is a warning (the real bags in
+#: ``realdata/lrs`` have none above 1.22)
+GAP_FACTOR = 5.0
+#: a topic whose receive times cover less than this share of the bag's span is a warning
+#: (the real bags' topics cover >= 99.7 %)
+COVERAGE = 0.9
+log = logging.getLogger(__name__)
 
 
 def is_rosbag(path: str | Path) -> bool:
@@ -67,6 +89,13 @@ def _open(path: Path, trial: str | None):
     except Exception as exc:  # rosbags raises AnyReaderError / ReaderError / OSError
         raise FileFormatError(f"not a readable ROS bag: {type(exc).__name__}: {exc}",
                               path=path, trial=trial) from None
+    if path.is_file():                      # ROS 1: the index must agree with the records
+        from gaitval.io.rosbag_check import check_structure
+        try:
+            check_structure(path, trial)
+        except FileFormatError:
+            reader.close()
+            raise
     return reader
 
 
@@ -100,6 +129,7 @@ def _read_topic(reader, topic: str, path: Path, trial: str | None) -> dict[str, 
     """Raw arrays of one LaserScan topic (ranges in metres, not yet cleaned)."""
     conns = [c for c in reader.connections if c.topic == topic and c.msgtype == LASERSCAN]
     stamps, recv, rows = [], [], []
+    per_conn: dict[int, int] = {}
     first = None
     frame_ids: set[str] = set()
     scan_times, time_incs = [], []
@@ -120,6 +150,7 @@ def _read_topic(reader, topic: str, path: Path, trial: str | None) -> dict[str, 
                                       f"{k}: angle_min/increment {geo0[1]:.6g}/{geo0[2]:.6g}"
                                       f" -> {geo[1]:.6g}/{geo[2]:.6g} rad",
                                       path=path, trial=trial)
+            per_conn[con.id] = per_conn.get(con.id, 0) + 1
             stamps.append(int(m.header.stamp.sec) * 1_000_000_000 + int(m.header.stamp.nanosec))
             recv.append(int(ts))
             rows.append(r)
@@ -133,6 +164,7 @@ def _read_topic(reader, topic: str, path: Path, trial: str | None) -> dict[str, 
                               f"{type(exc).__name__}: {exc}", path=path, trial=trial) from None
     if first is None:
         raise FileFormatError(f"topic {topic} holds no messages", path=path, trial=trial)
+    _check_message_counts(reader, conns, per_conn, topic, path, trial)
     stamps_ns = np.asarray(stamps, dtype=np.int64)
     if np.all(stamps_ns == 0):
         t_ns, source = np.asarray(recv, dtype=np.int64), "bag_receive_time"
@@ -147,7 +179,44 @@ def _read_topic(reader, topic: str, path: Path, trial: str | None) -> dict[str, 
         "time_source": source, "frame_ids": sorted(frame_ids),
         "scan_time_s": float(np.median(scan_times)),
         "time_increment_s": float(np.median(time_incs)),
+        "recv_span_s": (recv[-1] - recv[0]) * 1e-9,
     }
+
+
+def _check_message_counts(reader, conns, per_conn: dict[int, int], topic: str, path: Path,
+                          trial: str | None) -> None:
+    """The messages read against the index (module notes, "Short loads (errors)")."""
+    for c in conns:
+        listed, got = int(c.msgcount), per_conn.get(c.id, 0)
+        if listed != got:
+            raise FileFormatError(f"the bag's index disagrees with its contents: topic "
+                                  f"{topic} (connection {c.id}) lists {listed} messages, "
+                                  f"{got} were read", path=path, trial=trial,
+                                  hint="reindex it (`rosbag reindex`) or re-record it")
+    if path.is_file():                                           # ROS 1: walk the records
+        from gaitval.io.rosbag_check import check_counts
+        check_counts(path, trial, topic, per_conn, [c.id for c in conns])
+
+
+def _short_load_warnings(d: dict, topic: str, bag_span_s: float, n_topics: int
+                         ) -> list[str]:
+    """Gaps and a short coverage (module notes, "Short loads (warnings)")."""
+    out = []
+    dt = np.diff(d["t"])
+    good = dt[dt > 0]
+    if good.size:
+        period = float(np.median(good))
+        long = np.flatnonzero(dt > GAP_FACTOR * period)
+        if long.size:
+            k = int(long[np.argmax(dt[long])])
+            out.append(f"topic {topic}: {long.size} gap(s) longer than {GAP_FACTOR:g} x "
+                       f"the median scan period ({period:.4g} s); the longest is "
+                       f"{dt[k]:.3g} s after scan {k} of {len(d['t'])}")
+    if n_topics > 1 and bag_span_s > 0 and d["recv_span_s"] < COVERAGE * bag_span_s:
+        out.append(f"topic {topic}: its {len(d['t'])} scans cover {d['recv_span_s']:.3g} s "
+                   f"of the bag's {bag_span_s:.3g} s (less than {COVERAGE:.0%}); scans may "
+                   "be missing")
+    return out
 
 
 @loader("ROS bag")
@@ -172,22 +241,29 @@ def read_rosbag_scans(path: str | Path, topic: str | None = None, *,
         with NaN for no return, ``angle_min``, ``angle_increment``, ``range_min``,
         ``range_max``, ``source`` (``path#topic``), ``timestamp_issues``,
         ``n_no_return_raw``; ``meta`` has ``topic``, ``frame_id``, ``time_source``,
-        ``scan_time_s``, ``time_increment_s``.
+        ``scan_time_s``, ``time_increment_s``, ``warnings`` (gaps, short coverage).
 
     Raises
     ------
     FileFormatError
-        Unreadable bag, missing/ambiguous topic, undecodable messages, or a beam count /
-        angle change within the topic.
+        Unreadable bag, missing/ambiguous topic, undecodable messages, a beam count /
+        angle change within the topic, or messages read that disagree with the bag's
+        index (see the module notes).
     """
     path = Path(path)
     reader = _open(path, trial)
     try:
         chosen = _pick_topic(reader, topic, path, trial)
         d = _read_topic(reader, chosen, path, trial)
+        bag_span_s = (reader.end_time - reader.start_time) * 1e-9 if reader.connections \
+            else 0.0
+        n_topics = len({c.topic for c in reader.connections})
     finally:
         reader.close()
     _check_geometry(d, chosen, path, trial)
+    warnings = _short_load_warnings(d, chosen, bag_span_s, n_topics)
+    for w in warnings:
+        log.warning("%s: %s", path, w)
     ranges, n_bad = clean_ranges(d["raw"], d["range_min"], d["range_max"])
     return ScanSeries(
         t=d["t"], ranges=ranges, angle_min=d["angle_min"],
@@ -197,7 +273,8 @@ def read_rosbag_scans(path: str | Path, topic: str | None = None, *,
         n_no_return_raw=n_bad,
         meta={"topic": chosen, "frame_id": ",".join(d["frame_ids"]),
               "time_source": d["time_source"], "scan_time_s": d["scan_time_s"],
-              "time_increment_s": d["time_increment_s"], "format": "rosbag"})
+              "time_increment_s": d["time_increment_s"], "format": "rosbag",
+              "warnings": warnings})
 
 
 def _check_geometry(d: dict, topic: str, path: Path, trial: str | None) -> None:
@@ -214,6 +291,13 @@ def _check_geometry(d: dict, topic: str, path: Path, trial: str | None) -> None:
                               trial=trial)
     if not np.all(np.isfinite(d["t"])):
         raise FileFormatError(f"{where}: timestamps are not finite", path=path, trial=trial)
+    check_scan_geometry(f"LaserScan topic {topic}", d["raw"].shape[1], d["angle_min"],
+                        d["angle_increment"], d["time_increment_s"], path, trial)
+    if not (np.isfinite(d["scan_time_s"]) and 0 <= d["scan_time_s"] <= MAX_SCAN_TIME_S):
+        raise FileFormatError(f"LaserScan topic {topic}: the median scan_time is "
+                              f"{d['scan_time_s']!r} s; it must be finite, >= 0 (0: not "
+                              f"stated) and at most {MAX_SCAN_TIME_S:g} s", path=path,
+                              trial=trial)
 
 
 def scan_summary(s: ScanSeries) -> dict[str, Any]:
@@ -273,7 +357,8 @@ def describe_rosbag(path: str | Path, topic: str | None = None, *,
     for tp in scan_topics:
         s = read_rosbag_scans(path, tp, trial=trial)
         scans[tp] = {**scan_summary(s), "frame_id": s.meta["frame_id"],
-                     "time_source": s.meta["time_source"]}
+                     "time_source": s.meta["time_source"],
+                     "warnings": list(s.meta["warnings"])}
     return {
         "kind": "rosbag",
         "path": str(path),
@@ -282,4 +367,5 @@ def describe_rosbag(path: str | Path, topic: str | None = None, *,
         "topics": [{"topic": k[0], "msgtype": k[1], "count": n}
                    for k, n in sorted(topics.items())],
         "scans": scans,
+        "warnings": [w for s in scans.values() for w in s["warnings"]],
     }

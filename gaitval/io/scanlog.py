@@ -41,13 +41,41 @@ import pandas as pd
 from gaitval.errors import FileFormatError
 from gaitval.io.atomic import atomic_path
 from gaitval.io.filememo import FileMemo
-from gaitval.io.guard import column_names, json_meta, loader, number
+from gaitval.io.guard import (column_kind, column_names, enough_rows, json_meta, loader,
+                              number, text_field, version_field)
 from gaitval.types import ScanSeries
 
 META_KEY = b"gaitval:scanlog"
 FORMAT = "gaitval-scanlog"
 VERSION = 1
 SUFFIX = ".scan.parquet"
+#: physical bounds of the metadata (a scan of a 2-D laser scanner: 5-100 Hz, <= 10k beams)
+MAX_SCAN_TIME_S = 10.0
+MAX_BEAMS = 100_000
+#: a scan spans at most one turn (radians, with a little slack for rounding)
+MAX_SPAN_RAD = 2 * np.pi + 1e-3
+#: the beams of one scan are taken within this many seconds (time_increment x n_beams)
+MAX_SWEEP_S = 1.0
+
+
+def check_scan_geometry(where: str, n_beams: int, angle_min: float, angle_increment: float,
+                        time_increment: float | None, path, trial: str | None) -> None:
+    """Angles and beam timing within physical bounds (shared with the bag reader): the
+    first beam within one turn of 0, the beams spanning at most one turn, and a sweep
+    (``time_increment`` x beams) of at most :data:`MAX_SWEEP_S`.  ``where`` names the
+    fields' place ("scan-log metadata", "LaserScan topic /scan, first message")."""
+    if abs(angle_min) > MAX_SPAN_RAD:
+        raise FileFormatError(f"{where}: angle_min is {angle_min:g} rad, more than one "
+                              "turn from 0", path=path, trial=trial)
+    if abs(angle_increment) * max(n_beams - 1, 1) > MAX_SPAN_RAD:
+        raise FileFormatError(f"{where}: angle_increment {angle_increment:g} rad x "
+                              f"{n_beams} beams spans more than one turn", path=path,
+                              trial=trial)
+    if time_increment is not None and not (np.isfinite(time_increment) and
+                                           abs(time_increment) * n_beams <= MAX_SWEEP_S):
+        raise FileFormatError(f"{where}: time_increment is {time_increment!r} s; over "
+                              f"{n_beams} beams a scan must take a finite time of at most "
+                              f"{MAX_SWEEP_S:g} s", path=path, trial=trial)
 #: Scan logs read in this process (a warm worker runs every method of a trial: seed 000's
 #: six tracks read the same log), by file identity; a caller gets its own copy.
 _READ = FileMemo(256 * 2 ** 20)
@@ -134,9 +162,13 @@ def read_scanlog(path: str | Path, *, trial: str | None = None) -> ScanSeries:
     ------
     FileFormatError
         Missing file, not Parquet, missing or non-JSON metadata, a metadata field that is
-        missing, not a finite number or contradicts another (``range_min_m`` above
-        ``range_max_m``, ``angle_increment_rad`` 0), a newer version, non-finite
-        timestamps, or a ``ranges`` column whose length does not match ``n_beams``.
+        missing, not a finite number, outside its bounds or contradicts another
+        (``range_min_m`` above ``range_max_m``, ``angle_increment_rad`` 0), a ``format``
+        other than ``gaitval-scanlog``, a version that is not a whole number from 1 to
+        :data:`VERSION`, a ``sensor_model`` that is not text, fewer than 2 scans or times
+        that never advance, a ``t_s`` column that is not float/integer (bool,
+        timestamp), non-finite timestamps, or a ``ranges`` column whose length does not
+        match ``n_beams`` or whose type does not match ``range_unit``.
     """
     path = Path(path)
     series = _READ.fetch(_READ.key(path, str(path)),           # str(path): the series' source
@@ -165,14 +197,15 @@ def _read_scanlog(path: Path, trial: str | None) -> ScanSeries:
     for col in ("t_s", "ranges"):
         if col not in column_names(tab, path, trial):
             raise FileFormatError(f"scan log has no '{col}' column", path=path, trial=trial)
-    t, raw = _columns(tab, g["n_beams"], path, trial)
+    t, raw = _columns(tab, g["n_beams"], g["unit"], path, trial)
+    enough_rows(t, 2, path, trial, what="scan log", unit="scan")
     if g["unit"] == "mm":
         raw = raw / 1000.0
     ranges, n_bad = clean_ranges(raw, g["rmin"], g["rmax"])
     return ScanSeries(
         t=t, ranges=ranges, angle_min=g["amin"], angle_increment=g["ainc"],
         range_min=g["rmin"], range_max=g["rmax"],
-        sensor_model=str(meta.get("sensor_model", "unknown")),
+        sensor_model=g["model"] or "unknown",
         mounting_height_m=g["height"], source=str(path),
         timestamp_issues=check_timestamps(t), n_no_return_raw=n_bad,
         meta={k: v for k, v in meta.items() if k not in {"n_beams"}})
@@ -181,11 +214,11 @@ def _read_scanlog(path: Path, trial: str | None) -> ScanSeries:
 def _meta_fields(meta: dict, path: Path, trial: str | None) -> dict:
     """The metadata fields the reader uses, checked (finite, in range, consistent)."""
     kw = {"path": path, "trial": trial, "what": "scan-log metadata"}
-    version = number(meta, "version", optional=True, **kw)
-    if version is not None and version > VERSION:
-        raise FileFormatError(f"scan-log version {meta['version']} is newer than this "
-                              f"gaitval reads ({VERSION})", path=path, trial=trial)
-    g = {"n_beams": number(meta, "n_beams", above=0, integer=True, **kw),
+    text_field(meta, "format", expected=FORMAT, **kw)
+    version_field(meta, VERSION, **kw)
+    g = {"model": text_field(meta, "sensor_model", **kw),
+         "scan_time": number(meta, "scan_time_s", above=0, optional=True, **kw),
+         "n_beams": number(meta, "n_beams", above=0, integer=True, **kw),
          "amin": number(meta, "angle_min_rad", **kw),
          "ainc": number(meta, "angle_increment_rad", **kw),
          "rmin": number(meta, "range_min_m", minimum=0, **kw),
@@ -201,13 +234,26 @@ def _meta_fields(meta: dict, path: Path, trial: str | None) -> dict:
     if g["unit"] not in ("mm", "m"):
         raise FileFormatError(f"unknown range_unit {g['unit']!r} (expected 'mm' or 'm')",
                               path=path, trial=trial)
+    if g["scan_time"] is not None and g["scan_time"] > MAX_SCAN_TIME_S:
+        raise FileFormatError(f"scan-log metadata field 'scan_time_s' is {g['scan_time']:g}"
+                              f" s; a scan takes at most {MAX_SCAN_TIME_S:g} s", path=path,
+                              trial=trial)
+    if g["n_beams"] > MAX_BEAMS:
+        raise FileFormatError(f"scan-log metadata field 'n_beams' is {g['n_beams']}; a "
+                              f"laser scanner has at most {MAX_BEAMS} beams", path=path,
+                              trial=trial)
+    inc = number(meta, "time_increment_s", optional=True, **kw)   # beam timing, if stated
+    check_scan_geometry("scan-log metadata", g["n_beams"], g["amin"], g["ainc"], inc, path,
+                        trial)
     return g
 
 
-def _columns(tab, nb: int, path: Path, trial: str | None) -> tuple[np.ndarray, np.ndarray]:
+def _columns(tab, nb: int, unit: str, path: Path, trial: str | None
+             ) -> tuple[np.ndarray, np.ndarray]:
     """``t_s`` (finite) and ``ranges`` as (n_scans, n_beams) float64."""
     import pyarrow as pa
 
+    column_kind(tab, "t_s", ("float", "integer"), path, trial, what="scan-log column")
     try:
         t = tab["t_s"].to_numpy().astype(np.float64)
     except (pa.ArrowException, ValueError, TypeError) as exc:
@@ -225,6 +271,10 @@ def _columns(tab, nb: int, path: Path, trial: str | None) -> tuple[np.ndarray, n
     values = col.flatten()
     if not (pa.types.is_integer(values.type) or pa.types.is_floating(values.type)):
         raise FileFormatError(f"column 'ranges' holds {values.type}, not numbers",
+                              path=path, trial=trial)
+    if pa.types.is_integer(values.type) and unit == "m":
+        raise FileFormatError(f"column 'ranges' holds {values.type} but range_unit is 'm' "
+                              "(metres are stored as floats; integers are 'mm')",
                               path=path, trial=trial)
     values = values.to_numpy(zero_copy_only=False)
     if values.size != nb * len(t) or col.null_count:

@@ -40,7 +40,8 @@ import pandas as pd
 
 from gaitval.errors import FileFormatError, TimestampError
 from gaitval.io.atomic import atomic_path
-from gaitval.io.guard import column_names, json_meta, loader, number
+from gaitval.io.guard import (column_kind, column_names, enough_rows, json_meta, loader,
+                              number, text_field, version_field)
 from gaitval.io.scanlog import check_timestamps
 from gaitval.types import UltrasonicLog
 
@@ -48,6 +49,8 @@ META_KEY = b"gaitval:ultrasonic"
 FORMAT = "gaitval-ultrasonic"
 VERSION = 1
 SUFFIX = ".us.parquet"
+#: physical bounds of an air temperature (degrees Celsius) the ranging may use
+TEMPERATURE_RANGE_C = (-60.0, 80.0)
 #: Columns of an anchor table (``UltrasonicLog.anchors``): id, then position (m).
 ANCHOR_COLUMNS = ["anchor", "x_m", "y_m", "z_m"]
 
@@ -149,10 +152,15 @@ def read_ultrasonic(path: str | Path, *, trial: str | None = None) -> Ultrasonic
     Raises
     ------
     FileFormatError
-        Missing file, not Parquet, missing or non-JSON metadata, anchors that are not a
-        list of ``{anchor, x_m, y_m, z_m}`` with finite coordinates and distinct names, an
-        unknown ``quantity``, missing or non-numeric columns, non-finite times or
-        temperatures (the row is named).
+        Missing file, not Parquet, missing or non-JSON metadata, a ``format`` other than
+        ``gaitval-ultrasonic``, a version that is not a whole number from 1 to
+        :data:`VERSION`, a ``sensor_model`` or ``transmitter`` that is not text, anchors
+        that are not a list of ``{anchor, x_m, y_m, z_m}`` with finite coordinates and
+        distinct names, an unknown ``quantity``, missing columns, columns of the wrong
+        type (``t_s``/``temperature_c`` not float or integer, ``tof_*``/``dist_*`` not
+        float: a bool, a timestamp), fewer than 2 samples or times that never advance,
+        non-finite times or temperatures, temperatures outside
+        :data:`TEMPERATURE_RANGE_C` (the row is named).
     """
     from gaitval.io.parquet import read_table
 
@@ -169,6 +177,11 @@ def read_ultrasonic(path: str | Path, *, trial: str | None = None) -> Ultrasonic
         raise FileFormatError("Parquet file has no 'gaitval:ultrasonic' metadata",
                               path=path, trial=trial, hint="see docs/formats.md")
     meta = json_meta(md[META_KEY], META_KEY.decode(), path, trial)
+    kw = {"path": path, "trial": trial, "what": "ultrasonic metadata"}
+    text_field(meta, "format", expected=FORMAT, **kw)
+    version_field(meta, VERSION, **kw)
+    for key in ("sensor_model", "transmitter"):
+        text_field(meta, key, **kw)
     anchors = _anchors(meta, path, trial)
     quantity = meta.get("quantity")
     fmt = {"tof": "tof_{}_s", "distance": "dist_{}_m"}.get(quantity) \
@@ -181,7 +194,18 @@ def read_ultrasonic(path: str | Path, *, trial: str | None = None) -> Ultrasonic
     if missing:
         raise FileFormatError(f"ultrasonic log lacks columns {missing}", path=path,
                               trial=trial)
+    for c in need:                   # times, temperatures: any number; ranges: floats
+        column_kind(tab, c, ("float", "integer") if c in need[:2] else ("float",), path,
+                    trial, what="ultrasonic column")
     cols = _numeric_columns(tab, need, path, trial)
+    enough_rows(cols["t_s"], 2, path, trial, what="ultrasonic log", unit="sample")
+    lo, hi = TEMPERATURE_RANGE_C
+    bad = np.flatnonzero((cols["temperature_c"] < lo) | (cols["temperature_c"] > hi))
+    if bad.size:
+        worst = float(cols["temperature_c"][bad[0]])
+        raise FileFormatError(f"column 'temperature_c' holds {worst!r}"
+                              f" degC at row {int(bad[0])}; an air temperature lies within "
+                              f"{lo:g} .. {hi:g} degC", path=path, trial=trial)
     data = np.column_stack([cols[c] for c in need[2:]]) if len(need) > 2 else \
         np.empty((len(cols["t_s"]), 0))
     with np.errstate(invalid="ignore"):

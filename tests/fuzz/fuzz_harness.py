@@ -3,7 +3,15 @@ must end as a load or a gaitval error that names the file.
 
 Outcomes of one mutant (``run_mutant``):
 
-``load``          the loader returned
+``load``          the loader returned, with every count at least the seed's and every
+                  key number finite
+``warned``        the loader returned and listed warnings the seed does not give
+                  (``meta["warnings"]``, which ``gaitval inspect`` prints): loud, so not
+                  a failure
+``short``         the loader returned fewer frames, markers, scans or samples than the
+                  unmutated seed holds, or lost a topic, without a warning     (a failure)
+``nonfinite``     the loader returned, but a key number (rate, duration, count, start
+                  time, temperature) is NaN, inf or missing                  (a failure)
 ``error``         a GaitvalError naming the mutant's file
 ``unnamed``       a GaitvalError that does not name the file          (a failure)
 ``foreign``       any other exception, or a GaitvalError marked ``unexpected`` by
@@ -36,7 +44,21 @@ import fuzz_mutators as M  # noqa: E402
 import fuzz_seeds as S  # noqa: E402
 
 KINDS = ("c3d", "bag", "scanlog", "ultrasonic", "annotations", "sheet")
-FAILURES = ("unnamed", "foreign", "crash", "hang")
+FAILURES = ("short", "nonfinite", "unnamed", "foreign", "crash", "hang")
+#: the numbers a load must give finitely, per kind (bags: per LaserScan topic)
+FINITE_KEYS = {"c3d": ("rate_hz", "n_frames", "n_markers", "t_start_s", "t_end_s",
+                       "duration_s"),
+               "bag": ("n_scans", "rate_hz", "duration_s", "t_start_s"),
+               "scanlog": ("n_scans", "rate_hz", "duration_s", "t_start_s", "range_min_m",
+                           "range_max_m"),
+               "ultrasonic": ("n_samples", "rate_hz", "duration_s", "t_start_s")}
+#: the counts a load may not lose silently against its seed
+COUNT_KEYS = {"c3d": ("n_frames", "n_markers"), "bag": ("n_scans",),
+              "scanlog": ("n_scans",), "ultrasonic": ("n_samples",)}
+#: the wall-clock time-out (s) and the address-space limit (bytes) of a mutant's child
+#: process: the issue's 20 s and 3 GiB (run_fuzz.py --timeout/--mem-gib)
+LIMITS = {"timeout_s": 20.0, "memory_bytes": 3 * 2 ** 30}
+_BASELINES: dict[tuple[str, str], dict] = {}
 
 
 def make_mutant(kind: str, seed: int, index: int, work: Path) -> tuple[Path, str]:
@@ -49,7 +71,7 @@ def make_mutant(kind: str, seed: int, index: int, work: Path) -> tuple[Path, str
         name = seeds[index % len(seeds)]
         src = M.REALDATA / ("c3d" if kind == "c3d" else "lrs") / name
         data = src.read_bytes()
-        data, what = (M.c3d_mutation if kind == "c3d" else M.byte_mutation)(data, rng)
+        data, what = (M.c3d_mutation if kind == "c3d" else M.bag_mutation)(data, rng)
         out = d / (f"m.{kind}")
         out.write_bytes(data)
         return out, f"{name}: {what}"
@@ -74,29 +96,91 @@ def make_mutant(kind: str, seed: int, index: int, work: Path) -> tuple[Path, str
     return d / "trials.csv", f"{which}: {what}"
 
 
-def read_target(kind: str, path: Path) -> None:
-    """What ``gaitval inspect`` and the loaders do with a file of this kind."""
+def read_target(kind: str, path: Path) -> dict | None:
+    """What ``gaitval inspect`` and the loaders do with a file of this kind; the
+    description (None for a trial sheet)."""
     if kind == "sheet":
         from gaitval.io.trialsheet import load_trial_sheet
         load_trial_sheet(path)
-        return
+        return None
     from gaitval.io.inspect import describe
-    describe(path)
-    if kind == "bag":
+    d = describe(path)
+    if kind == "bag" and len(d.get("scans") or {}) == 1:     # the topic left implicit
         from gaitval.io.rosbag import read_rosbag_scans
         read_rosbag_scans(path, None)
+    return d
 
 
-def _child(kind: str, path: Path, name_part: str, wfd: int, cpu_s: int) -> None:
+def _numbers(kind: str, d: dict) -> dict[str, object]:
+    """The key numbers of a description: name -> value (bags: ``topic:name``)."""
+    if kind == "bag":
+        return {f"{t}:{k}": s.get(k) for t, s in (d.get("scans") or {}).items()
+                for k in FINITE_KEYS["bag"]}
+    out = {k: d.get(k) for k in FINITE_KEYS.get(kind, ())}
+    if kind == "ultrasonic":
+        out.update({f"temperature_c.{k}": (d.get("temperature_c") or {}).get(k)
+                    for k in ("min", "max")})
+    return out
+
+
+def _counts(kind: str, d: dict) -> dict[str, int]:
+    if kind == "bag":
+        return {f"{t}:n_scans": s.get("n_scans") for t, s in (d.get("scans") or {}).items()}
+    return {k: d.get(k) for k in COUNT_KEYS.get(kind, ())}
+
+
+def judge_load(kind: str, d: dict | None, base: dict | None) -> dict:
+    """The outcome of a load: ``nonfinite``, ``short``, ``warned`` or ``load``."""
+    import math
+    if d is None:
+        return {"outcome": "load", "detail": ""}
+    bad = [k for k, v in _numbers(kind, d).items()
+           if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v)]
+    if bad:
+        return {"outcome": "nonfinite", "detail": "not finite: " + ", ".join(
+            f"{k}={_numbers(kind, d)[k]!r}" for k in bad)[:300]}
+    seen = set((base or {}).get("warnings") or [])             # the seed's own warnings
+    warnings = [w for w in d.get("warnings") or [] if w not in seen]
+    lost = []
+    for k, v in (_counts(kind, base) if base else {}).items():
+        got = _counts(kind, d).get(k)
+        if got is None or got < v:
+            lost.append(f"{k} {got} of {v}")
+    if warnings:
+        return {"outcome": "warned", "detail": "; ".join(lost + warnings)[:300]}
+    if lost:
+        return {"outcome": "short", "detail": "silently short: " + ", ".join(lost)}
+    return {"outcome": "load", "detail": ""}
+
+
+def baseline(kind: str, seed_name: str) -> dict | None:
+    """The description of the unmutated seed (cached; None for sheets and annotations)."""
+    if kind not in COUNT_KEYS:
+        return None
+    key = (kind, seed_name)
+    if key not in _BASELINES:
+        if kind in ("c3d", "bag"):
+            src = M.REALDATA / ("c3d" if kind == "c3d" else "lrs") / seed_name
+            _BASELINES[key] = read_target(kind, src)
+        else:
+            cols, _key, _meta = S.parquet_parts(kind)
+            n = len(cols["t_s"])
+            _BASELINES[key] = {"n_scans" if kind == "scanlog" else "n_samples": n}
+    return _BASELINES[key]
+
+
+def _child(kind: str, path: Path, name_part: str, wfd: int, cpu_s: int,
+           base: dict | None = None, memory_bytes: int | None = None) -> None:
     code = 0
     try:
         import logging
         logging.getLogger("gaitval").setLevel(logging.ERROR)     # no duplicate-label notes
         resource.setrlimit(resource.RLIMIT_CPU, (cpu_s, cpu_s + 5))
-        resource.setrlimit(resource.RLIMIT_AS, (_vm_bytes() + (4 << 30),) * 2)
+        mem = memory_bytes or LIMITS["memory_bytes"]
+        resource.setrlimit(resource.RLIMIT_AS, (mem, mem))
         try:
-            read_target(kind, path)
-            out = {"outcome": "load", "detail": ""}
+            d = read_target(kind, path)
+            out = judge_load(kind, d, base)
         except Exception as exc:  # noqa: BLE001 - classified here
             out = classify(exc, name_part)
         os.write(wfd, json.dumps(out).encode()[:60000])
@@ -104,15 +188,6 @@ def _child(kind: str, path: Path, name_part: str, wfd: int, cpu_s: int) -> None:
         code = 3
     finally:
         os._exit(code)
-
-
-def _vm_bytes() -> int:
-    """This process's virtual size (the address-space rlimit is set this much higher)."""
-    with open("/proc/self/status", encoding="ascii") as fh:
-        for line in fh:
-            if line.startswith("VmSize:"):
-                return int(line.split()[1]) * 1024
-    return 0
 
 
 def classify(exc: Exception, name_part: str) -> dict:
@@ -128,17 +203,20 @@ def classify(exc: Exception, name_part: str) -> dict:
     return {"outcome": "error", "detail": ("contained " if contained else "") + msg}
 
 
-def run_mutant(kind: str, path: Path, timeout_s: float = 150.0) -> dict:
-    """Read ``path`` in a forked child (rlimit on CPU time; wall-clock time-out)."""
+def run_mutant(kind: str, path: Path, timeout_s: float | None = None,
+               base: dict | None = None, memory_bytes: int | None = None) -> dict:
+    """Read ``path`` in a forked child (rlimits on CPU time and address space; wall-clock
+    time-out; defaults :data:`LIMITS`); ``base``: the seed's description."""
+    timeout_s = timeout_s or LIMITS["timeout_s"]
     name_part = str(path.parent if kind == "sheet" else path)
     rfd, wfd = os.pipe()
     t0 = time.monotonic()
     pid = os.fork()
     if pid == 0:
         os.close(rfd)
-        _child(kind, path, name_part, wfd, int(timeout_s))
+        _child(kind, path, name_part, wfd, int(timeout_s) + 1, base, memory_bytes)
     os.close(wfd)
-    ready, _, _ = select.select([rfd], [], [], timeout_s)
+    ready, _, _ = select.select([rfd], [], [], timeout_s)   # (the child writes once)
     data = b""
     if ready:
         while chunk := os.read(rfd, 65536):
@@ -186,7 +264,8 @@ def fuzz_one(task: tuple[str, int, int, str]) -> dict:
     import shutil
     kind, seed, index, work = task
     path, what = make_mutant(kind, seed, index, Path(work))
-    res = run_mutant(kind, path)
+    seed_name = what.split(":", 1)[0] if kind in ("c3d", "bag") else kind
+    res = run_mutant(kind, path, base=baseline(kind, seed_name))
     shutil.rmtree(Path(work) / f"{kind}_{index}", ignore_errors=True)
     return {"kind": kind, "index": index, "what": what, **res}
 
@@ -195,8 +274,9 @@ def summarise(results: list[dict]) -> dict[str, dict[str, int]]:
     """Counts per kind: mutants, loads, errors (contained), and each failure."""
     table: dict[str, dict[str, int]] = {}
     for r in results:
-        row = table.setdefault(r["kind"], {"mutants": 0, "load": 0, "error": 0,
-                                           "contained": 0, **{f: 0 for f in FAILURES}})
+        row = table.setdefault(r["kind"], {"mutants": 0, "load": 0, "warned": 0,
+                                           "error": 0, "contained": 0,
+                                           **{f: 0 for f in FAILURES}})
         row["mutants"] += 1
         row[r["outcome"]] += 1
         row["contained"] += r["detail"].startswith("contained")
@@ -204,7 +284,8 @@ def summarise(results: list[dict]) -> dict[str, dict[str, int]]:
 
 
 def format_table(table: dict[str, dict[str, int]]) -> str:
-    cols = ["mutants", "load", "error", "contained", "crash", "hang", "foreign", "unnamed"]
+    cols = ["mutants", "load", "warned", "error", "contained", "crash", "hang", "foreign",
+            "unnamed", "short", "nonfinite"]
     lines = [f"{'file type':<12}" + "".join(f"{c:>10}" for c in cols)]
     total = {c: 0 for c in cols}
     for kind in KINDS:
