@@ -9,7 +9,9 @@ Each creates ``.venv`` and installs into it, on first use and again only when
 ``requirements.lock`` (hashed, ``pip install --require-hashes``; made with pip-tools, see
 the file's head) and then gaitval itself (``pip install --no-deps -e .``).  Extra arguments go to Snakemake
 (``report``) or pytest (``test``), e.g. ``python3 run.py report --config 'run=["tiny"]'``.
-Also: ``python3 run.py bench benchmarks/NAME.py`` (installs the benchmark-only extras).
+Also: ``python3 run.py bench benchmarks/NAME.py`` (installs the benchmark-only extras), and
+``python3 run.py sensitivity`` (the default report beside the same study under each
+alternative free choice of the twin: ``reports/default/tables/sensitivity.*``, issue 34).
 
 Resuming after a kill (power cut, killed cluster job): ``report`` finds Snakemake's lock
 left behind in ``.snakemake/locks``; when no live Snakemake works in this folder it
@@ -156,13 +158,48 @@ def _end_orphans(procs: dict, here: str) -> None:
               flush=True)
 
 
+#: The twin's free choices varied by ``run.py sensitivity`` (docs/simulator.md, "Free
+#: choices of the twin"): one study per alternative, defined in config/config.yaml.
+SENSITIVITY_STUDIES = ("mtst_sensor_beside", "mtst_attendant_left")
+
+
+def sensitivity(rest: list[str], env: dict) -> int:
+    """The default report, the same study under each alternative free choice, and the
+    table of verdicts beside each other (reports/default/tables/sensitivity.*), then the
+    default report's index again so it shows that table."""
+    ensure_env("test")
+    for name in ("default", *SENSITIVITY_STUDIES):
+        cmd = [str(BIN / "snakemake"), "--profile", "workflow/profiles/default",
+               "--config", f'run=["{name}"]', *rest]
+        print("[run.py] " + " ".join(cmd), flush=True)
+        if not clear_stale_lock(cmd, env, _workdir(rest)):
+            return 1
+        rc = subprocess.call(cmd, env=env)
+        if rc:
+            return rc
+    steps = [[str(PY), "-m", "gaitval.tables.sensitivity", "reports/default",
+              *[f"reports/{s}" for s in SENSITIVITY_STUDIES],
+              "--out", "reports/default/tables/sensitivity"],
+             [str(PY), "-m", "gaitval", "report", "--reports-dir", "reports/default",
+              "--studies", "default"]]
+    for cmd in steps:
+        print("[run.py] " + " ".join(cmd), flush=True)
+        rc = subprocess.call(cmd, env=env)
+        if rc:
+            return rc
+    print("[run.py] report: reports/default/index.html (section: sensitivity)", flush=True)
+    return 0
+
+
 def main(argv: list[str]) -> int:
-    if not argv or argv[0] not in ("report", "test", "bench"):
+    if not argv or argv[0] not in ("report", "test", "bench", "sensitivity"):
         print(__doc__)
         return 2
     verb, rest = argv[0], argv[1:]
     os.chdir(ROOT)
     env = dict(os.environ, MPLBACKEND="Agg", PATH=f"{BIN}{os.pathsep}{os.environ['PATH']}")
+    if verb == "sensitivity":
+        return sensitivity(rest, env)
     if verb == "report":
         ensure_env("test")
         cmd = [str(BIN / "snakemake"), "--profile", "workflow/profiles/default", *rest]

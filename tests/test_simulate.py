@@ -542,20 +542,21 @@ def test_attendant_side_moves_the_attendant_only():
 def test_sensitivity_table_names_the_flips(tmp_path):
     from gaitval.tables.sensitivity import sensitivity_table
     cols = ["study", "comparison", "source", "published", "reproduced", "criterion",
-            "reproduced_in_direction", "note"]
-    rows = [["mtst", "Success M1", "Table 3", "0.96", "0.63", "ci", "no", ""],
-            ["mtst", "Success M2", "Table 3", "0.92", "0.90", "ci", "yes", ""]]
-    for name, v in (("ref", ["no", "yes"]), ("alt", ["yes", "yes"])):
+            "outcome", "why"]
+    rows = [["mtst", "Success M1", "Table 3", "0.96", "0.63", "ci", "not reproduced", ""],
+            ["mtst", "Success M2", "Table 3", "0.92", "0.90", "ci", "reproduced", ""]]
+    for name, v in (("ref", ["not reproduced", "reproduced"]),
+                    ("alt", ["reproduced", "reproduced"])):
         (tmp_path / name).mkdir()
-        df = pd.DataFrame(rows, columns=cols).assign(reproduced_in_direction=v)
+        df = pd.DataFrame(rows, columns=cols).assign(outcome=v)
         df.to_csv(tmp_path / name / "verdicts.csv", index=False)
     t = sensitivity_table([tmp_path / "ref", tmp_path / "alt"])
     assert list(t["flips_under"]) == ["alt", ""]
-    assert list(t["alt_verdict"]) == ["yes", "yes"]
+    assert list(t["alt_verdict"]) == ["reproduced", "reproduced"]
     # a verdict the alternative does not compute is "absent", not a flip
     pd.DataFrame(rows[:1], columns=cols).to_csv(tmp_path / "alt" / "verdicts.csv", index=False)
     t = sensitivity_table([tmp_path / "ref", tmp_path / "alt"])
-    assert list(t["alt_verdict"]) == ["no", "absent"]
+    assert list(t["alt_verdict"]) == ["not reproduced", "absent"]
     assert list(t["flips_under"]) == ["", ""] and list(t["absent_in"]) == ["", "alt"]
     with pytest.raises(GaitvalError, match="verdicts.csv"):
         sensitivity_table([tmp_path / "ref", tmp_path / "nothing"])

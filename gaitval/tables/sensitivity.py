@@ -35,7 +35,9 @@ def _verdicts(report_dir: Path) -> pd.DataFrame:
         raise ConfigError(f"no verdicts.csv in {report_dir}", path=f,
                           hint="build that study's report first (python3 run.py report)")
     v = pd.read_csv(f, keep_default_na=False)
-    missing = [c for c in KEY + ["reproduced", "reproduced_in_direction"] if c not in v]
+    if "outcome" not in v and "reproduced_in_direction" in v:     # a report before issue 35
+        v = v.rename(columns={"reproduced_in_direction": "outcome"})
+    missing = [c for c in KEY + ["reproduced", "outcome"] if c not in v]
     if missing:
         raise ConfigError(f"verdicts.csv lacks columns {missing}", path=f)
     return v
@@ -54,7 +56,7 @@ def sensitivity_table(reports: list[Path], names: list[str] | None = None,
         ref = ref[ref["study"].isin(protocols)]
     out = ref[KEY].copy()
     out[f"{names[0]}_reproduced"] = ref["reproduced"].to_numpy()
-    out[f"{names[0]}_verdict"] = ref["reproduced_in_direction"].to_numpy()
+    out[f"{names[0]}_verdict"] = ref["outcome"].to_numpy()
     flips = [[] for _ in range(len(out))]
     absent = [[] for _ in range(len(out))]
     for rep, name in zip(reports[1:], names[1:]):
@@ -62,7 +64,7 @@ def sensitivity_table(reports: list[Path], names: list[str] | None = None,
         idx = pd.MultiIndex.from_frame(out[KEY])
         got = alt.reindex(idx)
         out[f"{name}_reproduced"] = got["reproduced"].fillna("absent").to_numpy()
-        verdict = got["reproduced_in_direction"].fillna("absent").to_numpy()
+        verdict = got["outcome"].fillna("absent").to_numpy()
         out[f"{name}_verdict"] = verdict
         for k, (a, b) in enumerate(zip(out[f"{names[0]}_verdict"], verdict)):
             if b == "absent":
