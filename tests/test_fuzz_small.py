@@ -48,3 +48,15 @@ def test_a_silently_short_or_non_finite_load_is_a_failure():
     seed = {**c3d, "n_markers": 137}
     assert H.judge_load("c3d", c3d, seed)["outcome"] == "short"   # the seed's own warning
     assert set(H.FAILURES) >= {"short", "nonfinite", "crash", "hang", "foreign", "unnamed"}
+
+
+def test_a_sheet_that_loads_with_an_unsafe_id_is_a_failure():
+    """Issue 33: the harness counts a trial sheet accepted with an id such as '..' or
+    'x$(id)' as a failure, not as a load."""
+    import fuzz_mutators as M
+    import numpy as np
+    assert H.judge_load("sheet", {"ids": ["s", "S01", ".."]}, None)["outcome"] == "unsafe"
+    assert "unsafe" in H.FAILURES
+    assert H.judge_load("sheet", {"ids": ["s", "S01", "tug_S01_1"]}, None)["outcome"] == "load"
+    data, what = M.sheet_id_mutation("h,a,b,c\ns,tug,S01,t1\n", np.random.default_rng(1))
+    assert "id column" in what and data.decode().count("\n") == 2

@@ -26,6 +26,7 @@ import copy
 import difflib
 import hashlib
 import math
+import warnings
 from functools import lru_cache
 from pathlib import Path
 
@@ -131,8 +132,10 @@ def _parse_csv(path: Path, kind: str) -> pd.DataFrame:
     try:
         if not path.is_file():
             raise TrialSheetError(f"{kind} not found", path=path)
-        df = pd.read_csv(path, dtype=str, keep_default_na=False, comment=None,
-                         encoding="utf-8", index_col=False)
+        with warnings.catch_warnings():      # a ragged row: said by _check_ragged below
+            warnings.simplefilter("ignore", pd.errors.ParserWarning)
+            df = pd.read_csv(path, dtype=str, keep_default_na=False, comment=None,
+                             encoding="utf-8", index_col=False)
         _check_ragged(path, kind, len(df.columns))
         return df
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError,

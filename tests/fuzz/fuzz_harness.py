@@ -12,6 +12,8 @@ Outcomes of one mutant (``run_mutant``):
                   unmutated seed holds, or lost a topic, without a warning     (a failure)
 ``nonfinite``     the loader returned, but a key number (rate, duration, count, start
                   time, temperature) is NaN, inf or missing                  (a failure)
+``unsafe``        a trial sheet loaded with a study, subject or trial id that cannot name
+                  a folder or stay one shell word (``..``, ``a b``, ``$(id)``)  (a failure)
 ``error``         a GaitvalError naming the mutant's file
 ``unnamed``       a GaitvalError that does not name the file          (a failure)
 ``foreign``       any other exception, or a GaitvalError marked ``unexpected`` by
@@ -44,7 +46,7 @@ import fuzz_mutators as M  # noqa: E402
 import fuzz_seeds as S  # noqa: E402
 
 KINDS = ("c3d", "bag", "scanlog", "ultrasonic", "annotations", "sheet")
-FAILURES = ("short", "nonfinite", "unnamed", "foreign", "crash", "hang")
+FAILURES = ("short", "nonfinite", "unsafe", "unnamed", "foreign", "crash", "hang")
 #: the numbers a load must give finitely, per kind (bags: per LaserScan topic)
 FINITE_KEYS = {"c3d": ("rate_hz", "n_frames", "n_markers", "t_start_s", "t_end_s",
                        "duration_s"),
@@ -89,7 +91,10 @@ def make_mutant(kind: str, seed: int, index: int, work: Path) -> tuple[Path, str
         (d / rel).write_bytes(b"")
     which = "trials.csv" if rng.random() < 0.7 else "subjects.csv"
     text = sheet if which == "trials.csv" else subjects
-    data, what = M.text_mutation(text, rng)
+    if which == "trials.csv" and rng.random() < 0.3:
+        data, what = M.sheet_id_mutation(text, rng)
+    else:
+        data, what = M.text_mutation(text, rng)
     (d / "trials.csv").write_text(sheet)
     (d / "subjects.csv").write_text(subjects)
     (d / which).write_bytes(data)
@@ -101,8 +106,8 @@ def read_target(kind: str, path: Path) -> dict | None:
     description (None for a trial sheet)."""
     if kind == "sheet":
         from gaitval.io.trialsheet import load_trial_sheet
-        load_trial_sheet(path)
-        return None
+        df = load_trial_sheet(path)
+        return {"ids": [str(v) for c in ("study", "subject", "trial") for v in df[c]]}
     from gaitval.io.inspect import describe
     d = describe(path)
     if kind == "bag" and len(d.get("scans") or {}) == 1:     # the topic left implicit
@@ -134,6 +139,11 @@ def judge_load(kind: str, d: dict | None, base: dict | None) -> dict:
     import math
     if d is None:
         return {"outcome": "load", "detail": ""}
+    if kind == "sheet":                       # a loaded sheet: every id a safe folder name
+        from gaitval.io.trialsheet import id_problem
+        bad = [v for v in d.get("ids", []) if id_problem(v)]
+        return ({"outcome": "unsafe", "detail": f"unsafe id accepted: {bad[0][:40]!r}"}
+                if bad else {"outcome": "load", "detail": ""})
     bad = [k for k, v in _numbers(kind, d).items()
            if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v)]
     if bad:
@@ -285,7 +295,7 @@ def summarise(results: list[dict]) -> dict[str, dict[str, int]]:
 
 def format_table(table: dict[str, dict[str, int]]) -> str:
     cols = ["mutants", "load", "warned", "error", "contained", "crash", "hang", "foreign",
-            "unnamed", "short", "nonfinite"]
+            "unnamed", "short", "nonfinite", "unsafe"]
     lines = [f"{'file type':<12}" + "".join(f"{c:>10}" for c in cols)]
     total = {c: 0 for c in cols}
     for kind in KINDS:

@@ -249,6 +249,23 @@ def parquet_mutation(kind: str, path: Path, rng: np.random.Generator) -> str:
     return f"{kind}: {what}"
 
 
+#: Ids that must never name a trial's folder or reach a shell word (issue 33).
+SPECIAL_IDS = [".", "..", "a b", "x$(id>PWNED)", "`id`", "a;b", "t" * 5000, "a/b", "-rf",
+               "../x", "a\tb", "é", "a'b", 'a"b', "*", "~", "a|b", "$HOME"]
+
+
+def sheet_id_mutation(text: str, rng: np.random.Generator) -> tuple[bytes, str]:
+    """Set the study, subject or trial cell of one row of a trial sheet to a special id."""
+    lines = text.splitlines()
+    i = int(rng.integers(1, len(lines)))
+    col = int(rng.choice([0, 2, 3]))                      # study, subject, trial
+    parts = lines[i].split(",")
+    special = SPECIAL_IDS[int(rng.integers(len(SPECIAL_IDS)))]
+    parts[col] = '"' + special.replace('"', '""') + '"'
+    lines[i] = ",".join(parts)
+    return ("\n".join(lines) + "\n").encode(), f"line {i} id column {col} = {special[:20]!r}"
+
+
 def text_mutation(text: str, rng: np.random.Generator, cells: bool = True
                   ) -> tuple[bytes, str]:
     """Mutate a CSV text: a cell, a line, or its encoding."""
