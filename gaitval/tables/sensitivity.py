@@ -63,8 +63,8 @@ def sensitivity_table(reports: list[Path], names: list[str] | None = None,
         alt = _verdicts(rep).drop_duplicates(KEY).set_index(KEY)
         idx = pd.MultiIndex.from_frame(out[KEY])
         got = alt.reindex(idx)
-        out[f"{name}_reproduced"] = got["reproduced"].fillna("absent").to_numpy()
-        verdict = got["outcome"].fillna("absent").to_numpy()
+        out[f"{name}_reproduced"] = got["reproduced"].astype(object).fillna("absent").to_numpy()
+        verdict = got["outcome"].astype(object).fillna("absent").to_numpy()
         out[f"{name}_verdict"] = verdict
         for k, (a, b) in enumerate(zip(out[f"{names[0]}_verdict"], verdict)):
             if b == "absent":
