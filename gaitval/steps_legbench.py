@@ -316,8 +316,12 @@ def _frames(t, positions, hyp, events) -> pd.DataFrame:
 
 
 def legbench_tables_step(inputs, tables_dir, figures_dir, reports_dir, config_hash: str = "",
-                         *, methods=None, inits=None) -> pd.DataFrame:
-    """The CLEAR-MOT table and the figure of every evaluated (trial, method, init)."""
+                         *, methods=None, inits=None, views_dir=None) -> pd.DataFrame:
+    """The CLEAR-MOT table and the figure of every evaluated (trial, method, init).
+
+    ``views_dir``: the folder of the method config views the tracks ran with; a method run
+    with ``tracking.overrides`` is then named with its changes in the tables
+    (:func:`gaitval.steps.method_display_names`)."""
     from gaitval.report.legbench_figures import write_legbench_figure
     from gaitval.report.provenance import stamp
     from gaitval.tables.legbench import write_legbench_table
@@ -329,6 +333,13 @@ def legbench_tables_step(inputs, tables_dir, figures_dir, reports_dir, config_ha
         r = s.iloc[0]
         frames[(r["trial"], r["method"], r["init"])] = read_parquet(d / FRAMES_FILE)
     summary = pd.concat(summaries, ignore_index=True)
+    if views_dir:
+        from gaitval.steps import method_display_names
+        shown = method_display_names(views_dir, list(dict.fromkeys(summary["method"])))
+        if any(shown.get(m, m) != m for m in shown):
+            summary["method"] = summary["method"].map(lambda m: shown.get(m, m))
+            frames = {(t, shown.get(m, m), i): f for (t, m, i), f in frames.items()}
+            methods = [shown.get(m, m) for m in methods] if methods else methods
     paths = write_legbench_table(summary, Path(tables_dir) / "legbench_clearmot",
                                  methods=methods, inits=inits)
     fig = write_legbench_figure(frames, summary, Path(figures_dir) / "legbench_tracks.png",
@@ -363,7 +374,8 @@ def add_legbench_verbs(sub) -> None:
             print(s[cols].to_string(index=False))
         else:
             legbench_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir,
-                                 a.config_hash, methods=a.methods, inits=a.inits)
+                                 a.config_hash, methods=a.methods, inits=a.inits,
+                                 views_dir=a.views_dir)
         return 0
 
     s = sub.add_parser("legbench-track", help="track an annotated recording (bag or scan "
@@ -401,6 +413,9 @@ def add_legbench_verbs(sub) -> None:
     s.add_argument("inputs", nargs="+", help="legbench-evaluate output folders")
     s.add_argument("--methods", nargs="+", default=None)
     s.add_argument("--inits", nargs="+", default=None)
+    s.add_argument("--views-dir", default=None,
+                   help="folder of the method config views the tracks ran with (names a "
+                        "method run with tracking.overrides with its changes)")
     s.add_argument("--tables-dir", required=True)
     s.add_argument("--figures-dir", required=True)
     s.add_argument("--reports-dir", default="reports")

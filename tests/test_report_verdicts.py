@@ -217,3 +217,20 @@ def test_table7_marked_not_comparable_by_its_own_column(tmp_path):
     rows = ultrasonic_verdicts({"ultrasonic_table8": pd.DataFrame(columns=["quantity"]),
                                 "ultrasonic_table7": t7}, {})
     assert [r["outcome"] for r in rows] == ["not comparable"] * 2
+
+
+def test_a_method_run_with_overrides_keeps_its_table4_verdict_and_says_so():
+    """Issue 35: with tracking.overrides the tables name the method with its changes
+    ("tug_m3 (occlusion.max_n = 10)"); its Table 4/5 verdicts stay, saying so."""
+    from gaitval.report.verdicts import tug_verdicts
+    t3 = _tug_t3(success=(20, 20, 20))
+    t4 = pd.DataFrame({"method": ["tug_m2", "tug_m3 (occlusion.max_n = 10)"],
+                       "tug_phase": ["turning", "turning"],
+                       "phase_reading": ["swing_first", "swing_first"],
+                       "rmse_x_m": [0.04, 0.03], "rmse_y_m": [0.03, 0.02],
+                       "rmse_x_m_published": [0.069, 0.055],
+                       "rmse_y_m_published": [0.062, 0.049], "n_steps": [100, 90]})
+    rows = tug_verdicts({"tug_table3": t3, "tug_table4": t4})
+    r = [x for x in rows if x["source"] == "Table 4"]
+    assert len(r) == 1 and r[0]["outcome"] == "reproduced"
+    assert r[0]["why"].startswith("tug_m3 (occlusion.max_n = 10) ran with tracking.overrides")

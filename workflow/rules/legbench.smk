@@ -58,9 +58,12 @@ rule legbench_evaluate:
 
 rule legbench_tables:
     input:
-        lambda w: [
+        evals=lambda w: [
             f"{d}/summary.parquet" for study in config["run"] for d in legbench_eval_dirs(study)
         ],
+        # the method views the tracks ran with: a method run with tracking.overrides is
+        # named with its changes in the table
+        views=study_views(legbench_cfg()["methods"], ALL_SCOPE),
     output:
         table=report(
             f"{REPORTS}/tables/legbench_clearmot.csv",
@@ -75,7 +78,8 @@ rule legbench_tables:
         ),
     params:
         gv=GV,
-        dirs=lambda w, input: [str(Path(p).parent) for p in input],
+        dirs=lambda w, input: [str(Path(p).parent) for p in input.evals],
+        views=lambda w, input: str(Path(input.views[0]).parent),
         methods=legbench_cfg()["methods"],
         inits=legbench_cfg()["inits"],
         tables=parent_of("table"),
@@ -88,7 +92,7 @@ rule legbench_tables:
         "logs/legbench_tables.log",
     shell:
         "{params.gv} legbench-tables {params.dirs:q} --methods {params.methods:q}"
-        " --inits {params.inits:q} --tables-dir {params.tables:q}"
+        " --inits {params.inits:q} --views-dir {params.views:q} --tables-dir {params.tables:q}"
         " --figures-dir {params.figures:q} --reports-dir {params.reports:q}"
         " --config-hash {params.chash:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
