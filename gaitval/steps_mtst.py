@@ -128,17 +128,18 @@ def read_scans(path, row: dict):
 def mtst_track_step(sensor, sheet, subjects, trial: str, method: str, config_json,
                     registration_json, out_parquet) -> pd.DataFrame:
     """Track one MTST trial with one method (module notes); sensor frame, sensor clock."""
-    from gaitval.methods import track_trial
+    from gaitval.methods import get_method, track_trial
 
     cfg, s = mtst_config(config_json)
     row, subj = trial_and_subject(sheet, subjects, trial)
     scans = keep_every(read_scans(sensor, row), float(s["scan_period_s"]), trial=trial)
     pose, _ = pose_and_clock(_registration(registration_json), row, scans, s, cfg, trial)
     overrides = dict(((cfg.get("tracking") or {}).get("overrides") or {}).get(method) or {})
-    overrides.setdefault("init__lane", mat_lane(pose, s["mat"]))
+    mdef = method_definition(cfg, method)
+    if "init" in get_method(mdef):      # the papers' methods start on the mat's lane; the
+        overrides.setdefault("init__lane", mat_lane(pose, s["mat"]))   # people tracker: own
     try:
-        track = track_trial(scans, method_definition(cfg, method), float(subj["leg_width_m"]),
-                            {"overrides": overrides})
+        track = track_trial(scans, mdef, float(subj["leg_width_m"]), {"overrides": overrides})
     except GaitvalError as exc:
         raise exc.with_context(path=sensor, trial=trial) from None
     track.insert(0, "method", method)

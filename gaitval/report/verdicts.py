@@ -56,6 +56,9 @@ STUDIES = {"tug": "TUG leg tracking (seed 000)", "mtst": "MTST (seed 001)",
 #: The table each study's verdicts need; absent → one ``not run`` row.
 REQUIRED = {"tug": "tug_table3", "mtst": "mtst_table3", "rollator": "rollator_table1",
             "ultrasonic": "ultrasonic_table8"}
+#: The papers' methods, the only rows a published comparison can be made for.
+PAPER_METHODS = {"tug": ("tug_m1", "tug_m2", "tug_m3"),
+                 "mtst": ("mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed")}
 SHORT = {"tug_m1": "M1", "tug_m2": "M2", "tug_m3": "M3", "mtst_m1": "M1", "mtst_m2": "M2",
          "mtst_m3": "M3", "mtst_proposed": "proposed"}
 #: TUG: the primary reading of seed000 eq. (3)-(4) (module notes).
@@ -223,6 +226,9 @@ def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[
     t3 = t["tug_table3"]
     if "phase_reading" not in t3:
         t3 = t3.assign(phase_reading=PRIMARY_READING, base_method=t3["method"])
+    # the paper's methods only: an extra row (the people tracker, an external tracker) has
+    # no published value to be compared with
+    t3 = t3[t3["base_method"].isin(PAPER_METHODS["tug"])]
     readings = {r: _tug_reading_rows(g) for r, g in t3.groupby("phase_reading", sort=False)}
     primary = PRIMARY_READING if PRIMARY_READING in readings else next(iter(readings))
     rows = []
@@ -324,6 +330,7 @@ def mtst_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list
         else:
             t3 = t3[t3["reference"] == "mocap"]
     t3 = t3.drop_duplicates("method").set_index("method")
+    t3 = t3[t3.index.isin(PAPER_METHODS["mtst"])]          # extra rows: no published value
     pub = {m: float(t3.loc[m, "success_pct_published"]) / 100 for m in t3.index}
     rep = {m: float(t3.loc[m, "success_pct"]) / 100 for m in t3.index}
     kn = {m: _k_n(str(t3.loc[m, "success"])) for m in t3.index}

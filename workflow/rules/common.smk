@@ -435,7 +435,7 @@ def parent_of(name, up=0):
 
 def tug_methods():
     """The TUG tracker methods to run (config tug.methods)."""
-    return list(config.get("tug", {}).get("methods", ["tug_m1", "tug_m2", "tug_m3"]))
+    return list(config.get("tug", {}).get("methods", ["tug_m1", "tug_m2", "tug_m3", "people"]))
 
 
 def _reading_variants():
@@ -450,6 +450,8 @@ def _reading_variants():
     for m in tug_methods():
         base = set_params(get_method(method_definition(config, m)),
                           (tracking.get("overrides") or {}).get(m))
+        if "phase" not in base:
+            continue        # no phase role of its own (the people tracker): one reading
         own = method_reading(m, {m: base})[1]
         for r in readings:
             name = f"{m}_{r}"
