@@ -23,7 +23,7 @@ from gaitval.evaluate.mtst_tracking import CATEGORIES
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = Path(sys.executable).parent / "snakemake"
 STUDY = "mtst_annot"
-METHODS = ["mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed"]
+METHODS = ["mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed", "people"]   # config mtst.methods
 
 
 def build_study(out: Path, sim: Path | None = None) -> Path:
