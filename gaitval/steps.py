@@ -461,3 +461,56 @@ def ultrasonic_tables_step(inputs: list[str | Path], tables_dir, figures_dir, re
     figs = write_ultrasonic_figures(gp, figures_dir)
     stamp("ultrasonic_figures", figs, reports_dir, config_hash_=config_hash)
     return paths + figs
+
+
+# -- external tracks (issue 37; gaitval/io/tracks.py, docs/formats.md "Leg tracks") ------
+def export_tracks_step(track_parquet, out, units: str = "m") -> Path:
+    """One of gaitval's own track files (``results/<study>/track/<method>/<trial>.parquet``)
+    in the exchange format (sensor frame and clock), CSV or Parquet by ``out``'s suffix."""
+    from gaitval.io.tracks import track_to_exchange, write_tracks
+
+    track = read_parquet(track_parquet)
+    rows = track_to_exchange(track)
+    if units == "mm":
+        for c in ("x", "y", "vx", "vy"):
+            if c in rows:
+                rows[c] = rows[c] * 1000.0
+    src = {}
+    if len(track) and "method" in track and "trial" in track:
+        src = {"source": f"gaitval {track['method'].iloc[0]}",
+               "trial": str(track["trial"].iloc[0])}
+    return write_tracks(rows, out, units=units, **src)
+
+
+def external_track_path(sheet, entry: dict, trial: str) -> Path:
+    """The external track file of one trial: ``entry["path"]`` relative to the trial
+    sheet's folder, ``{trial}`` replaced by the trial id."""
+    return Path(sheet).parent / str(entry["path"]).replace("{trial}", trial)
+
+
+def import_tracks_step(tracks_file, sensor_parquet, registration_json, trial: str,
+                       method: str, out_parquet) -> pd.DataFrame:
+    """An external tracker's file of one trial as gaitval's per-scan track (the columns of
+    :func:`gaitval.methods.track_trial`, plus ``trial`` and ``method``), so that the TUG
+    evaluation and tables treat it as one more method.  The clock and frame conversion use
+    the trial's registration (docs/formats.md); a file on the sensor clock in the sensor
+    frame needs none.  A trial whose registration was refused gets an empty track when the
+    file needs it (its evaluation is ``not_registered`` anyway)."""
+    from gaitval.io.scanlog import read_scanlog
+    from gaitval.io.tracks import TRACK_COLUMNS, read_tracks, tracks_to_sensor
+
+    rows, meta = read_tracks(tracks_file, trial=trial)
+    rec = load_json(registration_json)
+    needs_reg = "mocap" in (meta["frame"], meta["clock"])
+    if needs_reg and rec.get("status") != "ok":
+        track = pd.DataFrame(columns=list(TRACK_COLUMNS))
+    else:
+        scans = read_scanlog(sensor_parquet, trial=trial)
+        t = np.asarray(scans.t, float)
+        period = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+        track = tracks_to_sensor(rows, meta, rec, path=tracks_file, trial=trial,
+                                 t_range=(float(t[0]), float(t[-1])), tolerance_s=period)
+    track.insert(0, "method", method)
+    track.insert(0, "trial", trial)
+    write_parquet(track, out_parquet)
+    return track
