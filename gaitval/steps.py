@@ -60,8 +60,11 @@ def method_view(cfg: dict, view: str, scope: str = ALL_SCOPE) -> dict:
     out = {k: v for k, v in cfg.items()
            if scope == ALL_SCOPE or k not in SCOPES or k == scope}
     tracking = dict(out.get("tracking") or {})
-    for key in ("methods", "overrides"):
+    for key in ("methods", "overrides", "external"):
         entries = tracking.get(key) or {}
+        if key == "external" and view not in entries:
+            tracking.pop(key, None)   # declaring an external method changes no other view
+            continue
         tracking[key] = {view: entries[view]} if view in entries else {}
     out["tracking"] = tracking
     return out
@@ -352,12 +355,15 @@ def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, report
             cfgs[study] = cfg
             continue
         tracking = cfgs[study].setdefault("tracking", {})
-        for key in ("methods", "overrides"):
+        for key in ("methods", "overrides", "external"):
             tracking[key] = {**(tracking.get(key) or {}),
                              **((cfg.get("tracking") or {}).get(key) or {})}
     cfgs = cfgs or {"": {}}
     used: dict[str, dict] = {}
     for m in methods:
+        if any(m in ((cfg.get("tracking") or {}).get("external") or {})
+               for cfg in cfgs.values()):
+            continue                    # an external tracker: no parameters of gaitval's
         runs = {study: set_params(get_method(method_definition(cfg, m)),
                                   ((cfg.get("tracking") or {}).get("overrides") or {}).get(m))
                 for study, cfg in cfgs.items()}

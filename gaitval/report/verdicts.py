@@ -221,6 +221,8 @@ def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[
     unobservable (Table 5) RMSE."""
     st = "tug"
     t3 = t["tug_table3"]
+    if "success_rate_published" in t3:    # rows without a paper value (an external
+        t3 = t3[t3["success_rate_published"].notna()]   # tracker, issue 37): not compared
     if "phase_reading" not in t3:
         t3 = t3.assign(phase_reading=PRIMARY_READING, base_method=t3["method"])
     readings = {r: _tug_reading_rows(g) for r, g in t3.groupby("phase_reading", sort=False)}

@@ -1,4 +1,5 @@
 # Shared by all rule files -- config validation, paths, the trial sheet, provenance.
+import re
 import json
 import shlex
 import sys
@@ -464,9 +465,25 @@ def _reading_variants():
 _READING_VARIANTS = _reading_variants()
 
 
+def external_methods():
+    """The external methods (tracking.external, issue 37): another tracker's tracks of each
+    trial, read from files in the leg-track exchange format (docs/formats.md)."""
+    return list((config.get("tracking") or {}).get("external") or {})
+
+
+def external_tracks_file(wildcards):
+    """Input function: the external method's track file of one trial (its path relative to
+    the trial sheet's folder, {trial} replaced)."""
+    from gaitval.steps import external_track_path
+
+    entry = config["tracking"]["external"][wildcards.method]
+    return str(external_track_path(sheet_path(wildcards.study), entry, wildcards.trial))
+
+
 def tug_runs():
-    """The TUG methods (tug.methods) and their reading variants (tug.phase_readings)."""
-    return tug_methods() + _READING_VARIANTS
+    """The TUG methods (tug.methods), their reading variants (tug.phase_readings) and the
+    external methods (tracking.external)."""
+    return tug_methods() + _READING_VARIANTS + external_methods()
 
 
 def pendulum_trials():
