@@ -283,8 +283,9 @@ def _add_lrs_verbs(sub) -> None:
                        "one trial as gaitval's track (sensor clock and frame)")
     s.add_argument("--tracks", required=True, help="*.tracks.csv or *.tracks.parquet")
     s.add_argument("--sensor", required=True, help="ingested sensor.parquet (time span)")
-    s.add_argument("--registration", required=True, help="the trial's registration.json "
-                   "(pose and clock offset, for a file in the mocap frame or clock)")
+    s.add_argument("--registration", help="the trial's registration.json (pose and clock "
+                   "offset, for a file in the mocap frame or clock; none: a trial without "
+                   "mocap, the file must be on the sensor clock in the sensor frame)")
     s.add_argument("--trial", required=True)
     s.add_argument("--method", required=True, help="the external method's name")
     s.add_argument("--out", required=True)

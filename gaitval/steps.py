@@ -234,6 +234,8 @@ def method_display_names(view_dir: str | Path, methods) -> dict[str, str]:
         p = Path(view_dir) / f"{m}.json"
         if p.is_file():
             cfg = load_json(p)
+            if m in ((cfg.get("tracking") or {}).get("external") or {}):
+                continue                      # an external method (issue 37): its name
             d = set_params(get_method(method_definition(cfg, m)),
                            ((cfg.get("tracking") or {}).get("overrides") or {}).get(m))
             out[m] = display_name(m, d)
@@ -506,9 +508,9 @@ def import_tracks_step(tracks_file, sensor_parquet, registration_json, trial: st
     from gaitval.io.tracks import TRACK_COLUMNS, read_tracks, tracks_to_sensor
 
     rows, meta = read_tracks(tracks_file, trial=trial)
-    rec = load_json(registration_json)
+    rec = load_json(registration_json) if registration_json else None
     needs_reg = "mocap" in (meta["frame"], meta["clock"])
-    if needs_reg and rec.get("status") != "ok":
+    if needs_reg and rec is not None and rec.get("status") != "ok":
         track = pd.DataFrame(columns=list(TRACK_COLUMNS))
     else:
         scans = read_scanlog(sensor_parquet, trial=trial)

@@ -1,13 +1,14 @@
 """Issue 37: gaitval's own tracks, exported in the leg-track exchange format and declared as
-external methods (``tracking.external``), give the same TUG Tables 3-5 rows as the method
-they came from.
+external methods (``tracking.external``), give the same TUG Tables 3-5 and MTST Table 3
+rows as the method they came from.
 
-The tiny study's TUG part is run once (Snakemake in a temporary folder); then tug_m1's
-tracks are exported as CSV on the sensor clock in the sensor frame (``ext_m1``: exact
+The tiny study's TUG and MTST parts are run once (Snakemake in a temporary folder); then
+tug_m1's tracks (TUG trials) and mtst_m1's (MTST trials) are exported with
+``gaitval export-tracks`` as CSV on the sensor clock in the sensor frame (``ext_m1``: exact
 equality), and tug_m2's as Parquet in millimetres, in the mocap field frame and on the
-mocap clock (``ext_m2``: converted back with each trial's registration; equal to 1e-9).
-tug_m2 has a tracking-success trial in the tiny study, so Tables 4-5 compare RMSEs, not
-only empty rows.
+mocap clock (``ext_m2``, TUG only: converted back with each trial's registration; equal to
+1e-9).  tug_m2 has a tracking-success trial in the tiny study, so Tables 4-5 compare
+RMSEs, not only empty rows.
 """
 from __future__ import annotations
 
@@ -26,11 +27,11 @@ from gaitval.io.tracks import track_to_exchange, write_tracks
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = Path(sys.executable).parent / "snakemake"
-TARGET = "reports/tiny/tables/tug_table4.csv"
+TARGETS = ["reports/tiny/tables/tug_table4.csv", "reports/tiny/tables/mtst_table3.csv"]
 
 
 def snakemake(work: Path, *configfiles: Path) -> subprocess.CompletedProcess:
-    cmd = [str(SNAKEMAKE), TARGET, "--snakefile", str(ROOT / "Snakefile"), "--directory",
+    cmd = [str(SNAKEMAKE), *TARGETS, "--snakefile", str(ROOT / "Snakefile"), "--directory",
            str(work), "--cores", "2", "--configfile", *map(str, configfiles)]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
 
@@ -58,12 +59,16 @@ def ext_run(tmp_path_factory):
     results = work / "results" / "tiny"
     trials = sorted(p.stem for p in (results / "track" / "tug_m1").glob("*.parquet"))
     assert trials
-    for t in trials:
-        out = study / "ext" / f"{t}.tracks.csv"
-        r = subprocess.run([sys.executable, "-m", "gaitval", "export-tracks",
-                            str(results / "track" / "tug_m1" / f"{t}.parquet"), str(out)],
+    mtst = sorted(p.stem for p in (results / "mtst_track" / "mtst_m1").glob("*.parquet"))
+    assert mtst
+    for t in trials + mtst:
+        src = (results / "track" / "tug_m1" if t in trials else
+               results / "mtst_track" / "mtst_m1") / f"{t}.parquet"
+        r = subprocess.run([sys.executable, "-m", "gaitval", "export-tracks", str(src),
+                            str(study / "ext" / f"{t}.tracks.csv")],
                            capture_output=True, text=True)
         assert r.returncode == 0, r.stderr
+    for t in trials:
         reg = json.loads((results / "register" / t / "registration.json").read_text())
         track = pd.read_parquet(results / "track" / "tug_m2" / f"{t}.parquet")
         write_tracks(to_mocap(track, reg), study / "ext2" / f"{t}.tracks.parquet",
@@ -71,7 +76,7 @@ def ext_run(tmp_path_factory):
     ext = work / "ext.yaml"
     ext.write_text(yaml.safe_dump({"tracking": {"external": {
         "ext_m1": {"path": "ext/{trial}.tracks.csv"},
-        "ext_m2": {"path": "ext2/{trial}.tracks.parquet"}}}}))
+        "ext_m2": {"path": "ext2/{trial}.tracks.parquet", "protocols": ["tug"]}}}}))
     res = snakemake(work, base, ext)
     assert res.returncode == 0, res.stderr[-4000:]
     return work, res.stdout + res.stderr
@@ -94,7 +99,9 @@ def test_external_rows_equal_the_methods_rows(ext_run, ext, own, exact):
     work, log = ext_run
     tables = work / "reports" / "tiny" / "tables"
     # only the external methods' jobs and the tables ran the second time
-    assert "rule track:" not in log and "rule register:" not in log
+    for rule in ("track", "register", "mtst_track"):
+        assert f"rule {rule}:" not in log, rule
+    assert "rule track_external:" in log and "rule mtst_track_external:" in log
     for n in (3, 4, 5):
         t = pd.read_csv(tables / f"tug_table{n}.csv")
         a, b = _rows(t, own), _rows(t, ext)
@@ -113,6 +120,19 @@ def test_external_rows_equal_the_methods_rows(ext_run, ext, own, exact):
 
 
 @pytest.mark.slow
+def test_mtst_external_rows_equal_the_methods_rows(ext_run):
+    work, _ = ext_run
+    t = pd.read_csv(work / "reports" / "tiny" / "tables" / "mtst_table3.csv")
+    a, b = _rows(t, "mtst_m1"), _rows(t, "ext_m1")
+    assert len(a) and len(a) == len(b)
+    assert "ext_m2" not in set(t["method"])           # protocols: [tug]
+    cols = _results(t)
+    assert "success_pct" in cols and "n_trials_stick" in cols
+    pd.testing.assert_frame_equal(a[cols], b[cols], check_exact=True)
+    assert (a["success"] == b["success"]).all()
+
+
+@pytest.mark.slow
 def test_per_scan_evaluation_identical_for_the_csv_round_trip(ext_run):
     work, _ = ext_run
     ev = work / "results" / "tiny" / "evaluate"
@@ -123,15 +143,18 @@ def test_per_scan_evaluation_identical_for_the_csv_round_trip(ext_run):
 
 
 @pytest.mark.slow
-def test_verdicts_ignore_external_rows(ext_run):
-    from gaitval.report.verdicts import tug_verdicts
+@pytest.mark.parametrize("paper, names", [
+    ("tug", ("tug_table3", "tug_table4", "tug_table5")), ("mtst", ("mtst_table3",))])
+def test_verdicts_ignore_external_rows(ext_run, paper, names):
+    from gaitval.report.verdicts import mtst_verdicts, tug_verdicts
 
+    build = {"tug": tug_verdicts, "mtst": mtst_verdicts}[paper]
     work, _ = ext_run
     tables = work / "reports" / "tiny" / "tables"
-    t = {n: pd.read_csv(tables / f"{n}.csv") for n in ("tug_table3", "tug_table4",
-                                                       "tug_table5")}
-    rows = tug_verdicts(t)
+    t = {n: pd.read_csv(tables / f"{n}.csv") for n in names}
+    assert all(d["method"].str.startswith("ext_").any() for d in t.values())
+    rows = build(t)
     text = json.dumps(rows, default=str)
     assert rows and "ext_m" not in text
     own = {n: d[~d["method"].str.startswith("ext_")] for n, d in t.items()}
-    assert json.dumps(tug_verdicts(own), default=str) == text
+    assert json.dumps(build(own), default=str) == text

@@ -318,6 +318,8 @@ def mtst_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list
     st = "mtst"
     rows = []
     t3 = t["mtst_table3"]
+    if "success_pct_published" in t3:     # rows without a paper value (an external
+        t3 = t3[t3["success_pct_published"].notna()]    # tracker, issue 37): not compared
     ref = "mocap reference"
     if "reference" in t3:
         if not (t3["reference"] == "mocap").any() and len(t3):

@@ -465,10 +465,16 @@ def _reading_variants():
 _READING_VARIANTS = _reading_variants()
 
 
-def external_methods():
+def external_methods(protocol=None):
     """The external methods (tracking.external, issue 37): another tracker's tracks of each
-    trial, read from files in the leg-track exchange format (docs/formats.md)."""
-    return list((config.get("tracking") or {}).get("external") or {})
+    trial, read from files in the leg-track exchange format (docs/formats.md); those of
+    one protocol (an entry's `protocols`, default tug and mtst) when it is given."""
+    entries = (config.get("tracking") or {}).get("external") or {}
+    return [m for m, e in entries.items()
+            if protocol is None or protocol in ((e or {}).get("protocols") or EXTERNAL_PROTOCOLS)]
+
+
+EXTERNAL_PROTOCOLS = ("tug", "mtst")
 
 
 def external_tracks_file(wildcards):
@@ -483,7 +489,7 @@ def external_tracks_file(wildcards):
 def tug_runs():
     """The TUG methods (tug.methods), their reading variants (tug.phase_readings) and the
     external methods (tracking.external)."""
-    return tug_methods() + _READING_VARIANTS + external_methods()
+    return tug_methods() + _READING_VARIANTS + external_methods("tug")
 
 
 def pendulum_trials():

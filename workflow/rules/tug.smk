@@ -53,7 +53,7 @@ rule track_external:
         summary=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/summary.parquet",
         frames=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/frames.parquet",
     wildcard_constraints:
-        method="|".join(re.escape(m) for m in external_methods()) or "(?!x)x",
+        method="|".join(re.escape(m) for m in external_methods("tug")) or "(?!x)x",
     params:
         gv=GV,
         out=parent_of("summary"),
