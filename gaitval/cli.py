@@ -127,7 +127,7 @@ def cmd_evaluate_tug(a) -> int:
 
 def cmd_export_tracks(a) -> int:
     from gaitval.steps import export_tracks_step
-    print(f"wrote {export_tracks_step(a.track, a.out, a.units)}")
+    print(f"wrote {export_tracks_step(a.track, a.out, a.units, a.topic)}")
     return 0
 
 
@@ -272,11 +272,14 @@ def _add_lrs_verbs(sub) -> None:
     s.set_defaults(func=cmd_evaluate_tug)
 
     # external tracks (issue 37): docs/formats.md, "Leg tracks"
-    s = sub.add_parser("export-tracks", help="one of gaitval's track files in the leg-track "
-                       "exchange format (*.tracks.csv / *.tracks.parquet)")
-    s.add_argument("track", help="results/<study>/track/<method>/<trial>.parquet")
+    s = sub.add_parser("export-tracks", help="one of gaitval's track files (or a bag's people "
+                       "topic) in the leg-track exchange format (*.tracks.csv / .parquet)")
+    s.add_argument("track", help="results/<study>/track/<method>/<trial>.parquet, or a ROS "
+                   "bag with a tracker's people topic")
     s.add_argument("out", help="*.tracks.csv or *.tracks.parquet")
     s.add_argument("--units", choices=("m", "mm"), default="m")
+    s.add_argument("--topic", help="bags: the leg_tracker/PersonArray or people_msgs/People "
+                   "topic (default: the only one)")
     s.set_defaults(func=cmd_export_tracks)
 
     s = sub.add_parser("import-tracks", help="an external tracker's *.tracks.csv/parquet of "

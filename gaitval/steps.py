@@ -472,11 +472,20 @@ def ultrasonic_tables_step(inputs: list[str | Path], tables_dir, figures_dir, re
 
 
 # -- external tracks (issue 37; gaitval/io/tracks.py, docs/formats.md "Leg tracks") ------
-def export_tracks_step(track_parquet, out, units: str = "m") -> Path:
+def export_tracks_step(track_parquet, out, units: str = "m", topic: str | None = None
+                       ) -> Path:
     """One of gaitval's own track files (``results/<study>/track/<method>/<trial>.parquet``)
-    in the exchange format (sensor frame and clock), CSV or Parquet by ``out``'s suffix."""
-    from gaitval.io.tracks import track_to_exchange, write_tracks
+    in the exchange format (sensor frame and clock), CSV or Parquet by ``out``'s suffix; or
+    a tracker's people topic of a ROS bag (``*.bag`` or a ROS 2 bag folder; ``topic``:
+    leg_tracker/PersonArray or people_msgs/People, :func:`gaitval.io.tracks.read_bag_tracks`)."""
+    from gaitval.io.tracks import read_bag_tracks, track_to_exchange, write_tracks
 
+    src_path = Path(track_parquet)
+    if src_path.suffix == ".bag" or src_path.is_dir():
+        rows, meta = read_bag_tracks(src_path, topic)
+        if units == "mm":
+            rows[["x", "y"]] = rows[["x", "y"]] * 1000.0
+        return write_tracks(rows, out, units=units, source=meta["source"])
     track = read_parquet(track_parquet)
     rows = track_to_exchange(track)
     if units == "mm":

@@ -457,3 +457,109 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
     df["pattern"] = df["pattern"].astype(object)
     df["side"] = df["side"].astype(object)
     return df
+
+
+# -- ROS 1/2 bag topics of leg_tracker and people_msgs --------------------------------------
+#: tracker output types read from bags (ROS 2 style names, as rosbags reports them)
+BAG_PEOPLE_TYPES = ("leg_tracker/msg/PersonArray", "people_msgs/msg/People")
+BAG_LEG_DETECTIONS = "leg_tracker/msg/LegArray"
+
+
+def read_bag_tracks(path: str | Path, topic: str | None = None, *,
+                    trial: str | None = None) -> tuple[pd.DataFrame, dict]:
+    """A tracker's people topic of a ROS bag as exchange-format rows (``person``).
+
+    ``leg_tracker/PersonArray`` (leg_tracker's ``/people_tracked``: ``header``,
+    ``people[]`` with ``pose`` and ``id``) and ``people_msgs/People`` (``header``,
+    ``people[]`` with ``name`` and ``position``).  The message definitions are taken from
+    the bag (a ROS 1 bag embeds them; as :mod:`gaitval.io.annotations_bag` does), so
+    nothing needs ROS installed.  Times are the messages' ``header.stamp`` (the clock of
+    the scans they were tracked in: ``clock: sensor``); positions in metres
+    (``units: m``).  The header's ``frame_id`` must be the frame of the bag's LaserScan
+    messages (``frame: sensor``): gaitval does not read ``/tf``.
+
+    ``leg_tracker/LegArray`` (``/detected_leg_clusters``) holds leg *detections* of one
+    scan without identity or side, not tracks: it is refused with that reason.
+
+    Returns
+    -------
+    (DataFrame, dict)
+        Rows ``t_s, person, x, y`` (sorted by time and person, in metres) and the header
+        (``format, version, units: m, frame: sensor, clock: sensor, source``), ready for
+        :func:`write_tracks`.
+    """
+    from gaitval.io.annotations_bag import _register_custom_types
+    from gaitval.io.rosbag import LASERSCAN, _norm, _open
+
+    p = Path(path)
+    reader = _open(p, trial)
+    try:
+        _register_custom_types(reader)
+        known = BAG_PEOPLE_TYPES + (BAG_LEG_DETECTIONS,)
+        cands = [c for c in reader.connections if c.msgtype in known]
+        if topic is not None and str(topic).strip():
+            conns = [c for c in reader.connections if _norm(c.topic) == _norm(str(topic))]
+            if not conns:
+                raise _err(p, f"topic {topic!r} is not in this bag; tracker topics: "
+                           f"{sorted({c.topic for c in cands}) or 'none'}; all topics: "
+                           f"{sorted({c.topic for c in reader.connections})}", trial)
+        else:
+            topics = sorted({c.topic for c in cands})
+            if len(topics) != 1:
+                raise _err(p, f"{'no' if not topics else 'several'} tracker topic(s) of type "
+                           f"{', '.join(known)} in this bag"
+                           f"{': ' + str(topics) if topics else ''}", trial,
+                           hint="name the topic")
+            conns = [c for c in cands if c.topic == topics[0]]
+        msgtype, name = conns[0].msgtype, conns[0].topic
+        if msgtype == BAG_LEG_DETECTIONS:
+            raise _err(p, f"topic {name} holds {msgtype}: leg detections of one scan "
+                       "without identity or side, not tracks", trial,
+                       hint="record the tracker's people topic (leg_tracker/PersonArray, "
+                       "/people_tracked) or write the legs' tracks as a *.tracks.csv")
+        if msgtype not in BAG_PEOPLE_TYPES:
+            raise _err(p, f"topic {name} holds {msgtype}, not one of "
+                       f"{', '.join(BAG_PEOPLE_TYPES)}", trial)
+        scan_frames = set()
+        scans = [c for c in reader.connections if c.msgtype == LASERSCAN]
+        for con, _, raw in reader.messages(connections=scans):
+            scan_frames.add(str(reader.deserialize(raw, con.msgtype).header.frame_id))
+        rows, frames = [], set()
+        for n, (con, _, raw) in enumerate(reader.messages(connections=conns)):
+            m = reader.deserialize(raw, con.msgtype)
+            t = int(m.header.stamp.sec) + int(m.header.stamp.nanosec) * 1e-9
+            frames.add(str(m.header.frame_id))
+            for q in m.people:
+                if msgtype == BAG_PEOPLE_TYPES[0]:
+                    pid, pos = str(int(q.id)), q.pose.position
+                else:
+                    pid, pos = str(q.name), q.position
+                rows.append((t, pid, float(pos.x), float(pos.y), n + 1))
+    finally:
+        reader.close()
+    if not rows:
+        raise _err(p, f"topic {name} holds no person", trial)
+    if not scan_frames:
+        raise _err(p, f"no LaserScan topic in this bag: the frame of {name} "
+                   f"({', '.join(sorted(frames))}) cannot be checked against the laser's",
+                   trial, hint="record the scans with the tracker's output")
+    if frames != scan_frames or len(frames) != 1:
+        raise _err(p, f"topic {name} is in frame(s) {sorted(frames)} but the scans in "
+                   f"{sorted(scan_frames)}; gaitval does not transform between frames",
+                   trial, hint="publish the tracks in the laser frame")
+    df = pd.DataFrame(rows, columns=["t_s", "person", "x", "y", "msg"])
+    bad = ~np.isfinite(df[["t_s", "x", "y"]].to_numpy()).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise _err(p, f"topic {name}, message {df['msg'].iloc[i]}: person "
+                   f"{df['person'].iloc[i]!r} has a non-finite position", trial)
+    dup = df.duplicated(["t_s", "person"])
+    if dup.any():
+        i = int(np.flatnonzero(dup.to_numpy())[0])
+        raise _err(p, f"topic {name}, message {df['msg'].iloc[i]}: person "
+                   f"{df['person'].iloc[i]!r} twice at time stamp {df['t_s'].iloc[i]!r} s",
+                   trial)
+    df = df.drop(columns="msg").sort_values(["t_s", "person"], kind="stable")
+    meta = {"format": FORMAT, "version": VERSION, "units": "m", "frame": "sensor",
+            "clock": "sensor", "source": f"{msgtype} on {name}"}
+    return df.reset_index(drop=True), meta
