@@ -499,10 +499,21 @@ def export_tracks_step(track_parquet, out, units: str = "m", topic: str | None =
     return write_tracks(rows, out, units=units, **src)
 
 
-def external_track_path(sheet, entry: dict, trial: str) -> Path:
+def external_track_path(sheet, entry: dict, trial: str, method: str = "") -> Path:
     """The external track file of one trial: ``entry["path"]`` relative to the trial
-    sheet's folder, ``{trial}`` replaced by the trial id."""
-    return Path(sheet).parent / str(entry["path"]).replace("{trial}", trial)
+    sheet's folder, ``{trial}`` replaced by the trial id.  Like the sheet's own paths it
+    must stay inside that folder unless the study.yaml beside the sheet sets
+    ``allow_outside_paths: true``."""
+    from gaitval.io.trialsheet import _allows_outside
+
+    base = Path(sheet).parent
+    path = base / str(entry["path"]).replace("{trial}", trial)
+    if not path.resolve().is_relative_to(base.resolve()) and not _allows_outside(Path(sheet)):
+        raise ConfigError(f"tracking.external.{method}.path: {str(path)!r} (trial {trial}) "
+                          f"leads outside the trial sheet's folder {base}",
+                          hint="put the track files beside the sheet, or set "
+                               "allow_outside_paths: true in the study.yaml beside it")
+    return path
 
 
 def import_tracks_step(tracks_file, sensor_parquet, registration_json, trial: str,

@@ -200,3 +200,42 @@ def test_people_file_reads_but_is_refused_for_legs(tmp_path):
     assert rows["person"].tolist() == ["p1", "p2"]
     with pytest.raises(FileFormatError, match="gives people"):
         tracks_to_sensor(rows, meta, path=p)
+
+
+def test_external_path_stays_inside_the_sheets_folder(tmp_path):
+    from gaitval.errors import ConfigError
+    from gaitval.steps import external_track_path
+
+    sheet = tmp_path / "study" / "trials.csv"
+    sheet.parent.mkdir()
+    ok = external_track_path(sheet, {"path": "tracks/{trial}.tracks.csv"}, "T1", "mine")
+    assert ok == sheet.parent / "tracks" / "T1.tracks.csv"
+    with pytest.raises(ConfigError, match=r"tracking.external.mine.path: .*leads outside"):
+        external_track_path(sheet, {"path": "../x/{trial}.tracks.csv"}, "T1", "mine")
+    (sheet.parent / "study.yaml").write_text("allow_outside_paths: true\n")
+    assert external_track_path(sheet, {"path": "../x/{trial}.tracks.csv"}, "T1", "mine")
+
+
+def test_import_step_empty_track_for_a_refused_registration_and_errors_by_file(tmp_path):
+    """A mocap-frame file of a trial whose registration was refused gives an empty track
+    (its evaluation is not_registered); a file past the recording is one error naming it."""
+    from gaitval.io.scanlog import write_scanlog
+    from gaitval.steps import import_tracks_step
+    from gaitval.types import ScanSeries
+
+    scans = ScanSeries(t=np.arange(20) * 0.025, ranges=np.full((20, 5), 2.0),
+                       angle_min=-0.5, angle_increment=0.25, range_min=0.1, range_max=30.0)
+    sensor = tmp_path / "sensor.parquet"
+    write_scanlog(sensor, scans)
+    reg = tmp_path / "registration.json"
+    reg.write_text(json.dumps({"status": "refused", "reason": "no poles"}))
+    mocap = _csv(tmp_path, HEAD[:2] + ["# frame: mocap", HEAD[3]] + GOOD, "m.tracks.csv")
+    out = import_tracks_step(mocap, sensor, reg, "T1", "ext", tmp_path / "o.parquet")
+    assert len(out) == 0 and list(out.columns[:2]) == ["trial", "method"]
+    late = _csv(tmp_path, HEAD + GOOD + ["9.0,L,1,0", "9.0,R,1,0"], "late.tracks.csv")
+    with pytest.raises(FileFormatError) as exc:
+        import_tracks_step(late, sensor, reg, "T1", "ext", tmp_path / "o.parquet")
+    assert str(late) in str(exc.value) and "outside the recording" in str(exc.value)
+    ok = import_tracks_step(_csv(tmp_path, HEAD + GOOD, "ok.tracks.csv"), sensor, None,
+                            "T1", "ext", tmp_path / "o.parquet")
+    assert ok["method"].eq("ext").all() and len(ok) == 4

@@ -483,7 +483,8 @@ def external_tracks_file(wildcards):
     from gaitval.steps import external_track_path
 
     entry = config["tracking"]["external"][wildcards.method]
-    return str(external_track_path(sheet_path(wildcards.study), entry, wildcards.trial))
+    return str(external_track_path(sheet_path(wildcards.study), entry, wildcards.trial,
+                                   wildcards.method))
 
 
 def tug_runs():
