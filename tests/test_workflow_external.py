@@ -158,3 +158,31 @@ def test_verdicts_ignore_external_rows(ext_run, paper, names):
     assert rows and "ext_m" not in text
     own = {n: d[~d["method"].str.startswith("ext_")] for n, d in t.items()}
     assert json.dumps(build(own), default=str) == text
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("where", ["config", "study.yaml"])
+def test_external_method_declared_wrongly_stops_at_start(tmp_path, where):
+    """A name that is already a method, or tracking.external in a study.yaml (where the
+    workflow does not see it), stops the run before any job, naming the key."""
+    sheet = tmp_path / "study" / "trials.csv"
+    sheet.parent.mkdir()
+    sheet.write_text("study\n")
+    cf = tmp_path / "c.yaml"
+    doc = {"run": ["mine"], "peer_results": "",
+           "studies": {"mine": {"trial_sheet": str(sheet),
+                                "subjects": str(sheet.parent / "subjects.csv")}}}
+    if where == "config":
+        doc["tracking"] = {"external": {"tug_m2": {"path": "x/{trial}.tracks.csv"}}}
+        words = ["tracking.external.tug_m2", "already a tracking method"]
+    else:
+        (sheet.parent / "study.yaml").write_text(
+            "tracking:\n  external:\n    mine: {path: 'x/{trial}.tracks.csv'}\n")
+        words = ["study.yaml", "declared in the workflow config"]
+    cf.write_text(yaml.safe_dump(doc))
+    res = subprocess.run([str(SNAKEMAKE), "-n", "--snakefile", str(ROOT / "Snakefile"),
+                          "--directory", str(tmp_path), "--cores", "1", "--configfile",
+                          str(cf)], capture_output=True, text=True, timeout=300)
+    assert res.returncode != 0
+    for w in words:
+        assert w in res.stdout + res.stderr, (w, res.stderr[-2000:])

@@ -68,6 +68,27 @@ def _check_study_files(schema):
                 [(display_path(cal), own)]))
 
 
+def _check_external(cfg):
+    """tracking.external (issue 37): a name that is not already a method, and declared in
+    the workflow config, where the workflow sees it, not in a study.yaml."""
+    names = _method_definitions(cfg)
+    names.update(dict.fromkeys((cfg.get("tug") or {}).get("methods") or []))
+    names.update(dict.fromkeys((cfg.get("mtst") or {}).get("methods") or []))
+    for m in (cfg.get("tracking") or {}).get("external") or {}:
+        if m in names:
+            raise ConfigError(f"tracking.external.{m}: {m!r} is already a tracking method; "
+                              "give the external tracker another name")
+    for study in cfg["run"]:
+        entry = cfg["studies"].get(study) or {}
+        sheet = Path(entry.get("trial_sheet") or Path(DATA) / study / "trials.csv")
+        cal = sheet.parent / "study.yaml"
+        if cal.is_file() and ((load_configfile(str(cal)) or {}).get("tracking") or {}).get(
+                "external"):
+            raise ConfigError(f"[file {display_path(cal)}] tracking.external: external "
+                              "methods are declared in the workflow config (a --configfile), "
+                              "not in a study's study.yaml (docs/formats.md, Leg tracks)")
+
+
 DATA = config.get("data_dir", "data")
 # Numbers nested in a --config value as numbers (Snakemake leaves them strings).
 update_config(config, _command_line_config())
@@ -83,6 +104,7 @@ try:
         override_problems((config.get("tracking") or {}).get("overrides"),
                           _method_definitions(config)), _config_layers()))
     _check_study_files(_SCHEMA)
+    _check_external(config)
 except ConfigError as exc:
     sys.exit(f"ConfigError: {exc}")
 
