@@ -537,7 +537,8 @@ def import_tracks_step(tracks_file, sensor_parquet, registration_json, trial: st
         t = np.asarray(scans.t, float)
         period = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
         track = tracks_to_sensor(rows, meta, rec, path=tracks_file, trial=trial,
-                                 t_range=(float(t[0]), float(t[-1])), tolerance_s=period)
+                                 t_range=(float(t[0]), float(t[-1])), tolerance_s=period,
+                                 scan_t=t)
     track.insert(0, "method", method)
     track.insert(0, "trial", trial)
     write_parquet(track, out_parquet)

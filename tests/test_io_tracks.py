@@ -239,3 +239,12 @@ def test_import_step_empty_track_for_a_refused_registration_and_errors_by_file(t
     ok = import_tracks_step(_csv(tmp_path, HEAD + GOOD, "ok.tracks.csv"), sensor, None,
                             "T1", "ext", tmp_path / "o.parquet")
     assert ok["method"].eq("ext").all() and len(ok) == 4
+
+
+def test_converted_times_snap_to_the_scan_they_name():
+    from gaitval.io.tracks import snap_to_scans
+
+    scans = np.array([0.0, 0.025, 0.05, 0.075])
+    t = np.array([0.025 + 4e-16, 0.05 - 2e-7, 0.0374, 0.075 + 5e-6, -1e-9])
+    np.testing.assert_array_equal(snap_to_scans(t, scans),
+                                  [0.025, 0.05, 0.0374, 0.075 + 5e-6, 0.0])

@@ -347,10 +347,32 @@ def _swing_from_speed(speed: np.ndarray) -> np.ndarray:
     return out
 
 
+#: a converted time stamp this close to a scan's is that scan's (clock conversion rounding)
+SNAP_S = 1e-6
+
+
+def snap_to_scans(t: np.ndarray, scan_t: np.ndarray, tol_s: float = SNAP_S) -> np.ndarray:
+    """``t`` with each time within ``tol_s`` of a scan time replaced by that scan time: a
+    tracker's time stamp names the scan it tracked, and the mocap-to-sensor clock
+    conversion (a subtraction and a division and back) moves it by a few 1e-16 s, enough to
+    put a scan that lies on a TUG phase bound into the other phase."""
+    t = np.asarray(t, float).copy()
+    s = np.sort(np.asarray(scan_t, float))
+    if not len(s) or not len(t):
+        return t
+    i = np.clip(np.searchsorted(s, t), 1, len(s) - 1) if len(s) > 1 else np.zeros(len(t), int)
+    left, right = s[np.maximum(i - 1, 0)], s[i]
+    near = np.where(np.abs(t - left) <= np.abs(right - t), left, right)
+    hit = np.abs(near - t) <= tol_s
+    t[hit] = near[hit]
+    return t
+
+
 def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None = None, *,
                      path=None, trial: str | None = None,
                      t_range: tuple[float, float] | None = None,
-                     tolerance_s: float = 0.0) -> pd.DataFrame:
+                     tolerance_s: float = 0.0, scan_t: np.ndarray | None = None
+                     ) -> pd.DataFrame:
     """Exchange rows (from :func:`read_tracks`) as gaitval's per-scan leg track.
 
     Parameters
@@ -365,6 +387,9 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
         The recording's first and last scan time on the sensor clock; a track time stamp
         (after the clock conversion) outside it by more than ``tolerance_s`` is an error
         naming the row.
+    scan_t : ndarray, optional
+        The recording's scan times (sensor clock): a converted time stamp within
+        :data:`SNAP_S` of one becomes that scan's time (:func:`snap_to_scans`).
 
     Returns
     -------
@@ -394,6 +419,8 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
         # docs/formats.md, Clock: t_sensor = offset + (1 + drift ppm 1e-6) t_mocap
         drift = float(reg.get("clock_drift_ppm") or 0.0)
         t = float(reg["clock_offset_s"]) + (1.0 + drift * 1e-6) * t
+        if scan_t is not None:
+            t = snap_to_scans(t, scan_t)
     if t_range is not None:
         lo, hi = t_range[0] - tolerance_s, t_range[1] + tolerance_s
         out_of = (t < lo) | (t > hi)
