@@ -125,6 +125,18 @@ def cmd_evaluate_tug(a) -> int:
     return 0
 
 
+def cmd_export_tracks(a) -> int:
+    from gaitval.steps import export_tracks_step
+    print(f"wrote {export_tracks_step(a.track, a.out, a.units, a.topic)}")
+    return 0
+
+
+def cmd_import_tracks(a) -> int:
+    from gaitval.steps import import_tracks_step
+    import_tracks_step(a.tracks, a.sensor, a.registration, a.trial, a.method, a.out)
+    return 0
+
+
 def cmd_tug_tables(a) -> int:
     from gaitval.steps import tug_tables_step
     tug_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir, a.config_hash,
@@ -258,6 +270,29 @@ def _add_lrs_verbs(sub) -> None:
     s.add_argument("--config", required=True)
     s.add_argument("--out", required=True)
     s.set_defaults(func=cmd_evaluate_tug)
+
+    # external tracks (issue 37): docs/formats.md, "Leg tracks"
+    s = sub.add_parser("export-tracks", help="one of gaitval's track files (or a bag's people "
+                       "topic) in the leg-track exchange format (*.tracks.csv / .parquet)")
+    s.add_argument("track", help="results/<study>/track/<method>/<trial>.parquet, or a ROS "
+                   "bag with a tracker's people topic")
+    s.add_argument("out", help="*.tracks.csv or *.tracks.parquet")
+    s.add_argument("--units", choices=("m", "mm"), default="m")
+    s.add_argument("--topic", help="bags: the leg_tracker/PersonArray or people_msgs/People "
+                   "topic (default: the only one)")
+    s.set_defaults(func=cmd_export_tracks)
+
+    s = sub.add_parser("import-tracks", help="an external tracker's *.tracks.csv/parquet of "
+                       "one trial as gaitval's track (sensor clock and frame)")
+    s.add_argument("--tracks", required=True, help="*.tracks.csv or *.tracks.parquet")
+    s.add_argument("--sensor", required=True, help="ingested sensor.parquet (time span)")
+    s.add_argument("--registration", help="the trial's registration.json (pose and clock "
+                   "offset, for a file in the mocap frame or clock; none: a trial without "
+                   "mocap, the file must be on the sensor clock in the sensor frame)")
+    s.add_argument("--trial", required=True)
+    s.add_argument("--method", required=True, help="the external method's name")
+    s.add_argument("--out", required=True)
+    s.set_defaults(func=cmd_import_tracks)
 
     s = sub.add_parser("tug-tables", help="seed 000 Tables 2-5 and figures")
     s.add_argument("inputs", nargs="+", help="per-(trial, method) evaluation folders")

@@ -60,8 +60,11 @@ def method_view(cfg: dict, view: str, scope: str = ALL_SCOPE) -> dict:
     out = {k: v for k, v in cfg.items()
            if scope == ALL_SCOPE or k not in SCOPES or k == scope}
     tracking = dict(out.get("tracking") or {})
-    for key in ("methods", "overrides"):
+    for key in ("methods", "overrides", "external"):
         entries = tracking.get(key) or {}
+        if key == "external" and view not in entries:
+            tracking.pop(key, None)   # declaring an external method changes no other view
+            continue
         tracking[key] = {view: entries[view]} if view in entries else {}
     out["tracking"] = tracking
     return out
@@ -231,6 +234,8 @@ def method_display_names(view_dir: str | Path, methods) -> dict[str, str]:
         p = Path(view_dir) / f"{m}.json"
         if p.is_file():
             cfg = load_json(p)
+            if m in ((cfg.get("tracking") or {}).get("external") or {}):
+                continue                      # an external method (issue 37): its name
             d = set_params(get_method(method_definition(cfg, m)),
                            ((cfg.get("tracking") or {}).get("overrides") or {}).get(m))
             out[m] = display_name(m, d)
@@ -352,12 +357,15 @@ def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, report
             cfgs[study] = cfg
             continue
         tracking = cfgs[study].setdefault("tracking", {})
-        for key in ("methods", "overrides"):
+        for key in ("methods", "overrides", "external"):
             tracking[key] = {**(tracking.get(key) or {}),
                              **((cfg.get("tracking") or {}).get(key) or {})}
     cfgs = cfgs or {"": {}}
     used: dict[str, dict] = {}
     for m in methods:
+        if any(m in ((cfg.get("tracking") or {}).get("external") or {})
+               for cfg in cfgs.values()):
+            continue                    # an external tracker: no parameters of gaitval's
         runs = {study: set_params(get_method(method_definition(cfg, m)),
                                   ((cfg.get("tracking") or {}).get("overrides") or {}).get(m))
                 for study, cfg in cfgs.items()}
@@ -461,3 +469,77 @@ def ultrasonic_tables_step(inputs: list[str | Path], tables_dir, figures_dir, re
     figs = write_ultrasonic_figures(gp, figures_dir)
     stamp("ultrasonic_figures", figs, reports_dir, config_hash_=config_hash)
     return paths + figs
+
+
+# -- external tracks (issue 37; gaitval/io/tracks.py, docs/formats.md "Leg tracks") ------
+def export_tracks_step(track_parquet, out, units: str = "m", topic: str | None = None
+                       ) -> Path:
+    """One of gaitval's own track files (``results/<study>/track/<method>/<trial>.parquet``)
+    in the exchange format (sensor frame and clock), CSV or Parquet by ``out``'s suffix; or
+    a tracker's people topic of a ROS bag (``*.bag`` or a ROS 2 bag folder; ``topic``:
+    leg_tracker/PersonArray or people_msgs/People, :func:`gaitval.io.tracks.read_bag_tracks`)."""
+    from gaitval.io.tracks import read_bag_tracks, track_to_exchange, write_tracks
+
+    src_path = Path(track_parquet)
+    if src_path.suffix == ".bag" or src_path.is_dir():
+        rows, meta = read_bag_tracks(src_path, topic)
+        if units == "mm":
+            rows[["x", "y"]] = rows[["x", "y"]] * 1000.0
+        return write_tracks(rows, out, units=units, source=meta["source"])
+    track = read_parquet(track_parquet)
+    rows = track_to_exchange(track)
+    if units == "mm":
+        for c in ("x", "y", "vx", "vy"):
+            if c in rows:
+                rows[c] = rows[c] * 1000.0
+    src = {}
+    if len(track) and "method" in track and "trial" in track:
+        src = {"source": f"gaitval {track['method'].iloc[0]}",
+               "trial": str(track["trial"].iloc[0])}
+    return write_tracks(rows, out, units=units, **src)
+
+
+def external_track_path(sheet, entry: dict, trial: str, method: str = "") -> Path:
+    """The external track file of one trial: ``entry["path"]`` relative to the trial
+    sheet's folder, ``{trial}`` replaced by the trial id.  Like the sheet's own paths it
+    must stay inside that folder unless the study.yaml beside the sheet sets
+    ``allow_outside_paths: true``."""
+    from gaitval.io.trialsheet import _allows_outside
+
+    base = Path(sheet).parent
+    path = base / str(entry["path"]).replace("{trial}", trial)
+    if not path.resolve().is_relative_to(base.resolve()) and not _allows_outside(Path(sheet)):
+        raise ConfigError(f"tracking.external.{method}.path: {str(path)!r} (trial {trial}) "
+                          f"leads outside the trial sheet's folder {base}",
+                          hint="put the track files beside the sheet, or set "
+                               "allow_outside_paths: true in the study.yaml beside it")
+    return path
+
+
+def import_tracks_step(tracks_file, sensor_parquet, registration_json, trial: str,
+                       method: str, out_parquet) -> pd.DataFrame:
+    """An external tracker's file of one trial as gaitval's per-scan track (the columns of
+    :func:`gaitval.methods.track_trial`, plus ``trial`` and ``method``), so that the TUG
+    evaluation and tables treat it as one more method.  The clock and frame conversion use
+    the trial's registration (docs/formats.md); a file on the sensor clock in the sensor
+    frame needs none.  A trial whose registration was refused gets an empty track when the
+    file needs it (its evaluation is ``not_registered`` anyway)."""
+    from gaitval.io.scanlog import read_scanlog
+    from gaitval.io.tracks import TRACK_COLUMNS, read_tracks, tracks_to_sensor
+
+    rows, meta = read_tracks(tracks_file, trial=trial)
+    rec = load_json(registration_json) if registration_json else None
+    needs_reg = "mocap" in (meta["frame"], meta["clock"])
+    if needs_reg and rec is not None and rec.get("status") != "ok":
+        track = pd.DataFrame(columns=list(TRACK_COLUMNS))
+    else:
+        scans = read_scanlog(sensor_parquet, trial=trial)
+        t = np.asarray(scans.t, float)
+        period = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+        track = tracks_to_sensor(rows, meta, rec, path=tracks_file, trial=trial,
+                                 t_range=(float(t[0]), float(t[-1])), tolerance_s=period,
+                                 scan_t=t)
+    track.insert(0, "method", method)
+    track.insert(0, "trial", trial)
+    write_parquet(track, out_parquet)
+    return track

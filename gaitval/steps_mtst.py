@@ -228,6 +228,8 @@ def _gate(cfg: dict, method: str):
     """The method's gate when it is seed 001's variable region (Table 1), else None."""
     from gaitval.methods import get_method, set_params
     from gaitval.track import GATES
+    if method in ((cfg.get("tracking") or {}).get("external") or {}):
+        return None                    # an external tracker (issue 37): gate unknown
     m = set_params(get_method(method_definition(cfg, method)),
                    ((cfg.get("tracking") or {}).get("overrides") or {}).get(method))
     spec = m.get("gate")

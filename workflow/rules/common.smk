@@ -1,4 +1,5 @@
 # Shared by all rule files -- config validation, paths, the trial sheet, provenance.
+import re
 import json
 import shlex
 import sys
@@ -67,6 +68,27 @@ def _check_study_files(schema):
                 [(display_path(cal), own)]))
 
 
+def _check_external(cfg):
+    """tracking.external (issue 37): a name that is not already a method, and declared in
+    the workflow config, where the workflow sees it, not in a study.yaml."""
+    names = _method_definitions(cfg)
+    names.update(dict.fromkeys((cfg.get("tug") or {}).get("methods") or []))
+    names.update(dict.fromkeys((cfg.get("mtst") or {}).get("methods") or []))
+    for m in (cfg.get("tracking") or {}).get("external") or {}:
+        if m in names:
+            raise ConfigError(f"tracking.external.{m}: {m!r} is already a tracking method; "
+                              "give the external tracker another name")
+    for study in cfg["run"]:
+        entry = cfg["studies"].get(study) or {}
+        sheet = Path(entry.get("trial_sheet") or Path(DATA) / study / "trials.csv")
+        cal = sheet.parent / "study.yaml"
+        if cal.is_file() and ((load_configfile(str(cal)) or {}).get("tracking") or {}).get(
+                "external"):
+            raise ConfigError(f"[file {display_path(cal)}] tracking.external: external "
+                              "methods are declared in the workflow config (a --configfile), "
+                              "not in a study's study.yaml (docs/formats.md, Leg tracks)")
+
+
 DATA = config.get("data_dir", "data")
 # Numbers nested in a --config value as numbers (Snakemake leaves them strings).
 update_config(config, _command_line_config())
@@ -82,6 +104,7 @@ try:
         override_problems((config.get("tracking") or {}).get("overrides"),
                           _method_definitions(config)), _config_layers()))
     _check_study_files(_SCHEMA)
+    _check_external(config)
 except ConfigError as exc:
     sys.exit(f"ConfigError: {exc}")
 
@@ -466,9 +489,32 @@ def _reading_variants():
 _READING_VARIANTS = _reading_variants()
 
 
+def external_methods(protocol=None):
+    """The external methods (tracking.external, issue 37): another tracker's tracks of each
+    trial, read from files in the leg-track exchange format (docs/formats.md); those of
+    one protocol (an entry's `protocols`, default tug and mtst) when it is given."""
+    entries = (config.get("tracking") or {}).get("external") or {}
+    return [m for m, e in entries.items()
+            if protocol is None or protocol in ((e or {}).get("protocols") or EXTERNAL_PROTOCOLS)]
+
+
+EXTERNAL_PROTOCOLS = ("tug", "mtst")
+
+
+def external_tracks_file(wildcards):
+    """Input function: the external method's track file of one trial (its path relative to
+    the trial sheet's folder, {trial} replaced)."""
+    from gaitval.steps import external_track_path
+
+    entry = config["tracking"]["external"][wildcards.method]
+    return str(external_track_path(sheet_path(wildcards.study), entry, wildcards.trial,
+                                   wildcards.method))
+
+
 def tug_runs():
-    """The TUG methods (tug.methods) and their reading variants (tug.phase_readings)."""
-    return tug_methods() + _READING_VARIANTS
+    """The TUG methods (tug.methods), their reading variants (tug.phase_readings) and the
+    external methods (tracking.external)."""
+    return tug_methods() + _READING_VARIANTS + external_methods("tug")
 
 
 def pendulum_trials():

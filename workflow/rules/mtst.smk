@@ -38,6 +38,47 @@ rule mtst_track:
         " >> {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
 
 
+# An external method (tracking.external, issue 37): the other tracker's file of the trial,
+# converted to gaitval's track (sensor clock and frame; a trial with mocap: with its
+# registration), then the same evaluation as above.
+ruleorder: mtst_track_external > mtst_track
+
+
+rule mtst_track_external:
+    input:
+        unpack(mtst_inputs),
+        tracks=external_tracks_file,
+    output:
+        track=f"{RESULTS}/{{study}}/mtst_track/{{method}}/{{trial}}.parquet",
+        summary=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/summary.parquet",
+        contacts=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/contacts.parquet",
+        steps=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/steps.parquet",
+        events=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/events.parquet",
+        gates=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/gates.parquet",
+        track_field=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/track_field.parquet",
+        targets=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/targets.parquet",
+    wildcard_constraints:
+        method="|".join(re.escape(m) for m in external_methods("mtst")) or "(?!x)x",
+    params:
+        gv=GV,
+        subjects=lambda w: subjects_path(w.study),
+        out=parent_of("summary"),
+        reg=mtst_optional("reg", "--registration"),
+        gt=mtst_optional("gt", "--groundtruth"),
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/mtst_track/{study}/{method}/{trial}.log",
+    shell:
+        "{params.gv} import-tracks --tracks {input.tracks:q} --sensor {input.sensor:q}"
+        " {params.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
+        " --out {output.track:q} > {log:q} 2>&1"
+        " && {params.gv} mtst-evaluate --track {output.track:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
+        " --config {input.config:q} {params.reg:q} {params.gt:q} --out {params.out:q}"
+        " >> {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+
+
 rule mtst_tables:
     input:
         evals=mtst_summaries,
@@ -58,7 +99,7 @@ rule mtst_tables:
     params:
         gv=GV,
         dirs=lambda w, input: [str(Path(p).parent) for p in input.evals],
-        methods=mtst_methods(),
+        methods=mtst_methods() + external_methods("mtst"),
         config=lambda w, input: input.configs[0],
         tables=parent_of("t3"),
         figures=parent_of("fig"),

@@ -83,6 +83,6 @@ def mtst_summaries(wildcards):
     return [
         f"{RESULTS}/{study}/mtst_eval/{method}/{trial}/summary.parquet"
         for study in config["run"]
-        for method in mtst_methods()
+        for method in mtst_methods() + external_methods("mtst")
         for trial in trial_ids(study, ["mtst"])
     ]

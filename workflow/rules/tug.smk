@@ -35,6 +35,42 @@ rule track:
         " || (cat {log:q} >&2; exit 1)"
 
 
+# An external method (tracking.external, issue 37): the other tracker's file of the trial,
+# converted to gaitval's track (sensor clock and frame, with the trial's registration), then
+# the same evaluation as above.
+ruleorder: track_external > track
+
+
+rule track_external:
+    input:
+        tracks=external_tracks_file,
+        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
+        gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
+        reg=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
+        config=config_view_file,
+    output:
+        track=f"{RESULTS}/{{study}}/track/{{method}}/{{trial}}.parquet",
+        summary=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/summary.parquet",
+        frames=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/frames.parquet",
+    wildcard_constraints:
+        method="|".join(re.escape(m) for m in external_methods("tug")) or "(?!x)x",
+    params:
+        gv=GV,
+        out=parent_of("summary"),
+    conda:
+        "../envs/gaitval.yaml"
+    log:
+        "logs/track/{study}/{method}/{trial}.log",
+    shell:
+        "{params.gv} import-tracks --tracks {input.tracks:q} --sensor {input.sensor:q}"
+        " --registration {input.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
+        " --out {output.track:q} > {log:q} 2>&1"
+        " && {params.gv} evaluate-tug --track {output.track:q} --groundtruth {input.gt:q}"
+        " --registration {input.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
+        " --config {input.config:q} --out {params.out:q} >> {log:q} 2>&1"
+        " || (cat {log:q} >&2; exit 1)"
+
+
 rule tug_tables:
     input:
         evals=lambda w: [

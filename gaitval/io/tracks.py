@@ -1,0 +1,592 @@
+"""Leg tracks as an exchange format: ``*.tracks.csv`` and ``*.tracks.parquet`` (version 1).
+
+Any tracker's output — gaitval's own (``gaitval export-tracks``), a vendor's export, a
+ROS node's topics converted — enters gaitval's tables through this one format
+(issue 37; docs/formats.md, section *Leg tracks*).  One row per time stamp and leg
+(``side`` ``L``/``R``) or, for a tracker that gives only people, per time stamp and
+person (``person``).  Positions ``x``, ``y`` (velocities ``vx``, ``vy``) are in the
+header's ``units`` (``m`` or ``mm``; per second for velocities) and ``frame`` (``sensor``:
+the laser frame; ``mocap``: the field frame), times ``t_s`` in seconds on the header's
+``clock`` (``sensor`` or ``mocap``).
+
+:func:`read_tracks` returns the rows in metres with the header as a dict;
+:func:`tracks_to_sensor` turns them into gaitval's per-scan track table
+(:func:`gaitval.methods.track_trial`'s columns) on the sensor clock and in the sensor
+frame, given the trial's registration; :func:`track_to_exchange` and
+:func:`write_tracks` do the reverse for gaitval's own tracks, so that export and
+re-import give back the same table, value for value.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from gaitval.errors import FileFormatError
+from gaitval.io.atomic import write_bytes, write_parquet
+
+FORMAT = "gaitval-tracks"
+VERSION = 1
+META_KEY = b"gaitval:tracks"
+UNITS = {"m": 1.0, "mm": 1e-3}
+FRAMES = ("sensor", "mocap")
+CLOCKS = ("sensor", "mocap")
+SIDES = ("L", "R")
+#: leg patterns of seed 001 §2.3 (gaitval.detect.legpatterns); empty: no track yet
+PATTERNS = ("", "SL", "LT", "FS_O", "FS_U", "UO")
+#: the columns of the exchange format, in file order (required: t_s, x, y, and side or
+#: person)
+COLUMNS = ("t_s", "k", "side", "person", "x", "y", "vx", "vy", "observed", "pattern",
+           "phase", "swing", "interpolated")
+BOOL_COLUMNS = ("observed", "swing", "interpolated")
+#: gaitval's own per-scan track columns (gaitval.track.leg.TrackResult.to_frame)
+TRACK_COLUMNS = ("k", "t_sensor_s", "side", "x_m", "y_m", "vx_mps", "vy_mps", "observed",
+                 "pattern", "phase", "swing", "interpolated")
+#: seed 000 Table 2 speed thresholds: a track without ``swing`` is in swing from the scan
+#: its speed exceeds v_sw_th until it falls below v_st_th (the tracker's hysteresis)
+V_ST_TH, V_SW_TH = 0.47, 0.93
+_TRUE = {"true", "1", "yes"}
+_FALSE = {"false", "0", "no"}
+
+
+def _err(path, problem: str, trial=None, hint=None) -> FileFormatError:
+    return FileFormatError(problem, path=path, trial=trial, hint=hint)
+
+
+def _check_meta(meta: dict, path, trial) -> dict:
+    """The header, checked: format, version, units, frame, clock (each named when wrong)."""
+    if meta.get("format") != FORMAT:
+        raise _err(path, f"header field 'format' is {meta.get('format')!r}, not {FORMAT!r}",
+                   trial, hint="the first line of a CSV is '# gaitval-tracks v1'")
+    v = meta.get("version")
+    try:
+        ok = float(v) == VERSION
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise _err(path, f"header field 'version' is {v!r}; this gaitval reads version "
+                   f"{VERSION}", trial)
+    for key, allowed in (("units", tuple(UNITS)), ("frame", FRAMES), ("clock", CLOCKS)):
+        val = meta.get(key)
+        if val is None:
+            raise _err(path, f"header field {key!r} is missing (one of "
+                       f"{', '.join(allowed)})", trial)
+        if val not in allowed:
+            raise _err(path, f"header field {key!r} is {val!r}, not one of "
+                       f"{', '.join(allowed)}", trial)
+    out = dict(meta)
+    out["version"] = VERSION
+    return out
+
+
+def _read_csv(path: Path, trial) -> tuple[dict, list[str], list[list[str]], int]:
+    """(header, column names, rows as text, file line of the first data row)."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise _err(path, f"not UTF-8 text ({exc.reason} at byte {exc.start})", trial) from None
+    lines = text.splitlines()
+    if not lines or lines[0].strip().lower() != f"# {FORMAT} v{VERSION}":
+        first = lines[0][:60] if lines else ""
+        raise _err(path, f"line 1 is {first!r}, not '# {FORMAT} v{VERSION}'", trial)
+    meta: dict = {"format": FORMAT, "version": VERSION}
+    n = 1
+    while n < len(lines) and lines[n].startswith("#"):
+        key, sep, val = lines[n][1:].partition(":")
+        if sep:
+            meta[key.strip()] = val.strip()
+        n += 1
+    rows = list(csv.reader(io.StringIO("\n".join(lines[n:]))))
+    if not rows:
+        raise _err(path, "no column header after the '#' lines", trial)
+    return meta, [c.strip() for c in rows[0]], rows[1:], n + 2
+
+
+def _read_parquet(path: Path, trial) -> tuple[dict, pd.DataFrame]:
+    import pyarrow.parquet as pq
+    try:
+        tab = pq.read_table(path)
+    except Exception as exc:                        # noqa: BLE001 - any unreadable file
+        raise _err(path, f"not a readable Parquet file ({exc})", trial) from None
+    raw = (tab.schema.metadata or {}).get(META_KEY)
+    if raw is None:
+        raise _err(path, f"no schema metadata key {META_KEY.decode()!r}: not a "
+                   f"{FORMAT} file", trial)
+    try:
+        meta = json.loads(raw)
+    except ValueError:
+        raise _err(path, f"schema metadata {META_KEY.decode()!r} is not JSON", trial) from None
+    if not isinstance(meta, dict):
+        raise _err(path, f"schema metadata {META_KEY.decode()!r} is not a JSON object", trial)
+    return meta, tab.to_pandas()
+
+
+def _floats(path, col: str, values, rows, trial, finite: bool) -> np.ndarray:
+    out = np.empty(len(values))
+    for i, v in enumerate(values):
+        if isinstance(v, str):
+            v = v.strip()
+            if v == "":
+                v = "nan"
+        if isinstance(v, (bool, np.bool_)):
+            raise _err(path, f"column {col!r}, {rows(i)}: {v!r} is not a number", trial)
+        try:
+            out[i] = float(v)
+        except (TypeError, ValueError):
+            raise _err(path, f"column {col!r}, {rows(i)}: {v!r} is not a number",
+                       trial) from None
+        if finite and not math.isfinite(out[i]):
+            raise _err(path, f"column {col!r}, {rows(i)}: {v!r} is not a finite number "
+                       "(every row needs a time)", trial)
+    return out
+
+
+def _bools(path, col: str, values, rows, trial) -> np.ndarray:
+    out = np.empty(len(values), bool)
+    for i, v in enumerate(values):
+        if isinstance(v, (bool, np.bool_)):
+            out[i] = bool(v)
+            continue
+        s = str(v).strip().lower()
+        if s in _TRUE:
+            out[i] = True
+        elif s in _FALSE:
+            out[i] = False
+        else:
+            raise _err(path, f"column {col!r}, {rows(i)}: {v!r} is not true/false", trial)
+    return out
+
+
+def _ints(path, col: str, values, rows, trial, lo: int, hi: int) -> np.ndarray:
+    f = _floats(path, col, values, rows, trial, finite=True)
+    for i, v in enumerate(f):
+        if v != int(v) or not lo <= v <= hi:
+            raise _err(path, f"column {col!r}, {rows(i)}: {values[i]!r} is not a whole "
+                       f"number from {lo} to {hi}", trial)
+    return f.astype(np.int64)
+
+
+def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataFrame, dict]:
+    """Read a ``*.tracks.csv`` or ``*.tracks.parquet`` file.
+
+    Returns
+    -------
+    (DataFrame, dict)
+        The rows in file order, positions in metres (velocities m/s): ``t_s``, ``side``
+        (``L``/``R``) or ``person``, ``x_m``, ``y_m`` and whichever of ``k``, ``vx_mps``,
+        ``vy_mps``, ``observed``, ``pattern``, ``phase``, ``swing``, ``interpolated`` the
+        file has; and the header (``format, version, units, frame, clock``, and any other
+        key, e.g. ``source``).  Times are as stored, on the header's clock.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file, the field or column, and the row (CSV: the file's line;
+        Parquet: the data row, 1-based): a wrong format line or version, units other than
+        ``m``/``mm``, an unknown frame or clock, a missing column, a non-number, a side
+        other than L/R, a leg missing at a time stamp, a time stamp given twice.
+    """
+    p = Path(path)
+    if not p.exists():
+        raise _err(p, "no such file", trial)
+    if p.suffix == ".csv":
+        meta, names, rows_txt, first_line = _read_csv(p, trial)
+        for j, r in enumerate(rows_txt):
+            if len(r) != len(names):
+                raise _err(p, f"line {first_line + j}: {len(r)} cells, the header has "
+                           f"{len(names)}", trial)
+        cols = {n: [r[i] for r in rows_txt] for i, n in enumerate(names)}
+
+        def where(i):
+            return f"line {first_line + i}"
+    elif p.suffix == ".parquet":
+        meta, df = _read_parquet(p, trial)
+        names = list(df.columns)
+        cols = {n: df[n].tolist() for n in names}
+
+        def where(i):
+            return f"row {i + 1}"
+    else:
+        raise _err(p, f"unknown extension {p.suffix!r}", trial,
+                   hint="a track file is *.tracks.csv or *.tracks.parquet")
+    meta = _check_meta(meta, p, trial)
+    unknown = [n for n in names if n not in COLUMNS]
+    if unknown:
+        raise _err(p, f"unknown column(s) {', '.join(map(repr, unknown))}", trial,
+                   hint=f"the columns are {', '.join(COLUMNS)}")
+    for c in ("t_s", "x", "y"):
+        if c not in names:
+            raise _err(p, f"column {c!r} is missing", trial)
+    if ("side" in names) == ("person" in names):
+        raise _err(p, "exactly one of the columns 'side' (legs) and 'person' (people) "
+                   "is needed", trial)
+    n = len(cols["t_s"])
+    if n == 0:
+        raise _err(p, "no rows", trial)
+    scale = UNITS[meta["units"]]
+    out = {"t_s": _floats(p, "t_s", cols["t_s"], where, trial, finite=True)}
+    if "k" in names:
+        out["k"] = _ints(p, "k", cols["k"], where, trial, 0, 2 ** 62)
+    key = "side" if "side" in names else "person"
+    ids = ["" if v is None else str(v).strip() for v in cols[key]]
+    for i, v in enumerate(ids):
+        if key == "side" and v not in SIDES:
+            raise _err(p, f"column 'side', {where(i)}: {cols[key][i]!r} is not L or R",
+                       trial)
+        if key == "person" and not v:
+            raise _err(p, f"column 'person', {where(i)}: empty person id", trial)
+    out[key] = pd.Series(ids, dtype=object)
+    for c, name in (("x", "x_m"), ("y", "y_m"), ("vx", "vx_mps"), ("vy", "vy_mps")):
+        if c in names:
+            v = _floats(p, c, cols[c], where, trial, finite=False)
+            out[name] = v * scale if scale != 1.0 else v
+    for c in BOOL_COLUMNS:
+        if c in names:
+            out[c] = _bools(p, c, cols[c], where, trial)
+    if "pattern" in names:
+        pat = ["" if v is None or (isinstance(v, float) and np.isnan(v)) else str(v).strip()
+               for v in cols["pattern"]]
+        for i, v in enumerate(pat):
+            if v not in PATTERNS:
+                raise _err(p, f"column 'pattern', {where(i)}: {v!r} is not one of "
+                           f"{', '.join(x for x in PATTERNS if x)} or empty", trial)
+        out["pattern"] = pd.Series(pat, dtype=object)
+    if "phase" in names:
+        out["phase"] = _ints(p, "phase", cols["phase"], where, trial, -1, 5)
+    df = pd.DataFrame(out)
+    dup = df.duplicated(["t_s", key])
+    if dup.any():
+        i = int(np.flatnonzero(dup.to_numpy())[0])
+        raise _err(p, f"{where(i)}: time stamp {df['t_s'].iloc[i]!r} s has {key} "
+                   f"{ids[i]!r} twice", trial)
+    if key == "side":
+        for s in SIDES:
+            if not (df["side"] == s).any():
+                raise _err(p, f"column 'side': leg {s} is missing (no row has side {s})",
+                           trial, hint="a leg track file has rows for both legs; a tracker "
+                           "that gives only people uses the column 'person'")
+        counts = df.groupby("t_s", sort=False)["side"].transform("size")
+        if (counts < 2).any():
+            i = int(np.flatnonzero((counts < 2).to_numpy())[0])
+            other = "R" if ids[i] == "L" else "L"
+            raise _err(p, f"{where(i)}: leg {other} is missing at time stamp "
+                       f"{df['t_s'].iloc[i]!r} s (every time stamp has one row per leg; "
+                       "write x, y empty where a leg has no track)", trial)
+    df.attrs = {}
+    return df, meta
+
+
+# -- gaitval's own tracks ----------------------------------------------------------------
+def track_to_exchange(track: pd.DataFrame) -> pd.DataFrame:
+    """gaitval's per-scan track (sensor frame and clock, metres) as exchange-format rows."""
+    out = pd.DataFrame({
+        "t_s": track["t_sensor_s"].to_numpy(float), "k": track["k"].to_numpy(np.int64),
+        "side": track["side"].astype(str).to_numpy(object),
+        "x": track["x_m"].to_numpy(float), "y": track["y_m"].to_numpy(float)})
+    for c, src in (("vx", "vx_mps"), ("vy", "vy_mps")):
+        if src in track:
+            out[c] = track[src].to_numpy(float)
+    for c in ("observed", "pattern", "phase", "swing", "interpolated"):
+        if c in track:
+            out[c] = track[c].to_numpy()
+    if "pattern" in out:
+        out["pattern"] = out["pattern"].fillna("").astype(str)
+    return out
+
+
+def write_tracks(rows: pd.DataFrame, path: str | Path, *, units: str = "m",
+                 frame: str = "sensor", clock: str = "sensor", **extra) -> Path:
+    """Write exchange-format rows (columns of :data:`COLUMNS`; positions in ``units``)
+    to ``*.tracks.csv`` or ``*.tracks.parquet``, atomically.  ``extra`` header keys (e.g.
+    ``source``) are written after the required ones.  CSV floats are written with the
+    shortest text that reads back to the same float (Python's ``repr``), so a round trip
+    through CSV is exact."""
+    p = Path(path)
+    meta = _check_meta({"format": FORMAT, "version": VERSION, "units": units,
+                        "frame": frame, "clock": clock}, p, None)
+    meta.update({k: str(v) for k, v in extra.items()})
+    rows = rows[[c for c in COLUMNS if c in rows.columns]].reset_index(drop=True)
+    if p.suffix == ".parquet":
+        write_parquet(rows, p, metadata={META_KEY.decode(): json.dumps(meta, sort_keys=True)})
+        return p
+    if p.suffix != ".csv":
+        raise _err(p, f"unknown extension {p.suffix!r}", hint="*.tracks.csv or "
+                   "*.tracks.parquet")
+    head = [f"# {FORMAT} v{VERSION}"] + [f"# {k}: {v}" for k, v in meta.items()
+                                          if k not in ("format", "version")]
+    body = rows.copy()
+    for c in BOOL_COLUMNS:
+        if c in body:
+            body[c] = np.where(body[c].to_numpy(bool), "true", "false")
+    for c in body.columns:
+        if body[c].dtype.kind == "f":
+            body[c] = ["" if math.isnan(v) else repr(float(v))
+                       for v in body[c].to_numpy(float)]
+    text = "\n".join(head) + "\n" + body.to_csv(index=False, lineterminator="\n")
+    write_bytes(p, text.encode("utf-8"))
+    return p
+
+
+# -- into gaitval's per-scan track ---------------------------------------------------------
+def _swing_from_speed(speed: np.ndarray) -> np.ndarray:
+    """Swing by hysteresis on the leg speed (seed 000 Table 2 thresholds)."""
+    out = np.zeros(len(speed), bool)
+    state = False
+    for i, v in enumerate(speed):
+        if np.isfinite(v):
+            if not state and v > V_SW_TH:
+                state = True
+            elif state and v < V_ST_TH:
+                state = False
+        out[i] = state
+    return out
+
+
+#: a converted time stamp this close to a scan's is that scan's (clock conversion rounding)
+SNAP_S = 1e-6
+
+
+def snap_to_scans(t: np.ndarray, scan_t: np.ndarray, tol_s: float = SNAP_S) -> np.ndarray:
+    """``t`` with each time within ``tol_s`` of a scan time replaced by that scan time: a
+    tracker's time stamp names the scan it tracked, and the mocap-to-sensor clock
+    conversion (a subtraction and a division and back) moves it by a few 1e-16 s, enough to
+    put a scan that lies on a TUG phase bound into the other phase."""
+    t = np.asarray(t, float).copy()
+    s = np.sort(np.asarray(scan_t, float))
+    if not len(s) or not len(t):
+        return t
+    i = np.clip(np.searchsorted(s, t), 1, len(s) - 1) if len(s) > 1 else np.zeros(len(t), int)
+    left, right = s[np.maximum(i - 1, 0)], s[i]
+    near = np.where(np.abs(t - left) <= np.abs(right - t), left, right)
+    hit = np.abs(near - t) <= tol_s
+    t[hit] = near[hit]
+    return t
+
+
+def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None = None, *,
+                     path=None, trial: str | None = None,
+                     t_range: tuple[float, float] | None = None,
+                     tolerance_s: float = 0.0, scan_t: np.ndarray | None = None
+                     ) -> pd.DataFrame:
+    """Exchange rows (from :func:`read_tracks`) as gaitval's per-scan leg track.
+
+    Parameters
+    ----------
+    rows, meta
+        :func:`read_tracks` output.
+    registration : dict, optional
+        The trial's registration record (``registration.json``: ``x_m``, ``y_m``,
+        ``yaw_rad``, ``clock_offset_s``, ``clock_drift_ppm``); needed when the file's
+        frame or clock is ``mocap``.
+    t_range : (float, float), optional
+        The recording's first and last scan time on the sensor clock; a track time stamp
+        (after the clock conversion) outside it by more than ``tolerance_s`` is an error
+        naming the row.
+    scan_t : ndarray, optional
+        The recording's scan times (sensor clock): a converted time stamp within
+        :data:`SNAP_S` of one becomes that scan's time (:func:`snap_to_scans`).
+
+    Returns
+    -------
+    DataFrame
+        :data:`TRACK_COLUMNS`, sorted by time and side, on the sensor clock in the sensor
+        frame.  Columns the file lacks are filled as docs/formats.md says: ``k`` = the
+        index of the time stamp, velocities by central differences, ``observed`` = a
+        position is given, ``interpolated`` false, ``pattern`` ``UO`` where not observed
+        (else empty), ``phase`` −1, ``swing`` from the speed (hysteresis between
+        v_st_th = 0.47 and v_sw_th = 0.93 m/s, seed 000 Table 2).
+    """
+    if "side" not in rows:
+        raise _err(path, "the file gives people (column 'person'), not legs; the leg "
+                   "evaluation needs one row per leg (column 'side')", trial)
+    need = [f for f, used in (("frame", meta["frame"] == "mocap"),
+                              ("clock", meta["clock"] == "mocap")) if used]
+    reg = registration or {}
+    if need:
+        keys = (["x_m", "y_m", "yaw_rad"] if "frame" in need else []) + \
+            (["clock_offset_s"] if "clock" in need else [])
+        bad = [k for k in keys if reg.get(k) is None or not math.isfinite(float(reg[k]))]
+        if bad:
+            raise _err(path, f"header {' and '.join(need)} 'mocap' needs the trial's "
+                       f"registration ({', '.join(bad)} unknown)", trial)
+    t = rows["t_s"].to_numpy(float)
+    if meta["clock"] == "mocap":
+        # docs/formats.md, Clock: t_sensor = offset + (1 + drift ppm 1e-6) t_mocap
+        drift = float(reg.get("clock_drift_ppm") or 0.0)
+        t = float(reg["clock_offset_s"]) + (1.0 + drift * 1e-6) * t
+        if scan_t is not None:
+            t = snap_to_scans(t, scan_t)
+    if t_range is not None:
+        lo, hi = t_range[0] - tolerance_s, t_range[1] + tolerance_s
+        out_of = (t < lo) | (t > hi)
+        if out_of.any():
+            i = int(np.flatnonzero(out_of)[0])
+            line = f"data row {i + 1}"
+            raise _err(path, f"{line}: time stamp {rows['t_s'].iloc[i]!r} s "
+                       f"({meta['clock']} clock; {t[i]:.4f} s on the sensor clock) is "
+                       f"outside the recording ({t_range[0]:.4f} to {t_range[1]:.4f} s on "
+                       "the sensor clock)", trial,
+                       hint="check the header's clock and the trial's clock offset")
+    x, y = rows["x_m"].to_numpy(float), rows["y_m"].to_numpy(float)
+    has_v = "vx_mps" in rows and "vy_mps" in rows
+    vx = rows["vx_mps"].to_numpy(float) if has_v else None
+    vy = rows["vy_mps"].to_numpy(float) if has_v else None
+    if meta["frame"] == "mocap":
+        # inverse of p_f = R(yaw) p_s + [x, y] (docs/formats.md, Sensor pose)
+        c, s = math.cos(float(reg["yaw_rad"])), math.sin(float(reg["yaw_rad"]))
+        dx, dy = x - float(reg["x_m"]), y - float(reg["y_m"])
+        x, y = c * dx + s * dy, -s * dx + c * dy
+        if has_v:
+            vx, vy = c * vx + s * vy, -s * vx + c * vy
+    df = pd.DataFrame({"t_sensor_s": t, "side": rows["side"].to_numpy(object),
+                       "x_m": x, "y_m": y})
+    if has_v:
+        df["vx_mps"], df["vy_mps"] = vx, vy
+    for c in ("k", "observed", "pattern", "phase", "swing", "interpolated"):
+        if c in rows:
+            df[c] = rows[c].to_numpy()
+    df = df.sort_values(["t_sensor_s", "side"], kind="stable").reset_index(drop=True)
+    if "k" not in df:
+        df["k"] = pd.factorize(df["t_sensor_s"])[0].astype(np.int64)
+    finite = np.isfinite(df["x_m"].to_numpy(float)) & np.isfinite(df["y_m"].to_numpy(float))
+    if not has_v:
+        df["vx_mps"], df["vy_mps"] = np.nan, np.nan
+        for side in SIDES:
+            m = (df["side"] == side).to_numpy() & finite
+            if m.sum() >= 2:
+                tt = df.loc[m, "t_sensor_s"].to_numpy(float)
+                df.loc[m, "vx_mps"] = np.gradient(df.loc[m, "x_m"].to_numpy(float), tt)
+                df.loc[m, "vy_mps"] = np.gradient(df.loc[m, "y_m"].to_numpy(float), tt)
+    if "observed" not in df:
+        df["observed"] = finite
+    if "interpolated" not in df:
+        df["interpolated"] = False
+    if "pattern" not in df:
+        df["pattern"] = np.where(df["observed"].to_numpy(bool), "", "UO").astype(object)
+        df.loc[~finite, "pattern"] = ""
+    if "phase" not in df:
+        df["phase"] = np.int64(-1)
+    if "swing" not in df:
+        df["swing"] = False
+        for side in SIDES:
+            m = (df["side"] == side).to_numpy()
+            sp = np.hypot(df.loc[m, "vx_mps"].to_numpy(float),
+                          df.loc[m, "vy_mps"].to_numpy(float))
+            df.loc[m, "swing"] = _swing_from_speed(sp)
+    df = df[list(TRACK_COLUMNS)]
+    df = df.astype({"k": np.int64, "phase": np.int64, "observed": bool, "swing": bool,
+                    "interpolated": bool})
+    df["pattern"] = df["pattern"].astype(object)
+    df["side"] = df["side"].astype(object)
+    return df
+
+
+# -- ROS 1/2 bag topics of leg_tracker and people_msgs --------------------------------------
+#: tracker output types read from bags (ROS 2 style names, as rosbags reports them)
+BAG_PEOPLE_TYPES = ("leg_tracker/msg/PersonArray", "people_msgs/msg/People")
+BAG_LEG_DETECTIONS = "leg_tracker/msg/LegArray"
+
+
+def read_bag_tracks(path: str | Path, topic: str | None = None, *,
+                    trial: str | None = None) -> tuple[pd.DataFrame, dict]:
+    """A tracker's people topic of a ROS bag as exchange-format rows (``person``).
+
+    ``leg_tracker/PersonArray`` (leg_tracker's ``/people_tracked``: ``header``,
+    ``people[]`` with ``pose`` and ``id``) and ``people_msgs/People`` (``header``,
+    ``people[]`` with ``name`` and ``position``).  The message definitions are taken from
+    the bag (a ROS 1 bag embeds them; as :mod:`gaitval.io.annotations_bag` does), so
+    nothing needs ROS installed.  Times are the messages' ``header.stamp`` (the clock of
+    the scans they were tracked in: ``clock: sensor``); positions in metres
+    (``units: m``).  The header's ``frame_id`` must be the frame of the bag's LaserScan
+    messages (``frame: sensor``): gaitval does not read ``/tf``.
+
+    ``leg_tracker/LegArray`` (``/detected_leg_clusters``) holds leg *detections* of one
+    scan without identity or side, not tracks: it is refused with that reason.
+
+    Returns
+    -------
+    (DataFrame, dict)
+        Rows ``t_s, person, x, y`` (sorted by time and person, in metres) and the header
+        (``format, version, units: m, frame: sensor, clock: sensor, source``), ready for
+        :func:`write_tracks`.
+    """
+    from gaitval.io.annotations_bag import _register_custom_types
+    from gaitval.io.rosbag import LASERSCAN, _norm, _open
+
+    p = Path(path)
+    reader = _open(p, trial)
+    try:
+        _register_custom_types(reader)
+        known = BAG_PEOPLE_TYPES + (BAG_LEG_DETECTIONS,)
+        cands = [c for c in reader.connections if c.msgtype in known]
+        if topic is not None and str(topic).strip():
+            conns = [c for c in reader.connections if _norm(c.topic) == _norm(str(topic))]
+            if not conns:
+                raise _err(p, f"topic {topic!r} is not in this bag; tracker topics: "
+                           f"{sorted({c.topic for c in cands}) or 'none'}; all topics: "
+                           f"{sorted({c.topic for c in reader.connections})}", trial)
+        else:
+            topics = sorted({c.topic for c in cands})
+            if len(topics) != 1:
+                raise _err(p, f"{'no' if not topics else 'several'} tracker topic(s) of type "
+                           f"{', '.join(known)} in this bag"
+                           f"{': ' + str(topics) if topics else ''}", trial,
+                           hint="name the topic")
+            conns = [c for c in cands if c.topic == topics[0]]
+        msgtype, name = conns[0].msgtype, conns[0].topic
+        if msgtype == BAG_LEG_DETECTIONS:
+            raise _err(p, f"topic {name} holds {msgtype}: leg detections of one scan "
+                       "without identity or side, not tracks", trial,
+                       hint="record the tracker's people topic (leg_tracker/PersonArray, "
+                       "/people_tracked) or write the legs' tracks as a *.tracks.csv")
+        if msgtype not in BAG_PEOPLE_TYPES:
+            raise _err(p, f"topic {name} holds {msgtype}, not one of "
+                       f"{', '.join(BAG_PEOPLE_TYPES)}", trial)
+        scan_frames = set()
+        scans = [c for c in reader.connections if c.msgtype == LASERSCAN]
+        for con, _, raw in reader.messages(connections=scans):
+            scan_frames.add(str(reader.deserialize(raw, con.msgtype).header.frame_id))
+        rows, frames = [], set()
+        for n, (con, _, raw) in enumerate(reader.messages(connections=conns)):
+            m = reader.deserialize(raw, con.msgtype)
+            t = int(m.header.stamp.sec) + int(m.header.stamp.nanosec) * 1e-9
+            frames.add(str(m.header.frame_id))
+            for q in m.people:
+                if msgtype == BAG_PEOPLE_TYPES[0]:
+                    pid, pos = str(int(q.id)), q.pose.position
+                else:
+                    pid, pos = str(q.name), q.position
+                rows.append((t, pid, float(pos.x), float(pos.y), n + 1))
+    finally:
+        reader.close()
+    if not rows:
+        raise _err(p, f"topic {name} holds no person", trial)
+    if not scan_frames:
+        raise _err(p, f"no LaserScan topic in this bag: the frame of {name} "
+                   f"({', '.join(sorted(frames))}) cannot be checked against the laser's",
+                   trial, hint="record the scans with the tracker's output")
+    if frames != scan_frames or len(frames) != 1:
+        raise _err(p, f"topic {name} is in frame(s) {sorted(frames)} but the scans in "
+                   f"{sorted(scan_frames)}; gaitval does not transform between frames",
+                   trial, hint="publish the tracks in the laser frame")
+    df = pd.DataFrame(rows, columns=["t_s", "person", "x", "y", "msg"])
+    bad = ~np.isfinite(df[["t_s", "x", "y"]].to_numpy()).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise _err(p, f"topic {name}, message {df['msg'].iloc[i]}: person "
+                   f"{df['person'].iloc[i]!r} has a non-finite position", trial)
+    dup = df.duplicated(["t_s", "person"])
+    if dup.any():
+        i = int(np.flatnonzero(dup.to_numpy())[0])
+        raise _err(p, f"topic {name}, message {df['msg'].iloc[i]}: person "
+                   f"{df['person'].iloc[i]!r} twice at time stamp {df['t_s'].iloc[i]!r} s",
+                   trial)
+    df = df.drop(columns="msg").sort_values(["t_s", "person"], kind="stable")
+    meta = {"format": FORMAT, "version": VERSION, "units": "m", "frame": "sensor",
+            "clock": "sensor", "source": f"{msgtype} on {name}"}
+    return df.reset_index(drop=True), meta
