@@ -224,8 +224,6 @@ def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[
     unobservable (Table 5) RMSE."""
     st = "tug"
     t3 = t["tug_table3"]
-    if "success_rate_published" in t3:    # rows without a paper value (an external
-        t3 = t3[t3["success_rate_published"].notna()]   # tracker, issue 37): not compared
     if "phase_reading" not in t3:
         t3 = t3.assign(phase_reading=PRIMARY_READING, base_method=t3["method"])
     # the paper's methods only: an extra row (the people tracker, an external tracker) has
@@ -324,8 +322,6 @@ def mtst_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list
     st = "mtst"
     rows = []
     t3 = t["mtst_table3"]
-    if "success_pct_published" in t3:     # rows without a paper value (an external
-        t3 = t3[t3["success_pct_published"].notna()]    # tracker, issue 37): not compared
     ref = "mocap reference"
     if "reference" in t3:
         if not (t3["reference"] == "mocap").any() and len(t3):
