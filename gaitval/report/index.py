@@ -47,6 +47,8 @@ SECTION_TITLES = {
     "ultrasonic": "Ultrasonic foot tracking (Qi et al., Sensors 2014, seed 003)",
     "legbench": "Annotated recordings without mocap: CLEAR-MOT (Leigh et al., ICRA 2015)",
     "peer": "Worked example: agreement statistics on a peer's published data",
+    "sensitivity": "Sensitivity: the verdicts under the twin's alternative free choices "
+                   "(python3 run.py sensitivity)",
     "study": "Appendix: study, ingest and registration",
 }
 #: Captions of the figures, by stem (``{p}``: the parameter of a per-parameter figure).
