@@ -84,7 +84,7 @@ def cmd_ingest_summary(a) -> int:
     paths = write_table(df, stem, caption=(
         f"What gaitval read from each raw trial of study '{a.study}': mocap rate, frames and "
         "missing marker samples; sensor samples, rate, beams/anchors and no-return beams; "
-        "timestamp problems (reported, never reordered); rater annotations."), digits=2)
+        "timestamp problems (reported, never reordered); rater annotations."))
     stamp(stem.name, paths, a.reports_dir, config_hash_=a.config_hash)
     return 0
 

@@ -209,7 +209,7 @@ def registration_summary(inputs: list[str | Path], study: str, out_csv, out_stem
     n_ref = int((df["status"] != "ok").sum())
     notes = [f"{n_ref} trial(s) refused; their reason is given and later tables leave them "
              "out."] if n_ref else []
-    paths = write_table(show, out_stem, digits=4, notes=notes, caption=(
+    paths = write_table(show, out_stem, notes=notes, caption=(
         f"Registration of each trial of study '{study}': estimated sensor pose in the mocap "
         "field (pose_source: from the calibration poles, or measured by hand where the C3D "
         "has no poles — where both exist, the poles' pose minus the hand-measured one; "

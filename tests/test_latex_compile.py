@@ -39,12 +39,17 @@ def test_specials_and_unicode_are_latex_commands():
         r"\texttt{a\_b} \textbf{c} \emph{d} e"
 
 
-def test_numbers_at_fixed_precision_tiny_values_not_zero():
-    assert format_cell(0.05123, 3) == "0.051"
-    assert format_cell(-0.2, 2) == r"\ensuremath{-}0.20"
-    assert format_cell(4.8486e-09, 3) == r"\ensuremath{4.85\times10^{-9}}"
-    assert format_cell(np.nan, 3) == "" and format_cell(True, 3) == "yes"
-    assert format_cell(7, 3) == "7"
+def test_numbers_take_the_reports_one_format_never_e_notation():
+    """Issue 35: a LaTeX cell prints what the Markdown prints (gaitval.tables.numbers),
+    minus signs as maths minus; a tiny p-value is "< 0.001", not 4.85e-9 nor 0.000."""
+    from gaitval.tables.numbers import format_value
+    for v, col in ((0.05123, "rmse_m"), (-0.2, "bias_m"), (7, "n_trials")):
+        assert format_cell(v, col) == format_value(v, col).replace(
+            "-", r"\ensuremath{-}", 1)
+    assert format_cell(-0.2, "bias_m").startswith(r"\ensuremath{-}")
+    assert format_cell(4.8486e-09, "p") == r"\textless{} 0.001"
+    assert format_cell(np.nan, "p") == "" and format_cell(True, "ok") == "yes"
+    assert format_cell(float("-inf"), "x") == r"\ensuremath{-\infty}"
 
 
 def test_published_column_sits_beside_its_quantity_under_one_header():

@@ -12,10 +12,9 @@ does so that it does:
   Latin-1 letters (é, ü) are left to ``[T1]{fontenc}``; anything else is printed as
   ``[U+XXXX]`` rather than breaking the compile.  The inline Markdown of captions and notes
   (code, bold, italics, links) becomes ``\\texttt``, ``\\textbf``, ``\\emph`` and plain text.
-* **Numbers.** Floats with the table's fixed number of decimals (``digits``); a non-zero
-  value that would print as zero at that precision in scientific notation
-  (``4.85\\times10^{-9}``), so a p-value of 5e-9 is not shown as ``0.000``; minus signs
-  as maths minus; numeric columns right-aligned.
+* **Numbers.** The report's one number format (:func:`gaitval.tables.numbers.format_value`,
+  by column and table: the same text as the Markdown and HTML, never e-notation; p-values
+  as ``< 0.001``); minus signs as maths minus; numeric columns right-aligned.
 * **Published beside reproduced.** ``<q>_published`` moves right after ``<q>`` under one
   header ``<q>`` with sub-columns *ours* and *paper* (``\\multicolumn`` + ``\\cmidrule``).
 * **Page fit.**  Column widths are estimated from their longest entry and header (0.6 em a
@@ -152,46 +151,32 @@ def _is_missing(v) -> bool:
     return isinstance(v, (float, np.floating)) and math.isnan(v)
 
 
-def format_cell(v, digits: int, column: str | None = None, table: str | None = None) -> str:
-    """One cell as LaTeX.  With its ``column`` (display name) a number takes the report's
-    one number format (:func:`gaitval.tables.numbers.format_value`: the same text as the
-    Markdown and HTML, never e-notation); without, ``digits`` decimals (module docstring)."""
+def _cell_text(v, column: str, table: str | None) -> str:
+    """A cell's plain text: numbers in the report's number format, the rest as given."""
+    from gaitval.tables.numbers import format_value
+    if isinstance(v, (float, np.floating)) and math.isinf(float(v)):
+        return "-inf" if v < 0 else "inf"
+    return format_value(v, column, table)
+
+
+def format_cell(v, column: str, table: str | None = None) -> str:
+    """One cell of ``column`` (display name) of ``table`` as LaTeX (module docstring)."""
     if _is_missing(v):
         return ""
-    if isinstance(v, (bool, np.bool_)):
-        return "yes" if v else "no"
-    if column is not None and isinstance(v, (int, float, np.integer, np.floating)) \
-            and math.isfinite(float(v)):
-        from gaitval.tables.numbers import format_value
-        text = latex_text(format_value(v, column, table))
+    if isinstance(v, (float, np.floating)) and math.isinf(float(v)):
+        return r"\ensuremath{-\infty}" if v < 0 else r"\ensuremath{\infty}"
+    text = latex_text(_cell_text(v, column, table))
+    if isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(
+            v, (bool, np.bool_)):
         return text.replace("-", r"\ensuremath{-}", 1) if text.startswith("-") else text
-    if isinstance(v, (int, np.integer)):
-        return str(int(v)).replace("-", r"\ensuremath{-}")
-    if isinstance(v, (float, np.floating)):
-        x = float(v)
-        if math.isinf(x):
-            return r"\ensuremath{-\infty}" if x < 0 else r"\ensuremath{\infty}"
-        if x != 0 and abs(x) < 0.5 * 10.0 ** -digits:
-            mant, exp = f"{x:.2e}".split("e")
-            return rf"\ensuremath{{{mant}\times10^{{{int(exp)}}}}}"
-        text = f"{x:.{digits}f}"
-        return text.replace("-", r"\ensuremath{-}", 1) if text.startswith("-") else text
-    text = latex_text(v)
     if any(len(w) > 16 for w in str(v).split()):    # a path or identifier may break
         text = text.replace(r"\_", r"\_\allowbreak{}").replace("/", r"/\allowbreak{}")
     return text
 
 
-def _plain_len(v, digits: int) -> int:
+def _plain_len(v, column: str, table: str | None) -> int:
     """Printed width of a cell in characters (for the page-fit estimate)."""
-    if _is_missing(v):
-        return 0
-    if isinstance(v, (float, np.floating)) and not math.isinf(float(v)):
-        x = float(v)
-        if x != 0 and abs(x) < 0.5 * 10.0 ** -digits:
-            return 10
-        return len(f"{x:.{digits}f}")
-    return len(str(v))
+    return 0 if _is_missing(v) else len(_cell_text(v, column, table))
 
 
 def _numeric(col: pd.Series) -> bool:
@@ -216,11 +201,11 @@ def _groups(df: pd.DataFrame) -> list[list[str]]:
     return out
 
 
-def _col_info(df: pd.DataFrame, col: str, digits: int) -> dict:
+def _col_info(df: pd.DataFrame, col: str, table: str | None) -> dict:
     """Natural width (characters, entries and header), the narrowest a paragraph column
     may get (its longest word up to 17 characters -- longer ones may break -- or header
     piece between underscores, at least 8) and the kind."""
-    cells = max([_plain_len(v, digits) for v in df[col]] + [0])
+    cells = max([_plain_len(v, col, table) for v in df[col]] + [0])
     num = _numeric(df[col])
     words = [len(w) for v in df[col] if isinstance(v, str) for w in v.split()]
     return {"num": num, "chars": max(cells, len(col)), "cells": cells,
@@ -346,7 +331,7 @@ def _col_width_pt(spec: str, info: dict, page: dict) -> float:
     return float(m.group(1)) if m else info["chars"] * 0.6 * page["size_pt"]
 
 
-def _height_pt(df: pd.DataFrame, groups, specs, info, page, *, digits: int,
+def _height_pt(df: pd.DataFrame, groups, specs, info, page, *, table: str | None,
                caption: str, notes: list[str]) -> float:
     """A generous estimate of a part's height as a float: caption, header, rows (a row
     is as tall as its tallest paragraph cell) and notes."""
@@ -360,7 +345,7 @@ def _height_pt(df: pd.DataFrame, groups, specs, info, page, *, digits: int,
 
     rows = 0.0
     for _, row in df[cols].iterrows():
-        n = max([lines(_plain_len(row[c], digits), widths[c]) for c in para] + [1])
+        n = max([lines(_plain_len(row[c], c, table), widths[c]) for c in para] + [1])
         rows += n * line
     head = max([lines(len(c), widths[c]) for c in para] + [1]) * line
     head += line if any(len(g) == 2 for g in groups) else 0
@@ -371,7 +356,7 @@ def _height_pt(df: pd.DataFrame, groups, specs, info, page, *, digits: int,
 
 
 def _render_part(df: pd.DataFrame, groups: list[list[str]], specs: dict[str, str], *,
-                 caption: str, label: str, digits: int, long: bool) -> str:
+                 caption: str, label: str, table: str | None, long: bool) -> str:
     cols = [c for g in groups for c in g]
     paired = any(len(g) == 2 for g in groups)
     if paired:
@@ -382,8 +367,7 @@ def _render_part(df: pd.DataFrame, groups: list[list[str]], specs: dict[str, str
         columns = pd.MultiIndex.from_tuples(tuples)
     else:
         columns = pd.Index([_head(c) for c in cols])
-    table = re.sub(r"-\d+$", "", label)                # a part's label: its table's
-    body = pd.DataFrame([[format_cell(v, digits, c, table) for c, v in zip(cols, row)]
+    body = pd.DataFrame([[format_cell(v, c, table) for c, v in zip(cols, row)]
                          for row in df[cols].itertuples(index=False)], columns=columns)
     styler = body.style.hide(axis="index").format(lambda v: v)
     tex = styler.to_latex(
@@ -403,7 +387,7 @@ def _render_part(df: pd.DataFrame, groups: list[list[str]], specs: dict[str, str
 
 
 def _with_prose(tex: str, df: pd.DataFrame, prose: list[str], ncols: int, page: dict, *,
-                long: bool) -> str:
+                table: str | None, long: bool) -> str:
     """Each row of ``tex`` followed by its prose columns as one full-width line."""
     head, body = tex.rsplit("\\endlastfoot\n" if long else "\\midrule\n", 1)
     rows, tail = body.split("\\bottomrule", 1) if not long else (body, "")
@@ -411,7 +395,7 @@ def _with_prose(tex: str, df: pd.DataFrame, prose: list[str], ncols: int, page: 
     width = page["width_pt"] - 2 * page["tabcolsep_pt"]
     out = []
     for k, ln in enumerate(lines[:len(df)]):
-        text = "; ".join(rf"\textit{{{latex_text(c)}}}: {format_cell(df[c].iloc[k], 3, c)}"
+        text = "; ".join(rf"\textit{{{latex_text(c)}}}: {format_cell(df[c].iloc[k], c, table)}"
                          for c in prose if not _is_missing(df[c].iloc[k]))
         out.append(ln + " \\\\\n" + rf"\multicolumn{{{ncols}}}"
                    rf"{{>{{\raggedright\arraybackslash}}p{{{width:.1f}pt}}}}"
@@ -422,20 +406,23 @@ def _with_prose(tex: str, df: pd.DataFrame, prose: list[str], ncols: int, page: 
 
 
 def to_latex(df: pd.DataFrame, *, caption: str, label: str, notes: list[str] | None = None,
-             digits: int = 3, keys: list[str] | None = None) -> str:
+             keys: list[str] | None = None) -> str:
     """The table as LaTeX that fits a page, compiling inside :data:`PREAMBLE`.
 
     Portrait if it fits the text width, else landscape, else split into landscape parts
     that each repeat the key columns (``keys``, default :func:`key_columns`).  A part is a
     ``table`` float when its estimated height fits the page with room to spare, else a
     ``longtable`` (page breaks, repeated header) with the notes after it as a paragraph.
+    ``label`` is also the table's name for the number format
+    (:func:`gaitval.tables.numbers.format_value`).
     """
+    table = label
     df = df.reset_index(drop=True)
     df.columns = [str(c) for c in df.columns]
     notes = list(notes or [])
-    info = {c: _col_info(df, c, digits) for c in df.columns}
+    info = {c: _col_info(df, c, table) for c in df.columns}
     prose = [c for c in df.columns if not info[c]["num"] and len(df.columns) > 1
-             and np.mean([_plain_len(v, digits) for v in df[c]] or [0]) > PROSE_CHARS]
+             and np.mean([_plain_len(v, c, table) for v in df[c]] or [0]) > PROSE_CHARS]
     groups = [g for g in _groups(df) if g[0] not in prose]
     keys = [k for k in (keys if keys is not None else key_columns(df.drop(columns=prose)))
             if k in df.columns]
@@ -458,10 +445,10 @@ def to_latex(df: pd.DataFrame, *, caption: str, label: str, notes: list[str] | N
             for i in range(len(parts))]
     # a float must fit the page (the text height, or the text width in landscape) with
     # room for the text around it; anything taller, or long, is a longtable
-    prose_lines = sum(math.ceil(1.15 * _plain_len(v, digits) * 0.6 * page["size_pt"]
+    prose_lines = sum(math.ceil(1.15 * _plain_len(v, c, table) * 0.6 * page["size_pt"]
                                 / page["width_pt"]) for c in prose for v in df[c])
     long = len(df) > LONG_ROWS or sum(
-        _height_pt(df, p, part_specs[i], info, page, digits=digits, caption=caps[i],
+        _height_pt(df, p, part_specs[i], info, page, table=table, caption=caps[i],
                    notes=notes if i == len(parts) - 1 else []) + 12
         for i, p in enumerate(parts)) + prose_lines * page["baseline_pt"] \
         > FLOAT_FRACTION * page["height_pt"]
@@ -481,10 +468,10 @@ def to_latex(df: pd.DataFrame, *, caption: str, label: str, notes: list[str] | N
     for i, part in enumerate(parts):
         plabel = label if i == 0 else f"{label}-{i + 1}"
         tex = _render_part(df, part, part_specs[i], caption=caps[i], label=plabel,
-                           digits=digits, long=long).rstrip("\n")
+                           table=table, long=long).rstrip("\n")
         if prose and i == len(parts) - 1:
             tex = _with_prose(tex, df, prose, len([c for g in part for c in g]), page,
-                              long=long)
+                              table=table, long=long)
         if not long:
             tex = tex.replace("\\begin{table}[htbp]\n\\centering\n", "", 1)
             tex = tex.replace("\n\\end{table}", "")

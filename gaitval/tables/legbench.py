@@ -180,11 +180,11 @@ def write_legbench_table(summary: pd.DataFrame, stem, methods=None, inits=None
             caption="The leg_tracker benchmark (Leigh et al. ICRA 2015, Table III): its "
                     "published trackers beside gaitval's, counted by the authors' rules per "
                     "set (following sets: false positives ignored).",
-            notes=_bench_notes(b), digits=3)
+            notes=_bench_notes(b))
     return extra + write_table(
         t, stem,
         caption="CLEAR-MOT of gaitval's leg trackers on hand-annotated laser recordings "
                 "without motion capture (py-motmetrics, 0.75 m), with false leg tracks per "
                 "minute; own = the method's initialiser, annotation = started from the "
                 "first annotated position.",
-        notes=_notes(t, summary), digits=3)
+        notes=_notes(t, summary))

@@ -237,7 +237,7 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
     if shown:                                  # a method run with overrides says so
         t1, t3 = (t.assign(method=t["method"].map(lambda m: shown.get(m, m)))
                   for t in (t1, t3))
-    paths = write_table(t1, td / "mtst_table1", digits=3, caption=(
+    paths = write_table(t1, td / "mtst_table1", caption=(
         "Seed 001 Table 1: radius r_val of the variable validation region by the leg's gait "
         "phase at k-1 and whether it was observable (H = consecutive unobservable scans; "
         f"v_sw = {P.V_SW_MPS} m/s, v_st = {P.V_ST_MPS} m/s, dt = 0.05 s), with how often "
@@ -245,14 +245,14 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
         "The formulas are the paper's Table 1; the counts and radii are reproduced (the "
         "paper gives none). Radii are recomputed from each track exactly as the tracker "
         "built them (gaitval.evaluate.mtst_tracking.gate_usage)."])
-    paths += write_table(t3, td / "mtst_table3", digits=1, caption=(
+    paths += write_table(t3, td / "mtst_table3", caption=(
         "Seed 001 Table 3: lost and false tracks per trial (a failed trial counted once) "
         "for Methods 1-3 and the proposed method, participants without / with a stick, "
         "and the tracking success rate; published values beside. Reference 'mocap': the "
         "track against the mocap leg points (stands in for the paper's video check); "
         "'rater events': from the rater's contacts only (what a study without mocap "
         "has)."), notes=notes3)
-    paths += write_table(t4, td / "mtst_table4", digits=1, caption=(
+    paths += write_table(t4, td / "mtst_table4", caption=(
         "Seed 001 Table 4: target-step judgement and cross-step detection against the "
         "rater annotations on the trials the proposed method tracked successfully; "
         "success = (N - non-judgements or non-detections) / N, error rate = "

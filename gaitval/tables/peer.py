@@ -176,7 +176,7 @@ def write_peer_table(parquet_path: str | Path, out_stem: str | Path) -> list[Pat
              "intercept.",
              "Means, bias, limits, sd, RMSE and MAD are in the row's unit, var_* in the "
              "unit squared; ICC, ratios, slopes, t, df and p are dimensionless."]
-    return write_table(table, out_stem, caption=caption, notes=notes, digits=4)
+    return write_table(table, out_stem, caption=caption, notes=notes)
 
 
 def _rm_note(table: pd.DataFrame) -> str:

@@ -32,7 +32,7 @@ def to_markdown(df: pd.DataFrame, table: str | None = None) -> str:
 
 
 def write_table(df: pd.DataFrame, stem: str | Path, *, caption: str,
-                notes: list[str] | None = None, digits: int = 3,
+                notes: list[str] | None = None,
                 csv_float_format: str = "%.6g") -> list[Path]:
     """Write ``df`` to ``<stem>.csv``, ``<stem>.md`` and ``<stem>.tex`` (atomically).
 
@@ -46,10 +46,9 @@ def write_table(df: pd.DataFrame, stem: str | Path, *, caption: str,
         One paragraph: what the table is, which paper table it reproduces.
     notes : list of str
         Deviations from the paper, disagreements and their likely causes.
-    digits : int
-        Passed on to the LaTeX renderer; the Markdown's decimals are those of each
-        column's quantity (:mod:`gaitval.tables.numbers`; the CSV keeps
-        ``csv_float_format``).
+    csv_float_format : str
+        The CSV's floats (full precision); the Markdown and LaTeX print each column in
+        its quantity's format (:mod:`gaitval.tables.numbers`).
 
     Returns
     -------
@@ -64,7 +63,7 @@ def write_table(df: pd.DataFrame, stem: str | Path, *, caption: str,
         md += [""] + [f"- {n}" for n in notes]
     from gaitval.tables.latex import to_latex   # lazily: `python -m gaitval.tables.latex`
 
-    tex = to_latex(shown, caption=caption, notes=notes, label=stem.name, digits=digits)
+    tex = to_latex(shown, caption=caption, notes=notes, label=stem.name)
     paths = [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".tex")]
     write_text(paths[0], csv_text)
     write_text(paths[1], "\n".join(md) + "\n")

@@ -194,19 +194,19 @@ def write_rollator_tables(frames: pd.DataFrame, summary: pd.DataFrame, tables_di
     changed = [f"{tag} ran as {(shown or {})[m]}: parameters changed by "
                "tracking.overrides; the published values beside are the paper's method's"
                for tag, m in (("KF", kf), ("PF", pf)) if (shown or {}).get(m, m) != m]
-    paths = write_table(t1, td / "rollator_table1", digits=2, notes=changed + table1_notes(
+    paths = write_table(t1, td / "rollator_table1", notes=changed + table1_notes(
         t1, imp, model_sources), caption=(
         "Seed 002 Table I (tracking accuracy): RMSE and MAD of the mean position (x lateral, "
         "y forward) and mean velocity of both legs, KF (§II) vs PF (§III), per scenario and "
         "subject (repetitions pooled), in the moving laser frame; shown in the paper's cm "
         "and cm/s, published values beside (the CSV holds m and m/s)."))
-    paths += write_table(t2, td / "rollator_table2", digits=2, notes=changed + table2_notes(
+    paths += write_table(t2, td / "rollator_table2", notes=changed + table2_notes(
         t2, error_m), caption=(
         "Seed 002 Table II (tracking robustness): time of correct tracking, error frames and "
         "their share of the evaluated frames, KF re-initialisations, per scenario and "
         "subject (repetitions summed); published values beside; frames without a laser pose "
         "(rollator markers missing) or without a leg's truth are counted, not evaluated."))
-    paths += write_table(imp, td / "rollator_improvement", digits=1, notes=changed + [
+    paths += write_table(imp, td / "rollator_improvement", notes=changed + [
         "Mean over the Table I cells with a value of 100·(KF − PF)/KF; the published-cells "
         "column applies the same formula to the transcribed Table I (Scenario 2 "
         "reconstructed); the paper's text states ~30 % (RMSE) and ~43 % (MAD)."], caption=(

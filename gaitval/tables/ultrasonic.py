@@ -179,5 +179,5 @@ def write_ultrasonic_tables(gait_params_df: pd.DataFrame, out_dir: str | Path,
         if name in per_subject:                 # pooled vs repeated-measures limits
             notes = [*notes, agreement_note(table, per_subject[name])]
         paths += write_table(table, out_dir / f"ultrasonic_{name}", caption=caption,
-                             notes=notes, digits=5 if name == "tableC1" else 3)
+                             notes=notes)
     return paths
