@@ -56,7 +56,10 @@ from __future__ import annotations
 import math
 from collections import deque
 
+import numpy as np
+
 from gaitval.registry import Registry
+from gaitval.track.init import leg_pairs
 
 BIRTHS = Registry("birth")
 CONFIRMERS = Registry("confirmer")
@@ -153,14 +156,8 @@ class UnexplainedPairs(Birth):
     def propose(self, obs, free, leg_width_m):
         lo, hi = self.min_leg_widths * leg_width_m, self.max_pair_m
         idx = [j for j in range(len(obs)) if free[j]]
-        cand = []
-        for a, i in enumerate(idx):
-            xi, yi = obs[i][0], obs[i][1]
-            for j in idx[a + 1:]:
-                d = math.hypot(obs[j][0] - xi, obs[j][1] - yi)
-                if lo <= d <= hi:
-                    cand.append((d, i, j))
-        cand.sort()
+        sub = np.asarray([obs[j] for j in idx], dtype=float).reshape(-1, 2)
+        cand = sorted((d, idx[a], idx[b]) for a, b, d in leg_pairs(sub, lo, hi))
         used, out = set(), []
         for _, i, j in cand:
             if i not in used and j not in used:
