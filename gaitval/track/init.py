@@ -128,12 +128,19 @@ class ClosestMovingPair(ClosestPair):
                                  max_lost_scans=max_lost_scans)
 
     def find(self, source, leg_width_m):
-        start = super().find(source, leg_width_m)
-        if start is None or not self.require_motion or len(source) < self.min_scans:
-            return start
-        d_min = self.min_leg_widths * leg_width_m
-        moving = self.check.moving_pair(source, d_min, self.max_pair_m, first_scan=start[0])
-        return start if moving is not None else None
+        return keep_if_moving(self, source, super().find(source, leg_width_m), leg_width_m)
+
+
+def keep_if_moving(init, source, start, leg_width_m: float):
+    """``start``, or None when no leg-like pair of ``source`` moves from its scan on
+    (``init``'s ``check``, a :class:`MotionCheck`, with its ``require_motion``,
+    ``min_scans``, ``min_leg_widths`` and ``max_pair_m``): the no-subject rule of
+    ``closest_pair`` and ``mtst_participant``."""
+    if start is None or not init.require_motion or len(source) < init.min_scans:
+        return start
+    d_min = init.min_leg_widths * leg_width_m
+    moving = init.check.moving_pair(source, d_min, init.max_pair_m, first_scan=start[0])
+    return start if moving is not None else None
 
 
 class MotionCheck:

@@ -51,7 +51,7 @@ from __future__ import annotations
 import math
 
 from gaitval.errors import ConfigError
-from gaitval.track.init import INITIALISERS, Initialiser, MotionCheck
+from gaitval.track.init import INITIALISERS, Initialiser, MotionCheck, keep_if_moving
 
 
 @INITIALISERS.register("mtst_participant")
@@ -121,12 +121,8 @@ class MatLaneParticipant(Initialiser):
         return out, -self.margin_before_m, length
 
     def find(self, source, leg_width_m):
-        start = self._lane_pair(source, leg_width_m)
-        if start is None or not self.require_motion or len(source) < self.min_scans:
-            return start
-        d_min = self.min_leg_widths * leg_width_m
-        moving = self.check.moving_pair(source, d_min, self.max_pair_m, first_scan=start[0])
-        return start if moving is not None else None
+        return keep_if_moving(self, source, self._lane_pair(source, leg_width_m),
+                              leg_width_m)
 
     def _lane_pair(self, source, leg_width_m):
         """The first scan's pair on the lane (rule in the module notes), or None."""
