@@ -57,13 +57,13 @@ def sample_subject(rng: np.random.Generator, group: str, sid: str, sensor_height
     if group == "young":
         H = rng.normal(1.71, 0.06)
         age = rng.normal(23.0, 1.9)
-        sl, st, sf, cv, sd, W = 0.44 * H, rng.normal(0.42, 0.02), 0.58, 0.025, 0.015, rng.normal(0.09, 0.015)
+        sl, st, sf, cv, sd, W = 0.44 * H, rng.normal(0.45, 0.02), 0.58, 0.025, 0.015, rng.normal(0.09, 0.015)
     elif group == "elderly":
         H = rng.normal(1.58, 0.07)
         age = rng.normal(78.1, 6.0)
-        sl, st, sf, cv, sd, W = 0.31 * H, rng.normal(0.56, 0.04), 0.64, 0.045, 0.03, rng.normal(0.12, 0.02)
+        sl, st, sf, cv, sd, W = 0.35 * H, rng.normal(0.536, 0.04), 0.64, 0.045, 0.03, rng.normal(0.12, 0.02)
         if stick:
-            sl, st, sf, W = 0.25 * H, st * 1.2, 0.67, W + 0.02
+            sl, st, sf, W = 0.8 * sl, st * 1.2, 0.67, W + 0.02
     elif group == "patient":
         H = rng.normal(1.62, 0.07)
         age = rng.normal(80.0, 5.0)
