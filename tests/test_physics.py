@@ -155,3 +155,33 @@ def test_contact_statistics_see_overlapping_shanks(tmp_path):
     mins, n_close, n_scans = contact_stats(tmp_path, "x_t1")
     assert len(mins) == 1 and mins[0] == pytest.approx(0.4, abs=0.05)
     assert n_scans == 100 and 0 < n_close < 100
+
+
+def test_default_twin_gait_passes_the_step_and_cross_step_rows():
+    """The rows that failed on the default study before the gait calibration (see
+    docs/simulator.md, "Physical checks"): TUG cadence (141.5 > 140 /min), MTST step length
+    (0.272 < 0.297 body heights), MTST cadence (103.7 < 105 /min) and MTST cross steps
+    (2.54 < 2.76 per 100 steps).  Computed by physics.py's own row functions on the true
+    events of every TUG and MTST trial of the default preset, built without rendering
+    (the events are those written to truth/<trial>/events.csv); about 10 s."""
+    from gaitval.simulate import study as S
+    from gaitval.simulate.physics import mtst_cross_row, step_rows_from_events
+    from gaitval.simulate.render import gait_events
+    from gaitval.simulate.study import load_preset
+
+    cfg = load_preset("default")
+    seed = int(cfg["seed"])
+    events = {"tug": [], "mtst": []}
+    for idx, proto, build, bargs, subj, _drift in S._lrs_tasks(cfg, cfg["study"], seed, []):
+        if proto in events:
+            sim = build(S._rng(seed, 3, idx), *bargs)
+            events[proto].append((gait_events(sim), float(subj["height_m"])))
+    assert len(events["tug"]) == 28 and len(events["mtst"]) == 48
+    rows = {(r["protocol"], r["check"]): r for proto, evs in events.items()
+            for r in step_rows_from_events(proto, evs)}
+    rows[("mtst", "mtst_cross_steps")] = mtst_cross_row([ev for ev, _ in events["mtst"]])
+    for key in [("tug", "step_length"), ("tug", "cadence"), ("mtst", "step_length"),
+                ("mtst", "cadence"), ("mtst", "mtst_cross_steps")]:
+        r = rows[key]
+        assert r["passed"] is True, (key, r["value"], r["lower"], r["upper"])
+        assert r["lower"] <= r["value"] <= r["upper"], key

@@ -230,30 +230,42 @@ def _straight_steps(ev: pd.DataFrame, protocol: str) -> tuple[np.ndarray, np.nda
     return np.array(L), np.array(T)
 
 
+def step_rows_from_events(protocol: str, trials: list[tuple[pd.DataFrame, float]]
+                          ) -> list[dict]:
+    """The ``step_length`` and ``cadence`` rows of one protocol from its trials' true
+    events: ``trials`` holds ``(events, body height in m)`` per trial (``events`` as in
+    ``truth/<trial>/events.csv``; steps by :func:`_straight_steps`)."""
+    sl, st = [], []
+    for ev, height in trials:
+        L, T = _straight_steps(ev, protocol)
+        sl.append(L / float(height))
+        st.append(T)
+    sl = np.concatenate(sl) if sl else np.zeros(0)
+    st = np.concatenate(st) if st else np.zeros(0)
+    if not len(sl):
+        return []
+    group = GROUP_OF.get(protocol, "")
+    rng = STEP_RANGES.get(group)
+    rows = []
+    for check, v, key, unit in (("step_length", float(np.mean(sl)), "step_per_height",
+                                 "body heights"),
+                                ("cadence", 60.0 / float(np.mean(st)), "cadence_per_min",
+                                 "steps/min")):
+        lo, hi = rng[key] if rng else (None, None)
+        rows.append(_row(check, protocol, v, np.nan if lo is None else (lo + hi) / 2, lo, hi,
+                         unit, "mean inside the published range" if rng else "not checked",
+                         rng["source"] if rng else "no published range for this cohort",
+                         group=group, note=f"{len(sl)} straight steps"))
+    return rows
+
+
 def _step_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
     subj = pd.read_csv(study_dir / "subjects.csv").set_index("subject")
     rows = []
     for proto, g in trials.groupby("protocol", sort=True):
-        sl, st = [], []
-        for _, tr in g.iterrows():
-            L, T = _straight_steps(pd.read_csv(study_dir / "truth" / tr["trial"] / "events.csv"),
-                                   proto)
-            sl.append(L / float(subj.loc[tr["subject"], "height_m"]))
-            st.append(T)
-        sl, st = np.concatenate(sl), np.concatenate(st)
-        if not len(sl):
-            continue
-        group = GROUP_OF.get(proto, "")
-        rng = STEP_RANGES.get(group)
-        for check, v, key, unit in (("step_length", float(np.mean(sl)), "step_per_height",
-                                     "body heights"),
-                                    ("cadence", 60.0 / float(np.mean(st)), "cadence_per_min",
-                                     "steps/min")):
-            lo, hi = rng[key] if rng else (None, None)
-            rows.append(_row(check, proto, v, np.nan if lo is None else (lo + hi) / 2, lo, hi,
-                             unit, "mean inside the published range" if rng else "not checked",
-                             rng["source"] if rng else "no published range for this cohort",
-                             group=group, note=f"{len(sl)} straight steps"))
+        rows += step_rows_from_events(proto, [
+            (pd.read_csv(study_dir / "truth" / tr["trial"] / "events.csv"),
+             float(subj.loc[tr["subject"], "height_m"])) for _, tr in g.iterrows()])
     return rows
 
 
@@ -424,19 +436,25 @@ def _tug_sit_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
     ]
 
 
-def _mtst_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
+def mtst_cross_row(events: list[pd.DataFrame]) -> dict:
+    """The ``mtst_cross_steps`` row from the MTST trials' true events (``events.csv``):
+    cross steps per 100 foot contacts."""
     n_cross = n_steps = 0
-    for t in trials["trial"]:
-        ev = pd.read_csv(study_dir / "truth" / t / "events.csv")
+    for ev in events:
         n_cross += int((ev["event"] == "cross_step").sum())
         n_steps += int((ev["event"] == "foot_contact").sum())
     k, m = MTST_CROSS
     lo, hi = poisson_ci(k)
-    return [_row("mtst_cross_steps", "mtst", 100.0 * n_cross / max(n_steps, 1), 100.0 * k / m,
-                 100.0 * lo / m, 100.0 * hi / m, "per 100 steps",
-                 "inside the exact 95 % Poisson interval of 19 counts",
-                 "seed 001 Table 4: 19 cross steps of 414 steps", group="elderly",
-                 note=f"{n_cross} of {n_steps} steps (truth footfalls)")]
+    return _row("mtst_cross_steps", "mtst", 100.0 * n_cross / max(n_steps, 1), 100.0 * k / m,
+                100.0 * lo / m, 100.0 * hi / m, "per 100 steps",
+                "inside the exact 95 % Poisson interval of 19 counts",
+                "seed 001 Table 4: 19 cross steps of 414 steps", group="elderly",
+                note=f"{n_cross} of {n_steps} steps (truth footfalls)")
+
+
+def _mtst_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
+    return [mtst_cross_row([pd.read_csv(study_dir / "truth" / t / "events.csv")
+                            for t in trials["trial"]])]
 
 
 def _treadmill_rows(study_dir: Path) -> list[dict]:
