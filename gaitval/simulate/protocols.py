@@ -50,9 +50,13 @@ def sample_subject(rng: np.random.Generator, group: str, sid: str, sensor_height
     Segment proportions after Winter (2009): leg length 0.53 H, shank length 0.246 H.
     Shank width at the scan height includes clothing: ≈ 0.10 m at 0.27 m (seed 000 assumes
     w_l = 0.10 m) and wider at 0.40 m (calf).  Gait: young adults at maximum speed
-    (TUG instruction) ≈ 1.7 m/s, step length ≈ 0.44 H, cadence ≈ 140 /min, stance ≈ 58 %;
-    elderly slower, shorter, wider and more variable steps (stance ≈ 63–65 %,
-    CV 4–6 %); stick users and rollator patients slower still.
+    (TUG instruction) ≈ 1.7 m/s, step length ≈ 0.44 H, step time 0.45 s (≈ 133 /min, one
+    between-subject SD below the walk–run transition cadence of ≈ 140 /min), stance ≈ 58 %;
+    elderly: step 0.35 H and 0.536 s (112 /min), the centre of the older-adult range of
+    Espy et al. 2010 Table 2 (0.297–0.403 H, 105–119 /min), wider and more variable steps
+    (stance ≈ 63–65 %, CV 4–6 %); stick users 0.8 × the step and 1.2 × the step time;
+    rollator patients slower still.  Both calibrations are checked in ``physics.csv``
+    (docs/simulator.md, "Physical checks").
     """
     if group == "young":
         H = rng.normal(1.71, 0.06)
