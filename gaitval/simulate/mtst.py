@@ -27,11 +27,12 @@ TARGET_W, TARGET_L = 0.160, 0.165
 COLORS = ("red", "blue", "white")
 #: calibration poles (field frame); in :func:`mtst_calibration` the one at the smaller beam
 #: angle of the nominal sensor (beyond the goal, facing the walker) comes first.  Their
-#: midpoint is 0.35 m off the walking line: with two poles the registration tells the pose
+#: midpoint is 0.225 m off the walking line: with two poles the registration tells the pose
 #: from its 180° turn about that midpoint by where the walker's legs land, and a midpoint
 #: on the walking line maps the walk onto itself (issue 34: the first pole was at y = 1.35
-#: m, midpoint y = 0.025 m, and one trial of the calibrated twin could not be told apart)
-POLES_M = ((3.0, 2.0), (5.6, -1.3))
+#: m, midpoint y = 0.025 m, and one trial of the calibrated twin could not be told apart;
+#: at y = 2.0 m, 0.2 m before the wall, the pole was not found in one participant's scans)
+POLES_M = ((3.0, 1.75), (5.6, -1.3))
 #: The nursing attendant's place (seed 001: "walked alongside the participant"; side and
 #: distance are the twin's choice): side of the walker, distance from the mat's centreline
 #: and how far behind the participant's start the attendant starts (m).
