@@ -101,6 +101,50 @@ def test_kf_tracks_and_reinitialises_after_the_lost_frames():
 
 
 # -- §III PF ---------------------------------------------------------------------------------
+# -- no phantom user (issue 36) ---------------------------------------------------------------
+def _facing(**kw):
+    from gaitval.track.init import INITIALISERS
+    return INITIALISERS.build({"name": "facing_pair", **kw})
+
+
+def _source(scans):
+    from gaitval.track.observations import WindowedDetections
+    return WindowedDetections(DETECTORS.build("rollator_window"), scans, W)
+
+
+def test_facing_pair_keeps_the_start_of_a_walking_user():
+    """A user walking behind the rollator: the start (scan, labels) is the rule's without
+    the walking check, so the papers' tracks do not change."""
+    scans, _ = walk(200, seed=5)
+    src = _source(scans)
+    plain = _facing(require_motion=False).find(src, W)
+    assert plain is not None and plain[0] == 0
+    assert _facing().find(src, W) == plain
+    res = build_method("rollator_kf").track(scans, W)
+    assert res.k_init == 0 and np.isfinite(res.x).all()
+
+
+def test_facing_pair_finds_nobody_when_no_pair_walks_with_the_sensor():
+    """Two legs standing still in the window (amp 0: nobody walks), and two objects that
+    pass each other while they sweep across the window (as negative_2.bag's right laser
+    sees furniture while the robot turns, their centre travelling 0.9 m in 1.7 s): the pair
+    rule alone finds a pair in both, the walking check none, and KF and PF report no track.
+    The sweep is rejected by the "body stays with the sensor" test alone."""
+    scans_still, _ = walk(150, seed=6, amp=0.0)
+    n = 60
+    y = np.linspace(0.45, -0.45, n)
+    posts = [(np.column_stack([np.linspace(0.55, 0.80, n), y]), W / 2),
+             (np.column_stack([np.linspace(0.80, 0.55, n), y - 0.15]), W / 2)]
+    sweep = scan_series(cast(posts, n, seed=7))
+    for scans in (scans_still, sweep):
+        src = _source(scans)
+        assert _facing(require_motion=False).find(src, W) is not None
+        assert _facing().find(src, W) is None
+        for method in ("rollator_kf", "rollator_pf"):
+            assert not np.isfinite(build_method(method).track(scans, W).x).any()
+    assert _facing(stay_leg_widths=100.0).find(_source(sweep), W) is not None
+
+
 def test_model_learns_the_papers_region_ordering(model):
     pi = model["regions"]["pi"]
     assert min(pi[1], pi[2]) > max(pi[0], pi[3])                     # π1, π4 < π2, π3
