@@ -417,12 +417,8 @@ class WalkingPairCheck:
         idx = [q for q, h in enumerate(win) if h is not None]
         if len(idx) < m:
             return False
-        r = np.array([win[q][:2] for q in idx])          # û: where r varies most
-        ux, uy = np.linalg.eigh(np.cov(r.T))[1][:, -1]
-        norm = math.hypot(ux, uy)
-        if norm <= 0.0:
-            return False
-        proj = [(win[q][0] * ux + win[q][1] * uy) / norm for q in idx]
+        ux, uy = principal_axis([win[q][:2] for q in idx])    # û: where r varies most
+        proj = [win[q][0] * ux + win[q][1] * uy for q in idx]
         cp = self.pass_leg_widths * leg_width_m
         if min(proj) > -cp or max(proj) < cp:
             return False
@@ -467,6 +463,30 @@ class _LazyLists:
         if got is None:
             got = self.cache[k] = self.source.array(k).tolist()
         return got
+
+
+def principal_axis(rs) -> tuple[float, float]:
+    """The unit direction along which the 2-D vectors ``rs`` vary most: the principal axis
+    of their covariance, θ = ½·atan2(2 s_xy, s_xx − s_yy) (a 2 × 2 symmetric matrix's
+    eigenvector of the larger eigenvalue; (1, 0) when they do not vary).
+
+    For a walker's r = p_L − p_R this is the walking direction: r swings along it (± half
+    the step length) while its component across it stays at the step width.  The direction
+    of the *longest* r is not: it leans towards the step width, and when the step width is
+    close to the swing the other leg's r never reaches the far side along it (a = 0.25 m,
+    step width 0.2 m: −(a² − s²)/√(a² + s²) = −0.07 m, less than one leg width)."""
+    n = len(rs)
+    if n < 2:
+        return 1.0, 0.0
+    mx = sum(r[0] for r in rs) / n
+    my = sum(r[1] for r in rs) / n
+    sxx = sum((r[0] - mx) ** 2 for r in rs)
+    syy = sum((r[1] - my) ** 2 for r in rs)
+    sxy = sum((r[0] - mx) * (r[1] - my) for r in rs)
+    if sxx == 0.0 and syy == 0.0 and sxy == 0.0:
+        return 1.0, 0.0
+    th = 0.5 * math.atan2(2.0 * sxy, sxx - syy)
+    return math.cos(th), math.sin(th)
 
 
 def scan_period(source) -> float:
