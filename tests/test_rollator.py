@@ -145,6 +145,25 @@ def test_facing_pair_finds_nobody_when_no_pair_walks_with_the_sensor():
     assert _facing(stay_leg_widths=100.0).find(_source(sweep), W) is not None
 
 
+def test_walking_axis_is_where_the_legs_swing_not_the_longest_r():
+    """r = p_L − p_R of a walker: ± 0.25 m along the walking direction (x), 0.2 m step
+    width.  The principal axis is x (each leg passes the other by 0.25 m along it); along
+    the longest r the far side reaches only −0.07 m, less than one leg width."""
+    from gaitval.track.init import principal_axis
+    ph = np.linspace(0, 2 * np.pi, 17)              # includes ±90°: r = (±0.25, 0.2)
+    rs = [(0.25 * math.sin(a), 0.2) for a in ph]
+    ux, uy = principal_axis(rs)
+    assert abs(ux) == pytest.approx(1.0, abs=1e-9) and uy == pytest.approx(0.0, abs=1e-9)
+    proj = [r[0] * ux + r[1] * uy for r in rs]
+    assert min(proj) < -W and max(proj) > W
+    lx, ly = max(rs, key=lambda r: math.hypot(*r))
+    along = [(r[0] * lx + r[1] * ly) / math.hypot(lx, ly) for r in rs]
+    assert min(along) == pytest.approx(-(0.25 ** 2 - 0.2 ** 2) / math.hypot(0.25, 0.2),
+                                      abs=1e-3)
+    assert min(along) > -W
+    assert principal_axis([(0.5, 0.25)] * 3) == (1.0, 0.0)     # r does not vary
+
+
 def test_model_learns_the_papers_region_ordering(model):
     pi = model["regions"]["pi"]
     assert min(pi[1], pi[2]) > max(pi[0], pi[3])                     # π1, π4 < π2, π3
