@@ -366,6 +366,10 @@ class WalkingPairCheck:
         self.max_gate_m = float(max_gate_m)
         self.per_scan = int(per_scan)
 
+    def window_scans(self, source) -> int:
+        """N: the scans of one window at the source's scan period."""
+        return max(2, int(round(self.window_s / scan_period(source))))
+
     def moving_pair(self, source, d_min: float, d_max: float, first_scan: int = 0,
                     leg_width_m: float = 0.10) -> tuple[int, int, int] | None:
         """The first walking pair ``(k, i, j)`` from ``first_scan`` on, or None."""

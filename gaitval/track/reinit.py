@@ -64,7 +64,9 @@ class FacingPair(ClosestPair):
         False: the first pair is kept whether or not anything walks (the rule before
         issue 36).
     min_scans : int
-        A source with fewer scans (one scan: :meth:`pair`) keeps its pair.
+        A source with fewer scans (one scan: :meth:`pair`) keeps its pair; so does one
+        with less than one walking window (1.4 s) from the pair's scan on, which cannot
+        show a stride.
     window_s, pass_leg_widths, stay_leg_widths, max_speed_mps : float
         :class:`~gaitval.track.init.WalkingPairCheck`.
     """
@@ -82,7 +84,10 @@ class FacingPair(ClosestPair):
                                       max_speed_mps=max_speed_mps)
 
     def find(self, source, leg_width_m):
-        found = keep_if_moving(self, source, super().find(source, leg_width_m), leg_width_m)
+        found = super().find(source, leg_width_m)
+        if found is not None and len(source) - found[0] >= self.check.window_scans(source):
+            found = keep_if_moving(self, source, found, leg_width_m)
+        # else: less than one window from the pair on cannot show a stride; kept
         if found is None or not self.sensor_faces_user:
             return found
         k, il, ir = found
