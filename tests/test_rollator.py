@@ -101,6 +101,69 @@ def test_kf_tracks_and_reinitialises_after_the_lost_frames():
 
 
 # -- §III PF ---------------------------------------------------------------------------------
+# -- no phantom user (issue 36) ---------------------------------------------------------------
+def _facing(**kw):
+    from gaitval.track.init import INITIALISERS
+    return INITIALISERS.build({"name": "facing_pair", **kw})
+
+
+def _source(scans):
+    from gaitval.track.observations import WindowedDetections
+    return WindowedDetections(DETECTORS.build("rollator_window"), scans, W)
+
+
+def test_facing_pair_keeps_the_start_of_a_walking_user():
+    """A user walking behind the rollator: the start (scan, labels) is the rule's without
+    the walking check, so the papers' tracks do not change."""
+    scans, _ = walk(200, seed=5)
+    src = _source(scans)
+    plain = _facing(require_motion=False).find(src, W)
+    assert plain is not None and plain[0] == 0
+    assert _facing().find(src, W) == plain
+    res = build_method("rollator_kf").track(scans, W)
+    assert res.k_init == 0 and np.isfinite(res.x).all()
+
+
+def test_facing_pair_finds_nobody_when_no_pair_walks_with_the_sensor():
+    """Two legs standing still in the window (amp 0: nobody walks), and two objects that
+    pass each other while they sweep across the window (as negative_2.bag's right laser
+    sees furniture while the robot turns, their centre travelling 0.9 m in 1.7 s): the pair
+    rule alone finds a pair in both, the walking check none, and KF and PF report no track.
+    The sweep is rejected by the "body stays with the sensor" test alone."""
+    scans_still, _ = walk(150, seed=6, amp=0.0)
+    n = 60
+    y = np.linspace(0.45, -0.45, n)
+    posts = [(np.column_stack([np.linspace(0.55, 0.80, n), y]), W / 2),
+             (np.column_stack([np.linspace(0.80, 0.55, n), y - 0.15]), W / 2)]
+    sweep = scan_series(cast(posts, n, seed=7))
+    for scans in (scans_still, sweep):
+        src = _source(scans)
+        assert _facing(require_motion=False).find(src, W) is not None
+        assert _facing().find(src, W) is None
+        for method in ("rollator_kf", "rollator_pf"):
+            assert not np.isfinite(build_method(method).track(scans, W).x).any()
+    assert _facing(stay_leg_widths=100.0).find(_source(sweep), W) is not None
+
+
+def test_walking_axis_is_where_the_legs_swing_not_the_longest_r():
+    """r = p_L − p_R of a walker: ± 0.25 m along the walking direction (x), 0.2 m step
+    width.  The principal axis is x (each leg passes the other by 0.25 m along it); along
+    the longest r the far side reaches only −0.07 m, less than one leg width."""
+    from gaitval.track.init import principal_axis
+    ph = np.linspace(0, 2 * np.pi, 17)              # includes ±90°: r = (±0.25, 0.2)
+    rs = [(0.25 * math.sin(a), 0.2) for a in ph]
+    ux, uy = principal_axis(rs)
+    assert abs(ux) == pytest.approx(1.0, abs=1e-9) and uy == pytest.approx(0.0, abs=1e-9)
+    proj = [r[0] * ux + r[1] * uy for r in rs]
+    assert min(proj) < -W and max(proj) > W
+    lx, ly = max(rs, key=lambda r: math.hypot(*r))
+    along = [(r[0] * lx + r[1] * ly) / math.hypot(lx, ly) for r in rs]
+    assert min(along) == pytest.approx(-(0.25 ** 2 - 0.2 ** 2) / math.hypot(0.25, 0.2),
+                                      abs=1e-3)
+    assert min(along) > -W
+    assert principal_axis([(0.5, 0.25)] * 3) == (1.0, 0.0)     # r does not vary
+
+
 def test_model_learns_the_papers_region_ordering(model):
     pi = model["regions"]["pi"]
     assert min(pi[1], pi[2]) > max(pi[0], pi[3])                     # π1, π4 < π2, π3

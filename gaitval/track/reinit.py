@@ -25,6 +25,18 @@ of consecutive frames, we re-initialize the algorithm."
     on the laser's right, at the smaller bearing.  ``sensor_faces_user=False`` gives the
     usual labelling (left = larger bearing) of a laser behind or beside the walker.
 
+    **No phantom user** (issue 36): seed 002 §III.A initialises at k = 1 on the legs the
+    §II detector finds in the predefined window, "both legs still in front of the
+    rollator"; the paper's subjects are always there.  A robot driving through an empty
+    room (leg_tracker's ``negative_2.bag``) puts chair legs, walls and door frames into
+    the window on 71–94 % of its scans, and the KF and PF then tracked them to the end.
+    The start is kept exactly as before (the first pair, at rest), but only when some
+    pair of the trial, from that scan on, *walks with the sensor*
+    (:class:`~gaitval.track.init.WalkingPairCheck`: within 1.4 s the legs pass each other
+    while the body stays in place w.r.t. the rollator); otherwise the run reports no
+    track, as the TUG and MTST initialisers do (``keep_if_moving``).  Re-initialisation
+    looks at one scan (:meth:`FacingPair.pair`) and keeps its pair.
+
 References
 ----------
 Chalvatzaki G, Papageorgiou XS, Tzafestas CS, Maragos P. Comparative experimental validation
@@ -33,13 +45,14 @@ of human gait tracking algorithms for an intelligent robotic rollator. IEEE ICRA
 from __future__ import annotations
 
 from gaitval.errors import ConfigError
-from gaitval.track.init import INITIALISERS, ClosestPair
+from gaitval.track.init import INITIALISERS, ClosestPair, WalkingPairCheck, keep_if_moving
 from gaitval.track.occlusion import OCCLUSION_HANDLERS, OcclusionHandler
 
 
 @INITIALISERS.register("facing_pair")
 class FacingPair(ClosestPair):
-    """The closest plausible pair, left = smaller bearing when the laser faces the user.
+    """The closest plausible pair, left = smaller bearing when the laser faces the user;
+    None when no pair of the trial walks with the sensor (module notes).
 
     Parameters
     ----------
@@ -47,15 +60,34 @@ class FacingPair(ClosestPair):
         As :class:`~gaitval.track.init.ClosestPair`.
     sensor_faces_user : bool
         True: left leg at the smaller bearing (module notes).
+    require_motion : bool
+        False: the first pair is kept whether or not anything walks (the rule before
+        issue 36).
+    min_scans : int
+        A source with fewer scans (one scan: :meth:`pair`) keeps its pair; so does one
+        with less than one walking window (1.4 s) from the pair's scan on, which cannot
+        show a stride.
+    window_s, pass_leg_widths, stay_leg_widths, max_speed_mps : float
+        :class:`~gaitval.track.init.WalkingPairCheck`.
     """
 
     def __init__(self, max_pair_m: float = 0.8, min_leg_widths: float = 0.7,
-                 sensor_faces_user: bool = True):
+                 sensor_faces_user: bool = True, require_motion: bool = True,
+                 min_scans: int = 10, window_s: float = 1.4, pass_leg_widths: float = 1.0,
+                 stay_leg_widths: float = 1.0, max_speed_mps: float = 5.0):
         super().__init__(max_pair_m=max_pair_m, min_leg_widths=min_leg_widths)
         self.sensor_faces_user = bool(sensor_faces_user)
+        self.require_motion = bool(require_motion)
+        self.min_scans = int(min_scans)
+        self.check = WalkingPairCheck(window_s=window_s, pass_leg_widths=pass_leg_widths,
+                                      stay_leg_widths=stay_leg_widths,
+                                      max_speed_mps=max_speed_mps)
 
     def find(self, source, leg_width_m):
         found = super().find(source, leg_width_m)
+        if found is not None and len(source) - found[0] >= self.check.window_scans(source):
+            found = keep_if_moving(self, source, found, leg_width_m)
+        # else: less than one window from the pair on cannot show a stride; kept
         if found is None or not self.sensor_faces_user:
             return found
         k, il, ir = found
