@@ -2,15 +2,15 @@
 
 gaitval's ``rollator_pf`` (two filters of N = 500 particles, seed 002 §III) runs over one
 rollator trial's scans; the time per frame covers both legs' full step
-(:meth:`~gaitval.track.pf.ParticleFilterTracker.step`): the numpy draws and the compiled
-kernels (:mod:`gaitval.track.pf_kernels`) of the GMM propagation from the previous estimate
-(§III.B), the laser-point likelihood (§III.C), the resample-move when N_eff < N/2 (§III.D)
-and the best-80 % estimate (§III.E).  The figures:
+(:meth:`~gaitval.track.pf.ParticleFilterTracker.step`, numpy but for the compiled
+likelihood loop of :mod:`gaitval.track.pf_kernels`): the GMM propagation from the previous
+estimate (§III.B), the laser-point likelihood (§III.C), the resample-move when N_eff < N/2
+(§III.D) and the best-80 % estimate (§III.E).  The figures:
 
 * the one-off cost per process, paid once by a ``rollator_track`` job before its first
-  scan and not part of the frames/s: importing numba with the kernels module, and the first
-  step, which loads the compiled kernels from numba's cache (``__pycache__`` beside
-  ``pf_kernels.py``; compiles them instead when there is no usable cache — the line says
+  scan and not part of the frames/s: importing numba with the kernel module, and the first
+  step, which loads the compiled likelihood from numba's cache (``__pycache__`` beside
+  ``pf_kernels.py``; compiles it instead when there is no usable cache — the line says
   which);
 * frames/s against the UBG-04LX-F01's scan rate (the trial's median period, ≈ 37 Hz):
   "× real time per leg pair" (the bar of issue 12 is ≥ 50×);
@@ -179,7 +179,7 @@ def run_stonesoup(P, scans, k0, p0, frames: int, dt: float, N: int):
 def one_off_cost(tracker, P, scans, k0, p0, dt):
     """What a process pays once before its first PF step: importing numba and
     :mod:`gaitval.track.pf_kernels` (which imports numba), and the first step, which loads
-    the compiled kernels from numba's cache (or compiles them when there is no cache).
+    the compiled likelihood from numba's cache (or compiles it when there is no cache).
 
     Returns ``(import_cpu, import_wall, first_cpu, first_wall, how)`` in seconds; ``how``:
     "loaded from the cache" or "compiled (no usable cache)".
@@ -194,8 +194,7 @@ def one_off_cost(tracker, P, scans, k0, p0, dt):
     c, w = time.process_time(), time.perf_counter()
     tracker.step(P, np.random.default_rng(0), pts, k0 + 1, prev, dt)
     first = (time.process_time() - c, time.perf_counter() - w)
-    kernels = [getattr(pf_kernels, n) for n in ("propagate_weigh", "estimate")]
-    hits = all(sum(f.stats.cache_hits.values()) > 0 for f in kernels)
+    hits = sum(pf_kernels.region_likelihood.stats.cache_hits.values()) > 0
     return (*imp, *first, "loaded from the cache" if hits else "compiled (no usable cache)")
 
 

@@ -171,6 +171,11 @@ def cmd_ultrasonic_tables(a) -> int:
     return 0
 
 
+def cmd_compare_tables(a) -> int:
+    from gaitval.report.compare import run
+    return run(a)
+
+
 def cmd_report(a) -> int:
     from gaitval.report.index import build_index
     md, html = build_index(a.reports_dir, study_names=a.studies)
@@ -451,6 +456,11 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--reports-dir", default="reports")
     s.add_argument("--studies", nargs="*", default=[])
     s.set_defaults(func=cmd_report)
+    s = sub.add_parser("compare-tables", help="two report folders' tables within a stated "
+                       "tolerance (docs/numerics.md)")
+    from gaitval.report.compare import add_arguments
+    add_arguments(s)
+    s.set_defaults(func=cmd_compare_tables)
     from gaitval.cli_exit import add_verbosity
     add_verbosity(p, sub)
     return p

@@ -247,54 +247,39 @@ def _eventful_ranges(near_plane=True):
 
 
 @pytest.mark.parametrize("gate", [4.0, np.inf])
-def test_kernel_repeats_the_numpy_formulation_bit_for_bit(gate):
-    """The numba kernel calls numpy's BLAS and scipy's LAPACK routines with the numpy
-    formulation's arguments in its order (gaitval.track.ukf_kernel notes), so every
-    output is the same to the last bit; W_0 ≈ -1e6 would show any other order."""
+def test_kernel_agrees_with_the_numpy_formulation(gate):
+    """The compiled cycle against the numpy formulation it came from
+    (tests/ukf_numpy_reference.py), away from the receiver plane: the same decisions
+    (gate, re-initialisation, reflection) and states equal within round-off, amplified by
+    W_0 ≈ -1e6 (docs/numerics.md: the kernel makes no attempt to repeat numpy's order of
+    operations)."""
     import ukf_numpy_reference as ref
 
-    from gaitval.track.ukf import _pointers
-
-    if not _pointers().all():
-        pytest.skip("numpy/scipy without the scipy-openblas symbols: the kernel runs its "
-                    "loops (equal to round-off only, the next test)")
-    t, d = _eventful_ranges()
+    t, d = _eventful_ranges(near_plane=False)
     kw = dict(W_sigma=[50.0] * 3, V=SIG ** 2, init_guess=GUESS, gate_sigma=gate)
     new, old = run_toa_ukf(t, d, ANCHORS, **kw), ref.run_toa_ukf(t, d, ANCHORS, **kw)
-    assert new.reinit.sum() >= 2 and new.reflected.any()
+    assert new.reinit.sum() >= 2
     assert new.rejected.any() == np.isfinite(gate)
-    for name in ("x", "P_diag", "used", "rejected", "reinit", "reflected"):
-        a, b = getattr(new, name), getattr(old, name)
-        assert np.array_equal(a, b, equal_nan=True), (name, np.argwhere(a != b)[:3])
-
-
-def test_kernel_loops_agree_with_the_numpy_formulation(monkeypatch):
-    """Without the BLAS symbols the kernel runs the same routines as loops: the same
-    decisions (gate, re-initialisation) and states equal to round-off, away from the
-    receiver plane (near it a round-off decides on which side the state lands)."""
-    import ukf_numpy_reference as ref
-
-    from gaitval.track import ukf
-
-    monkeypatch.setattr(ukf, "_pointers", lambda: np.zeros(5, dtype=np.int64))
-    t, d = _eventful_ranges(near_plane=False)
-    kw = dict(W_sigma=[50.0] * 3, V=SIG ** 2, init_guess=GUESS)
-    new, old = run_toa_ukf(t, d, ANCHORS, **kw), ref.run_toa_ukf(t, d, ANCHORS, **kw)
-    assert new.rejected.any() and new.reinit.sum() >= 2
     for name in ("used", "rejected", "reinit", "reflected"):
         assert np.array_equal(getattr(new, name), getattr(old, name)), name
     assert np.array_equal(np.isnan(new.x), np.isnan(old.x))
-    assert np.nanmax(np.abs(new.x[:, :3] - old.x[:, :3])) < 1e-7      # metres
-    assert np.nanmax(np.abs(new.P_diag - old.P_diag) / old.P_diag) < 1e-6
+    assert np.nanmax(np.abs(new.x[:, :3] - old.x[:, :3])) < 1e-6      # metres
+    assert np.nanmax(np.abs(new.P_diag - old.P_diag) / old.P_diag) < 1e-4
 
 
-def test_kernel_without_the_blas_symbols_runs_its_loops(monkeypatch):
-    """Another BLAS build (no scipy-openblas symbols): no address, so the loops run."""
-    from gaitval.track import ukf_kernel
+def test_kernel_near_the_receiver_plane_reflects_like_the_numpy_formulation():
+    """Within 1 cm of the plane a round-off decides on which side an update lands, so the
+    tracks part there (here from sample 80 on); before, they agree within round-off, and
+    both reflect and re-initialise; the kernel's state stays on the physical side."""
+    import ukf_numpy_reference as ref
 
-    assert ukf_kernel.blas_pointers().shape == (5,)
-    monkeypatch.setattr(ukf_kernel, "NUMPY_SYMBOLS", ("no_such_cblas_dgemm",) * 3)
-    assert not ukf_kernel.blas_pointers().any()
+    t, d = _eventful_ranges(near_plane=True)
+    kw = dict(W_sigma=[50.0] * 3, V=SIG ** 2, init_guess=GUESS)
+    new, old = run_toa_ukf(t, d, ANCHORS, **kw), ref.run_toa_ukf(t, d, ANCHORS, **kw)
+    for r in (new, old):
+        assert r.reflected.any() and r.reinit.sum() >= 2
+    assert np.nanmax(new.x[:, 2]) <= 1e-9                   # never on the mirror side
+    assert np.nanmax(np.abs(new.x[:75, :3] - old.x[:75, :3])) < 1e-6
 
 
 # -- checked (re-)initialisation (issue 34) ---------------------------------------------

@@ -90,6 +90,29 @@ def test_same_config_and_seed_give_byte_identical_tables(tiny_run, tmp_path):
         assert q.read_bytes() == p.read_bytes(), p.name
 
 
+#: The tiny study's tables as the code made them last (docs/numerics.md); regenerate with
+#: ``.venv/bin/python tests/data/regenerate_tiny_reference.py`` when a change is meant to
+#: alter numbers.
+REFERENCE = ROOT / "tests" / "data" / "tiny_reference"
+#: The tolerance the tables keep across machines and BLAS builds (docs/numerics.md).
+RTOL = 1e-9
+
+
+@pytest.mark.slow
+def test_tables_equal_the_stored_reference_within_the_tolerance(tiny_run):
+    """Every number of the tiny report's tables within RTOL of tests/data/tiny_reference
+    (or one unit in the 6th printed digit), counts, text and verdicts exactly."""
+    from gaitval.report.compare import compare_folders, format_report
+
+    ignore = []
+    if not (ROOT / ".." / "shared" / "realdata" / "peer-results").is_dir():
+        ignore.append("tables/peer_agreement.csv")          # made only with the peer's file
+    diffs = compare_folders(tiny_run / "reports" / "tiny", REFERENCE, rtol=RTOL,
+                            ignore=["tables/sensitivity.csv", *ignore])
+    assert len(diffs) >= 10
+    assert all(d.ok for d in diffs), format_report(diffs, RTOL)
+
+
 @pytest.mark.slow
 def test_switching_run_rebuilds_into_that_runs_folder(tiny_run):
     """After the tiny report, the tiny run is up to date and a default run asks for its

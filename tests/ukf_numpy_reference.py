@@ -2,10 +2,10 @@
 
 :func:`run_toa_ukf` here is ``gaitval.track.ukf.run_toa_ukf`` as it was before the
 per-sample cycle moved into numba (:mod:`gaitval.track.ukf_kernel`), verbatim: each product
-is numpy's ``@`` (OpenBLAS), the factorisations scipy's LAPACK.  tests/test_ukf.py runs both
-on the same ranges and requires the same bits (the kernel calls the same routines in the
-same order), or agreement to round-off where the kernel runs its loops.  One change since:
-the (re-)initialisation is the checked trilateration both use (issue 34).
+is numpy's ``@``, the factorisations scipy's LAPACK.  tests/test_ukf.py runs both on the
+same ranges and requires the same decisions and states equal within round-off
+(docs/numerics.md).  One change since: the (re-)initialisation is the checked
+trilateration both use (issue 34).
 """
 from __future__ import annotations
 

@@ -28,11 +28,10 @@ E. Estimate: the weighted mean (position and velocity) of the particles with
    ω ≥ 0.8·max ω.
 
 All random draws come from one ``numpy.random.Generator`` seeded with ``seed``: the same
-seed and input give the same track, bit for bit.  The draws are made here, in numpy; the
-per-scan arithmetic (B–E) is compiled with numba (:mod:`gaitval.track.pf_kernels`, imported
-at the first :meth:`ParticleFilterTracker.track`, so that importing this module — every
-tracking job does — does not import numba) and gives the numbers of the numpy version it
-replaced, bit for bit.
+seed, input and machine give the same track, bit for bit.  The steps are numpy, but for
+the likelihood's loop over particle–point pairs, compiled with numba
+(:mod:`gaitval.track.pf_kernels`, imported at the first likelihood, so that importing this
+module — every tracking job does — does not import numba).
 
 Output columns as every tracker's: ``observed`` (and pattern ``SL``) when some particle of
 the leg had laser points in its window, else ``UO``; ``phase`` from seed 000's speed
@@ -57,7 +56,7 @@ from gaitval.track.init import INITIALISERS
 from gaitval.track.kinds import TRACKER_KINDS, RawScanTracker
 from gaitval.track.leg import TrackResult, empty_result
 from gaitval.track.observations import WindowedDetections
-from gaitval.track.pf_likelihood import PFArrays, draw_mixture, likelihood, sample_velocities
+from gaitval.track.pf_likelihood import PFArrays, likelihood, sample_velocities
 from gaitval.track.pf_model import default_pf_model
 from gaitval.track.phase import PHASE_MODELS
 from gaitval.track.tracker import step_durations
@@ -152,25 +151,37 @@ class ParticleFilterTracker(RawScanTracker):
     def step(self, P: PFArrays, rng, pts: _Scan, k: int, prev: np.ndarray, dt: float):
         """One scan for both legs: B (propagate), C (weigh), D (resample-move), E.
 
-        The draws come from ``rng`` here, in numpy, in the order B (component uniforms,
-        normals), D (one systematic-resampling uniform per leg, the walk's normals, the MH
-        uniforms); the arithmetic is the compiled kernels of :mod:`gaitval.track.pf_kernels`.
+        The draws come from ``rng`` in the order B (component uniforms, normals), D (one
+        systematic-resampling uniform per leg, the walk's normals, the MH uniforms).
+        Returns the (2, 4) estimate (x, y, vx, vy per leg) and whether each leg saw points.
         """
-        from gaitval.track import pf_kernels as K
-
         N = self.n_particles
-        u, z = draw_mixture(rng, N)                                   # §III.B draws
         X, Y = pts.X[k], pts.Y[k]
-        vx, vy, px, py, lik, w, seen, need = K.propagate_weigh(       # §III.B–C, N_eff
-            prev, dt, u, z, X, Y, P.kernel, self.resample_fraction)
-        legs = np.flatnonzero(need)
-        if legs.size:                                                 # §III.D
-            u_res = rng.random(legs.size)
-            z_walk = rng.standard_normal((legs.size, N, 2))
-            u_mh = rng.random((legs.size, N))
-            K.resample_move(prev, dt, vx, vy, px, py, lik, w, legs, u_res, z_walk, u_mh,
-                            X, Y, P.kernel)
-        return K.estimate(vx, vy, px, py, w, self.best_fraction), seen   # §III.E
+        v = sample_velocities(P, rng, N)                              # §III.B, (2, N, 2)
+        lik, cnt = _weigh(P, prev, v, dt, X, Y, (0, 1))               # §III.C
+        w = _normalise(lik)
+        need = np.flatnonzero(1.0 / np.sum(w * w, axis=1)             # N_eff, §III.D
+                              < self.resample_fraction * N)
+        if need.size:                                                 # §III.D
+            u_res = rng.random(need.size)
+            z_walk = rng.standard_normal((need.size, N, 2))
+            u_mh = rng.random((need.size, N))
+            idx = np.stack([systematic_resample(w[f], u_res[r]) for r, f in enumerate(need)])
+            v_old = np.take_along_axis(v[need], idx[..., None], axis=1)
+            lik_old = np.take_along_axis(lik[need], idx, axis=1)
+            v_new = v_old + z_walk * P.walk_sd                        # random walk on v
+            lik_new, _ = _weigh(P, prev, v_new, dt, X, Y, need)
+            accept = (lik_old <= 0.0) | (u_mh * lik_old < lik_new)    # u < ω*/ω (MH)
+            v[need] = np.where(accept[..., None], v_new, v_old)
+            lik[need] = np.where(accept, lik_new, lik_old)
+            w[need] = _normalise(lik[need])
+        pos = prev[:, None, :2] + v * dt                              # p = p̂_{k−1} + v Δt
+        best = w >= self.best_fraction * w.max(axis=1, keepdims=True)  # seed002 §III.E
+        ws = np.where(best, w, 0.0)
+        ws /= ws.sum(axis=1, keepdims=True)
+        est = np.concatenate([np.einsum("ln,lnj->lj", ws, pos),
+                              np.einsum("ln,lnj->lj", ws, v)], axis=1)
+        return est, cnt.max(axis=1) > 0
 
     def _result(self, res: TrackResult, est: np.ndarray, seen: np.ndarray, k0: int):
         res.k_init = k0
@@ -184,17 +195,38 @@ class ParticleFilterTracker(RawScanTracker):
 
 
 
+def _weigh(P: PFArrays, prev: np.ndarray, v: np.ndarray, dt: float, X, Y, legs):
+    """Likelihoods and contour counts (len(legs), N) of the particles p = p̂_{k−1} + v Δt
+    of ``legs`` (``v``: (len(legs), N, 2)), β against the other leg's p̂_{k−1}."""
+    out = [likelihood(P, prev[f, 0] + v[r, :, 0] * dt, prev[f, 1] + v[r, :, 1] * dt, X, Y,
+                      prev[1 - f, 0], prev[1 - f, 1]) for r, f in enumerate(legs)]
+    return np.array([o[0] for o in out]), np.array([o[1] for o in out])
+
+
+def _normalise(lik: np.ndarray) -> np.ndarray:
+    """Weights per row; a row of zeros (no laser point near any particle): uniform."""
+    s = lik.sum(axis=-1, keepdims=True)
+    return np.where(s > 0, lik / np.where(s > 0, s, 1.0), 1.0 / lik.shape[-1])
+
+
+def systematic_resample(w: np.ndarray, u: float) -> np.ndarray:
+    """Indices of systematic resampling of normalised weights ``w`` with one uniform ``u``
+    (Arulampalam et al. 2002, Algorithm 2): for each (i + u)/N the first cumulative weight
+    ≥ it, the last cumulative weight set to 1."""
+    c = np.cumsum(w)
+    c[-1] = 1.0
+    return np.searchsorted(c, (np.arange(w.size) + u) / w.size)
+
+
 def warm_up() -> None:
-    """Compile the kernels a PF track (and the training's likelihood) runs, or load them
-    from numba's cache, on a tiny problem (two scans of an arc, eight particles per leg,
+    """Compile the likelihood kernel a PF track (and the training) runs, or load it from
+    numba's cache, on a tiny problem (two scans of an arc, eight particles per leg,
     resampling forced).
 
-    The fork server calls it before forking its workers, so that a report loads them once
-    (≈ 0.4 s CPU) instead of once per worker, and a checkout without a cache compiles them
-    once (≈ 10 s CPU) instead of in every worker that runs a PF; ``run.py`` calls it after
-    installing.  The arguments have the types and layouts of :meth:`ParticleFilterTracker.
-    step`'s (float64 C arrays, the scan's rows, an int64 leg index), so a track afterwards
-    finds the same specialisations (tests/test_pf_kernel.py checks that it adds none).
+    The fork server calls it before forking its workers, so that a report loads it once
+    instead of once per worker; ``run.py`` calls it after installing.  The arguments have
+    the types and layouts of :meth:`ParticleFilterTracker.step`'s (tests/test_pf_kernel.py
+    checks that a track afterwards adds no specialisation).
     """
     tracker = ParticleFilterTracker(n_particles=8, resample_fraction=1.0)
     P = PFArrays(default_pf_model(0.10))

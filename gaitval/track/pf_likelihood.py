@@ -1,8 +1,8 @@
 """The particle filter's model arrays, draws and likelihood (seed 002 §III).
 
 :class:`PFArrays` turns a model (:mod:`gaitval.track.pf_model`) into the arrays the
-per-scan steps use (and the tuple the compiled kernels of :mod:`gaitval.track.pf_kernels`
-take); :func:`sample_velocities` draws from the Gaussian mixtures (§III.A–B);
+per-scan steps use (and the tuple the compiled likelihood of :mod:`gaitval.track.pf_kernels`
+takes); :func:`sample_velocities` draws from the Gaussian mixtures (§III.A–B);
 :func:`likelihood` weighs one leg's particles against the scan's points near them
 (§III.C, the compiled kernel).  numba is imported only when a likelihood is computed.
 
@@ -35,11 +35,10 @@ class PFArrays:
     ----------
     w : (2, 2) mixture weights per leg; mean : (2, 2, 2); chol : (2, 2, 2, 2) Cholesky
     factors of the covariances; hx, hy : window half-sizes; mu, inv_sd, norm, pi : (4,)
-    per region R1..R4; abc, pi_code : the same per pair code (see :func:`likelihood`);
-    count_pdf : (T,); gamma_a, gamma_scale, gamma_lognorm : β's constants; walk_sd : (2,)
-    m/s; kernel : the tuple (w, chol, mean, hx, hy, abc, pi_code, count_pdf, gamma_a,
-    gamma_scale, gamma_lognorm, walk_sd) the kernels of :mod:`gaitval.track.pf_kernels`
-    take.
+    per region R1..R4; count_pdf : (T,); gamma_a, gamma_scale, gamma_lognorm : β's
+    constants; walk_sd : (2,) m/s; kernel : the tuple (hx, hy, mu, inv_sd, norm, pi,
+    count_pdf, gamma_a, gamma_scale, gamma_lognorm) that
+    :func:`gaitval.track.pf_kernels.region_likelihood` takes.
     """
 
     def __init__(self, model: dict):
@@ -56,13 +55,6 @@ class PFArrays:
         self.inv_sd = 1.0 / sd
         self.norm = 1.0 / (sd * math.sqrt(2.0 * math.pi))
         self.pi = np.asarray(reg["pi"], dtype=float)
-        # per pair code 0..3 = R1, R2, R4, R3 (see likelihood): exponent coefficients
-        # A d² + B d + C of π-free N(d | μ, σ), and π in the same order
-        order = [0, 1, 3, 2]
-        mu, isd = self.mu[order], self.inv_sd[order]
-        self.abc = np.column_stack([-0.5 * isd ** 2, mu * isd ** 2,
-                                    -0.5 * (mu * isd) ** 2 + np.log(self.norm[order])])
-        self.pi_code = self.pi[order]
         self.count_pdf = np.asarray(model["count_pdf"], dtype=float)
         ga = model["gamma"]
         self.gamma_a, self.gamma_scale = float(ga["a"]), float(ga["scale"])
@@ -71,9 +63,9 @@ class PFArrays:
         self.gamma_lognorm = gammaln(self.gamma_a) + self.gamma_a * math.log(self.gamma_scale)
         self.walk_sd = np.asarray(model["walk_sd_mps"], dtype=float)
         c = np.ascontiguousarray
-        self.kernel = (c(self.w), c(self.chol), c(self.mean), self.hx, self.hy, c(self.abc),
-                       c(self.pi_code), c(self.count_pdf), self.gamma_a, self.gamma_scale,
-                       float(self.gamma_lognorm), c(self.walk_sd))
+        self.kernel = (self.hx, self.hy, c(self.mu), c(self.inv_sd), c(self.norm),
+                       c(self.pi), c(self.count_pdf), self.gamma_a, self.gamma_scale,
+                       float(self.gamma_lognorm))
 
 
 def sample_velocities(P: PFArrays, rng: np.random.Generator, n: int,
@@ -102,7 +94,7 @@ def draw_mixture(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarr
 def likelihood(P: PFArrays, px: np.ndarray, py: np.ndarray, X: np.ndarray, Y: np.ndarray,
                ox: float, oy: float) -> tuple[np.ndarray, np.ndarray]:
     """Observation likelihood of one leg's K particles against a scan's points (seed002
-    §III.C), by the compiled kernel :func:`gaitval.track.pf_kernels.leg_likelihood`.
+    §III.C), by the compiled loops of :mod:`gaitval.track.pf_kernels`.
 
     Parameters
     ----------
@@ -120,17 +112,16 @@ def likelihood(P: PFArrays, px: np.ndarray, py: np.ndarray, X: np.ndarray, Y: np
     -----
     Per pair, with u = x_particle − x_point (> 0: the point is in the lower half) and
     v = y_particle − y_point: in the window when 0 < u ≤ h_x and |v| ≤ h_y; inner when
-    |v| < u; code = inner + 2·[v ≥ 0] (0: R1, 1: R2, 2: R4, 3: R3).  The normal density is
-    evaluated as exp(A d² + B d + C) with A = −1/(2σ²), B = μ/σ² and
-    C = −μ²/(2σ²) + ln(1/(σ√2π)), which is N(d | μ, σ) term for term, with one table
-    look-up per pair.  Only the points that can lie in some particle's window are visited
-    (x in [min px − h_x, max px), y in [min py − h_y, max py + h_y]).
+    |v| < u; the region R1..R4 as :func:`gaitval.track.pf_model.regions`.  Only the points
+    that can lie in some particle's window are visited (x in [min px − h_x, max px),
+    y in [min py − h_y, max py + h_y]).
     """
-    from gaitval.track.pf_kernels import leg_likelihood
+    from gaitval.track.pf_kernels import pair_exponents, region_likelihood
 
     px, py = np.ascontiguousarray(px, dtype=float), np.ascontiguousarray(py, dtype=float)
+    E, R = pair_exponents(px, py, np.ascontiguousarray(X, dtype=float),
+                          np.ascontiguousarray(Y, dtype=float), P.hx, P.hy, P.mu, P.inv_sd)
+    np.exp(E, out=E)                            # N(d | μ, σ) up to the factor 1/(σ√2π)
     lik, cnt = np.empty(px.size), np.empty(px.size, dtype=np.intp)
-    leg_likelihood(px, py, np.ascontiguousarray(X, dtype=float),
-                   np.ascontiguousarray(Y, dtype=float), float(ox), float(oy), P.kernel,
-                   lik, cnt)
+    region_likelihood(E, R, px, py, float(ox), float(oy), P.kernel, lik, cnt)
     return lik, cnt

@@ -41,12 +41,10 @@ What the paper leaves open is made explicit here:
   the round-off of the large negative weight ``W_0`` that ``alpha = 1e-3`` produces.
 
 The per-sample cycle (predict, sigma points, gate, update, reflect) runs compiled
-(:mod:`gaitval.track.ukf_kernel`, numba): ≈ 13× less CPU than the numpy formulation it
-replaces, with the same numbers bit for bit.  ``W_0 ≈ -10^6`` amplifies round-off, so a
-track's last digits depend on the order of every sum: the kernel calls the BLAS and LAPACK
-routines the numpy formulation's ``@`` and ``dpotrf``/``dposv`` called, with the same
-arguments (OpenBLAS chooses its kernels for the CPU, so the digits are the machine's;
-docs/speed.md, seventh session).
+(:mod:`gaitval.track.ukf_kernel`, numba, the numpy formulation's array expressions).
+``alpha = 1e-3`` gives ``W_0 ≈ -10^6`` (eq. 12), which amplifies round-off, so a track's
+last digits depend on the BLAS build and the CPU; on one machine the numbers are the same
+every run (docs/numerics.md).
 
 References
 ----------
@@ -56,7 +54,6 @@ Parameters Using a Low-Cost Ultrasonic Motion Analysis System. *Sensors* 2014, 1
 """
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -294,13 +291,15 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     d = np.ascontiguousarray(d, dtype=float)
     anchors = np.ascontiguousarray(anchors, dtype=float)
     n_s = len(d)
-    mdl = _Model(anchors, W_sigma, V, alpha, beta, kappa, gate_sigma, max_reject)
     guess = anchors.mean(axis=0) if init_guess is None else np.asarray(init_guess, float)
     normal, centre = _mirror_plane(anchors, guess, mirror_guard and init_guess is not None)
+    model = _model(anchors, W_sigma, V, alpha, beta, kappa, gate_sigma, max_reject,
+                   min_anchors, reinit_after, normal, centre)
     P0 = np.diag([init_sigma_pos ** 2] * 3 + [init_sigma_vel ** 2] * 3)
     finite = np.isfinite(d)
     n_finite = finite.sum(axis=1).astype(np.int64)
     res = ToaUkfResult.start(finite)
+    out = (res.x, res.P_diag, res.used, res.rejected, res.reflected)
     x = P = None
     starved = np.zeros(1, dtype=np.int64)
     k = 0
@@ -309,66 +308,38 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
         # from the guess: its side of the array; a fix the ranges do not support is refused
         fix = trilaterate_checked(d[k], anchors, guess, max_residual_m=init_max_residual_m,
                                   max_range_m=max_range_m)
-        p0 = fix.p
-        if np.all(np.isfinite(p0)):
+        force = False
+        if np.all(np.isfinite(fix.p)):
             res.used[k] = fix.used                  # the anchors of the fix
-            # the kernel keeps P row-major and flat (36,)
-            x, P, starved[0] = np.concatenate([p0, np.zeros(3)]), P0.flatten(), 0
+            x, P, starved[0] = np.concatenate([fix.p, np.zeros(3)]), P0.copy(), 0
             res.reinit[k] = True
             res.x[k], res.P_diag[k] = x, P0.diagonal()
             k += 1
-            force = False
-        elif x is None:
-            res.used[k] = False
-            res.refused[k] = n_finite[k] >= 3       # ranges there, but no consistent fix
-            k += 1                                  # wait for a sample with >= 3 ranges
-            continue
         else:
-            res.refused[k] = n_finite[k] >= 3
+            res.refused[k] = n_finite[k] >= 3       # ranges there, but no consistent fix
+            if x is None:
+                res.used[k] = False
+                k += 1                              # wait for a sample with >= 3 ranges
+                continue
             force = True                            # still lost: predict and update anyway
         if k < n_s:
             # per sample: predict (eq. 8), update (eq. 9-11), reflect (module notes)
-            k = ukf_steps(k, force, _pointers(), t, d, n_finite, anchors, mdl.S, mdl.Wm,
-                          mdl.Wc, mdl.scale, mdl.Vm, mdl.Q4, mdl.Q3, mdl.Q2, mdl.gate2,
-                          mdl.use_gate, mdl.max_reject, min_anchors, reinit_after,
-                          centre if normal is None else normal, centre,
-                          normal is not None, x, P, starved, res.x, res.P_diag,
-                          res.used, res.rejected, res.reflected)
+            k, P = ukf_steps(k, force, t, d, n_finite, model, x, P, starved, out)
     return res
 
 
-class _Model:
-    """The constant pieces of one run: weights (eq. 12–13), noises, eq. (5) and the gate."""
-
-    def __init__(self, anchors, W_sigma, V, alpha, beta, kappa, gate_sigma, max_reject):
-        self.anchors = anchors
-        self.Wm, self.Wc, lam = ukf_weights(N_STATE, alpha, beta, kappa)
-        self.scale = N_STATE + lam                       # B = chol((n + lambda) P), eq. (7)
-        V = np.asarray(V, dtype=float)
-        self.Vm = np.ascontiguousarray(np.diag(V) if V.ndim == 1 else V, float).ravel()
-        # chi_i - X = S B^T, seed003 eq. (7)
-        I6 = np.eye(N_STATE)
-        self.S = np.vstack([np.zeros((1, N_STATE)), I6, -I6]).ravel()
-        # seed003 eq. (5): A = I + dt E,  G W G^T = dt^4/4 Q4 + dt^3/2 Q3 + dt^2 Q2,
-        # W = diag(q)
-        q = np.asarray(W_sigma, dtype=float) ** 2
-        self.Q4, self.Q3, self.Q2 = (np.zeros((N_STATE, N_STATE)) for _ in range(3))
-        self.Q4[:3, :3] = np.diag(q)
-        self.Q3[:3, 3:] = self.Q3[3:, :3] = np.diag(q)
-        self.Q2[3:, 3:] = np.diag(q)
-        self.Q4, self.Q3, self.Q2 = self.Q4.ravel(), self.Q3.ravel(), self.Q2.ravel()
-        self.gate2 = float(gate_sigma) ** 2
-        self.use_gate = bool(np.isfinite(gate_sigma))
-        self.max_reject = int(max_reject)
-
-
-@functools.cache
-def _pointers() -> np.ndarray:
-    """The kernel's BLAS and LAPACK entry points (:func:`gaitval.track.ukf_kernel.
-    blas_pointers`), looked up once per process."""
-    from gaitval.track.ukf_kernel import blas_pointers
-
-    return blas_pointers()
+def _model(anchors, W_sigma, V, alpha, beta, kappa, gate_sigma, max_reject, min_anchors,
+           reinit_after, normal, centre) -> tuple:
+    """The constants of one run as :func:`gaitval.track.ukf_kernel.ukf_steps` takes them:
+    weights (eq. 12–13), ``n + lambda`` of eq. (7), V, W's diagonal (eq. 4–5), the gate,
+    the re-initialisation rule and the receiver plane (``normal`` empty: none)."""
+    Wm, Wc, lam = ukf_weights(N_STATE, alpha, beta, kappa)
+    V = np.asarray(V, dtype=float)
+    V = np.ascontiguousarray(np.diag(V) if V.ndim == 1 else V)
+    q = np.asarray(W_sigma, dtype=float) ** 2
+    return (anchors, Wm, Wc, float(N_STATE + lam), V, q, float(gate_sigma) ** 2,
+            bool(np.isfinite(gate_sigma)), int(max_reject), int(min_anchors),
+            int(reinit_after), np.zeros(0) if normal is None else normal, centre)
 
 
 def _mirror_plane(anchors: np.ndarray, guess: np.ndarray, guard: bool):
