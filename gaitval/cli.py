@@ -44,6 +44,13 @@ def cmd_validate(a) -> int:
     return 0
 
 
+def cmd_init_study(a) -> int:
+    from gaitval.io.initstudy import init_study
+    res = init_study(a.folder, study=a.study, force=a.force, max_time_gap_s=a.max_time_gap_s)
+    print(res.text())
+    return 1 if res.problems else 0
+
+
 def cmd_simulate(a) -> int:
     from gaitval.simulate import generate_study
     preset = a.preset
@@ -200,6 +207,18 @@ def _add_input_verbs(sub) -> None:
     s.add_argument("--jobs", type=int, default=None,
                    help="processes for --deep (default: one per core)")
     s.set_defaults(func=cmd_validate)
+
+    s = sub.add_parser("init-study", help="trial sheet, subject table, study.yaml and a "
+                       "config snippet from a folder of recordings; then validate")
+    s.add_argument("folder", help="the study's folder: C3D files, scan logs or bags, "
+                   "ultrasonic logs, annotations, target layouts (sub-folders too)")
+    s.add_argument("--study", help="study id (default: the folder's name)")
+    s.add_argument("--force", action="store_true",
+                   help="replace an existing trials.csv and subjects.csv")
+    s.add_argument("--max-time-gap-s", type=float, default=300.0,
+                   help="pair a sensor file with a C3D of another name when the two were "
+                   "written at most this far apart (s; default 300)")
+    s.set_defaults(func=cmd_init_study)
 
     s = sub.add_parser("simulate", help="generate a simulated study (raw files + truth/)")
     s.add_argument("--preset", default="default",
