@@ -391,7 +391,8 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
     write_text(subjects_csv, _csv(subjects, SUBJECT_COLUMNS))
     res.written += [sheet, subjects_csv]
     snippet = folder / "gaitval.config.yaml"
-    write_text(snippet, _config_snippet(study, folder, files))
+    write_text(snippet, _config_snippet(study, folder, files,
+                                        _external_methods(trials, files, res)))
     res.written.append(snippet)
     res.notes.append(f"{len(trials)} trials, {len(subjects)} subjects; run with "
                      f"`python3 run.py report --configfile {snippet}`")
@@ -488,18 +489,59 @@ def _study_yaml(trials: list[dict], files: list[Found], res: InitResult) -> str:
     return "\n".join(lines) + "\n" + body
 
 
-def _config_snippet(study: str, folder: Path, files: list[Found]) -> str:
+def _external_methods(trials: list[dict], files: list[Found], res: InitResult) -> dict:
+    """External trackers' files (``<folder>/<trial>.tracks.csv`` or ``.parquet``): one
+    method per folder and suffix whose files are named by trial ids, named after the
+    folder; its protocols those of its trials (docs/formats.md, *External methods*)."""
+    proto = {r["trial"]: r.get("protocol") for r in trials}
+    groups: dict[tuple[str, str], list[str]] = {}
+    for f in files:
+        if f.kind != "tracks":
+            continue
+        parent = str(Path(f.rel).parent)
+        suffix = Path(f.rel).name[len(f.stem):]
+        groups.setdefault((parent, suffix), []).append(f.stem)
+    out: dict = {}
+    for (parent, suffix), stems in sorted(groups.items()):
+        known = [t for t in stems if t in proto]
+        if not known:
+            res.unpaired += [f"{parent}/{t}{suffix}: external tracks of no trial id"
+                             for t in stems]
+            continue
+        protos = sorted({proto[t] for t in known} & {"tug", "mtst", "rollator"})
+        name = _ID_BAD.sub("_", Path(parent).name if parent != "." else "external")
+        name = f"ext_{name}" if not name.startswith("ext") else name
+        path = (f"{parent}/{{trial}}{suffix}" if parent != "." else f"{{trial}}{suffix}")
+        want = sorted(t for t, p in proto.items() if p in protos)
+        missing = sorted(set(want) - set(known))
+        if not protos:
+            continue
+        out[name] = {"path": path, "protocols": protos}
+        res.notes.append(f"gaitval.config.yaml tracking.external.{name}: {path} "
+                         f"({', '.join(protos)} trials)")
+        if missing:
+            res.todo.append(f"tracking.external.{name}: no file for trial(s) "
+                            f"{', '.join(missing[:5])}{' ...' if len(missing) > 5 else ''} "
+                            "(every trial of its protocols needs one; narrow protocols or "
+                            "add the files)")
+    return out
+
+
+def _config_snippet(study: str, folder: Path, files: list[Found],
+                    external: dict | None = None) -> str:
     sheet = (folder / "trials.csv").resolve()
     subjects = (folder / "subjects.csv").resolve()
     doc = {"studies": {study: {"trial_sheet": str(sheet), "subjects": str(subjects)}},
            "run": [study]}
+    if external:
+        doc["tracking"] = {"external": external}
     text = ("# Workflow config of this study, written by gaitval init-study: pass it with\n"
             "#   python3 run.py report --configfile " + str((folder /
                                                             "gaitval.config.yaml").resolve())
             + "\n# (or snakemake --configfile ...); config/config.yaml stays as it is.\n"
             + yaml.safe_dump(doc, sort_keys=False))
     tracks = sorted({f.rel for f in files if f.kind == "tracks"})
-    if tracks:
+    if tracks and not external:
         text += ("# External trackers' tracks were found (docs/formats.md, 'Leg tracks'); "
                  "declare each as a method, e.g.\n# tracking:\n#   external:\n"
                  "#     my_tracker: {path: " + tracks[0] + "}   # {trial} for the trial id\n")
