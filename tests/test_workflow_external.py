@@ -57,6 +57,7 @@ def people_bag(path: Path, sensor_parquet: Path, track: pd.DataFrame) -> Path:
             sec=sec, nanosec=int(round((t - sec) * 1e9))), frame_id="laser")
 
     by_k = {k: g for k, g in track.groupby("k")}
+    path.parent.mkdir(parents=True, exist_ok=True)
     with Writer(path) as w:
         cs = w.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=store)
         cp = w.add_connection("/people_tracked", "leg_tracker/msg/PersonArray",
