@@ -214,6 +214,20 @@ def test_mtst_external_rows_equal_the_methods_rows(ext_run):
     assert "success_pct" in cols and "n_trials_stick" in cols
     pd.testing.assert_frame_equal(a[cols], b[cols], check_exact=True)
     assert (a["success"] == b["success"]).all()
+    # Table 4: the proposed method's rows, then ext_m1's, judged on the trials it tracked
+    # successfully: the rows mtst_m1 would get from the same per-trial evaluations
+    from gaitval.tables.mtst import table4
+    t4 = pd.read_csv(work / "reports" / "tiny" / "tables" / "mtst_table4.csv")
+    assert t4["method"].tolist() == ["mtst_proposed"] * 2 + ["ext_m1"] * 2
+    ev = work / "results" / "tiny" / "mtst_eval"
+    summary = pd.concat([pd.read_parquet(p) for p in sorted(ev.glob("*/*/summary.parquet"))],
+                        ignore_index=True)
+    want = table4(summary, "mtst_m1")
+    got = _rows(t4, "ext_m1")
+    for c in ("n_trials", "n_steps_stick", "n_steps_no_stick", "non_stick", "non_no_stick",
+              "mis_or_false_stick", "mis_or_false_no_stick"):
+        assert got[c].tolist() == want[c].tolist(), c
+    assert got["success_published"].isna().all()
 
 
 @pytest.mark.slow
