@@ -293,6 +293,7 @@ def test_names_become_safe_ids_and_links_out_of_the_folder_are_skipped(tiny_file
     init_study(lab)
     sheet = pd.read_csv(lab / "trials.csv", dtype=str, keep_default_na=False)
     assert list(sheet["trial"]) == ["tug_Y01___id_"]
+    assert list(sheet["scenario"]) == ["__id_"]
     assert list(sheet["sensor_file"]) == [f"{name}.scan.parquet"]   # a file name, quoted
     # the config snippet names this folder's sheet, nothing else
     cfg = yaml.safe_load((lab / "gaitval.config.yaml").read_text())
@@ -323,3 +324,13 @@ def test_external_tracks_named_by_trial_become_an_external_method(tiny_files, tm
     assert cfg["tracking"]["external"] == {"ext_mytracker": {
         "path": "mytracker/{trial}.tracks.csv", "protocols": ["tug"]}}
     assert any("tug_Y01_t2" in t and "ext_mytracker" in t for t in res.todo)
+
+
+def test_an_unreadable_file_is_reported_not_fatal(tiny_files, tmp_path):
+    lab = tmp_path / "lab"
+    lab.mkdir()
+    shutil.copy(tiny_files / "lrs" / "tug_Y01_t1.scan.parquet", lab / "tug_Y01_t1.scan.parquet")
+    (lab / "tug_Y01_t1.c3d").write_bytes(b"not a c3d file")
+    res = init_study(lab)
+    assert any(u.startswith("tug_Y01_t1.c3d: ") and "C3D" in u for u in res.unpaired)
+    assert (lab / "trials.csv").is_file()

@@ -282,6 +282,7 @@ def _trial_from_name(stem: str, kind: str, labels: list[str]) -> dict:
             out.setdefault("repetition", int(_REPETITION.match(lw).group(1)))
         else:
             rest.append(w)
+    rest = [_ID_BAD.sub("_", w) for w in rest]          # ids: letters, digits, _ . -
     if out.get("protocol") == "pendulum":
         out["subject"] = "pendulum"
         rest = [w for w in rest if w.lower() != "pendulum"]
@@ -326,7 +327,12 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
     ids: set[str] = set()
     for s in sensors:
         c3d = pairs.get(s.rel)
-        f = _c3d_facts(folder / c3d.rel) if c3d else {"labels": []}
+        f = {"labels": []}
+        if c3d:
+            try:
+                f = _c3d_facts(folder / c3d.rel)
+            except GaitvalError as exc:               # a file gaitval cannot read: said
+                res.unpaired.append(f"{c3d.rel}: {exc}")
         if c3d:
             facts[c3d.rel] = f
         info = _trial_from_name(s.stem, s.kind, f["labels"])
@@ -344,7 +350,11 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
         if ann:
             row["annotation_file"] = ann.rel
         if s.kind == "bag":
-            topic = _bag_topic(folder / s.rel)
+            try:
+                topic = _bag_topic(folder / s.rel)
+            except GaitvalError as exc:
+                res.unpaired.append(f"{s.rel}: {exc}")
+                topic = None
             row["sensor_topic"] = topic or FILL_IN
             if topic is None:
                 res.todo.append(f"trials.csv {trial}: sensor_topic (the bag has none or "
