@@ -334,3 +334,21 @@ def test_an_unreadable_file_is_reported_not_fatal(tiny_files, tmp_path):
     res = init_study(lab)
     assert any(u.startswith("tug_Y01_t1.c3d: ") and "C3D" in u for u in res.unpaired)
     assert (lab / "trials.csv").is_file()
+
+
+def test_a_tracker_recorded_in_the_sensor_bags_is_offered_commented(tiny_files, tmp_path):
+    from test_io_tracks_bag import make_bag
+
+    lab = tmp_path / "lab"
+    (lab / "bags").mkdir(parents=True)
+    make_bag(lab / "bags" / "tug_Y01_t1.bag")
+    shutil.copy(tiny_files / "mocap" / "tug_Y01_t1.c3d", lab / "tug_Y01_t1.c3d")
+    res = init_study(lab)
+    row = pd.read_csv(lab / "trials.csv", dtype=str, keep_default_na=False).iloc[0]
+    assert (row["sensor_file"], row["sensor_topic"], row["sensor_height_m"]) == (
+        "bags/tug_Y01_t1.bag", "/scan", FILL_IN)        # a bag: no height in its metadata
+    text = (lab / "gaitval.config.yaml").read_text()
+    assert "tracking" not in yaml.safe_load(text)       # commented: the legs are the user's
+    assert ('#     ext_people_tracked: {path: "bags/{trial}.bag", topic: "/people_tracked", '
+            "protocols: ['tug'], legs: {L: FILL_IN, R: FILL_IN}}") in text
+    assert any("/people_tracked" in t and "uncomment" in t for t in res.todo)

@@ -188,15 +188,20 @@ def _c3d_facts(path: Path) -> dict:
     return out
 
 
-def _bag_topic(path: Path) -> str | None:
+def _bag_topics(path: Path) -> tuple[str | None, list[str]]:
+    """The bag's LaserScan topic (None unless exactly one) and its tracker topics
+    (:data:`gaitval.io.tracks.BAG_PEOPLE_TYPES`: a tracker recorded with the scans)."""
     from gaitval.io.rosbag import LASERSCAN, _open
+    from gaitval.io.tracks import BAG_PEOPLE_TYPES
 
     reader = _open(path, None)
     try:
         scans = sorted({c.topic for c in reader.connections if c.msgtype == LASERSCAN})
+        trackers = sorted({c.topic for c in reader.connections
+                           if c.msgtype in BAG_PEOPLE_TYPES})
     finally:
         reader.close()
-    return scans[0] if len(scans) == 1 else None
+    return (scans[0] if len(scans) == 1 else None), trackers
 
 
 def _scanlog_height(path: Path) -> float | None:
@@ -323,6 +328,7 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
                      for c in c3ds if c.rel not in paired_c3d]
 
     facts: dict[str, dict] = {}
+    bag_trackers: dict[str, list[str]] = {}       # tracker topic -> sensor bags with it
     trials: list[dict] = []
     ids: set[str] = set()
     for s in sensors:
@@ -351,10 +357,12 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
             row["annotation_file"] = ann.rel
         if s.kind == "bag":
             try:
-                topic = _bag_topic(folder / s.rel)
+                topic, trackers = _bag_topics(folder / s.rel)
             except GaitvalError as exc:
                 res.unpaired.append(f"{s.rel}: {exc}")
-                topic = None
+                topic, trackers = None, []
+            for tt in trackers:
+                bag_trackers.setdefault(tt, []).append(s.rel)
             row["sensor_topic"] = topic or FILL_IN
             if topic is None:
                 res.todo.append(f"trials.csv {trial}: sensor_topic (the bag has none or "
@@ -402,7 +410,8 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
     res.written += [sheet, subjects_csv]
     snippet = folder / "gaitval.config.yaml"
     write_text(snippet, _config_snippet(study, folder, files,
-                                        _external_methods(trials, files, res)))
+                                        _external_methods(trials, files, res),
+                                        _bag_tracker_lines(trials, bag_trackers, res)))
     res.written.append(snippet)
     res.notes.append(f"{len(trials)} trials, {len(subjects)} subjects; run with "
                      f"`python3 run.py report --configfile {snippet}`")
@@ -537,8 +546,37 @@ def _external_methods(trials: list[dict], files: list[Found], res: InitResult) -
     return out
 
 
+def _bag_tracker_lines(trials: list[dict], bag_trackers: dict[str, list[str]],
+                       res: InitResult) -> list[str]:
+    """Commented config lines for a tracker topic recorded in the sensor bags: which
+    person id is which leg only the user knows, so the entry is left for them to enable."""
+    lines = []
+    by_file = {r["sensor_file"]: r["trial"] for r in trials}
+    for topic, bags in sorted(bag_trackers.items()):
+        dirs = {str(Path(b).parent) for b in bags}
+        named = all(Path(b).stem == by_file.get(b) for b in bags)
+        if len(dirs) != 1 or not named:
+            continue
+        d = dirs.pop()
+        path = f"{d}/{{trial}}.bag" if d != "." else "{trial}.bag"
+        protos = sorted({r.get("protocol") for r in trials if r["sensor_file"] in bags}
+                        & {"tug", "mtst", "rollator"})
+        if not protos:
+            continue
+        name = "ext_" + (_ID_BAD.sub("_", topic.strip("/")) or "bag")
+        lines += [f"#     {name}: {{path: \"{path}\", topic: \"{topic}\", "
+                  f"protocols: {protos}, legs: {{L: FILL_IN, R: FILL_IN}}}}"]
+        res.todo.append(f"gaitval.config.yaml: the sensor bags hold tracker topic {topic}; "
+                        f"to validate that tracker, give the person id of each leg and "
+                        f"uncomment tracking.external.{name}")
+    if lines:
+        lines = ["# A tracker recorded in the sensor bags (docs/formats.md, 'Leg tracks'):",
+                 "# tracking:", "#   external:"] + lines
+    return lines
+
+
 def _config_snippet(study: str, folder: Path, files: list[Found],
-                    external: dict | None = None) -> str:
+                    external: dict | None = None, extra: list[str] = ()) -> str:
     sheet = (folder / "trials.csv").resolve()
     subjects = (folder / "subjects.csv").resolve()
     doc = {"studies": {study: {"trial_sheet": str(sheet), "subjects": str(subjects)}},
@@ -550,6 +588,8 @@ def _config_snippet(study: str, folder: Path, files: list[Found],
                                                             "gaitval.config.yaml").resolve())
             + "\n# (or snakemake --configfile ...); config/config.yaml stays as it is.\n"
             + yaml.safe_dump(doc, sort_keys=False))
+    if extra and not external:
+        text += "\n".join(extra) + "\n"
     tracks = sorted({f.rel for f in files if f.kind == "tracks"})
     if tracks and not external:
         text += ("# External trackers' tracks were found (docs/formats.md, 'Leg tracks'); "
