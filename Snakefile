@@ -21,6 +21,7 @@ include: "workflow/rules/mtst.smk"
 include: "workflow/rules/ultrasonic.smk"
 include: "workflow/rules/peer.smk"
 include: "workflow/rules/rollator.smk"
+include: "workflow/rules/external.smk"
 include: "workflow/rules/legbench.smk"
 include: "workflow/rules/report.smk"
 

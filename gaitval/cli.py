@@ -44,6 +44,13 @@ def cmd_validate(a) -> int:
     return 0
 
 
+def cmd_init_study(a) -> int:
+    from gaitval.io.initstudy import init_study
+    res = init_study(a.folder, study=a.study, force=a.force, max_time_gap_s=a.max_time_gap_s)
+    print(res.text())
+    return 1 if res.problems else 0
+
+
 def cmd_simulate(a) -> int:
     from gaitval.simulate import generate_study
     preset = a.preset
@@ -127,13 +134,17 @@ def cmd_evaluate_tug(a) -> int:
 
 def cmd_export_tracks(a) -> int:
     from gaitval.steps import export_tracks_step
-    print(f"wrote {export_tracks_step(a.track, a.out, a.units, a.topic)}")
+    legs = None
+    if a.legs:
+        legs = dict(kv.split("=", 1) for kv in a.legs.split(",") if "=" in kv)
+    print(f"wrote {export_tracks_step(a.track, a.out, a.units, a.topic, legs)}")
     return 0
 
 
 def cmd_import_tracks(a) -> int:
     from gaitval.steps import import_tracks_step
-    import_tracks_step(a.tracks, a.sensor, a.registration, a.trial, a.method, a.out)
+    import_tracks_step(a.tracks, a.sensor, a.registration, a.trial, a.method, a.out,
+                       config_json=a.config, moving_sensor=a.moving_sensor)
     return 0
 
 
@@ -205,6 +216,18 @@ def _add_input_verbs(sub) -> None:
     s.add_argument("--jobs", type=int, default=None,
                    help="processes for --deep (default: one per core)")
     s.set_defaults(func=cmd_validate)
+
+    s = sub.add_parser("init-study", help="trial sheet, subject table, study.yaml and a "
+                       "config snippet from a folder of recordings; then validate")
+    s.add_argument("folder", help="the study's folder: C3D files, scan logs or bags, "
+                   "ultrasonic logs, annotations, target layouts (sub-folders too)")
+    s.add_argument("--study", help="study id (default: the folder's name)")
+    s.add_argument("--force", action="store_true",
+                   help="replace an existing trials.csv and subjects.csv")
+    s.add_argument("--max-time-gap-s", type=float, default=300.0,
+                   help="pair a sensor file with a C3D of another name when the two were "
+                   "written at most this far apart (s; default 300)")
+    s.set_defaults(func=cmd_init_study)
 
     s = sub.add_parser("simulate", help="generate a simulated study (raw files + truth/)")
     s.add_argument("--preset", default="default",
@@ -285,17 +308,24 @@ def _add_lrs_verbs(sub) -> None:
     s.add_argument("--units", choices=("m", "mm"), default="m")
     s.add_argument("--topic", help="bags: the leg_tracker/PersonArray or people_msgs/People "
                    "topic (default: the only one)")
+    s.add_argument("--legs", help="bags whose people are legs: the person ids of the "
+                   "left and right leg, e.g. L=1,R=2 (a PoseArray: the poses' indices)")
     s.set_defaults(func=cmd_export_tracks)
 
     s = sub.add_parser("import-tracks", help="an external tracker's *.tracks.csv/parquet of "
                        "one trial as gaitval's track (sensor clock and frame)")
-    s.add_argument("--tracks", required=True, help="*.tracks.csv or *.tracks.parquet")
+    s.add_argument("--tracks", required=True, help="*.tracks.csv or *.tracks.parquet, or a "
+                   "ROS bag with a tracker's topic (--config names topic and legs)")
     s.add_argument("--sensor", required=True, help="ingested sensor.parquet (time span)")
     s.add_argument("--registration", help="the trial's registration.json (pose and clock "
                    "offset, for a file in the mocap frame or clock; none: a trial without "
                    "mocap, the file must be on the sensor clock in the sensor frame)")
     s.add_argument("--trial", required=True)
     s.add_argument("--method", required=True, help="the external method's name")
+    s.add_argument("--config", help="the method's config view: tracking.external.<method> "
+                   "gives a bag's topic and legs")
+    s.add_argument("--moving-sensor", action="store_true",
+                   help="the laser moves (rollator): refuse tracks in the mocap frame")
     s.add_argument("--out", required=True)
     s.set_defaults(func=cmd_import_tracks)
 

@@ -22,7 +22,7 @@ import yaml
 
 from gaitval import consts as C
 from gaitval.config import deep_merge
-from gaitval.errors import ConfigError, GaitvalError
+from gaitval.errors import ConfigError, FileFormatError, GaitvalError
 from gaitval.io.atomic import write_csv, write_parquet, write_text
 from gaitval.io.filememo import FileMemo, file_identity
 from gaitval.io.parquet import read_parquet
@@ -472,8 +472,8 @@ def ultrasonic_tables_step(inputs: list[str | Path], tables_dir, figures_dir, re
 
 
 # -- external tracks (issue 37; gaitval/io/tracks.py, docs/formats.md "Leg tracks") ------
-def export_tracks_step(track_parquet, out, units: str = "m", topic: str | None = None
-                       ) -> Path:
+def export_tracks_step(track_parquet, out, units: str = "m", topic: str | None = None,
+                       legs: dict | None = None) -> Path:
     """One of gaitval's own track files (``results/<study>/track/<method>/<trial>.parquet``)
     in the exchange format (sensor frame and clock), CSV or Parquet by ``out``'s suffix; or
     a tracker's people topic of a ROS bag (``*.bag`` or a ROS 2 bag folder; ``topic``:
@@ -483,6 +483,10 @@ def export_tracks_step(track_parquet, out, units: str = "m", topic: str | None =
     src_path = Path(track_parquet)
     if src_path.suffix == ".bag" or src_path.is_dir():
         rows, meta = read_bag_tracks(src_path, topic)
+        if legs:                  # each leg a person: leg rows (docs/formats.md, Leg tracks)
+            from gaitval.io.tracks import people_to_legs
+            rows = people_to_legs(rows, legs, path=src_path, topic=meta["source"]).rename(
+                columns={"x_m": "x", "y_m": "y"})
         if units == "mm":
             rows[["x", "y"]] = rows[["x", "y"]] * 1000.0
         return write_tracks(rows, out, units=units, source=meta["source"])
@@ -516,18 +520,54 @@ def external_track_path(sheet, entry: dict, trial: str, method: str = "") -> Pat
     return path
 
 
+def external_entry(config_json, method: str) -> dict:
+    """``tracking.external.<method>`` of a config view (empty without one)."""
+    if not config_json:
+        return {}
+    ext = ((load_json(config_json).get("tracking") or {}).get("external") or {})
+    return dict(ext.get(method) or {})
+
+
+def read_external(tracks_file, entry: dict, trial: str) -> tuple[pd.DataFrame, dict]:
+    """An external method's file of one trial as :func:`gaitval.io.tracks.read_tracks`
+    rows: a ``*.tracks.csv``/``.parquet``, or a ROS bag's tracker topic (``entry``'s
+    ``topic``) whose people are the legs named by ``entry``'s ``legs``."""
+    from gaitval.io.rosbag import is_rosbag
+    from gaitval.io.tracks import people_to_legs, read_bag_tracks, read_tracks
+
+    if not is_rosbag(tracks_file):
+        return read_tracks(tracks_file, trial=trial)
+    rows, meta = read_bag_tracks(tracks_file, entry.get("topic"), trial=trial)
+    legs = entry.get("legs")
+    if not legs:
+        return rows.rename(columns={"x": "x_m", "y": "y_m"}), meta
+    return people_to_legs(rows, legs, path=tracks_file, trial=trial,
+                          topic=meta["source"]), meta
+
+
 def import_tracks_step(tracks_file, sensor_parquet, registration_json, trial: str,
-                       method: str, out_parquet) -> pd.DataFrame:
+                       method: str, out_parquet, config_json=None,
+                       moving_sensor: bool = False) -> pd.DataFrame:
     """An external tracker's file of one trial as gaitval's per-scan track (the columns of
     :func:`gaitval.methods.track_trial`, plus ``trial`` and ``method``), so that the TUG
     evaluation and tables treat it as one more method.  The clock and frame conversion use
     the trial's registration (docs/formats.md); a file on the sensor clock in the sensor
     frame needs none.  A trial whose registration was refused gets an empty track when the
-    file needs it (its evaluation is ``not_registered`` anyway)."""
+    file needs it (its evaluation is ``not_registered`` anyway).  ``config_json``: the
+    method's config view, whose ``tracking.external.<method>`` gives a bag's ``topic``
+    and ``legs`` (:func:`read_external`).  ``moving_sensor`` (the rollator): a file in
+    the mocap frame is refused (the laser's pose changes every frame; give the tracks in
+    the laser's frame)."""
     from gaitval.io.scanlog import read_scanlog
-    from gaitval.io.tracks import TRACK_COLUMNS, read_tracks, tracks_to_sensor
+    from gaitval.io.tracks import TRACK_COLUMNS, tracks_to_sensor
 
-    rows, meta = read_tracks(tracks_file, trial=trial)
+    rows, meta = read_external(tracks_file, external_entry(config_json, method), trial)
+    if moving_sensor and meta["frame"] == "mocap":
+        raise FileFormatError(
+            "header field 'frame' is 'mocap', but this trial's laser moves (rollator): "
+            "gaitval converts only a fixed laser's tracks from the mocap frame",
+            path=tracks_file, trial=trial, hint="write the tracks in the laser's frame "
+            "(frame: sensor)")
     rec = load_json(registration_json) if registration_json else None
     needs_reg = "mocap" in (meta["frame"], meta["clock"])
     if needs_reg and rec is not None and rec.get("status") != "ok":

@@ -299,7 +299,10 @@ def mtst_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, repor
     methods = list(methods or (s or {}).get("methods") or
                    ["mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed"])
     shown = method_display_names(Path(config_json).parent, methods) if config_json else {}
-    paths = write_mtst_tables(data, tables_dir, methods=methods, shown=shown)
+    own = set((s or {}).get("methods") or ("mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed"))
+    external = [m for m in methods if m not in own]    # tracking.external (issue 37)
+    paths = write_mtst_tables(data, tables_dir, methods=methods, shown=shown,
+                              external=external)
     stamp("mtst_tables", paths, reports_dir, config_hash_=config_hash)
     figs = write_mtst_figure(data, figures_dir, trial=(s or {}).get("figure_trial"),
                              methods=methods)

@@ -226,9 +226,11 @@ def rollator_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, r
     sources = sorted({load_json(m).get("source", "") for m in models})
     shown = (method_display_names(Path(config_json).parent, [kf_method, pf_method])
              if config_json else {})
+    # the other trackers evaluated are external methods (tracking.external, issue 37)
+    external = sorted(set(summary["tracker"].astype(str)) - {kf_method, pf_method})
     paths = write_rollator_tables(frames_df, summary, tables_dir, kf=kf_method,
                                   pf=pf_method, error_m=float(rc["error_m"]),
-                                  model_sources=sources, shown=shown)
+                                  model_sources=sources, shown=shown, external=external)
     stamp("rollator_tables", paths, reports_dir, config_hash_=config_hash)
     figs = write_rollator_figure(frames_df, figures_dir, kf=kf_method, pf=pf_method,
                                  trial=rc["figure_trial"],

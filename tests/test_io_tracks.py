@@ -248,3 +248,16 @@ def test_converted_times_snap_to_the_scan_they_name():
     t = np.array([0.025 + 4e-16, 0.05 - 2e-7, 0.0374, 0.075 + 5e-6, -1e-9])
     np.testing.assert_array_equal(snap_to_scans(t, scans),
                                   [0.025, 0.05, 0.0374, 0.075 + 5e-6, 0.0])
+
+
+def test_rollator_tracks_in_the_mocap_frame_are_refused(tmp_path):
+    """The rollator's laser moves: a file in the mocap frame cannot be brought to it with
+    one pose, and the import says so naming the file and the trial."""
+    from gaitval.steps import import_tracks_step
+
+    p = _csv(tmp_path, HEAD[:2] + ["# frame: mocap", HEAD[3]] + GOOD)
+    with pytest.raises(FileFormatError) as exc:
+        import_tracks_step(p, tmp_path / "none.parquet", None, "R1", "ext", tmp_path / "o",
+                           moving_sensor=True)
+    msg = str(exc.value)
+    assert str(p) in msg and "trial R1" in msg and "laser moves" in msg

@@ -127,3 +127,63 @@ def test_export_tracks_verb_converts_a_bag_topic(tmp_path):
     assert meta["units"] == "mm" and meta["source"] == "people_msgs/msg/People on /people"
     np.testing.assert_allclose(rows["x_m"], [2.0] * 3)     # read back in metres
     assert main(["export-tracks", str(bag), str(out), "--topic", "/nope"]) == 1
+
+
+def test_people_as_legs_and_a_missing_leg(tmp_path):
+    """A tracker that publishes each leg as a person: ``legs`` names the ids; a time stamp
+    without one of them has that leg without a position; an id that never appears is an
+    error naming the leg, the id and the ids present."""
+    from gaitval.cli import main
+    from gaitval.io.tracks import people_to_legs
+
+    bag = make_bag(tmp_path / "t.bag")
+    rows, meta = read_bag_tracks(bag, "/people_tracked")
+    legs = people_to_legs(rows, {"L": "7", "R": 9}, path=bag)
+    assert legs["side"].tolist() == ["L", "R"] * 3
+    assert np.isnan(legs["x_m"].iloc[1]) and np.isfinite(legs["x_m"].iloc[2:]).all()
+    with pytest.raises(FileFormatError) as exc:
+        people_to_legs(rows, {"L": "7", "R": "3"}, path=bag, trial="T9",
+                       topic=meta["source"])
+    msg = str(exc.value)
+    for w in (str(bag), "trial T9", "/people_tracked", "leg R (person id '3') is missing",
+              "['7', '9']"):
+        assert w in msg, (w, msg)
+    with pytest.raises(FileFormatError, match="both sides L and R"):
+        people_to_legs(rows, {"L": "7"}, path=bag)
+    out = tmp_path / "legs.tracks.csv"
+    assert main(["export-tracks", str(bag), str(out), "--topic", "/people_tracked",
+                 "--legs", "L=7,R=9"]) == 0
+    back, _ = read_tracks(out)           # a valid leg file: both legs at every time stamp
+    assert back["side"].tolist() == ["L", "R"] * 3
+
+
+def test_pose_array_index_is_the_id(tmp_path):
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    T = store.types
+    path = tmp_path / "p.bag"
+    with Writer(path) as w:
+        cs = w.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=store)
+        cp = w.add_connection("/legs", "geometry_msgs/msg/PoseArray", typestore=store)
+        for k in range(2):
+            hdr = T["std_msgs/msg/Header"](seq=k, stamp=T["builtin_interfaces/msg/Time"](
+                sec=5, nanosec=k * 50_000_000), frame_id="laser")
+            scan = T["sensor_msgs/msg/LaserScan"](
+                header=hdr, angle_min=-1.0, angle_max=1.0, angle_increment=1.0,
+                time_increment=0.0, scan_time=0.05, range_min=0.1, range_max=30.0,
+                ranges=np.array([1.0, 2.0, 3.0], np.float32),
+                intensities=np.array([], np.float32))
+            w.write(cs, 10**9 + k, store.serialize_ros1(scan, "sensor_msgs/msg/LaserScan"))
+            poses = [T["geometry_msgs/msg/Pose"](
+                position=T["geometry_msgs/msg/Point"](x=1.0 + k, y=y, z=0.0),
+                orientation=T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0))
+                for y in (0.1, -0.1)]
+            w.write(cp, 10**9 + k + 1, store.serialize_ros1(T["geometry_msgs/msg/PoseArray"](
+                header=hdr, poses=poses), "geometry_msgs/msg/PoseArray"))
+    rows, meta = read_bag_tracks(path)
+    assert meta["source"] == "geometry_msgs/msg/PoseArray on /legs"
+    assert rows["person"].tolist() == ["0", "1", "0", "1"]
+    np.testing.assert_allclose(rows["y"], [0.1, -0.1, 0.1, -0.1])
+    np.testing.assert_allclose(rows["t_s"], [5.0, 5.0, 5.05, 5.05])

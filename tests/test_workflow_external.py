@@ -27,7 +27,72 @@ from gaitval.io.tracks import track_to_exchange, write_tracks
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = Path(sys.executable).parent / "snakemake"
-TARGETS = ["reports/tiny/tables/tug_table4.csv", "reports/tiny/tables/mtst_table3.csv"]
+TARGETS = ["reports/tiny/tables/tug_table4.csv", "reports/tiny/tables/mtst_table3.csv",
+           "reports/tiny/tables/rollator_table1.csv"]
+PERSON_DEFS = {"leg_tracker/msg/Person": "geometry_msgs/Pose pose\nuint32 id\n",
+               "leg_tracker/msg/PersonArray": "Header header\nleg_tracker/Person[] people\n"}
+
+
+def people_bag(path: Path, sensor_parquet: Path, track: pd.DataFrame) -> Path:
+    """A ROS 1 bag as leg_tracker would record it: the trial's scans on /scan and the
+    method's legs on /people_tracked (leg_tracker/PersonArray, message definitions in the
+    bag), the left leg as person 1, the right as person 2, a leg without a position left
+    out of its message; header stamps = the scans' times (integer s + ns)."""
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    from gaitval.io.scanlog import read_scanlog
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    types = {}
+    for name, text in PERSON_DEFS.items():
+        types.update(get_types_from_msg(text, name))
+    store.register(types)
+    T = store.types
+    scans = read_scanlog(sensor_parquet)
+
+    def header(k, t):
+        sec = int(math.floor(t))
+        return T["std_msgs/msg/Header"](seq=k, stamp=T["builtin_interfaces/msg/Time"](
+            sec=sec, nanosec=int(round((t - sec) * 1e9))), frame_id="laser")
+
+    by_k = {k: g for k, g in track.groupby("k")}
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with Writer(path) as w:
+        cs = w.add_connection("/scan", "sensor_msgs/msg/LaserScan", typestore=store)
+        cp = w.add_connection("/people_tracked", "leg_tracker/msg/PersonArray",
+                              typestore=store)
+        n = scans.ranges.shape[1]
+        for k, t in enumerate(np.asarray(scans.t, float)):
+            ts = 10**9 + k * 1000
+            msg = T["sensor_msgs/msg/LaserScan"](
+                header=header(k, t), angle_min=scans.angle_min,
+                angle_max=scans.angle_min + (n - 1) * scans.angle_increment,
+                angle_increment=scans.angle_increment, time_increment=0.0, scan_time=0.025,
+                range_min=scans.range_min, range_max=scans.range_max,
+                ranges=np.nan_to_num(scans.ranges[k], nan=0.0).astype(np.float32),
+                intensities=np.array([], np.float32))
+            w.write(cs, ts, store.serialize_ros1(msg, "sensor_msgs/msg/LaserScan"))
+            people = []
+            for r in (by_k[k].itertuples() if k in by_k else ()):
+                if np.isfinite(r.x_m) and np.isfinite(r.y_m):
+                    pose = T["geometry_msgs/msg/Pose"](
+                        position=T["geometry_msgs/msg/Point"](x=r.x_m, y=r.y_m, z=0.0),
+                        orientation=T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0,
+                                                                      w=1.0))
+                    people.append(T["leg_tracker/msg/Person"](
+                        pose=pose, id={"L": 1, "R": 2}[r.side]))
+            w.write(cp, ts + 1, store.serialize_ros1(T["leg_tracker/msg/PersonArray"](
+                header=header(k, t), people=people), "leg_tracker/msg/PersonArray"))
+    return path
+
+
+def positions_only(track: pd.DataFrame) -> pd.DataFrame:
+    """The exchange rows a positions-only tracker gives (t_s, side, x, y): the scans where
+    at least one leg has a position, the other leg there without one."""
+    rows = track_to_exchange(track)[["t_s", "side", "x", "y"]]
+    has = rows.groupby("t_s")["x"].transform(lambda v: np.isfinite(v).any())
+    return rows[has.to_numpy(bool)].reset_index(drop=True)
 
 
 def snakemake(work: Path, *configfiles: Path) -> subprocess.CompletedProcess:
@@ -73,10 +138,28 @@ def ext_run(tmp_path_factory):
         track = pd.read_parquet(results / "track" / "tug_m2" / f"{t}.parquet")
         write_tracks(to_mocap(track, reg), study / "ext2" / f"{t}.tracks.parquet",
                      units="mm", frame="mocap", clock="mocap")
+    for t in trials:                    # tug_m2: it tracks a trial successfully here
+        track = pd.read_parquet(results / "track" / "tug_m2" / f"{t}.parquet")
+        people_bag(study / "bags" / f"{t}.bag", results / "ingest" / t / "sensor.parquet",
+                   track)
+        write_tracks(positions_only(track), study / "pos" / f"{t}.tracks.csv")
+    rollator = sorted(p.name[:-len(".track.parquet")]
+                      for p in (results / "rollator" / "rollator_kf").glob("*.track.parquet"))
+    assert rollator
+    for t in rollator:
+        r = subprocess.run([sys.executable, "-m", "gaitval", "export-tracks",
+                            str(results / "rollator" / "rollator_kf" / f"{t}.track.parquet"),
+                            str(study / "extr" / f"{t}.tracks.csv")],
+                           capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
     ext = work / "ext.yaml"
     ext.write_text(yaml.safe_dump({"tracking": {"external": {
         "ext_m1": {"path": "ext/{trial}.tracks.csv"},
-        "ext_m2": {"path": "ext2/{trial}.tracks.parquet", "protocols": ["tug"]}}}}))
+        "ext_m2": {"path": "ext2/{trial}.tracks.parquet", "protocols": ["tug"]},
+        "ext_bag": {"path": "bags/{trial}.bag", "protocols": ["tug"],
+                    "topic": "/people_tracked", "legs": {"L": "1", "R": "2"}},
+        "ext_pos": {"path": "pos/{trial}.tracks.csv", "protocols": ["tug"]},
+        "ext_kf": {"path": "extr/{trial}.tracks.csv", "protocols": ["rollator"]}}}}))
     res = snakemake(work, base, ext)
     assert res.returncode == 0, res.stderr[-4000:]
     return work, res.stdout + res.stderr
@@ -131,6 +214,20 @@ def test_mtst_external_rows_equal_the_methods_rows(ext_run):
     assert "success_pct" in cols and "n_trials_stick" in cols
     pd.testing.assert_frame_equal(a[cols], b[cols], check_exact=True)
     assert (a["success"] == b["success"]).all()
+    # Table 4: the proposed method's rows, then ext_m1's, judged on the trials it tracked
+    # successfully: the rows mtst_m1 would get from the same per-trial evaluations
+    from gaitval.tables.mtst import table4
+    t4 = pd.read_csv(work / "reports" / "tiny" / "tables" / "mtst_table4.csv")
+    assert t4["method"].tolist() == ["mtst_proposed"] * 2 + ["ext_m1"] * 2
+    ev = work / "results" / "tiny" / "mtst_eval"
+    summary = pd.concat([pd.read_parquet(p) for p in sorted(ev.glob("*/*/summary.parquet"))],
+                        ignore_index=True)
+    want = table4(summary, "mtst_m1")
+    got = _rows(t4, "ext_m1")
+    for c in ("n_trials", "n_steps_stick", "n_steps_no_stick", "non_stick", "non_no_stick",
+              "mis_or_false_stick", "mis_or_false_no_stick"):
+        assert got[c].tolist() == want[c].tolist(), c
+    assert got["success_published"].isna().all()
 
 
 @pytest.mark.slow
@@ -187,3 +284,68 @@ def test_external_method_declared_wrongly_stops_at_start(tmp_path, where):
     assert res.returncode != 0
     for w in words:
         assert w in res.stdout + res.stderr, (w, res.stderr[-2000:])
+
+
+@pytest.mark.slow
+def test_a_leg_tracker_bag_gives_the_rows_of_the_same_positions_as_csv(ext_run):
+    """leg_tracker/PersonArray in a ROS 1 bag (each leg a person; tug_m2's legs) gives the
+    same TUG Tables 3-5 rows as the same positions written as a CSV: the bag path loses
+    nothing.  (Positions alone are less than gaitval's own track, which also says where it
+    saw a leg and when a leg swung, so these rows need not equal tug_m2's.)"""
+    work, _ = ext_run
+    tables = work / "reports" / "tiny" / "tables"
+    for n in (3, 4, 5):
+        t = pd.read_csv(tables / f"tug_table{n}.csv")
+        a, b = _rows(t, "ext_pos"), _rows(t, "ext_bag")
+        assert len(a) and len(a) == len(b), n
+        cols = _results(t)
+        pd.testing.assert_frame_equal(a[cols], b[cols], check_exact=True)
+        if n == 4:                      # a success trial: RMSEs compared, not empty rows
+            assert (b["n_steps"] > 0).any() and np.isfinite(b["rmse_x_m"]).any()
+    ev = work / "results" / "tiny" / "evaluate"
+    for p in sorted((ev / "ext_pos").glob("*/frames.parquet")):
+        a = pd.read_parquet(p).drop(columns="method")
+        b = pd.read_parquet(ev / "ext_bag" / p.parent.name / "frames.parquet")
+        pd.testing.assert_frame_equal(a, b.drop(columns="method"), check_exact=True)
+
+
+@pytest.mark.slow
+def test_bag_rows_equal_the_methods_positions(ext_run):
+    """Reader level: the bag's legs are the method's positions, time stamps included."""
+    from gaitval.io.tracks import people_to_legs, read_bag_tracks
+
+    work, _ = ext_run
+    results = work / "results" / "tiny"
+    for bag in sorted((work / "data" / "tiny" / "bags").glob("*.bag")):
+        rows, meta = read_bag_tracks(bag, "/people_tracked")
+        got = people_to_legs(rows, {"L": "1", "R": "2"}, path=bag)
+        want = positions_only(pd.read_parquet(results / "track" / "tug_m2" /
+                                              f"{bag.stem}.parquet"))
+        assert len(got) == len(want)
+        np.testing.assert_allclose(got["t_s"], want["t_s"], atol=1e-9, rtol=0)
+        assert got["side"].tolist() == want["side"].tolist()
+        np.testing.assert_array_equal(got[["x_m", "y_m"]].to_numpy(),
+                                      want[["x", "y"]].to_numpy())
+
+
+@pytest.mark.slow
+def test_rollator_tables_get_the_external_method(ext_run):
+    """rollator_kf's tracks as an external method: Table I's ext_kf columns and Table II's
+    ext_kf rows equal the KF's (re-initialisations aside: the file does not carry them)."""
+    work, _ = ext_run
+    tables = work / "reports" / "tiny" / "tables"
+    t1 = pd.read_csv(tables / "rollator_table1.csv")
+    assert len(t1)
+    for st in ("n", "rmse", "mad"):
+        pd.testing.assert_series_equal(t1[f"{st}_kf"], t1[f"{st}_ext_kf"],
+                                       check_names=False, check_exact=True)
+    t2 = pd.read_csv(tables / "rollator_table2.csv")
+    kf, ext = _rows(t2.rename(columns={"tracker": "method"}), "KF"), \
+        _rows(t2.rename(columns={"tracker": "method"}), "ext_kf")
+    assert len(kf) and len(kf) == len(ext)
+    cols = ["trials", "evaluated_frames", "tracking_time_s", "error_frames", "error_pct",
+            "swapped_frames", "pose_unknown_frames", "no_truth_frames"]
+    pd.testing.assert_frame_equal(kf[cols], ext[cols], check_exact=True)
+    assert ext["tracking_time_s_published"].isna().all()
+    md = (tables / "rollator_table1.md").read_text()
+    assert "ext_kf" in md and "External method" in md

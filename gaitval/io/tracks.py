@@ -419,8 +419,8 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
         # docs/formats.md, Clock: t_sensor = offset + (1 + drift ppm 1e-6) t_mocap
         drift = float(reg.get("clock_drift_ppm") or 0.0)
         t = float(reg["clock_offset_s"]) + (1.0 + drift * 1e-6) * t
-        if scan_t is not None:
-            t = snap_to_scans(t, scan_t)
+    if scan_t is not None:      # also a bag's integer sec + nanosec stamps (1e-9 s steps)
+        t = snap_to_scans(t, scan_t)
     if t_range is not None:
         lo, hi = t_range[0] - tolerance_s, t_range[1] + tolerance_s
         out_of = (t < lo) | (t > hi)
@@ -452,7 +452,13 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
             df[c] = rows[c].to_numpy()
     df = df.sort_values(["t_sensor_s", "side"], kind="stable").reset_index(drop=True)
     if "k" not in df:
-        df["k"] = pd.factorize(df["t_sensor_s"])[0].astype(np.int64)
+        tt = df["t_sensor_s"].to_numpy(float)
+        idx = (np.clip(np.searchsorted(scan_t, tt), 0, len(scan_t) - 1)
+               if scan_t is not None and len(scan_t) else None)
+        if idx is not None and np.array_equal(np.asarray(scan_t)[idx], tt):
+            df["k"] = idx.astype(np.int64)      # the scan each time stamp names
+        else:
+            df["k"] = pd.factorize(df["t_sensor_s"])[0].astype(np.int64)
     finite = np.isfinite(df["x_m"].to_numpy(float)) & np.isfinite(df["y_m"].to_numpy(float))
     if not has_v:
         df["vx_mps"], df["vy_mps"] = np.nan, np.nan
@@ -488,7 +494,8 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
 
 # -- ROS 1/2 bag topics of leg_tracker and people_msgs --------------------------------------
 #: tracker output types read from bags (ROS 2 style names, as rosbags reports them)
-BAG_PEOPLE_TYPES = ("leg_tracker/msg/PersonArray", "people_msgs/msg/People")
+BAG_PEOPLE_TYPES = ("leg_tracker/msg/PersonArray", "people_msgs/msg/People",
+                    "geometry_msgs/msg/PoseArray")
 BAG_LEG_DETECTIONS = "leg_tracker/msg/LegArray"
 
 
@@ -504,6 +511,10 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
     the scans they were tracked in: ``clock: sensor``); positions in metres
     (``units: m``).  The header's ``frame_id`` must be the frame of the bag's LaserScan
     messages (``frame: sensor``): gaitval does not read ``/tf``.
+
+    ``geometry_msgs/PoseArray`` (``header``, ``poses[]``): the pose's index in the array
+    is its ``person`` id (``0``, ``1``, ...), for a tracker that publishes its two legs
+    in a fixed order.
 
     ``leg_tracker/LegArray`` (``/detected_leg_clusters``) holds leg *detections* of one
     scan without identity or side, not tracks: it is refused with that reason.
@@ -556,11 +567,13 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
             m = reader.deserialize(raw, con.msgtype)
             t = int(m.header.stamp.sec) + int(m.header.stamp.nanosec) * 1e-9
             frames.add(str(m.header.frame_id))
-            for q in m.people:
-                if msgtype == BAG_PEOPLE_TYPES[0]:
-                    pid, pos = str(int(q.id)), q.pose.position
-                else:
-                    pid, pos = str(q.name), q.position
+            if msgtype == BAG_PEOPLE_TYPES[2]:          # PoseArray: the index is the id
+                items = [(str(i), q.position) for i, q in enumerate(m.poses)]
+            elif msgtype == BAG_PEOPLE_TYPES[0]:
+                items = [(str(int(q.id)), q.pose.position) for q in m.people]
+            else:
+                items = [(str(q.name), q.position) for q in m.people]
+            for pid, pos in items:
                 rows.append((t, pid, float(pos.x), float(pos.y), n + 1))
     finally:
         reader.close()
@@ -590,3 +603,34 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
     meta = {"format": FORMAT, "version": VERSION, "units": "m", "frame": "sensor",
             "clock": "sensor", "source": f"{msgtype} on {name}"}
     return df.reset_index(drop=True), meta
+
+
+def people_to_legs(rows: pd.DataFrame, legs: dict, *, path=None, trial: str | None = None,
+                   topic: str = "") -> pd.DataFrame:
+    """People rows (``t_s, person, x, y`` in metres, :func:`read_bag_tracks`) as leg rows
+    (``t_s, side, x_m, y_m``, :func:`read_tracks`' columns): ``legs`` maps each side to
+    the person id that tracked it (``{"L": "1", "R": "2"}``; a PoseArray's index), for a
+    tracker that publishes each leg as a person.  Other ids are dropped.  A time stamp
+    where one leg's id is absent gets that leg without a position (not observed: the
+    tracker had no track); an id that never appears is an error naming it."""
+    if set(legs) != set(SIDES):
+        raise _err(path, f"legs {dict(legs)!r} must map both sides L and R to a person id",
+                   trial)
+    ids = {str(v): k for k, v in legs.items()}
+    if len(ids) != 2:
+        raise _err(path, f"legs {dict(legs)!r}: L and R name the same person id", trial)
+    present = set(rows["person"].astype(str))
+    for side in SIDES:
+        if str(legs[side]) not in present:
+            raise _err(path, f"{topic + ': ' if topic else ''}leg {side} (person id "
+                       f"{str(legs[side])!r}) is missing: no message holds it; ids present: "
+                       f"{sorted(present)[:10]}", trial,
+                       hint="set tracking.external.<method>.legs to the ids the tracker "
+                       "gave the legs")
+    r = rows[rows["person"].astype(str).isin(ids)]
+    r = r.assign(side=r["person"].astype(str).map(ids))
+    times = np.unique(rows["t_s"].to_numpy(float))
+    full = pd.MultiIndex.from_product([times, list(SIDES)], names=["t_s", "side"])
+    out = (r.set_index(["t_s", "side"])[["x", "y"]].reindex(full).reset_index()
+           .rename(columns={"x": "x_m", "y": "y_m"}))
+    return out[["t_s", "side", "x_m", "y_m"]]

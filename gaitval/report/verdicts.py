@@ -359,6 +359,8 @@ def mtst_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list
                          "paper inside our 95% CI", ok, why, "mtst_table3",
                          not_comparable=small))
     t4 = t.get("mtst_table4")
+    if t4 is not None and "method" in t4:              # external rows: no published value
+        t4 = t4[t4["method"] == "mtst_proposed"]
     if t4 is not None:
         for r in t4.itertuples(index=False):
             pp = _pct_of(str(r.success_published)) / 100

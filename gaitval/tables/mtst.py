@@ -217,12 +217,30 @@ def mocap_notes(summary: pd.DataFrame) -> list[str]:
             "rows count those only, the 'rater events' rows every trial with annotations."]
 
 
+def table4_external(summary: pd.DataFrame, t4: pd.DataFrame, external: list[str]
+                    ) -> pd.DataFrame:
+    """Table 4 with a ``method`` column: the proposed method's rows, then each external
+    method's (tracking.external, issue 37) on the trials *it* tracked successfully, without
+    published values (they are the proposed method's)."""
+    out = [t4.assign(method="mtst_proposed")]
+    for m in external:
+        e = table4(summary, m).assign(method=m)
+        for c in e.columns:
+            if c.endswith("_published"):
+                e[c] = np.nan
+        out.append(e)
+    df = pd.concat(out, ignore_index=True)
+    return df[["method"] + [c for c in df.columns if c != "method"]]
+
+
 def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
-                      methods: list[str], shown: dict[str, str] | None = None) -> list[Path]:
+                      methods: list[str], shown: dict[str, str] | None = None,
+                      external: list[str] = ()) -> list[Path]:
     """Write ``mtst_table1``, ``mtst_table3``, ``mtst_table4`` (csv, md, tex) from the
     concatenated per-trial tables ``data`` (``summary``, ``gates``).  ``shown``: method ->
     the name the tables print (a method run with overrides,
-    :func:`gaitval.methods.display_name`)."""
+    :func:`gaitval.methods.display_name`).  ``external``: external methods (issue 37),
+    which get rows in Tables 3 and 4 (Table 4 then has a ``method`` column)."""
     td = Path(tables_dir)
     summary = data.get("summary", pd.DataFrame())
     if summary.empty:
@@ -252,11 +270,17 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
         "track against the mocap leg points (stands in for the paper's video check); "
         "'rater events': from the rater's contacts only (what a study without mocap "
         "has)."), notes=notes3)
+    notes4 = mocap_notes(summary) + table4_notes(t4, table4_trials(summary))
+    if external:
+        t4 = table4_external(summary, t4, list(external))
+        notes4.append(f"External method{'s' * (len(external) > 1)} {', '.join(external)}: "
+                      "another tracker's tracks (tracking.external), judged on the trials it "
+                      "tracked successfully; no published values (the paper's are the "
+                      "proposed method's).")
     paths += write_table(t4, td / "mtst_table4", caption=(
         "Seed 001 Table 4: target-step judgement and cross-step detection against the "
         "rater annotations on the trials the proposed method tracked successfully; "
         "success = (N - non-judgements or non-detections) / N, error rate = "
         "misjudgements / steps or false detections / detected cross steps; published "
-        "values beside."), notes=mocap_notes(summary)
-        + table4_notes(t4, table4_trials(summary)))
+        "values beside."), notes=notes4)
     return paths

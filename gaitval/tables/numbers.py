@@ -76,6 +76,11 @@ TABLE_COLUMNS: dict[str, dict[str, Format]] = {
         "rmse_kf", "rmse_pf", "mad_kf", "mad_pf")},            # seed 002: cm, cm/s
     "rollator_table2": {"tracking_time_s": Format("fixed", 2)},
 }
+#: Per-table formats of columns by prefix: an external method's columns (issue 37) are
+#: named after it (``rmse_<method>``), so they are matched by their statistic.
+TABLE_PREFIXES: dict[str, dict[tuple[str, ...], Format]] = {
+    "rollator_table1": {("rmse_", "mad_"): Format("fixed", 2, 100.0)},
+}
 #: Text columns whose values change with a table's display unit.
 TABLE_TEXT = {"rollator_table1": {"unit": {"m": "cm", "m/s": "cm/s"}}}
 #: Decimals of floats no rule covers, per table (the papers' precision); default 3.
@@ -99,6 +104,10 @@ def column_format(column: str, table: str | None = None) -> Format:
     key = _table_key(table, TABLE_COLUMNS)
     if key and base in TABLE_COLUMNS[key]:
         return TABLE_COLUMNS[key][base]
+    pkey = _table_key(table, TABLE_PREFIXES)
+    for prefixes, fmt in (TABLE_PREFIXES[pkey].items() if pkey else ()):
+        if base.startswith(prefixes):
+            return fmt
     low = base.lower()
     paper = bool(table) and table.startswith(PAPER_TABLES)
     if _P.match(low):

@@ -71,15 +71,17 @@ def _cell_note(key: tuple, p: str) -> str:
     return "; ".join(notes)
 
 
-def rollator_table1(frames: pd.DataFrame, summary: pd.DataFrame, kf: str, pf: str
-                    ) -> pd.DataFrame:
+def rollator_table1(frames: pd.DataFrame, summary: pd.DataFrame, kf: str, pf: str,
+                    external: list[str] = ()) -> pd.DataFrame:
     """Table I.
 
     Returns
     -------
     DataFrame, one row per scenario, subject and parameter: ``scenario_no, scenario,
     subject_no, subject, parameter, unit, n_kf, n_pf, rmse_kf, rmse_pf, mad_kf, mad_pf``,
-    the four ``*_published`` values and ``published_note``.
+    the four ``*_published`` values and ``published_note``; then ``n_<m>, rmse_<m>,
+    mad_<m>`` of each external method ``m`` (tracking.external, issue 37; no published
+    values).
     """
     sub_no, scen_no = _numbers(summary)
     m = mean_of_legs(frames)
@@ -90,7 +92,7 @@ def rollator_table1(frames: pd.DataFrame, summary: pd.DataFrame, kf: str, pf: st
         for p, (_, unit) in AXES.items():
             row = {"scenario_no": key[0] or np.nan, "scenario": scen, "subject_no": key[1],
                    "subject": subj, "parameter": p, "unit": unit}
-            for tag, method in (("kf", kf), ("pf", pf)):
+            for tag, method in (("kf", kf), ("pf", pf), *((m, m) for m in external)):
                 e = g[g["tracker"] == method]
                 s = summarize_errors(e[f"{p}_true"].to_numpy(), e[f"{p}_est"].to_numpy())
                 row.update({f"n_{tag}": s["n"], f"rmse_{tag}": s["rmse"],
@@ -103,16 +105,19 @@ def rollator_table1(frames: pd.DataFrame, summary: pd.DataFrame, kf: str, pf: st
     cols = ["scenario_no", "scenario", "subject_no", "subject", "parameter", "unit", "n_kf",
             "n_pf", "rmse_kf", "rmse_pf", "mad_kf", "mad_pf", "rmse_kf_published",
             "rmse_pf_published", "mad_kf_published", "mad_pf_published", "published_note"]
+    cols += [f"{st}_{m}" for m in external for st in ("n", "rmse", "mad")]
     return pd.DataFrame(rows, columns=cols).sort_values(
         ["scenario_no", "subject_no"], kind="stable").reset_index(drop=True)
 
 
-def rollator_table2(summary: pd.DataFrame, kf: str, pf: str) -> pd.DataFrame:
+def rollator_table2(summary: pd.DataFrame, kf: str, pf: str,
+                    external: list[str] = ()) -> pd.DataFrame:
     """Table II.
 
     Returns
     -------
-    DataFrame, one row per scenario, subject and tracker (``KF``, ``PF``): ``trials,
+    DataFrame, one row per scenario, subject and tracker (``KF``, ``PF``, then each
+    external method by its name, without published values or re-initialisations): ``trials,
     evaluated_frames, tracking_time_s, error_frames, error_pct, swapped_frames,
     reinitialisations, pose_unknown_frames, no_truth_frames`` and ``*_published``.
     """
@@ -120,11 +125,11 @@ def rollator_table2(summary: pd.DataFrame, kf: str, pf: str) -> pd.DataFrame:
     s = summary[summary["status"] == "ok"]
     rows = []
     for (scen, subj, method), g in s.groupby(["scenario", "subject", "tracker"], sort=True):
-        if method not in (kf, pf):
+        if method not in (kf, pf, *external):
             continue
         key = (scen_no.get(scen, 0), sub_no[str(subj)])
-        tag = "KF" if method == kf else "PF"
-        pub = PUB.TABLE_II.get(key)
+        tag = "KF" if method == kf else "PF" if method == pf else method
+        pub = PUB.TABLE_II.get(key) if tag in ("KF", "PF") else None
         i = 0 if tag == "KF" else 1
         n_ev, n_err = int(g["n_evaluated"].sum()), int(g["n_error"].sum())
         rows.append({
@@ -140,9 +145,15 @@ def rollator_table2(summary: pd.DataFrame, kf: str, pf: str) -> pd.DataFrame:
             "reinitialisations_published": pub[6] if (pub and tag == "KF") else np.nan,
             "pose_unknown_frames": int(g["n_pose_unknown"].sum()),
             "no_truth_frames": int(g["n_no_truth"].sum()),
-            "published_note": PUB.TABLE_II_FLAGS.get(key, "") if pub else "no published row"})
-    df = pd.DataFrame(rows).sort_values(["scenario_no", "subject_no", "tracker"],
-                                        kind="stable").reset_index(drop=True)
+            "published_note": (PUB.TABLE_II_FLAGS.get(key, "") if pub else
+                               "external method" if tag not in ("KF", "PF") else
+                               "no published row")})
+    order = {"KF": 0, "PF": 1, **{m: 2 + i for i, m in enumerate(external)}}
+    df = pd.DataFrame(rows)
+    if len(df):
+        df = df.assign(_o=df["tracker"].map(order)).sort_values(
+            ["scenario_no", "subject_no", "_o"], kind="stable").drop(columns="_o")
+    df = df.reset_index(drop=True)
     for c in ("reinitialisations", "reinitialisations_published", "error_frames_published"):
         if c in df:
             df[c] = df[c].astype("Int64")
@@ -179,8 +190,8 @@ def improvement(t1: pd.DataFrame) -> pd.DataFrame:
 
 def write_rollator_tables(frames: pd.DataFrame, summary: pd.DataFrame, tables_dir, *,
                           kf: str, pf: str, error_m: float = 0.10,
-                          model_sources=(), shown: dict[str, str] | None = None
-                          ) -> list[Path]:
+                          model_sources=(), shown: dict[str, str] | None = None,
+                          external: list[str] = ()) -> list[Path]:
     """Write ``rollator_table1``, ``rollator_table2`` and ``rollator_improvement``.
     ``shown``: method -> its name with the overrides it ran with
     (:func:`gaitval.methods.display_name`); a modified KF or PF is named in a note of
@@ -188,10 +199,16 @@ def write_rollator_tables(frames: pd.DataFrame, summary: pd.DataFrame, tables_di
     from gaitval.tables.rollator_notes import table1_notes, table2_notes
 
     td = Path(tables_dir)
-    t1 = rollator_table1(frames, summary, kf, pf)
-    t2 = rollator_table2(summary, kf, pf)
+    t1 = rollator_table1(frames, summary, kf, pf, external)
+    t2 = rollator_table2(summary, kf, pf, external)
     imp = improvement(t1)
-    changed = [f"{tag} ran as {(shown or {})[m]}: parameters changed by "
+    if external:                  # another tracker's tracks (tracking.external, issue 37)
+        changed = [f"External method{'s' * (len(external) > 1)} {', '.join(external)}: "
+                   "another tracker's tracks (tracking.external), evaluated like the KF and "
+                   "PF; no published values and no re-initialisation count"]
+    else:
+        changed = []
+    changed += [f"{tag} ran as {(shown or {})[m]}: parameters changed by "
                "tracking.overrides; the published values beside are the paper's method's"
                for tag, m in (("KF", kf), ("PF", pf)) if (shown or {}).get(m, m) != m]
     paths = write_table(t1, td / "rollator_table1", notes=changed + table1_notes(

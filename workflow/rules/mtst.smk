@@ -72,7 +72,7 @@ rule mtst_track_external:
     shell:
         "{params.gv} import-tracks --tracks {input.tracks:q} --sensor {input.sensor:q}"
         " {params.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --out {output.track:q} > {log:q} 2>&1"
+        " --config {input.config:q} --out {output.track:q} > {log:q} 2>&1"
         " && {params.gv} mtst-evaluate --track {output.track:q} --sheet {input.sheet:q}"
         " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
         " --config {input.config:q} {params.reg:q} {params.gt:q} --out {params.out:q}"

@@ -75,7 +75,7 @@ rule rollator_tables:
         evals=lambda w: [
             f"{RESULTS}/{study}/rollator/{method}/{trial}/summary.parquet"
             for study in config["run"]
-            for method in rollator_methods()
+            for method in rollator_methods() + external_methods("rollator")
             for trial in trial_ids(study, ["rollator"])
         ],
         models=lambda w: [

@@ -64,7 +64,7 @@ rule track_external:
     shell:
         "{params.gv} import-tracks --tracks {input.tracks:q} --sensor {input.sensor:q}"
         " --registration {input.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --out {output.track:q} > {log:q} 2>&1"
+        " --config {input.config:q} --out {output.track:q} > {log:q} 2>&1"
         " && {params.gv} evaluate-tug --track {output.track:q} --groundtruth {input.gt:q}"
         " --registration {input.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
         " --config {input.config:q} --out {params.out:q} >> {log:q} 2>&1"
