@@ -67,6 +67,9 @@ class Associator:
         d = λ (seed 000) or d = λ² (seed 001).
     """
 
+    #: ``select`` calls ``phase_of`` (False: the tracker may pass None and skip its cache)
+    uses_phase = True
+
     def __init__(self, d_max: float = D_MAX_DEFAULT, cost: str = "mahalanobis"):
         if cost not in _COSTS:
             raise ConfigError(f"unknown association cost {cost!r}",
@@ -130,6 +133,8 @@ def ranked_associations(cand_l, cand_r, d_max: float) -> list[tuple[float, int, 
 class GNNAssociator(Associator):
     """Global nearest neighbour: least total cost (seed 000 Method 1, seed 001)."""
 
+    uses_phase = False
+
     def select(self, cand_l, cand_r, prev_phase, phase_of):
         a, b = self.obvious(cand_l, cand_r)
         if a >= 0:
@@ -177,6 +182,8 @@ class AssignmentGNN(Associator):
     cost : {"mahalanobis2", "mahalanobis"}
         d = λ² (seed 001, default) or λ.
     """
+
+    uses_phase = False
 
     def __init__(self, cost: str = "mahalanobis2"):
         super().__init__(d_max=math.inf, cost=cost)

@@ -103,9 +103,11 @@ class SwingAccelerationWindow:
 
 
 class MotionModel:
-    """Role base.  ``n_ac`` = 0 means the model needs no acceleration gain."""
+    """Role base.  ``n_ac`` = 0 means the model needs no acceleration gain;
+    ``zero_input = True`` says :meth:`inputs` is always zero (the tracker then skips it)."""
 
     n_ac = 0
+    zero_input = False
 
     def inputs(self, phase: int, vl, vr, gl: float, gr: float, dt: float):
         raise NotImplementedError
@@ -145,6 +147,8 @@ class GaitPhaseAcceleration(MotionModel):
 @MOTION_MODELS.register("constant_velocity")
 class ConstantVelocity(MotionModel):
     """u = 0: the constant-velocity model of seed001 eq. (2) and seed 002 §II."""
+
+    zero_input = True
 
     def inputs(self, phase, vl, vr, gl, gr, dt):
         return _ZERO, _ZERO

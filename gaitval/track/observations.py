@@ -26,8 +26,11 @@ class DetectionSeries:
         arrs = [np.asarray(o, dtype=float) for o in xy]
         self._arrays = [o if o.ndim == 2 and o.shape[1:] == (2,) else o.reshape(-1, 2)
                         for o in arrs]
-        # and plain Python floats for the loop (numpy scalars are several times slower)
-        self._lists = [o.tolist() for o in self._arrays]
+        # and plain Python floats for the loop (numpy scalars are several times slower),
+        # converted in one call and cut per scan (one tolist per scan costs more)
+        flat = (np.concatenate(self._arrays).tolist() if self._arrays else [])
+        ends = np.cumsum([len(o) for o in self._arrays]).tolist()
+        self._lists = [flat[a:b] for a, b in zip([0] + ends, ends)]
 
     def __len__(self) -> int:
         return len(self._arrays)
@@ -37,6 +40,11 @@ class DetectionSeries:
 
     def at(self, k: int, prior):
         return self._lists[k], self._patterns[k]
+
+    def precomputed(self) -> tuple[list, list]:
+        """``(lists(), patterns)``: what :meth:`at` returns for every scan, for a loop that
+        reads them directly."""
+        return self._lists, self._patterns
 
     def lists(self) -> list[list[list[float]]]:
         """Every scan's observations as lists of ``[x, y]`` floats (``array(k).tolist()``)."""

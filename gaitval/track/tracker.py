@@ -42,7 +42,7 @@ from gaitval.track.leg import (TRACK_COLUMNS, LegTrack, TrackResult,  # noqa: F4
                                empty_result, handedness, swap_sides)
 from gaitval.track.motion import MOTION_MODELS
 from gaitval.track.observations import DetectionSeries, WindowedDetections
-from gaitval.track.occlusion import OCCLUSION_HANDLERS
+from gaitval.track.occlusion import OCCLUSION_HANDLERS, OcclusionHandler
 from gaitval.track.phase import PHASE_MODELS
 
 _SWING = tuple(SWINGING[i] for i in range(6))
@@ -113,7 +113,13 @@ class Tracker:
                                                       self.filter), leg_width_m)
 
     def track(self, t, source, leg_width_m: float) -> TrackResult:
-        """The per-scan loop over an observation source (see module notes)."""
+        """The per-scan loop over an observation source (see module notes).
+
+        The loop is :meth:`TrackingRun.predict`, the roles, :meth:`TrackingRun.commit` and
+        :meth:`TrackingRun.book` written out with every name bound to a local (one scan
+        costs a few microseconds, so Python's calls and attribute look-ups would be a large
+        share of it); the operations and their order are those methods' exactly.
+        """
         t = np.asarray(t, dtype=float)
         start = self.init.find(source, leg_width_m)
         if start is None:                                       # no subject found
@@ -123,17 +129,93 @@ class Tracker:
         context = gate.needs_context
         state = occ.begin(run)
         hyp = Hypotheses(run)
+        candidates, select, reset, phase_of = (gate.candidates, assoc.select, hyp.reset,
+                                               hyp.phase_of)
+        uses_phase = assoc.uses_phase
+        after_scan = (occ.after_scan if type(occ).after_scan is not OcclusionHandler.after_scan
+                      else None)                                  # predict only: nothing to do
+        F = run.filter
+        fpredict, correct, identify = F.predict, F.correct, run.phase_model.identify
+        inputs = None if self.motion.zero_input else self.motion.inputs
+        L, R = run.legs
+        Lpost, Rpost, Lwin, Rwin = L.post, R.post, L.window, R.window
+        Lz, Rz, Lreal, Rreal = L.z, R.z, L.real, R.real
+        Lpat, Rpat, Lidx, Ridx = L.pattern, R.pattern, L.obs_index, R.obs_index
+        Lacc, Racc = L.acc, R.acc
+        phase, dts, hypot, swing_of = run.phase, run.dts, math.hypot, _SWING
+        c0, c1 = hyp.cache
+        pre = source.precomputed() if isinstance(source, DetectionSeries) else None
+        at = source.at
         for k in range(run.k0 + 1, run.n):
-            prior = run.predict(k)                                # seed000 eq. (7)–(8)
-            obs, pats = source.at(k, prior)                       # detect, or take detections
-            cl = gate.candidates(run.filter, prior[0], obs,       # seed000 eq. (11)–(13)
-                                 run.gate_context(0, k) if context else None)
-            cr = gate.candidates(run.filter, prior[1], obs,
-                                 run.gate_context(1, k) if context else None)
-            hyp.reset(prior, obs)
-            a, b = assoc.select(cl, cr, run.phase[k - 1], hyp.phase_of)   # seed000 eq. (9)–(10)
-            run.commit(k, a, b, hyp, obs, pats)          # seed000 eq. (14)–(16), (3)–(5)
-            occ.after_scan(state, run, k)                         # seed000 eq. (17)
+            # seed000 eq. (7)–(8), u from eq. (18)–(20) (TrackingRun.predict written out)
+            dt, ph = dts[k], phase[k - 1]
+            sl, sr = Lpost[k - 1], Rpost[k - 1]
+            if inputs is None:
+                pl, pr = fpredict(sl, dt, 0.0, 0.0), fpredict(sr, dt, 0.0, 0.0)
+            else:
+                ul, ur = inputs(ph, (sl[2], sl[3]), (sr[2], sr[3]),
+                                Lwin.mean if Lwin is not None else 0.0,
+                                Rwin.mean if Rwin is not None else 0.0, dt)
+                pl, pr = fpredict(sl, dt, ul[0], ul[1]), fpredict(sr, dt, ur[0], ur[1])
+            prior = (pl, pr)
+            if pre is not None:                                   # take detections
+                obs, pats = pre[0][k], pre[1][k]
+            else:                                                 # detect
+                obs, pats = at(k, prior)
+            if context:                                           # seed000 eq. (11)–(13)
+                cl = candidates(F, pl, obs, run.gate_context(0, k))
+                cr = candidates(F, pr, obs, run.gate_context(1, k))
+            else:
+                cl, cr = candidates(F, pl, obs, None), candidates(F, pr, obs, None)
+            # TrackingRun.commit written out: seed000 eq. (14)–(16) (corrected states) and
+            # eq. (3)–(5) (the phase they are in)
+            if uses_phase:                   # the associator compares candidates' phases
+                reset(prior, obs)
+                a, b = select(cl, cr, ph, phase_of)               # seed000 eq. (9)–(10)
+                php = phase[k] = phase_of(a, b)
+                s1l, s1r = Lpost[k], Rpost[k] = c0[a], c1[b]
+            else:
+                a, b = select(cl, cr, ph, None)                   # seed000 eq. (9)–(10)
+                if a:
+                    z = obs[a - 1]
+                    s1l = Lpost[k] = correct(pl, z[0], z[1])      # seed000 eq. (14)–(16)
+                else:
+                    s1l = Lpost[k] = pl
+                if b:
+                    z = obs[b - 1]
+                    s1r = Rpost[k] = correct(pr, z[0], z[1])
+                else:
+                    s1r = Rpost[k] = pr
+                php = phase[k] = identify(s1l, s1r)               # seed000 eq. (3)–(5)
+            if a:
+                z = obs[a - 1]
+                Lz[k] = (z[0], z[1])
+                Lreal[k] = True
+                Lpat[k] = pats[a - 1]
+                Lidx[k] = a - 1
+                L.n_unobserved = 0
+            else:
+                Lpat[k] = "UO"
+                L.n_unobserved += 1
+            if b:
+                z = obs[b - 1]
+                Rz[k] = (z[0], z[1])
+                Rreal[k] = True
+                Rpat[k] = pats[b - 1]
+                Ridx[k] = b - 1
+                R.n_unobserved = 0
+            else:
+                Rpat[k] = "UO"
+                R.n_unobserved += 1
+            # TrackingRun.book written out: ‖a_k‖ per leg into its window (seed 000 §5.5)
+            al = Lacc[k] = hypot(s1l[2] - sl[2], s1l[3] - sl[3]) / dt
+            ar = Racc[k] = hypot(s1r[2] - sr[2], s1r[3] - sr[3]) / dt
+            if Lwin is not None:
+                sw = swing_of[php]
+                Lwin.push(al, sw[0])
+                Rwin.push(ar, sw[1])
+            if after_scan is not None:
+                after_scan(state, run, k)                         # seed000 eq. (17)
         occ.finish(state, run)
         res = run.result()
         if self.sides == "walking_direction" and handedness(res) < 0:
