@@ -26,11 +26,8 @@ class DetectionSeries:
         arrs = [np.asarray(o, dtype=float) for o in xy]
         self._arrays = [o if o.ndim == 2 and o.shape[1:] == (2,) else o.reshape(-1, 2)
                         for o in arrs]
-        # and plain Python floats for the loop (numpy scalars are several times slower),
-        # converted in one call and cut per scan (one tolist per scan costs more)
-        flat = (np.concatenate(self._arrays).tolist() if self._arrays else [])
-        ends = np.cumsum([len(o) for o in self._arrays]).tolist()
-        self._lists = [flat[a:b] for a, b in zip([0] + ends, ends)]
+        # and plain Python floats for the loop (numpy scalars are several times slower)
+        self._lists = [o.tolist() for o in self._arrays]
 
     def __len__(self) -> int:
         return len(self._arrays)

@@ -144,6 +144,7 @@ class Tracker:
         Lacc, Racc = L.acc, R.acc
         phase, dts, hypot, swing_of = run.phase, run.dts, math.hypot, _SWING
         c0, c1 = hyp.cache
+        pcache = hyp.pcache
         pre = source.precomputed() if isinstance(source, DetectionSeries) else None
         at = source.at
         for k in range(run.k0 + 1, run.n):
@@ -172,7 +173,8 @@ class Tracker:
             if uses_phase:                   # the associator compares candidates' phases
                 reset(prior, obs)
                 a, b = select(cl, cr, ph, phase_of)               # seed000 eq. (9)–(10)
-                php = phase[k] = phase_of(a, b)
+                php = pcache.get((a, b))                 # select has mostly computed it
+                php = phase[k] = php if php is not None else phase_of(a, b)
                 s1l, s1r = Lpost[k], Rpost[k] = c0[a], c1[b]
             else:
                 a, b = select(cl, cr, ph, None)                   # seed000 eq. (9)–(10)
@@ -357,17 +359,33 @@ class TrackingRun:
     def replay(self, ka: int, k_now: int) -> None:
         """Filter both legs again over ka+1..k_now with the stored observations (real or
         virtual) and associations (seed 000 §5.4)."""
-        correct, identify = self.filter.correct, self.phase_model.identify
-        predict, book, phase = self.predict, self.book, self.phase
+        F = self.filter
+        fpredict, correct, identify = F.predict, F.correct, self.phase_model.identify
+        inputs = self.motion.inputs
+        phase, dts, hypot, swing_of = self.phase, self.dts, math.hypot, _SWING
         L, R = self.legs
+        Lpost, Rpost, Lz, Rz, Lacc, Racc = L.post, R.post, L.z, R.z, L.acc, R.acc
+        Lwin, Rwin = L.window, R.window
         for k in range(ka + 1, k_now + 1):
-            sl, sr = predict(k)
-            z = L.z[k]
-            sl = L.post[k] = correct(sl, z[0], z[1]) if z is not None else sl
-            z = R.z[k]
-            sr = R.post[k] = correct(sr, z[0], z[1]) if z is not None else sr
-            phase[k] = identify(sl, sr)                           # seed000 eq. (3)–(5)
-            book(k)
+            # predict (as TrackingRun.predict, seed000 eq. (7)–(8), (18)–(20))
+            dt = dts[k]
+            s0l, s0r = Lpost[k - 1], Rpost[k - 1]
+            ul, ur = inputs(phase[k - 1], (s0l[2], s0l[3]), (s0r[2], s0r[3]),
+                            Lwin.mean if Lwin is not None else 0.0,
+                            Rwin.mean if Rwin is not None else 0.0, dt)
+            sl, sr = fpredict(s0l, dt, ul[0], ul[1]), fpredict(s0r, dt, ur[0], ur[1])
+            z = Lz[k]
+            sl = Lpost[k] = correct(sl, z[0], z[1]) if z is not None else sl
+            z = Rz[k]
+            sr = Rpost[k] = correct(sr, z[0], z[1]) if z is not None else sr
+            ph = phase[k] = identify(sl, sr)                      # seed000 eq. (3)–(5)
+            # book (as TrackingRun.book): ‖a_k‖ per leg into its window (seed 000 §5.5)
+            al = Lacc[k] = hypot(sl[2] - s0l[2], sl[3] - s0l[3]) / dt
+            ar = Racc[k] = hypot(sr[2] - s0r[2], sr[3] - s0r[3]) / dt
+            if Lwin is not None:
+                sw = swing_of[ph]
+                Lwin.push(al, sw[0])
+                Rwin.push(ar, sw[1])
 
     def resync(self, k: int) -> None:
         """Rebuild the acceleration windows from the (rewritten) history up to k."""
