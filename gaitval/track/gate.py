@@ -67,8 +67,11 @@ class Gate:
         px, py = prior[0], prior[1]
         r2 = r * r
         inside = []
-        for j, (zx, zy) in enumerate(obs, 1):
-            dx, dy = zx - px, zy - py
+        j = 0
+        for zx, zy in obs:
+            j += 1
+            dx = zx - px
+            dy = zy - py
             if dx * dx + dy * dy < r2:
                 inside.append(j)
         if not inside:

@@ -31,7 +31,10 @@ class PseudoObservation(OcclusionHandler):
     """Correct an unobserved (UO) leg with its own prediction (seed 001 §2.4.3)."""
 
     def after_scan(self, state, run, k: int) -> None:
-        for leg in run.legs:
-            if leg.z[k] is None:                          # UO: no real or virtual observation
-                s = leg.post[k]
-                leg.post[k] = run.filter.correct(s, s[0], s[1])   # seed001 §2.4.3: y = ŷ
+        L, R = run.legs                                   # (written out: once per scan)
+        if L.z[k] is None:                                # UO: no real or virtual observation
+            s = L.post[k]
+            L.post[k] = run.filter.correct(s, s[0], s[1])         # seed001 §2.4.3: y = ŷ
+        if R.z[k] is None:
+            s = R.post[k]
+            R.post[k] = run.filter.correct(s, s[0], s[1])         # seed001 §2.4.3: y = ŷ
