@@ -48,7 +48,8 @@ holds none of their rules (Stone Soup's initiator/deleter split, docs/STYLE §13
     a tentative person ends as soon as neither leg is observed for ``tentative_unsupported_s``.
 
 Statuses (:data:`TENTATIVE`, :data:`CONFIRMED`, :data:`COASTING`, :data:`ENDED`): a confirmed
-person without a leg observation on the current scan is *coasting* (its legs predicted on).
+person without a leg observation on the current scan is *coasting* (its legs predicted on);
+an ended person found again by the ``refind`` role is confirmed again, with its id.
 
 Measurement areas (:data:`AREAS`): ``field_of_view`` (the scan's bearings and range limits,
 less a margin) and ``rectangle`` (x, y bounds in the sensor frame: the mat, the walkway).
