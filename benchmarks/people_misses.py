@@ -2,7 +2,7 @@
 
 Usage::
 
-    .venv/bin/python benchmarks/people_misses.py BAG TOPIC FRAMES
+    .venv/bin/python benchmarks/people_misses.py BAG TOPIC FRAMES [--refind none]
 
 ``FRAMES``: the ``frames.parquet`` that ``gaitval legbench-evaluate`` wrote for a ``people``
 track of the same bag and topic (one row per scan: the annotated position ``gt_x_m,
@@ -89,6 +89,9 @@ def main() -> None:
     ap.add_argument("bag")
     ap.add_argument("topic")
     ap.add_argument("frames")
+    ap.add_argument("--refind", default=None,
+                    help="the refind role (e.g. none: v4, without re-finding; default: the "
+                         "method's)")
     args = ap.parse_args()
     from gaitval.detect.base import split_observations
     from gaitval.io.rosbag import read_rosbag_scans
@@ -97,7 +100,7 @@ def main() -> None:
     from gaitval.track.init import principal_axis
 
     scans = read_rosbag_scans(args.bag, args.topic)
-    kind = build_method("people")
+    kind = build_method("people", {"kind__refind": args.refind} if args.refind else None)
     xy, pats = split_observations(kind.detector.detect(scans, 0.10), scans.n_scans)
     seen = collections.defaultdict(list)            # k -> [(status, cx, cy, why)]
     why: dict[int, str] = {}                        # person id -> last failed test
