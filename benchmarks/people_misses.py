@@ -2,7 +2,7 @@
 
 Usage::
 
-    .venv/bin/python benchmarks/people_misses.py BAG TOPIC FRAMES
+    .venv/bin/python benchmarks/people_misses.py BAG TOPIC FRAMES [--refind none]
 
 ``FRAMES``: the ``frames.parquet`` that ``gaitval legbench-evaluate`` wrote for a ``people``
 track of the same bag and topic (one row per scan: the annotated position ``gt_x_m,
@@ -22,6 +22,12 @@ counts as a miss is put in one class, the first that applies:
     or ``static`` (all passed but a leg lies on a static cell).
 ``no hypothesis``
     observations, but no hypothesis near (they were explained, static, or unpaired).
+
+Then every confirmed person that ended: the scan, why (``left the area`` / ``unsupported``),
+how long it had been unseen, how far its last observed centre was from the annotation
+(the latest click of the last 5 scans), and on how many of the annotated scans of the next 3 s a leg observation lay
+within 0.75 m of the annotation (the person was still there to be seen); and the re-finds
+(``refind`` role): on the annotated person (< 0.75 m) or elsewhere.
 
 Then the runs of consecutive misses, longest first, with the annotation's mean range and
 its path speed in the sensor frame (clicks included), and on how many of its scans the
@@ -83,6 +89,9 @@ def main() -> None:
     ap.add_argument("bag")
     ap.add_argument("topic")
     ap.add_argument("frames")
+    ap.add_argument("--refind", default=None,
+                    help="the refind role (e.g. none: v4, without re-finding; default: the "
+                         "method's)")
     args = ap.parse_args()
     from gaitval.detect.base import split_observations
     from gaitval.io.rosbag import read_rosbag_scans
@@ -91,18 +100,35 @@ def main() -> None:
     from gaitval.track.init import principal_axis
 
     scans = read_rosbag_scans(args.bag, args.topic)
-    kind = build_method("people")
+    kind = build_method("people", {"kind__refind": args.refind} if args.refind else None)
     xy, pats = split_observations(kind.detector.detect(scans, 0.10), scans.n_scans)
     seen = collections.defaultdict(list)            # k -> [(status, cx, cy, why)]
     why: dict[int, str] = {}                        # person id -> last failed test
     spread: dict[int, float] = {}                   # person id -> r spread in the window
     ended = kind.deleter.ended
+    ends = []                                       # (k, pid, why, unseen s, last centre)
+    refound = []                                    # (t, pid, centre)
 
     def observed_ended(p, k, tk, area):
         out = ended(p, k, tk, area)
         seen[k].append((p.status, *p.centre(), why.get(p.pid, "young"),
                         spread.get(p.pid)))
+        if out and p.reported:
+            ends.append((k, p.pid, out, tk - p.t_last_seen, p.seen_centre))
         return out
+
+    rbind = lc.LegTrackerGate.bind
+
+    def observed_rbind(self, dt):
+        r = rbind(self, dt)
+        match = r.match
+
+        def observed_match(persons, t):
+            out = match(persons, t)
+            refound.extend((t, pid, p.centre()) for p, pid in out)
+            return out
+        r.match = observed_match
+        return r
 
     bind = lc.MOfNMoving.bind
 
@@ -124,11 +150,14 @@ def main() -> None:
 
     kind.deleter.ended = observed_ended
     lc.MOfNMoving.bind = observed_bind
+    lc.LegTrackerGate.bind = observed_rbind
     try:
         kind.run(scans, xy, pats, 0.10)
     finally:
         lc.MOfNMoving.bind = bind
+        lc.LegTrackerGate.bind = rbind
     f = pd.read_parquet(args.frames)
+    gt_all = f.set_index("k")[["gt_x_m", "gt_y_m"]]
     f = f[np.isfinite(f["gt_x_m"])]
     classes = collections.Counter()
     n_known = n_still = 0
@@ -156,6 +185,32 @@ def main() -> None:
         print(f"  {k:5d} ({100 * k / n:4.1f} %)  {c}")
     print(f"  on {n_still} of the {n_known} misses with a hypothesis near, its legs are still "
           "(r spread < w_l over 1.4 s)")
+    # the confirmed persons that ended, and the re-finds
+    dt0 = float(np.median(np.diff(scans.t)))
+    print(f"{len(ends)} confirmed persons ended:")
+    for k, pid, reason, unseen, c in ends:
+        prev = gt_all.loc[max(0, k - 5):k].dropna()        # the latest click of the last 0.5 s
+        d = (math.dist(c, (prev.iloc[-1].gt_x_m, prev.iloc[-1].gt_y_m)) if len(prev)
+             else math.nan)
+        nxt = gt_all.loc[k + 1:k + int(round(3.0 / dt0))].dropna()
+        near = sum(len(xy[int(j)]) and np.hypot(xy[int(j)][:, 0] - r.gt_x_m,
+                                                 xy[int(j)][:, 1] - r.gt_y_m).min() < 0.75
+                   for j, r in nxt.iterrows())
+        print(f"  scan {k} person {pid}: {reason} after {unseen:.1f} s unseen; last observed "
+              f"centre ({c[0]:.2f}, {c[1]:.2f}) m, {d:.2f} m from the annotation; next 3 s: "
+              f"{len(nxt)} annotated scans, {near} with a leg observation within 0.75 m")
+    ts = np.asarray(scans.t, float)
+    on = off = na = 0
+    for t, pid, c in refound:
+        g = gt_all.loc[int(np.argmin(np.abs(ts - t)))]
+        if not np.isfinite(g.gt_x_m):
+            na += 1
+        elif math.dist(c, (g.gt_x_m, g.gt_y_m)) < 0.75:
+            on += 1
+        else:
+            off += 1
+    print(f"{len(refound)} re-finds: {on} on the annotated person, {off} further than 0.75 m "
+          f"from it, {na} on scans without an annotation")
     # runs of consecutive misses
     miss = f[f["event"] == "MISS"]["k"].to_numpy()
     runs = np.split(miss, np.flatnonzero(np.diff(miss) != 1) + 1) if len(miss) else []

@@ -8,8 +8,8 @@ import pytest
 
 from gaitval.methods import METHODS, build_method, track_trial
 from gaitval.track import TRACK_COLUMNS
-from gaitval.track.lifecycle import (AREAS, BIRTHS, CONFIRMERS, DELETERS, FieldOfView,
-                                     UnexplainedPairs)
+from gaitval.track.lifecycle import (AREAS, BIRTHS, CONFIRMERS, DELETERS, REFINDS,
+                                     FieldOfView, UnexplainedPairs, leg_tracker_person_gate)
 from gaitval.track.people import PEOPLE_COLUMNS, PeopleTracker, people_frame_for_scoring
 from gaitval.types import ScanSeries
 
@@ -63,6 +63,7 @@ def _owner(people, centres):
 def test_role_registries_hold_the_life_cycle_parts():
     assert "unexplained_pairs" in BIRTHS and "m_of_n_moving" in CONFIRMERS
     assert "unsupported_time" in DELETERS and {"field_of_view", "rectangle"} <= set(AREAS.names())
+    assert {"leg_tracker_gate", "none"} <= set(REFINDS.names())
 
 
 def test_births_pair_the_closest_unexplained_observations():
@@ -224,8 +225,68 @@ def test_empty_room_gives_no_track_for_any_method(realdata):
             tracked[(topic, method)] = scans_with_track
             if method == "people":
                 tracked[(topic, "people confirmed")] = res.n_confirmed
-    assert len(tracked) == len(topics) * (len(METHODS) + 1)
+                tracked[(topic, "people re-found")] = res.n_refound
+    assert len(tracked) == len(topics) * (len(METHODS) + 2)
     assert not any(tracked.values()), {k: v for k, v in tracked.items() if v}
+
+
+def test_leg_tracker_person_gate_follows_its_filter():
+    """The re-finding gate is leg_tracker's person gate: 1.645·√(P_xx + 0.5²) with its
+    constant-velocity filter; it grows while the person is unobserved and ends on the scan
+    leg_tracker deletes the person (P_xx + 0.25 > 0.9²: 30 scans at 10 Hz, the deleter's
+    3.0 s; 20 at 7.5 Hz)."""
+    g10 = leg_tracker_person_gate(0.1)
+    assert len(g10) == 30 and len(leg_tracker_person_gate(1 / 7.5)) == 20
+    assert np.all(np.diff(g10) > 0)
+    assert 1.645 * 0.5 < g10[0] < 0.85                  # observed: P_xx small against 0.25
+    assert g10[-1] <= 1.645 * 0.9 + 1e-9                 # never beyond the deletion bound
+
+
+def _stop_at_the_edge(k_stop=22, k_back=25, n=80, moved_m=(0.0, 0.0)):
+    """A walker (1 m/s along x) stops at x = 2.6 m, 0.25 m inside the area's edge, unseen
+    for k_back − k_stop scans; its coasting prediction carries it out of the area (the
+    track ends), then its legs are seen again, standing (shifted by ``moved_m``)."""
+    t = np.arange(n) * DT
+    c, left, right = _walker((0.5, 0.0), (1.0, 0.0), t)
+    stand = np.vstack([left[k_stop - 1], right[k_stop - 1]]) + np.asarray(moved_m)
+    legs = [np.vstack([left[k], right[k]]) if k < k_stop else
+            (np.zeros((0, 2)) if k < k_back else stand) for k in range(n)]
+    xy, pats = _observations(legs, np.random.default_rng(7))
+    area = {"name": "rectangle", "x_m": [0.0, float(c[k_stop - 1][0]) + 0.25],
+            "y_m": [-2.0, 2.0]}
+    return xy, pats, area, n
+
+
+def test_a_person_whose_track_ended_is_found_again_and_kept_while_standing():
+    """Re-finding (lifecycle.LegTrackerGate): the walker's track ends while it is unseen
+    (its prediction leaves the area); when its legs are seen again where it stopped, the
+    new hypothesis is that person — confirmed at once, with the same id — and it stays
+    confirmed while it stands (support = observations).  Without re-finding the standing
+    person is never confirmed again."""
+    xy, pats, area, n = _stop_at_the_edge()
+    res = _tracker(area=area).run(_scans(n), xy, pats, 0.10)
+    p = res.people
+    assert res.n_confirmed == 1 and res.n_refound == 1
+    assert p["person_id"].nunique() == 1                     # the same id throughout
+    assert p["k"].max() == n - 1 and p.loc[p["k"] >= 25, "k"].nunique() == n - 25
+    assert set(p.loc[p["k"] >= 25, "status"]) == {"confirmed"}
+    alone = _tracker(area=area, refind="none").run(_scans(n), xy, pats, 0.10)
+    assert alone.n_confirmed == 1 and alone.n_refound == 0
+    assert alone.people["k"].max() < 25                      # ended, and never again
+
+
+def test_a_hypothesis_beyond_the_gate_or_too_late_is_not_the_ended_person():
+    """2 m from where the person was last seen (beyond leg_tracker's largest person gate,
+    1.645 · 0.9 = 1.48 m, reached just before it would delete the person), or after
+    leg_tracker's deletion time (3.0 s at 10 Hz), a standing pair is not re-found.  (A
+    pair 1.5 m away is, once the gate has grown to 1.5 m, as leg_tracker's coasting
+    person would take it.)"""
+    xy, pats, area, n = _stop_at_the_edge(moved_m=(-2.0, 0.0))
+    far = _tracker(area=area).run(_scans(n), xy, pats, 0.10)
+    assert far.n_refound == 0 and far.people["k"].max() < 25
+    xy, pats, area, n = _stop_at_the_edge(k_back=22 + 32)
+    late = _tracker(area=area).run(_scans(n), xy, pats, 0.10)
+    assert late.n_refound == 0 and late.people["k"].max() < 22 + 32
 
 
 def test_an_initialiser_seeds_a_confirmed_person():

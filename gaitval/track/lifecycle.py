@@ -33,6 +33,14 @@ holds none of their rules (Stone Soup's initiator/deleter split, docs/STYLE §13
     leg to travel ``dist_travelled_together_to_initiate_leg_pair`` = 0.5 m in the odometry
     frame; gaitval has no odometry, so the same 0.5 m is asked of the vector between the
     legs.
+``refind`` (:data:`REFINDS`)
+    ``remember(pid, t_last_seen, centre)`` when a reported person ends; ``match(tentative
+    persons, t_k)`` → [(person, pid)]: tentative hypotheses that are a recently ended person
+    found again, and inherit its confirmation and its id.  ``leg_tracker_gate``: a
+    hypothesis whose legs are both observed on the scan and whose centre lies within
+    leg_tracker's person gate of where the ended person was last observed, the gate as
+    leg_tracker's person filter would have grown it over the time since (module notes of
+    :class:`LegTrackerGate`).
 ``deleter`` (:data:`DELETERS`)
     ``ended(person, k, t_k, area) -> str``: "" to keep the person, else why it ends.
     ``unsupported_time``: a confirmed person ends after ``max_unsupported_s`` without a leg
@@ -40,7 +48,8 @@ holds none of their rules (Stone Soup's initiator/deleter split, docs/STYLE §13
     a tentative person ends as soon as neither leg is observed for ``tentative_unsupported_s``.
 
 Statuses (:data:`TENTATIVE`, :data:`CONFIRMED`, :data:`COASTING`, :data:`ENDED`): a confirmed
-person without a leg observation on the current scan is *coasting* (its legs predicted on).
+person without a leg observation on the current scan is *coasting* (its legs predicted on);
+an ended person found again by the ``refind`` role is confirmed again, with its id.
 
 Measurement areas (:data:`AREAS`): ``field_of_view`` (the scan's bearings and range limits,
 less a margin) and ``rectangle`` (x, y bounds in the sensor frame: the mat, the walkway).
@@ -64,6 +73,7 @@ from gaitval.track.init import leg_pairs
 BIRTHS = Registry("birth")
 CONFIRMERS = Registry("confirmer")
 DELETERS = Registry("deleter")
+REFINDS = Registry("refind")
 AREAS = Registry("measurement area")
 
 TENTATIVE, CONFIRMED, COASTING, ENDED = "tentative", "confirmed", "coasting", "ended"
@@ -300,6 +310,132 @@ class MOfNMoving(Confirmer):
             return False
         # fewer than M of the last N scans saw both legs: not a person (yet)
         return sum(1 for r in mem["win"] if r is not None) < self.m
+
+
+# -- re-finding ----------------------------------------------------------------------------
+class Refind:
+    """Role base: ``bind(dt)`` → one for a recording; ``remember`` an ended person;
+    ``match`` tentative persons against the remembered ones."""
+
+    def bind(self, dt: float) -> "Refind":
+        return self
+
+    def remember(self, pid: int, t_last_seen: float, centre) -> None:
+        pass
+
+    def match(self, persons, t: float) -> list:
+        return []
+
+
+@REFINDS.register("none")
+class NoRefind(Refind):
+    """An ended person stays ended: every new hypothesis is confirmed anew."""
+
+
+def leg_tracker_person_gate(dt: float, max_std_m: float = 0.9, percentile: float = 0.90,
+                            std_obs_m: float = 0.1, assoc_extra_m: float = 0.4,
+                            p0: float = 0.5, process_std_per_s: float = 0.5) -> np.ndarray:
+    """leg_tracker's person gate (m) after n = 0, 1, … scans without an observation, up to
+    the scan on which it would delete the person (the array's length − 1).
+
+    leg_tracker's person filter (``joint_leg_tracker.py``, ``ObjectTracked``): constant
+    velocity, process noise std ``0.5·Δt`` on position and velocity per step (its 0.0667,
+    0.05, 0.0333 at 7.5, 10, 15 Hz), observation std 0.1 m, P₀ = 0.5·I.  It gates a
+    detection at Mahalanobis distance ``z = Φ⁻¹(1 − (1 − 0.90)/2)`` = 1.645 with
+    cov = P_xx + (σ_obs + 0.4)², i.e. within ``z·√(P_xx + 0.25)`` m, and deletes the person
+    once ``P_xx + 0.25 > max_std²`` = 0.81.  P_xx is the filter's steady state under
+    observation, then predicted n scans on."""
+    from scipy.stats import norm
+    z = float(norm.ppf(1.0 - (1.0 - percentile) / 2.0))
+    F = np.array([[1.0, 0, dt, 0], [0, 1.0, 0, dt], [0, 0, 1.0, 0], [0, 0, 0, 1.0]])
+    Q = (process_std_per_s * dt) ** 2 * np.eye(4)
+    H = np.eye(2, 4)
+    R = std_obs_m ** 2 * np.eye(2)
+    var_assoc = (std_obs_m + assoc_extra_m) ** 2
+    P = p0 * np.eye(4)
+    for _ in range(1000):                     # the observed filter's steady state
+        P = F @ P @ F.T + Q
+        K = P @ H.T @ np.linalg.inv(H @ P @ H.T + R)
+        P_new = (np.eye(4) - K @ H) @ P
+        if np.allclose(P_new, P, rtol=0.0, atol=1e-12):
+            P = P_new
+            break
+        P = P_new
+    out = [z * math.sqrt(P[0, 0] + var_assoc)]
+    while True:
+        P = F @ P @ F.T + Q
+        if P[0, 0] + var_assoc > max_std_m ** 2:
+            return np.asarray(out)
+        out.append(z * math.sqrt(P[0, 0] + var_assoc))
+
+
+@REFINDS.register("leg_tracker_gate")
+class LegTrackerGate(Refind):
+    """A tentative hypothesis near where a confirmed person was last seen is that person.
+
+    A confirmed person ends here sooner than leg_tracker would delete it (the measurement
+    area test, docs/people.md), and a person whose track ended must otherwise be confirmed
+    anew, which a standing person never is.  leg_tracker keeps an unobserved person until
+    its filter's covariance passes ``max_std`` and matches it, meanwhile, to any detection
+    inside its person gate; this role gives the same person back: for n scans between the
+    ended person's last observation and now, a tentative hypothesis with both legs
+    observed on this scan, whose centre lies within :func:`leg_tracker_person_gate` [n] of
+    the ended person's last observed centre, is that person — confirmed, with its id.
+    After leg_tracker's deletion time (3.0 s at 10 Hz) nobody is re-found.  Each ended
+    person is re-found once, by the nearest such hypothesis.
+
+    Parameters are leg_tracker's defaults (``max_std`` 0.9 m, ``confidence_percentile``
+    0.90, observation std 0.1 m, +0.4 m for association, P₀ = 0.5 I, process std 0.5·Δt).
+    """
+
+    def __init__(self, max_std_m: float = 0.9, percentile: float = 0.90,
+                 std_obs_m: float = 0.1, assoc_extra_m: float = 0.4):
+        self.max_std_m = max_std_m
+        self.percentile = percentile
+        self.std_obs_m = std_obs_m
+        self.assoc_extra_m = assoc_extra_m
+        self.gate_m = np.zeros(1)
+        self.dt = 0.1
+        self.ended: list[tuple[int, float, float, float]] = []
+
+    def bind(self, dt):
+        out = LegTrackerGate(self.max_std_m, self.percentile, self.std_obs_m,
+                             self.assoc_extra_m)
+        out.dt = float(dt)
+        out.gate_m = leg_tracker_person_gate(out.dt, self.max_std_m, self.percentile,
+                                             self.std_obs_m, self.assoc_extra_m)
+        return out
+
+    def _gate(self, gap_s: float) -> float:
+        n = int(round(gap_s / self.dt))
+        return float(self.gate_m[n]) if 0 <= n < len(self.gate_m) else -1.0
+
+    def remember(self, pid, t_last_seen, centre):
+        self.ended.append((int(pid), float(t_last_seen), float(centre[0]), float(centre[1])))
+
+    def match(self, persons, t):
+        self.ended = [e for e in self.ended if self._gate(t - e[1]) >= 0.0]
+        if not self.ended:
+            return []
+        cand = []
+        for i, (pid, t_e, ex, ey) in enumerate(self.ended):
+            g = self._gate(t - t_e)
+            for q, p in enumerate(persons):
+                if not (p.seen[0] and p.seen[1]):
+                    continue
+                cx, cy = p.centre()
+                d = math.hypot(cx - ex, cy - ey)
+                if d <= g:
+                    cand.append((d, i, q))
+        out, used_e, used_p = [], set(), set()
+        for d, i, q in sorted(cand):
+            if i in used_e or q in used_p:
+                continue
+            used_e.add(i)
+            used_p.add(q)
+            out.append((persons[q], self.ended[i][0]))
+        self.ended = [e for i, e in enumerate(self.ended) if i not in used_e]
+        return out
 
 
 # -- deletion ------------------------------------------------------------------------------

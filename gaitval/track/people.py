@@ -9,6 +9,8 @@ Tracker kind ``people`` (:class:`PeopleTracker`).  Per scan k (docs/people.md)::
     confirmer.step(person)   → tentative becomes confirmed           (lifecycle.MOfNMoving)
     deleter.ended(person)    → ended: unsupported too long, or left the area
     birth.propose(unexplained observations) → new tentative persons  (lifecycle.UnexplainedPairs)
+    refind.match(tentative persons seen now) → a recently ended person found again: confirmed,
+                                               with the ended person's id (lifecycle.LegTrackerGate)
 
 The leg model is the seed papers': one ``filter`` per leg (seed 000's KF, seed000 eq.
 (7)–(8), (14)–(16)), a ``motion`` input (constant velocity, seed001 eq. (2); or seed 000's
@@ -57,7 +59,7 @@ from gaitval.track.kalman import FILTERS
 from gaitval.track.kinds import TRACKER_KINDS, TrackerKind
 from gaitval.track.leg import TrackResult, empty_result, handedness, swap_sides
 from gaitval.track.lifecycle import (AREAS, BIRTHS, COASTING, CONFIRMED, CONFIRMERS,
-                                     DELETERS, ENDED, TENTATIVE)
+                                     DELETERS, ENDED, REFINDS, TENTATIVE)
 from gaitval.track.motion import MOTION_MODELS
 from gaitval.track.observations import DetectionSeries
 from gaitval.track.phase import PHASE_MODELS
@@ -76,12 +78,14 @@ class PeopleResult(TrackResult):
 
     ``people``: DataFrame with :data:`PEOPLE_COLUMNS`; ``subject_id``: the person id the
     TrackResult arrays follow (−1: nobody); ``n_born``/``n_confirmed``: hypotheses started /
-    confirmed over the run."""
+    confirmed over the run; ``n_refound``: hypotheses that were an ended person found again
+    (confirmed by the ``refind`` role, not counted in ``n_confirmed``)."""
 
     people: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=PEOPLE_COLUMNS))
     subject_id: int = -1
     n_born: int = 0
     n_confirmed: int = 0
+    n_refound: int = 0
 
 
 class Person:
@@ -89,7 +93,7 @@ class Person:
 
     __slots__ = ("pid", "status", "post", "prior", "seen", "pattern", "obs_j", "phase",
                  "windows", "t_last_seen", "confirm_memory", "n_unobs", "k_born", "n_obs",
-                 "world_centre")
+                 "world_centre", "seen_centre")
 
     def __init__(self, pid, filter, zl, zr, pl, pr, jl, jr, k, t, windows, memory,
                  status=TENTATIVE):
@@ -109,6 +113,7 @@ class Person:
         self.n_obs = [1, 1]
         self.k_born = k
         self.world_centre = (0, 0.0, 0.0)      # (ego-motion segment, x, y)
+        self.seen_centre = self.centre()       # the centre on the last scan with a leg seen
 
     def pos(self, f: int) -> tuple[float, float]:
         s = self.post[f]
@@ -133,8 +138,10 @@ class PeopleTracker(TrackerKind):
         The leg roles (registries of :mod:`gaitval.detect` and :mod:`gaitval.track`).
     tentative_gate : spec or None
         The gate of tentative persons' legs (None: ``gate``).
-    birth, confirmer, deleter, area : spec
-        The life-cycle roles (:mod:`gaitval.track.lifecycle`).
+    birth, confirmer, deleter, area, refind : spec
+        The life-cycle roles (:mod:`gaitval.track.lifecycle`); ``refind`` (default
+        ``leg_tracker_gate``; ``none``: an ended person stays ended) gives a recently ended
+        person back when a tentative hypothesis appears where it was last seen.
     ego_motion, static_map : spec
         The sensor's motion and the map of what never moves (:mod:`gaitval.track.staticmap`):
         an observation on a static cell starts no person, and a tentative person with
@@ -154,7 +161,7 @@ class PeopleTracker(TrackerKind):
                  phase="speed_thresholds", gate="chi2", birth="unexplained_pairs",
                  confirmer="m_of_n_moving", deleter="unsupported_time",
                  area="field_of_view", ego_motion="none", static_map="none",
-                 init=None, tentative_gate=None,
+                 init=None, tentative_gate=None, refind="leg_tracker_gate",
                  max_leg_separation_m: float = 0.8,
                  dt_s: float | None = None, sides: str = "walking_direction"):
         self.detector = DETECTORS.build(detector)
@@ -167,6 +174,7 @@ class PeopleTracker(TrackerKind):
         self.confirmer = CONFIRMERS.build(confirmer)
         self.deleter = DELETERS.build(deleter)
         self.area = AREAS.build(area)
+        self.refind = REFINDS.build(refind)
         self.ego_motion = EGO_MOTIONS.build(ego_motion)
         self.static_map = STATIC_MAPS.build(static_map)
         self.init = INITIALISERS.build(init) if init else None
@@ -197,6 +205,7 @@ class PeopleTracker(TrackerKind):
         gates = (self.gate.for_leg_width(leg_width_m),
                  (self.tentative_gate or self.gate).for_leg_width(leg_width_m))
         confirmer = self.confirmer.bind(dt0, leg_width_m)
+        refind = self.refind.bind(dt0)
         area = self.area.bind(scans)
         poses, segment = self.ego_motion.poses(scans)
         smap, seg = None, None
@@ -206,7 +215,7 @@ class PeopleTracker(TrackerKind):
         persons: list[Person] = []
         rows: list[tuple] = []
         next_id = 1
-        n_born = n_conf = 0
+        n_born = n_conf = n_refound = 0
         predict, correct, identify = F.predict, F.correct, self.phase.identify
         inputs = self.motion.inputs
         sep2 = self.max_leg_separation_m ** 2
@@ -295,6 +304,7 @@ class PeopleTracker(TrackerKind):
                         p.n_obs[f] += 1
                 if p.seen[0] or p.seen[1]:
                     p.t_last_seen = tk
+                    p.seen_centre = p.centre()
                 p.phase = identify(p.post[0], p.post[1])
                 for f in (0, 1):                          # ‖a_k‖ (seed 000 §5.5)
                     w = p.windows[f]
@@ -316,6 +326,8 @@ class PeopleTracker(TrackerKind):
                     continue
                 why = self.deleter.ended(p, k, tk, area)
                 if why:
+                    if p.reported:
+                        refind.remember(p.pid, p.t_last_seen, p.seen_centre)
                     p.status = ENDED
                 elif p.reported:
                     p.status = CONFIRMED if (p.seen[0] or p.seen[1]) else COASTING
@@ -343,6 +355,11 @@ class PeopleTracker(TrackerKind):
                     p.world_centre = (seg, *to_world(pose, np.array([p.centre()]))[0].tolist())
                     confirmer.step(p, k)
                 persons.append(p)
+            # a recently ended person found again keeps its confirmation and its id
+            for p, pid in refind.match([p for p in persons if p.status == TENTATIVE], tk):
+                p.status = CONFIRMED
+                p.pid = pid
+                n_refound += 1
             # record the reported persons
             for p in persons:
                 if p.reported:
@@ -357,6 +374,7 @@ class PeopleTracker(TrackerKind):
         people = people.astype({"k": np.int64, "person_id": np.int64, "phase": np.int64,
                                 "observed": bool})
         res = self._result(t, people, n_born, n_conf)
+        res.n_refound = n_refound
         if profile:
             res.scan_seconds = np.asarray(cost)
             res.scan_hypotheses = np.asarray(alive, dtype=np.int64)
