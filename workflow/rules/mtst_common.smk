@@ -73,10 +73,36 @@ def mtst_inputs(wildcards):
     return files
 
 
-def mtst_optional(name, flag):
-    """Param function: ``[--flag, path]`` when input `name` is there, else nothing (a list,
-    so the rule's ``{params.x:q}`` quotes each word)."""
-    return lambda wildcards, input: [flag, str(input[name])] if name in input.keys() else []
+def mtst_trial_files(study, trial):
+    """One trial's paths for its verbs: the scan log, ``[--registration, path]`` and
+    ``[--groundtruth, path]`` (empty for a trial without mocap)."""
+    w = trial_wildcards(study, trial)
+    reg = mtst_registration(w)
+    return {
+        "sensor": mtst_sensor(w),
+        "reg": ["--registration", reg["reg"]] if reg else [],
+        "gt": ["--groundtruth", reg["gt"]] if reg else [],
+    }
+
+
+def mtst_batch_inputs(wildcards):
+    """What a (study, method) job reads: the method's view, the sheet, the study's ingest
+    and register folders (when a trial has mocap), the raw scan logs of the trials without,
+    the target layouts and the rater annotations."""
+    study = wildcards.study
+    trials = trial_ids(study, ["mtst"])
+    files = {
+        "config": f"{RESULTS}/{study}/config_views/mtst/{wildcards.method}.json",
+        "sheet": sheet_path(study),
+        "targets": [p for t in trials for p in mtst_targets_file(trial_wildcards(study, t))],
+        "annotations": [trial_row(study, t)["annotation_path"] for t in trials
+                        if trial_row(study, t)["annotation_path"]],
+        "raw": [trial_row(study, t)["sensor_path"] for t in trials if not has_mocap(study, t)],
+    }
+    if any(has_mocap(study, t) for t in trials):
+        files["ingest"] = f"{RESULTS}/{study}/ingest"
+        files["register"] = f"{RESULTS}/{study}/register"
+    return files
 
 
 def mtst_summaries(wildcards):

@@ -1,7 +1,7 @@
 # Input functions and constants of workflow/rules/rollator.smk (seed 002, robotic rollator).
 # Kept apart from the rules (snakemake --lint: functions belong in a common file).
 
-ROLLATOR_WC = {"study": "[^/]+", "method": "[^/]+", "trial": "[^/]+", "subject": "[^/]+"}
+ROLLATOR_WC = {"study": "[^/]+", "method": "(?!model$)[^/]+", "trial": "[^/]+", "subject": "[^/]+"}
 
 
 def rollator_cfg():
@@ -20,19 +20,11 @@ def rollator_subjects(study):
     return sorted(set(df.loc[df["protocol"] == "rollator", "subject"]))
 
 
-def rollator_training_inputs(w):
-    """Every rollator trial of the other subjects: scans, truth, registration record."""
-    df = trials(w.study)
-    others = sorted(df.index[(df["protocol"] == "rollator") & (df["subject"] != w.subject)])
-    return [
-        f"{RESULTS}/{w.study}/{kind}/{t}/{name}"
-        for t in others
-        for kind, name in (
-            ("ingest", "sensor.parquet"),
-            ("register", "groundtruth.parquet"),
-            ("register", "registration.json"),
-        )
-    ]
+def rollator_models(w):
+    """The study's PF models (its model folder), for the PF method only."""
+    if w.method != rollator_cfg()["pf_method"]:
+        return []
+    return [f"{RESULTS}/{w.study}/rollator/model"]
 
 
 def rollator_model(w):
