@@ -102,11 +102,16 @@ def run_verbs(argvs: list[list[str]]) -> None:
     from gaitval.cli import parser
     from gaitval.cli_exit import run_verb
 
-    for argv in argvs:
-        args = copy.deepcopy(parser().parse_args(list(argv)))
-        rc = run_verb(args.func, args)
-        if rc:
-            raise VerbFailed(f"gaitval {argv[0]} exited with status {rc}")
+    saved = sys.argv
+    try:
+        for argv in argvs:
+            sys.argv = ["gaitval", *argv]        # what a table's provenance records
+            args = copy.deepcopy(parser().parse_args(list(argv)))
+            rc = run_verb(args.func, args)
+            if rc:
+                raise VerbFailed(f"gaitval {argv[0]} exited with status {rc}")
+    finally:
+        sys.argv = saved
 
 
 def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None) -> None:
