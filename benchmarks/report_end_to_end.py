@@ -15,8 +15,10 @@ To compare with another checkout, run *its* copy of this script with *its* venv,
 alternation with this one, on the same machine (docs/speed.md, "Measuring").
 
 Prints per repeat ``wall``, ``cpu`` (user + system of Snakemake and every process it
-started) and the job count, Snakemake's own CPU, and the jobs' wall time per rule (from
-the batch jobs' logs, ``logs/<rule>/...``: "N task(s) in P process(es), W s wall"); then::
+started, the process pools' forkserver and workers included) and the job count,
+Snakemake's own CPU, and per rule the jobs' wall time and their tasks' CPU (from the
+batch jobs' logs, ``logs/<rule>/...``: "N task(s) in P process(es), W s wall, C s cpu");
+then::
 
     report <study>: wall <median> s, cpu <median> s, <jobs> jobs
 """
@@ -34,10 +36,26 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
-# runs Snakemake in this process and prints its own CPU (not its jobs') at exit
+# runs Snakemake in this process and prints at exit its own CPU (not its jobs') and that
+# of the process pools' forkserver (a child of Snakemake that is never waited for, so
+# its CPU, and its reaped workers', is not in getrusage(RUSAGE_CHILDREN)): its
+# /proc/PID/stat utime + stime + cutime + cstime
 _SNAKEMAKE_SELF = ("import atexit, os, runpy, sys\n"
-                   "atexit.register(lambda: print('snakemake itself: cpu %.2f s' % "
-                   "(os.times().user + os.times().system), file=sys.stderr))\n"
+                   "def _forkservers():\n"
+                   "    tick, cpu = os.sysconf('SC_CLK_TCK'), 0.0\n"
+                   "    for d in os.listdir('/proc'):\n"
+                   "        try:\n"
+                   "            if not d.isdigit(): continue\n"
+                   "            cmd = open(f'/proc/{d}/cmdline', 'rb').read()\n"
+                   "            st = open(f'/proc/{d}/stat').read().rsplit(')', 1)[1].split()\n"
+                   "            if int(st[1]) == os.getpid() and b'forkserver' in cmd:\n"
+                   "                cpu += sum(int(x) for x in st[11:15]) / tick\n"
+                   "        except (OSError, ValueError):\n"
+                   "            pass\n"
+                   "    return cpu\n"
+                   "atexit.register(lambda: print('snakemake itself: cpu %.2f s; forkserver: '\n"
+                   "    'cpu %.2f s' % (os.times().user + os.times().system, _forkservers()),\n"
+                   "    file=sys.stderr))\n"
                    "sys.argv[0] = 'snakemake'\n"
                    "runpy.run_module('snakemake', run_name='__main__', alter_sys=True)\n")
 
@@ -72,18 +90,21 @@ def _job_stats(log: str) -> dict[str, int]:
     return counts
 
 
-def _batch_walls(logs: Path) -> dict[str, tuple[int, int, float]]:
-    """rule (the log's folder) -> (jobs, tasks, wall s) of the batch jobs' logs."""
+def _batch_walls(logs: Path) -> dict[str, tuple[int, int, float, float]]:
+    """rule (the log's folder) -> (jobs, tasks, wall s, tasks' cpu s) of the batch jobs'
+    logs."""
     out: dict[str, list] = {}
     for p in sorted(logs.rglob("*.log")):
         first = p.read_text(errors="replace").split("\n", 1)[0]
-        m = re.match(r"(\d+) task\(s\) in \d+ process\(es\), ([\d.]+) s wall", first)
+        m = re.match(r"(\d+) task\(s\) in \d+ process\(es\), ([\d.]+) s wall, "
+                     r"([\d.]+) s cpu", first)
         if m:
             rule = p.relative_to(logs).parts[0].removesuffix(".log")
-            acc = out.setdefault(rule, [0, 0, 0.0])
+            acc = out.setdefault(rule, [0, 0, 0.0, 0.0])
             acc[0] += 1
             acc[1] += int(m[1])
             acc[2] += float(m[2])
+            acc[3] += float(m[3])
     return {k: tuple(v) for k, v in out.items()}
 
 
@@ -105,15 +126,18 @@ def main() -> None:
             work.mkdir()
             wall, cpu, log = _run_snakemake(ROOT, work, args.study, args.cores)
             jobs = sum(_job_stats(log).values())
+            m = re.search(r"snakemake itself: cpu ([\d.]+) s; forkserver: cpu ([\d.]+) s", log)
+            own, pool = (float(m[1]), float(m[2])) if m else (float("nan"), 0.0)
+            cpu += pool
             walls.append(wall)
             cpus.append(cpu)
-            m = re.search(r"snakemake itself: cpu ([\d.]+) s", log)
             print(f"run {r + 1}: wall {wall:.1f} s, cpu {cpu:.1f} s, {jobs} jobs; "
-                  f"snakemake itself {float(m[1]) if m else float('nan'):.1f} cpu-s",
-                  flush=True)
-            for rule, (n, tasks, w) in sorted(_batch_walls(work / "logs").items(),
-                                              key=lambda kv: -kv[1][2]):
-                print(f"    {rule:24s} {n:4d} jobs {tasks:5d} tasks {w:7.1f} s wall")
+                  f"snakemake itself {own:.1f} cpu-s, the pools (forkserver, its imports "
+                  f"and workers) {pool:.1f} cpu-s", flush=True)
+            for rule, (n, tasks, w, c) in sorted(_batch_walls(work / "logs").items(),
+                                                 key=lambda kv: -kv[1][3]):
+                print(f"    {rule:24s} {n:4d} jobs {tasks:5d} tasks {w:7.1f} s wall "
+                      f"{c:7.1f} s cpu")
     print(f"report {args.study}: wall {statistics.median(walls):.1f} s, "
           f"cpu {statistics.median(cpus):.1f} s, {jobs} jobs")
 

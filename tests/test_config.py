@@ -68,14 +68,6 @@ def test_top_level_typo(cfg):
     assert "unknown key groundtruh — did you mean groundtruth?" in msg
 
 
-def test_a_lowercase_false_on_the_command_line_says_how_to_write_it(cfg):
-    """Snakemake's --config parser reads False as a boolean but false as a string."""
-    cfg["fork_server"] = "false"
-    msg = error_of(cfg, [("--config", {"fork_server": "false"})])
-    assert "fork_server must be true or false, got 'false' (str)" in msg
-    assert "--config fork_server=False" in msg
-
-
 def test_numbers_nested_in_a_command_line_value_are_numbers():
     """Snakemake reads the scalars inside a --config mapping as strings (YAML BaseLoader);
     the workflow types them as a config file would (rollator={"pf_seed": 2018} -> 2018)."""
@@ -84,13 +76,13 @@ def test_numbers_nested_in_a_command_line_value_are_numbers():
     cli = {"rollator": {"pf_seed": "2018", "error_m": "0.1", "figure_trial": "rollator_P01"},
            "tracking": {"overrides": {"tug_m3": {"occlusion__max_n": "7", "x": ["1", "a"]}}},
            "mtst": {"poles_m": "null", "flag": "true", "label": "", "day": "2026-11-26"},
-           "run": ["tiny"], "fork_server": "false"}
+           "run": ["tiny"], "data_dir": "false"}
     out = retype_command_line(cli)
     assert out["rollator"] == {"pf_seed": 2018, "error_m": 0.1, "figure_trial": "rollator_P01"}
     assert out["tracking"]["overrides"]["tug_m3"] == {"occlusion__max_n": 7, "x": [1, "a"]}
     assert out["mtst"] == {"poles_m": None, "flag": True, "label": "", "day": "2026-11-26"}
     assert out["run"] == ["tiny"]
-    assert out["fork_server"] == "false"      # top level: Snakemake's own parsing, checked
+    assert out["data_dir"] == "false"         # top level: Snakemake's own parsing, checked
     assert cli["rollator"]["pf_seed"] == "2018"                        # input not modified
 
 

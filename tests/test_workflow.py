@@ -55,28 +55,28 @@ def test_dag_runs_end_to_end_and_index_has_provenance(tiny_run):
 
 
 @pytest.mark.slow
-def test_a_track_job_tracks_then_evaluates_both_in_the_fork_server(tiny_run):
-    """Issue 13: a TUG, MTST, rollator or ultrasonic tracking job runs two gaitval steps
-    (tracking, then its evaluation or the gait parameters);
-    locally both go to the fork server from Snakemake's thread, one after the other, and
-    the job's log holds what both printed (the evaluation's summary row)."""
+def test_a_track_job_tracks_then_evaluates_every_trial(tiny_run):
+    """Issue 38: one TUG, MTST, rollator or ultrasonic job per (study[, method]) runs, for
+    each trial, two gaitval verbs (tracking, then its evaluation or the gait parameters) in
+    its process pool; its log holds both commands and what both printed, per trial."""
     import re
 
-    log = (tiny_run / "logs" / "forkserver.log").read_text()
-    cmds = dict(re.findall(r"^job (\S+): gaitval (\S+) ", log, re.M))
-    via = dict(re.findall(r"^job (\S+): exit 0, .*, via (\S+)$", log, re.M))
-    for track, evaluate in (("track", "evaluate-tug"), ("mtst-track", "mtst-evaluate"),
-                            ("rollator-track", "rollator-evaluate"),
-                            ("ultrasonic-track", "gait-parameters")):
-        ran = [j for j, v in cmds.items() if v == track]
-        evals = [j for j, v in cmds.items() if v == evaluate]
-        assert ran and len(evals) == len(ran), (track, len(ran), len(evals))
-        assert {via.get(j) for j in ran + evals} <= {"snakemake", None}    # None: plain start
-    n_trials = len(list((tiny_run / "results" / "tiny" / "track" / "tug_m1").glob("*.parquet")))
-    job_logs = sorted((tiny_run / "logs" / "track" / "tiny" / "tug_m1").glob("*.log"))
-    assert len(job_logs) == n_trials
-    for f in job_logs:
-        assert "category" in f.read_text(), f        # the evaluation's summary, appended
+    for log, track, evaluate, folder in (
+            ("track/tiny/tug_m1.log", "track", "evaluate-tug", "track/tug_m1"),
+            ("mtst_track/tiny/mtst_m1.log", "mtst-track", "mtst-evaluate",
+             "mtst_track/mtst_m1"),
+            ("rollator_track/tiny/rollator_kf.log", "rollator-track", "rollator-evaluate",
+             "rollator/rollator_kf"),
+            ("ultrasonic_track/tiny.log", "ultrasonic-track", "gait-parameters",
+             "ultrasonic/track")):
+        text = (tiny_run / "logs" / log).read_text()
+        trials = re.findall(r"^== (\S+)$", text, re.M)
+        assert trials, text[:2000]
+        assert len(re.findall(rf"^\$ gaitval {track} ", text, re.M)) == len(trials)
+        assert len(re.findall(rf"^\$ gaitval {evaluate} ", text, re.M)) == len(trials)
+        written = list((tiny_run / "results" / "tiny" / folder).glob("*.parquet"))
+        assert len(written) == len(trials), (log, written)
+    assert "category" in (tiny_run / "logs" / "track" / "tiny" / "tug_m1.log").read_text()
 
 
 @pytest.mark.slow

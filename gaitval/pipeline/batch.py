@@ -26,6 +26,7 @@ import copy
 import io
 import logging
 import multiprocessing
+import shlex
 import sys
 import time
 import traceback
@@ -59,8 +60,15 @@ def _context():
     return ctx
 
 
-def _call(func, kwargs) -> tuple[bool, str, str]:
-    """Run one task in a worker: (ok, its printed output and log messages, the error)."""
+def _call(func, kwargs) -> tuple[bool, str, str, float]:
+    """Run one task in a worker: (ok, its printed output and log messages, the error, its
+    CPU seconds)."""
+    cpu0 = time.process_time()
+    ok, text, err = _call_captured(func, kwargs)
+    return ok, text, err, time.process_time() - cpu0
+
+
+def _call_captured(func, kwargs) -> tuple[bool, str, str]:
     out = io.StringIO()
     handler = logging.StreamHandler(out)
     handler.setFormatter(logging.Formatter("gaitval: %(message)s"))
@@ -98,7 +106,8 @@ class VerbFailed(GaitvalError):
 def run_verbs(argvs: list[list[str]]) -> None:
     """A task: gaitval verbs one after the other, each as ``gaitval ARGV`` on the command
     line would run it (:func:`gaitval.cli.main`'s parser and exit codes); the first that
-    fails stops the task."""
+    fails stops the task.  Each verb's command line goes to the log first (``$ gaitval
+    ...``, quoted as a shell would need it): the same step, by hand."""
     from gaitval.cli import parser
     from gaitval.cli_exit import run_verb
 
@@ -106,6 +115,7 @@ def run_verbs(argvs: list[list[str]]) -> None:
     try:
         for argv in argvs:
             sys.argv = ["gaitval", *argv]        # what a table's provenance records
+            print(f"$ {shlex.join(sys.argv)}", flush=True)   # the same step by hand
             args = copy.deepcopy(parser().parse_args(list(argv)))
             rc = run_verb(args.func, args)
             if rc:
@@ -128,7 +138,7 @@ def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None) 
             Path(log).write_text("no trials\n", encoding="utf-8")
         return
     processes = max(1, min(int(processes), len(tasks)))
-    results: list[tuple[bool, str, str] | None] = [None] * len(tasks)
+    results: list[tuple[bool, str, str, float] | None] = [None] * len(tasks)
     failed: int | None = None
     t0 = time.perf_counter()
     with cf.ProcessPoolExecutor(max_workers=processes, mp_context=_context()) as pool:
@@ -140,7 +150,7 @@ def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None) 
             except cf.CancelledError:
                 continue
             except Exception as exc:                      # the worker died (killed, OOM)
-                results[i] = (False, "", f"worker process failed: {exc!r}")
+                results[i] = (False, "", f"worker process failed: {exc!r}", 0.0)
             if not results[i][0] and failed is None:
                 failed = i
                 for f in futures:
@@ -155,12 +165,14 @@ def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None) 
 
 
 def _write_log(log, tasks, results, processes, wall) -> None:
-    lines = [f"{len(tasks)} task(s) in {processes} process(es), {wall:.2f} s wall"]
+    cpu = sum(r[3] for r in results if r is not None)
+    lines = [f"{len(tasks)} task(s) in {processes} process(es), {wall:.2f} s wall, "
+             f"{cpu:.2f} s cpu"]
     for t, r in sorted(zip(tasks, results), key=lambda tr: tr[0].label):
         if r is None:
             lines.append(f"== {t.label}: not run (an earlier task failed)")
             continue
-        ok, text, err = r
+        ok, text, err, _ = r
         lines.append(f"== {t.label}" + ("" if ok else f": FAILED: {err}"))
         if text:
             lines.append(text.rstrip("\n"))
