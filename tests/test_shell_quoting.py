@@ -4,7 +4,7 @@ Trial sheets come from collaborators and a reviewer runs them.  Before issue 33,
 ``mtst_track`` put ``{input.sensor}`` (the sheet's ``sensor_file`` for a trial without
 mocap) into its command unquoted, and a sheet naming ``lrs/y$(id>PWNED2).scan.parquet`` ran
 ``id`` in the job's shell.  Since issue 38 the per-trial rules pass each value as one
-argument of a gaitval verb (``run:`` blocks, gaitval.pipeline.batch: no shell at all);
+argument of a gaitval verb (``run:`` blocks, gaitval.jobs.batch: no shell at all);
 the remaining ``shell:`` rules quote.  Here:
 
 * every value interpolated into every rule's ``shell:`` command carries Snakemake's ``:q``

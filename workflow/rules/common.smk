@@ -15,7 +15,7 @@ from gaitval.errors import ConfigError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash
 from gaitval.methods import METHODS, get_method, override_problems, set_params
-from gaitval.steps import (ALL_SCOPE, ANALYSIS_SECTIONS, PROTOCOL_SCOPE, SCOPES, STUDY_VIEW,
+from gaitval.pipeline.steps import (ALL_SCOPE, ANALYSIS_SECTIONS, PROTOCOL_SCOPE, SCOPES, STUDY_VIEW,
                            method_definition, method_view)
 from gaitval.tables.tug_evidence import method_reading
 
@@ -119,7 +119,7 @@ REPORTS_ROOT = config.get("reports_dir", "reports")
 REPORTS = f"{REPORTS_ROOT}/{RUN_NAME}"
 # HOW JOBS RUN (issue 38; docs/speed.md).  One Snakemake job per (study, stage) or
 # (study, stage, method), not per trial: its `run:` block hands the trials to
-# gaitval.pipeline.batch.run_batch, which runs each trial's gaitval verbs (the CLI's, with
+# gaitval.jobs.batch.run_batch, which runs each trial's gaitval verbs (the CLI's, with
 # the same arguments as `python -m gaitval VERB ...` by hand) in a process pool of the
 # rule's `threads`, forked from the standard library's forkserver that imported numpy,
 # pandas, scipy and gaitval once.  Every trial still writes its own files, in the same
@@ -154,10 +154,10 @@ def verb(*words):
 
 
 def run_trials(tasks, threads, log, sizes=None, outdirs=()):
-    """Run a batch job's tasks (label, [verb, ...]) in the pool (gaitval.pipeline.batch),
+    """Run a batch job's tasks (label, [verb, ...]) in the pool (gaitval.jobs.batch),
     largest first when their ``sizes`` are given; ``outdirs``: the job's `directory()`
     outputs, made first (a study with no trial of the stage gets an empty one)."""
-    from gaitval.pipeline.batch import Task, by_size, run_batch, run_verbs
+    from gaitval.jobs.batch import Task, by_size, run_batch, run_verbs
 
     for d in outdirs:
         Path(d).mkdir(parents=True, exist_ok=True)
@@ -173,7 +173,7 @@ def run_verb_job(argv, log):
 
 
 def size_of(path):
-    from gaitval.pipeline.batch import file_size
+    from gaitval.jobs.batch import file_size
 
     return file_size(path)
 
@@ -191,7 +191,7 @@ CONFIG_HASH = config_hash({k: config[k] for k in ANALYSIS_SECTIONS if k in confi
 
 def analysis_sections_json(view=None, scope=ALL_SCOPE):
     """The analysis sections as canonical JSON (sorted keys), or one view of them
-    (gaitval.steps.method_view): the params of rules study_config and config_view."""
+    (gaitval.pipeline.steps.method_view): the params of rules study_config and config_view."""
     sections = {k: config[k] for k in ANALYSIS_SECTIONS if k in config}
     if view is not None:
         sections = method_view(sections, view, scope)
@@ -233,7 +233,7 @@ def study_views(views, scope):
 def config_view_file(wildcards, scope=None):
     """Input function: the config view a job reads (made by the config_view rule), its
     {method}'s, or the study view for a job without a method, in the scope of its trial's
-    protocol (gaitval.steps.PROTOCOL_SCOPE) unless `scope` is given."""
+    protocol (gaitval.pipeline.steps.PROTOCOL_SCOPE) unless `scope` is given."""
     view = getattr(wildcards, "method", None) or STUDY_VIEW
     if scope is None:
         protocol = trial_row(wildcards.study, wildcards.trial)["protocol"]
@@ -432,7 +432,7 @@ EXTERNAL_PROTOCOLS = ("tug", "mtst")
 def external_tracks_file(wildcards):
     """Input function: the external method's track file of one trial (its path relative to
     the trial sheet's folder, {trial} replaced)."""
-    from gaitval.steps import external_track_path
+    from gaitval.pipeline.steps import external_track_path
 
     entry = config["tracking"]["external"][wildcards.method]
     return str(external_track_path(sheet_path(wildcards.study), entry, wildcards.trial,

@@ -1,7 +1,7 @@
 # Multi-target stepping task (seed 001): one job per (study, method) that tracks and
 # evaluates each trial, then Tables 1, 3, 4 and the trial figure.  A trial without mocap (annotations
 # only) is tracked from its raw scan log; its pose comes from mtst.poles_m and its clock
-# from the trial sheet (gaitval.steps_mtst).
+# from the trial sheet (gaitval.pipeline.mtst).
 include: "mtst_common.smk"
 
 

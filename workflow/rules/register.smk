@@ -14,12 +14,12 @@ rule study_config:
     log:
         "logs/study_config/{study}.log",
     run:
-        from gaitval.steps import study_config
+        from gaitval.pipeline.steps import study_config
 
         study_config(json.loads(params.sections), input.sheet, output[0])
 
 
-# The config as the per-trial jobs of one method read it (gaitval.steps.method_view): every
+# The config as the per-trial jobs of one method read it (gaitval.pipeline.steps.method_view): every
 # per-trial job takes its view (config_view_file, common.smk) instead of config.json, so a
 # change of one method's parameter reruns that method's tracking and evaluation and the
 # tables of its study section (the pooled tables read the views too: study_views), not
@@ -39,7 +39,7 @@ rule config_view:
     log:
         "logs/config_view/{study}/{scope}/{view}.log",
     run:
-        from gaitval.steps import study_config
+        from gaitval.pipeline.steps import study_config
 
         study_config(
             json.loads(params.sections), input.sheet, output[0], view=wildcards.view,

@@ -5,7 +5,7 @@ ROLLATOR_WC = {"study": "[^/]+", "method": "(?!model$)[^/]+", "trial": "[^/]+", 
 
 
 def rollator_cfg():
-    from gaitval.steps_rollator import rollator_cfg as _rc
+    from gaitval.pipeline.rollator import rollator_cfg as _rc
 
     return _rc(config)
 

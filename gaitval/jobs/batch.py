@@ -38,7 +38,7 @@ from gaitval.errors import GaitvalError
 
 #: what the forkserver imports once before it forks a worker: every step module and what
 #: they import (a module not listed is imported by the worker that needs it)
-PRELOAD = ("gaitval.pipeline.preload",)
+PRELOAD = ("gaitval.jobs.preload",)
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""Imported once by the pool's forkserver (:data:`gaitval.pipeline.batch.PRELOAD`): the
+"""Imported once by the pool's forkserver (:data:`gaitval.jobs.batch.PRELOAD`): the
 step modules, the libraries they import lazily, and the trackers' compiled kernels, so
 that every worker forked from it starts with them loaded."""
 from __future__ import annotations
