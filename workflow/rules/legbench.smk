@@ -31,21 +31,8 @@ rule legbench_track:
     log:
         "logs/legbench_track/{study}/{method}/{init}.log",
     run:
-        run_trials(
-            [(t, [verb("legbench-track", "--sensor", sensor, "--annotations", ann, topics,
-                       "--method", wildcards.method, "--init", wildcards.init,
-                       "--leg-width-m", width, "--config", input.config, "--trial", t,
-                       "--out", f"{output.track}/{t}/track.parquet"),
-                  verb("legbench-evaluate", "--track", f"{output.track}/{t}/track.parquet",
-                       "--annotations", ann, topics, score, "--match-m", params.match_m,
-                       "--min-false-s", params.min_false_s, "--trial", t,
-                       "--out", f"{output.evaluate}/{t}")])
-             for t, sensor, ann, topics, score, width in zip(
-                 params.trials, input.sensors, input.annotations, params.topics,
-                 params.score, params.leg_width)],
-            threads, log[0], outdirs=output,
-            sizes=[size_of(p) for p in input.sensors],
-        )
+        run_trials(legbench_tasks(wildcards, input, output, params), threads, log[0],
+                   outdirs=output, sizes=[size_of(p) for p in input.sensors])
 
 
 rule legbench_tables:

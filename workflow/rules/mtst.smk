@@ -20,20 +20,8 @@ rule mtst_track:
     log:
         "logs/mtst_track/{study}/{method}.log",
     run:
-        tasks = []
-        for t in params.trials:
-            f = mtst_trial_files(wildcards.study, t)
-            common = ["--sheet", input.sheet, "--subjects", params.subjects, "--trial", t,
-                      "--method", wildcards.method, "--config", input.config, f["reg"]]
-            tasks.append((t, [
-                verb("mtst-track", "--sensor", f["sensor"], common,
-                     "--out", f"{output.track}/{t}.parquet"),
-                verb("mtst-evaluate", "--track", f"{output.track}/{t}.parquet", common,
-                     f["gt"], "--out", f"{output.evaluate}/{t}"),
-            ]))
-        run_trials(tasks, threads, log[0], outdirs=output,
-                   sizes=[size_of(mtst_trial_files(wildcards.study, t)["sensor"])
-                          for t in params.trials])
+        run_trials(mtst_tasks(wildcards, input, output, params), threads, log[0],
+                   outdirs=output, sizes=mtst_sizes(wildcards, params.trials))
 
 
 # An external method (tracking.external, issue 37): the other tracker's file of each trial,
@@ -59,19 +47,8 @@ rule mtst_track_external:
     log:
         "logs/mtst_track/{study}/{method}.log",
     run:
-        tasks = []
-        for t, tracks in zip(params.trials, input.tracks):
-            f = mtst_trial_files(wildcards.study, t)
-            tasks.append((t, [
-                verb("import-tracks", "--tracks", tracks, "--sensor", f["sensor"], f["reg"],
-                     "--trial", t, "--method", wildcards.method,
-                     "--out", f"{output.track}/{t}.parquet"),
-                verb("mtst-evaluate", "--track", f"{output.track}/{t}.parquet",
-                     "--sheet", input.sheet, "--subjects", params.subjects, "--trial", t,
-                     "--method", wildcards.method, "--config", input.config, f["reg"],
-                     f["gt"], "--out", f"{output.evaluate}/{t}"),
-            ]))
-        run_trials(tasks, threads, log[0], outdirs=output)
+        run_trials(mtst_tasks(wildcards, input, output, params, external=True), threads,
+                   log[0], outdirs=output)
 
 
 rule mtst_tables:

@@ -56,23 +56,6 @@ def mtst_targets_file(wildcards):
     return [str(path)] if path.is_file() else []
 
 
-def mtst_inputs(wildcards):
-    """What a trial's tracking and evaluation read: the scan log, the method's config view,
-    the sheet, the registration and ground truth (a trial with mocap), the target layout and
-    the rater annotations (when there are)."""
-    files = {
-        "sensor": mtst_sensor(wildcards),
-        "config": config_view_file(wildcards),
-        "sheet": sheet_path(wildcards.study),
-        "targets": mtst_targets_file(wildcards),
-        **mtst_registration(wildcards),
-    }
-    ann = trial_row(wildcards.study, wildcards.trial)["annotation_path"]
-    if ann:
-        files["annotations"] = ann
-    return files
-
-
 def mtst_trial_files(study, trial):
     """One trial's paths for its verbs: the scan log, ``[--registration, path]`` and
     ``[--groundtruth, path]`` (empty for a trial without mocap)."""
@@ -103,6 +86,31 @@ def mtst_batch_inputs(wildcards):
         files["ingest"] = f"{RESULTS}/{study}/ingest"
         files["register"] = f"{RESULTS}/{study}/register"
     return files
+
+
+def mtst_tasks(wildcards, input, output, params, external=False):
+    """A (study, method) job's tasks: per trial, its tracking (or, for an external method,
+    the conversion of the other tracker's file) and then its evaluation."""
+    tasks = []
+    for i, t in enumerate(params.trials):
+        f = mtst_trial_files(wildcards.study, t)
+        track = f"{output.track}/{t}.parquet"
+        common = ["--sheet", input.sheet, "--subjects", params.subjects, "--trial", t,
+                  "--method", wildcards.method, "--config", input.config, f["reg"]]
+        if external:
+            first = verb("import-tracks", "--tracks", input.tracks[i], "--sensor",
+                         f["sensor"], f["reg"], "--trial", t, "--method", wildcards.method,
+                         "--out", track)
+        else:
+            first = verb("mtst-track", "--sensor", f["sensor"], common, "--out", track)
+        tasks.append((t, [first, verb("mtst-evaluate", "--track", track, common, f["gt"],
+                                      "--out", f"{output.evaluate}/{t}")]))
+    return tasks
+
+
+def mtst_sizes(wildcards, trials):
+    """Each trial's scan log bytes (a batch starts the largest first)."""
+    return [size_of(mtst_trial_files(wildcards.study, t)["sensor"]) for t in trials]
 
 
 def mtst_summaries(wildcards):

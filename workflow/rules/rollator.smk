@@ -58,22 +58,8 @@ rule rollator_track:
     log:
         "logs/rollator_track/{study}/{method}.log",
     run:
-        tasks = []
-        for t in params.trials:
-            model = rollator_model(trial_wildcards(wildcards.study, t, wildcards.method))
-            common = ["--sheet", input.sheet, "--subjects", params.subjects, "--trial", t,
-                      "--method", wildcards.method, "--config", input.config]
-            tasks.append((t, [
-                verb("rollator-track", "--sensor", f"{input.ingest}/{t}/sensor.parquet",
-                     common, ["--model", model[0]] if model else [],
-                     "--out", f"{output[0]}/{t}.track.parquet"),
-                verb("rollator-evaluate", "--track", f"{output[0]}/{t}.track.parquet",
-                     "--groundtruth", f"{input.register}/{t}/groundtruth.parquet",
-                     "--registration", f"{input.register}/{t}/registration.json",
-                     "--ingest", f"{input.ingest}/{t}", common,
-                     "--out", f"{output[0]}/{t}"),
-            ]))
-        run_trials(tasks, threads, log[0], outdirs=output,
+        run_trials(rollator_tasks(wildcards, input, output, params), threads, log[0],
+                   outdirs=output,
                    sizes=[trial_bytes(wildcards.study, t) for t in params.trials])
 
 
