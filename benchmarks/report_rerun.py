@@ -11,9 +11,9 @@ folder (a folder built by another command gets its ``report_config`` record rewr
 the rebuild command it names differs), then ``--repeat`` times more, each of which must
 find nothing to do; prints their wall and CPU times.  Then plans (``-n``) the rerun after a
 new value of one tracker method's parameter (``tracking.overrides.<method>``, default
-``tug_m1``'s ``occlusion__max_n``) and prints Snakemake's job counts per rule; the jobs it
+``tug_m3``'s ``occlusion__max_n``) and prints Snakemake's job counts per rule; the jobs it
 may plan are that method's ``track`` jobs, one per study, each tracking and evaluating
-every TUG trial (the method and its reading variant, e.g. ``tug_m1_stance_first``), the
+every TUG trial (the method and its reading variant, e.g. ``tug_m3_stance_first``), the
 config views and records, the TUG tables and the report.  Exits 1 when a rerun did work or the plan holds another rule or method.
 
 Last line: ``rerun <folder>: nothing changed <median> s wall (bar 5 s); one method's
@@ -72,7 +72,7 @@ def main() -> None:
     ap.add_argument("--directory", type=Path, required=True,
                     help="a run folder in which the report was built")
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--method", default="tug_m1")
+    ap.add_argument("--method", default="tug_m3")
     ap.add_argument("--param", default="occlusion__max_n")
     ap.add_argument("--value", default="7")
     args = ap.parse_args()
