@@ -44,7 +44,7 @@ def snakemake_8() -> Path:
 def _run(snakemake: Path, work: Path, *extra: str) -> subprocess.CompletedProcess:
     cmd = [str(snakemake), "--snakefile", str(ROOT / "Snakefile"),
            "--profile", str(ROOT / "workflow" / "profiles" / "default"),
-           "--directory", str(work), "--cores", "2",
+           "--directory", str(work), "--cores", "2", "--force-use-threads",
            "--config", 'run=["tiny"]', f"data_dir={work / 'data'}", "peer_results=", *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=1800)
 

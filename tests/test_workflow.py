@@ -20,7 +20,7 @@ SNAKEMAKE = Path(sys.executable).parent / "snakemake"
 def run_workflow(workdir: Path, data_dir: Path, *extra: str) -> subprocess.CompletedProcess:
     peer = (ROOT / ".." / "shared" / "realdata" / "peer-results" / "gailo_results.parquet").resolve()
     cmd = [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(workdir),
-           "--cores", "2", "--config", 'run=["tiny"]', f"data_dir={data_dir}",
+           "--cores", "2", "--force-use-threads", "--config", 'run=["tiny"]', f"data_dir={data_dir}",
            f"peer_results={peer}", *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
 

@@ -44,7 +44,7 @@ def bad_ingest(tiny_data, tmp_path_factory):
     row = sheet.set_index("trial").loc[BAD]
     (work / "data" / "tiny" / row["mocap_file"]).write_bytes(b"not a C3D file" * 100)
     cmd = [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(work),
-           "--cores", "2", "results/tiny/ingest",
+           "--cores", "2", "--force-use-threads", "results/tiny/ingest",
            "--config", 'run=["tiny"]', f"data_dir={work / 'data'}"]
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     return work, res
@@ -67,7 +67,7 @@ def test_the_log_gives_each_trials_command(tiny_data, tmp_path):
     data, sheet = tiny_data
     shutil.copytree(data, tmp_path / "data")
     cmd = [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory",
-           str(tmp_path), "--cores", "2", "results/tiny/ingest",
+           str(tmp_path), "--cores", "2", "--force-use-threads", "results/tiny/ingest",
            "--config", 'run=["tiny"]', f"data_dir={tmp_path / 'data'}"]
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     assert res.returncode == 0, res.stderr[-3000:]
@@ -128,7 +128,7 @@ def test_ctrl_c_stops_a_batch_job(tiny_data, tmp_path):
     shutil.copytree(data, tmp_path / "data")
     cmd = [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(tmp_path),
            "--profile", str(ROOT / "workflow" / "profiles" / "default"),
-           "--cores", "2", "--config", 'run=["tiny"]', f"data_dir={tmp_path / 'data'}"]
+           "--cores", "2", "--force-use-threads", "--config", 'run=["tiny"]', f"data_dir={tmp_path / 'data'}"]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                             start_new_session=True)
     deadline = time.time() + 300
