@@ -127,15 +127,18 @@ def run_verbs(argvs: list[list[str]]) -> None:
 def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None) -> None:
     """Run every task, ``processes`` at a time, each in a worker process.
 
-    The log (``log``) gets each task's output under a ``== <label>`` line, by label.  The first task that fails stops the batch: the tasks not started are
-    cancelled, the log is written, and :class:`BatchError` is raised with that task's
-    label and error (the data problem named as the step named it: file, trial, problem).
-    Give the longest tasks first: the pool starts them in this order.
+    The log (``log``) starts with the task count, the wall time and the tasks' CPU, then
+    gives each task's output under a ``== <label>`` line, by label.  The first task that
+    fails stops the batch: the tasks not started are cancelled, the log is written, and
+    :class:`BatchError` is raised with that task's label and error (the data problem
+    named as the step named it: file, trial, problem).  Give the longest tasks first: the
+    pool starts them in this order.
     """
     if not tasks:
         if log is not None:
             Path(log).parent.mkdir(parents=True, exist_ok=True)
-            Path(log).write_text("no trials\n", encoding="utf-8")
+            Path(log).write_text("0 task(s) in 0 process(es), 0.00 s wall, 0.00 s cpu\n",
+                                 encoding="utf-8")
         return
     processes = max(1, min(int(processes), len(tasks)))
     results: list[tuple[bool, str, str, float] | None] = [None] * len(tasks)
