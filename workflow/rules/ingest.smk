@@ -29,6 +29,7 @@ rule ingest:
 rule ingest_summary:
     input:
         f"{RESULTS}/{{study}}/ingest",
+        sheet=lambda w: sheet_path(w.study),  # the params list its trials
     output:
         csv=report(
             f"{REPORTS}/tables/study_ingest_{{study}}.csv",

@@ -43,6 +43,9 @@ rule legbench_tables:
         # the method views the tracks ran with: a method run with tracking.overrides is
         # named with its changes in the table
         views=study_views(legbench_cfg()["methods"], ALL_SCOPE),
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
         table=report(
             f"{REPORTS}/tables/legbench_clearmot.csv",

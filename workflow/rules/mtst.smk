@@ -57,6 +57,9 @@ rule mtst_tables:
                          for study in config["run"] if trial_ids(study, ["mtst"])
                          for method in mtst_methods() + external_methods("mtst")],
         configs=study_views([STUDY_VIEW], "mtst"),  # the mtst: section
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
         t3=report(
             f"{REPORTS}/tables/mtst_table3.csv",

@@ -79,6 +79,7 @@ rule register:
 rule registration_summary:
     input:
         f"{RESULTS}/{{study}}/register",
+        sheet=lambda w: sheet_path(w.study),  # the params list its trials
     output:
         csv=f"{RESULTS}/{{study}}/registration.csv",
         table=report(

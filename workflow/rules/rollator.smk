@@ -71,6 +71,9 @@ rule rollator_tables:
         models=lambda w: [f"{RESULTS}/{study}/rollator/model"
                           for study in config["run"] if trial_ids(study, ["rollator"])],
         config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/rollator/{STUDY_VIEW}.json",
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
         t1=report(
             f"{REPORTS}/tables/rollator_table1.csv",

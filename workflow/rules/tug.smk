@@ -50,6 +50,7 @@ rule track_external:
         ingest=f"{RESULTS}/{{study}}/ingest",
         register=f"{RESULTS}/{{study}}/register",
         config=f"{RESULTS}/{{study}}/config_views/tug/{{method}}.json",
+        sheet=lambda w: sheet_path(w.study),  # the params list its trials
     output:
         track=directory(f"{RESULTS}/{{study}}/track/{{method}}"),
         evaluate=directory(f"{RESULTS}/{{study}}/evaluate/{{method}}"),
@@ -83,6 +84,9 @@ rule tug_tables:
                          for study in config["run"] if trial_ids(study, ["tug"])
                          for method in tug_runs()],
         configs=study_views(tug_runs(), "tug"),  # Table 2: each study's method definitions
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
         t4=report(
             f"{REPORTS}/tables/tug_table4.csv",

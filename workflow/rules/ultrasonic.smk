@@ -10,6 +10,9 @@ rule ultrasonic_noise:
         # the study view (no method's definition): a tracker parameter changed elsewhere
         # does not rerun the noise identification and every ultrasonic track after it
         config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/ultrasonic/{STUDY_VIEW}.json",
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
         noise=f"{RESULTS}/ultrasonic_noise.json",
         table=report(
@@ -76,6 +79,9 @@ rule ultrasonic_tables:
         tracks=lambda w: sorted({f"{RESULTS}/{s}/ultrasonic" for s, _ in treadmill_trials()}),
         # ultrasonic.tables: the strides the tables use (the study view, as the noise rule)
         config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/ultrasonic/{STUDY_VIEW}.json",
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
         t2=report(
             f"{REPORTS}/tables/ultrasonic_table2.csv",
