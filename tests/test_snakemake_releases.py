@@ -45,7 +45,7 @@ def _run(snakemake: Path, work: Path, *extra: str) -> subprocess.CompletedProces
     cmd = [str(snakemake), "--snakefile", str(ROOT / "Snakefile"),
            "--profile", str(ROOT / "workflow" / "profiles" / "default"),
            "--directory", str(work), "--cores", "2", "--force-use-threads",
-           "--config", 'run=["tiny"]', f"data_dir={work / 'data'}", "peer_results=", *extra]
+           "--config", 'run=["tiny"]', f"data_dir={work / 'data'}", "peer_results=''", *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=1800)
 
 

@@ -91,11 +91,16 @@ def _call_captured(func, kwargs) -> tuple[bool, str, str]:
 
 
 def _message(text: str, exc: BaseException) -> str:
-    """The task's error: the last ``gaitval: error: ...`` line it printed (the CLI's one
-    message naming file, trial and problem), else the exception."""
-    lines = [ln for ln in text.splitlines() if ln.startswith("gaitval: error: ")]
+    """The task's error: the last ``gaitval[ VERB]: error: ...`` line it printed (the CLI's
+    one message naming file, trial and problem, or argparse's usage error), else the
+    exception's own message."""
+    import re
+
+    lines = [m.group(1) for m in re.finditer(r"^gaitval(?: \S+)?: error: (.*)$", text, re.M)]
     if lines:
-        return lines[-1][len("gaitval: error: "):]
+        return lines[-1]
+    if isinstance(exc, GaitvalError):
+        return str(exc)
     return f"{type(exc).__name__}: {exc}"
 
 
