@@ -18,6 +18,8 @@ ROOT = Path(__file__).resolve().parents[1]
 #: the newest Snakemake 8 on the package index (2026-11)
 SNAKEMAKE_8 = "8.30.0"
 VENV_8 = ROOT / ".venv-snakemake8"
+#: as tests/test_workflow.py: the peer data when ../shared is there, else no such table
+PEER = (ROOT / ".." / "shared" / "realdata" / "peer-results" / "gailo_results.parquet").resolve()
 
 
 def snakemake_8() -> Path:
@@ -45,7 +47,7 @@ def _run(snakemake: Path, work: Path, *extra: str) -> subprocess.CompletedProces
     cmd = [str(snakemake), "--snakefile", str(ROOT / "Snakefile"),
            "--profile", str(ROOT / "workflow" / "profiles" / "default"),
            "--directory", str(work), "--cores", "2", "--force-use-threads",
-           "--config", 'run=["tiny"]', f"data_dir={work / 'data'}", "peer_results=''", *extra]
+           "--config", 'run=["tiny"]', f"data_dir={work / 'data'}", f"peer_results={PEER}", *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=1800)
 
 
