@@ -108,19 +108,22 @@ class VerbFailed(GaitvalError):
     """A verb of :func:`run_verbs` exited with a non-zero status (its message printed)."""
 
 
-def run_verbs(argvs: list[list[str]]) -> None:
+def run_verbs(argvs: list[list[str]], shown: list[list[str]] | None = None) -> None:
     """A task: gaitval verbs one after the other, each as ``gaitval ARGV`` on the command
     line would run it (:func:`gaitval.cli.main`'s parser and exit codes); the first that
     fails stops the task.  Each verb's command line goes to the log first (``$ gaitval
-    ...``, quoted as a shell would need it): the same step, by hand."""
+    ...``, quoted as a shell would need it; ``shown``: the command lines to show instead,
+    the job's final paths where it writes into a staging folder, :func:`staged`): the
+    same step, by hand."""
     from gaitval.cli import parser
     from gaitval.cli_exit import run_verb
 
     saved = sys.argv
     try:
-        for argv in argvs:
+        for i, argv in enumerate(argvs):
             sys.argv = ["gaitval", *argv]        # what a table's provenance records
-            print(f"$ {shlex.join(sys.argv)}", flush=True)   # the same step by hand
+            show = ["gaitval", *(shown[i] if shown else argv)]
+            print(f"$ {shlex.join(show)}", flush=True)        # the same step by hand
             args = copy.deepcopy(parser().parse_args(list(argv)))
             rc = run_verb(args.func, args)
             if rc:
@@ -186,6 +189,40 @@ def _write_log(log, tasks, results, processes, wall) -> None:
             lines.append(text.rstrip("\n"))
     Path(log).parent.mkdir(parents=True, exist_ok=True)
     Path(log).write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+@contextlib.contextmanager
+def staged(outdirs):
+    """Write a job's output folders atomically: the tasks write into ``<folder>.partial``
+    (``swap`` maps a word of a command line naming a path in a folder to the same path in
+    its ``.partial`` twin), and only when every task succeeded does each twin replace its
+    folder (a rename).  A job killed half-way leaves no folder that looks finished, whatever
+    Snakemake's own record of it."""
+    import os
+    import shutil
+
+    pairs = [(Path(d), Path(f"{d}.partial")) for d in outdirs]
+    for _, tmp in pairs:
+        shutil.rmtree(tmp, ignore_errors=True)
+        tmp.mkdir(parents=True)
+
+    def swap(word: str) -> str:
+        for final, tmp in pairs:
+            head = str(final)
+            if word == head or word.startswith(head + "/"):
+                return str(tmp) + word[len(head):]
+        return word
+
+    try:
+        yield swap
+    except BaseException:
+        for _, tmp in pairs:
+            shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    for final, tmp in pairs:
+        if final.exists():
+            shutil.rmtree(final)
+        os.replace(tmp, final)
 
 
 def by_size(tasks: list[Task], sizes: list[float]) -> list[Task]:

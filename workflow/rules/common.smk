@@ -155,16 +155,18 @@ def verb(*words):
 
 def run_trials(tasks, threads, log, sizes=None, outdirs=()):
     """Run a batch job's tasks (label, [verb, ...]) in the pool (gaitval.jobs.batch),
-    largest first when their ``sizes`` are given; ``outdirs``: the job's `directory()`
-    outputs, made first (a study with no trial of the stage gets an empty one)."""
-    from gaitval.jobs.batch import Task, by_size, run_batch, run_verbs
+    largest first when their ``sizes`` are given.  ``outdirs``: the job's `directory()`
+    outputs, written atomically (gaitval.jobs.batch.staged: the tasks write into a
+    `.partial` twin that replaces the folder when all succeeded)."""
+    from gaitval.jobs.batch import Task, by_size, run_batch, run_verbs, staged
 
-    for d in outdirs:
-        Path(d).mkdir(parents=True, exist_ok=True)
-    tasks = [Task(label, run_verbs, {"argvs": argvs}) for label, argvs in tasks]
-    if sizes is not None:
-        tasks = by_size(tasks, sizes)
-    run_batch(tasks, threads, log)
+    with staged(outdirs) as swap:
+        tasks = [Task(label, run_verbs, {"argvs": [[swap(w) for w in argv] for argv in argvs],
+                                         "shown": argvs})
+                 for label, argvs in tasks]
+        if sizes is not None:
+            tasks = by_size(tasks, sizes)
+        run_batch(tasks, threads, log)
 
 
 def run_verb_job(argv, log):
