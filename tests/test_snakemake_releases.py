@@ -26,19 +26,22 @@ def snakemake_8() -> Path:
     """``.venv-snakemake8/bin/snakemake`` at :data:`SNAKEMAKE_8`, made if missing."""
     py = VENV_8 / "bin" / "python"
     check = [str(py), "-c", "import snakemake, gaitval; print(snakemake.__version__)"]
+    # (from another folder than the checkout: gaitval must come from the venv, not cwd)
     if py.exists():
-        got = subprocess.run(check, capture_output=True, text=True)
+        got = subprocess.run(check, capture_output=True, text=True, cwd="/")
         if got.returncode == 0 and got.stdout.strip() == SNAKEMAKE_8:
             return VENV_8 / "bin" / "snakemake"
     subprocess.run([sys.executable, "-m", "venv", "--clear", str(VENV_8)], check=True)
     own = subprocess.run([str(py), "-c", "import sysconfig; "
                           "print(sysconfig.get_paths()['purelib'])"],
                          capture_output=True, text=True, check=True).stdout.strip()
-    # after its own site-packages: this venv's (numpy, pandas, gaitval, ...)
-    Path(own, "zz-gaitval-venv.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+    # after its own site-packages: this venv's (numpy, pandas, gaitval, ...), as a site
+    # folder, so that its own .pth files (gaitval's editable install) count too
+    Path(own, "zz-gaitval-venv.pth").write_text(
+        f"import site; site.addsitedir({sysconfig.get_paths()['purelib']!r})\n")
     subprocess.run([str(py), "-m", "pip", "install", "--quiet", f"snakemake=={SNAKEMAKE_8}"],
                    check=True, timeout=900)
-    got = subprocess.run(check, capture_output=True, text=True, check=True)
+    got = subprocess.run(check, capture_output=True, text=True, check=True, cwd="/")
     assert got.stdout.strip() == SNAKEMAKE_8, got
     return VENV_8 / "bin" / "snakemake"
 
@@ -48,7 +51,7 @@ def _run(snakemake: Path, work: Path, *extra: str) -> subprocess.CompletedProces
            "--profile", str(ROOT / "workflow" / "profiles" / "default"),
            "--directory", str(work), "--cores", "2", "--force-use-threads",
            "--config", 'run=["tiny"]', f"data_dir={work / 'data'}", f"peer_results={PEER}", *extra]
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=1800)
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
 
 
 @pytest.fixture(scope="module")
