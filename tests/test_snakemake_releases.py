@@ -76,7 +76,7 @@ def test_the_tiny_study_on_both_releases_gives_the_same_tables(releases, tmp_pat
     for release in ("8", "9"):
         work = tmp_path / release
         res = _run(releases[release], work)
-        assert res.returncode == 0, (release, res.stderr[-4000:])
+        assert res.returncode == 0, (release, res.stdout[-3000:] + res.stderr[-3000:])
         found = sorted((work / "reports" / "tiny" / "tables").glob("*.csv"))
         assert len(found) >= 10, (release, found)
         tables[release] = {p.name: p.read_bytes() for p in found}
