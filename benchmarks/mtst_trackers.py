@@ -37,7 +37,7 @@ from tug_trackers import filterpy_loop  # noqa: E402
 from gaitval.detect import split_observations  # noqa: E402
 from gaitval.io.scanlog import read_scanlog  # noqa: E402
 from gaitval.methods import build_tracker, get_method  # noqa: E402
-from gaitval.steps_mtst import mat_lane  # noqa: E402
+from gaitval.pipeline.mtst import mat_lane  # noqa: E402
 from gaitval.evaluate.mtst_trial import DEFAULTS  # noqa: E402
 
 METHODS = ("mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed")

@@ -11,10 +11,10 @@ folder (a folder built by another command gets its ``report_config`` record rewr
 the rebuild command it names differs), then ``--repeat`` times more, each of which must
 find nothing to do; prints their wall and CPU times.  Then plans (``-n``) the rerun after a
 new value of one tracker method's parameter (``tracking.overrides.<method>``, default
-``tug_m1``'s ``occlusion__max_n``) and prints Snakemake's job counts per rule; the jobs it
-may plan are that method's ``track`` jobs, each tracking and evaluating one trial (the
-method and its reading variant, e.g. ``tug_m1_stance_first``), the config views and
-records, the TUG tables and the report.  Exits 1 when a rerun did work or the plan holds another rule or method.
+``tug_m3``'s ``occlusion__max_n``) and prints Snakemake's job counts per rule; the jobs it
+may plan are that method's ``track`` jobs, one per study, each tracking and evaluating
+every TUG trial (the method and its reading variant, e.g. ``tug_m3_stance_first``), the
+config views and records, the TUG tables and the report.  Exits 1 when a rerun did work or the plan holds another rule or method.
 
 Last line: ``rerun <folder>: nothing changed <median> s wall (bar 5 s); one method's
 parameter: <n> jobs, only its own: yes|no``.
@@ -72,7 +72,7 @@ def main() -> None:
     ap.add_argument("--directory", type=Path, required=True,
                     help="a run folder in which the report was built")
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--method", default="tug_m1")
+    ap.add_argument("--method", default="tug_m3")
     ap.add_argument("--param", default="occlusion__max_n")
     ap.add_argument("--value", default="7")
     args = ap.parse_args()
@@ -93,7 +93,7 @@ def main() -> None:
     for rule, n in counts.items():
         print(f"    {rule:16s} {n:5d}")
     # the methods whose tracks and evaluations are planned (output folder names)
-    methods = sorted(set(re.findall(r"^\s+output: \S+?/(?:track|evaluate)/([^/\s]+)/", out,
+    methods = sorted(set(re.findall(r"^\s+output: \S+?/(?:track|evaluate)/([^/\s,]+)", out,
                                     flags=re.M)))
     print(f"    methods rerun: {', '.join(methods) or 'none'}")
     own = (bool(counts) and set(counts) <= ALLOWED and bool(methods)

@@ -66,8 +66,8 @@ def cmd_simulate(a) -> int:
 
 def cmd_ingest(a) -> int:
     from gaitval.io.ingest import ingest_trial
-    from gaitval.io.trialsheet import load_trial_row
-    s = ingest_trial(load_trial_row(a.sheet, a.subjects, a.trial), a.out)
+    from gaitval.pipeline.steps import trial_row
+    s = ingest_trial(trial_row(a.sheet, a.subjects, a.trial), a.out)
     print(json.dumps(s, sort_keys=True, default=str))
     return 0
 
@@ -105,27 +105,27 @@ def cmd_peer(a) -> int:
 
 
 def cmd_register(a) -> int:
-    from gaitval.steps import register_step
+    from gaitval.pipeline.steps import register_step
     rec = register_step(a.ingest, a.sheet, a.subjects, a.trial, a.config, a.out)
     print(json.dumps(rec, sort_keys=True, default=str))
     return 0
 
 
 def cmd_registration_summary(a) -> int:
-    from gaitval.steps import registration_summary
+    from gaitval.pipeline.steps import registration_summary
     registration_summary(a.inputs, a.study, a.out_csv, a.out_stem, a.reports_dir,
                          a.config_hash)
     return 0
 
 
 def cmd_track(a) -> int:
-    from gaitval.steps import track_step
+    from gaitval.pipeline.steps import track_step
     track_step(a.sensor, a.sheet, a.subjects, a.trial, a.method, a.config, a.out)
     return 0
 
 
 def cmd_evaluate_tug(a) -> int:
-    from gaitval.steps import evaluate_tug_step
+    from gaitval.pipeline.steps import evaluate_tug_step
     s = evaluate_tug_step(a.track, a.groundtruth, a.registration, a.trial, a.method,
                           a.config, a.out)
     print(s.to_string(index=False))
@@ -133,7 +133,7 @@ def cmd_evaluate_tug(a) -> int:
 
 
 def cmd_export_tracks(a) -> int:
-    from gaitval.steps import export_tracks_step
+    from gaitval.pipeline.steps import export_tracks_step
     legs = None
     if a.legs:
         legs = dict(kv.split("=", 1) for kv in a.legs.split(",") if "=" in kv)
@@ -142,21 +142,21 @@ def cmd_export_tracks(a) -> int:
 
 
 def cmd_import_tracks(a) -> int:
-    from gaitval.steps import import_tracks_step
+    from gaitval.pipeline.steps import import_tracks_step
     import_tracks_step(a.tracks, a.sensor, a.registration, a.trial, a.method, a.out,
                        config_json=a.config, moving_sensor=a.moving_sensor)
     return 0
 
 
 def cmd_tug_tables(a) -> int:
-    from gaitval.steps import tug_tables_step
+    from gaitval.pipeline.steps import tug_tables_step
     tug_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir, a.config_hash,
                     methods=a.methods, configs=a.configs)
     return 0
 
 
 def cmd_ultrasonic_noise(a) -> int:
-    from gaitval.steps import ultrasonic_noise_step
+    from gaitval.pipeline.steps import ultrasonic_noise_step
     n = ultrasonic_noise_step(a.ingest, a.trials, a.config, a.out, a.table_stem,
                               a.reports_dir, a.config_hash)
     print(json.dumps(n, sort_keys=True))
@@ -164,19 +164,19 @@ def cmd_ultrasonic_noise(a) -> int:
 
 
 def cmd_ultrasonic_track(a) -> int:
-    from gaitval.steps import ultrasonic_track_step
+    from gaitval.pipeline.steps import ultrasonic_track_step
     ultrasonic_track_step(a.ingest, a.trial, a.config, a.noise, a.out)
     return 0
 
 
 def cmd_gait_parameters(a) -> int:
-    from gaitval.steps import gait_parameters_step
+    from gaitval.pipeline.steps import gait_parameters_step
     gait_parameters_step(a.track, a.ingest, a.sheet, a.subjects, a.trial, a.config, a.out)
     return 0
 
 
 def cmd_ultrasonic_tables(a) -> int:
-    from gaitval.steps import ultrasonic_tables_step
+    from gaitval.pipeline.steps import ultrasonic_tables_step
     ultrasonic_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir,
                            a.config_hash, config_json=a.config)
     return 0
@@ -387,7 +387,7 @@ def _add_ultrasonic_verbs(sub) -> None:
 def _add_mtst_verbs(sub) -> None:
     """The MTST study (seed 001): tracking, walking parameters and evaluation, Tables 1/3/4."""
     def run(a) -> int:
-        from gaitval import steps_mtst as S
+        from gaitval.pipeline import mtst as S
         if a.verb == "mtst-track":
             S.mtst_track_step(a.sensor, a.sheet, a.subjects, a.trial, a.method, a.config,
                               a.registration, a.out)
@@ -425,7 +425,7 @@ def _add_mtst_verbs(sub) -> None:
 def _add_rollator_verbs(sub) -> None:
     """The rollator study (seed 002): PF training, KF/PF tracking, evaluation, Tables I-II."""
     def run(a) -> int:
-        from gaitval import steps_rollator as S
+        from gaitval.pipeline import rollator as S
         if a.verb == "rollator-train":
             S.rollator_train_step(a.results, a.sheet, a.subjects, a.subject, a.config, a.out)
         elif a.verb == "rollator-track":
@@ -479,7 +479,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_ultrasonic_verbs(sub)
     _add_mtst_verbs(sub)
     _add_rollator_verbs(sub)
-    from gaitval.steps_legbench import add_legbench_verbs
+    from gaitval.pipeline.legbench import add_legbench_verbs
     add_legbench_verbs(sub)              # annotated recordings without mocap (issue 18)
 
     s = sub.add_parser("report", help="write reports/index.md and index.html")
@@ -498,8 +498,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 @functools.cache
 def parser() -> argparse.ArgumentParser:
-    """:func:`build_parser`, built once per process (~12 ms; a warm fork-server worker runs
-    hundreds of jobs)."""
+    """:func:`build_parser`, built once per process (~12 ms; a batch job's worker runs
+    the verbs of many trials, gaitval.jobs.batch)."""
     return build_parser()
 
 

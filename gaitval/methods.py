@@ -140,7 +140,7 @@ METHODS["rollator_pf"] = {
 # -- seed 001 (MTST), Table 3 definitions; everything but the detector's FS_U pattern and the
 # validation region is shared.  Δt = 0.05 s (§3.1): the loop's Δt is the period of the scans
 # it is given (dt_s None), and the MTST steps keep every n-th scan of a log so that the
-# period is mtst.scan_period_s = 0.05 s (gaitval.steps_mtst).  P0 is not given (GAP): the
+# period is mtst.scan_period_s = 0.05 s (gaitval.pipeline.mtst).  P0 is not given (GAP): the
 # first observation's own noise w_l/2 ≈ 0.05 m, and 0.5 m/s for a participant who stands.
 _SEED001 = "seed 001 (Yorozu et al., Sensors 2015, 15, 11151)"
 

@@ -204,7 +204,7 @@ def test_people_file_reads_but_is_refused_for_legs(tmp_path):
 
 def test_external_path_stays_inside_the_sheets_folder(tmp_path):
     from gaitval.errors import ConfigError
-    from gaitval.steps import external_track_path
+    from gaitval.pipeline.steps import external_track_path
 
     sheet = tmp_path / "study" / "trials.csv"
     sheet.parent.mkdir()
@@ -220,7 +220,7 @@ def test_import_step_empty_track_for_a_refused_registration_and_errors_by_file(t
     """A mocap-frame file of a trial whose registration was refused gives an empty track
     (its evaluation is not_registered); a file past the recording is one error naming it."""
     from gaitval.io.scanlog import write_scanlog
-    from gaitval.steps import import_tracks_step
+    from gaitval.pipeline.steps import import_tracks_step
     from gaitval.types import ScanSeries
 
     scans = ScanSeries(t=np.arange(20) * 0.025, ranges=np.full((20, 5), 2.0),
@@ -253,7 +253,7 @@ def test_converted_times_snap_to_the_scan_they_name():
 def test_rollator_tracks_in_the_mocap_frame_are_refused(tmp_path):
     """The rollator's laser moves: a file in the mocap frame cannot be brought to it with
     one pose, and the import says so naming the file and the trial."""
-    from gaitval.steps import import_tracks_step
+    from gaitval.pipeline.steps import import_tracks_step
 
     p = _csv(tmp_path, HEAD[:2] + ["# frame: mocap", HEAD[3]] + GOOD)
     with pytest.raises(FileFormatError) as exc:

@@ -182,7 +182,7 @@ def test_annotated_pair_starts_on_the_annotated_person_not_the_closest_pair():
 # -- the steps on the real bag -----------------------------------------------------------------
 @pytest.mark.realdata
 def test_track_and_evaluate_the_outdoor_bag_from_its_first_annotation(outdoor, tmp_path):
-    from gaitval.steps_legbench import legbench_evaluate_step, legbench_track_step
+    from gaitval.pipeline.legbench import legbench_evaluate_step, legbench_track_step
     path, (ann, _) = outdoor
     topics = {"annotation_topic": "/ground_truth_people_tracks", "scan_topic": "/scan_base2"}
     legbench_track_step(path, "tug_m1", tmp_path / "track.parquet", init="annotation",

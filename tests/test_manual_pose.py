@@ -71,7 +71,7 @@ def run(work: Path, sheet: Path, *extra: str) -> subprocess.CompletedProcess:
                             "subjects": str(sheet.parent / "subjects.csv")}},
         "run": [STUDY], "peer_results": ""}))
     cmd = [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(work),
-           "--cores", "2", "--configfile", str(cf), *extra]
+           "--cores", "2", "--force-use-threads", "--configfile", str(cf), *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
 
 

@@ -102,28 +102,3 @@ def test_track_trial_is_deterministic(scans_truth):
     assert a.equals(b)
 
 
-def test_methods_sharing_a_detector_detect_once_with_the_same_tracks(scans_truth,
-                                                                     monkeypatch):
-    """A process running many jobs (a warm fork-server worker) detects a trial's legs once per
-    detector: seed 000's three methods share theirs.  The tracks are those of a fresh
-    detection, and other scans or another detector parameter are detected anew."""
-    import dataclasses
-
-    from gaitval.detect.legpatterns import LegPatternDetector
-    from gaitval.track import kinds
-
-    scans, _ = scans_truth
-    fresh = {m: track_trial(scans, m, 0.1) for m in ("tug_m1", "tug_m2", "tug_m3")}
-    kinds._DETECTIONS.clear()
-    calls = []
-    real = LegPatternDetector.detect
-    monkeypatch.setattr(LegPatternDetector, "detect",
-                        lambda self, s, w: calls.append(1) or real(self, s, w))
-    for m in ("tug_m1", "tug_m2", "tug_m3", "tug_m1"):
-        assert track_trial(scans, m, 0.1).equals(fresh[m]), m
-    assert len(calls) == 1
-    track_trial(scans, "tug_m1", 0.1, {"overrides": {"detector__max_occluder_m": 0.2}})
-    assert len(calls) == 2
-    shifted = dataclasses.replace(scans, ranges=scans.ranges * 1.001)
-    track_trial(shifted, "tug_m1", 0.1)
-    assert len(calls) == 3

@@ -1,4 +1,4 @@
-"""The MTST steps (gaitval.steps_mtst) on the tiny simulated study: with mocap, on a trial
+"""The MTST steps (gaitval.pipeline.mtst) on the tiny simulated study: with mocap, on a trial
 sheet with annotations only (no mocap: poles from study.yaml, clock from the sheet), the
 bad inputs of issue 11 Scope 7, and the published values against the seed text."""
 from __future__ import annotations
@@ -13,8 +13,8 @@ import pytest
 import yaml
 
 from gaitval.errors import ConfigError, FileFormatError
-from gaitval.steps import ANALYSIS_SECTIONS, register_step, study_config
-from gaitval.steps_mtst import (keep_every, load_targets, mtst_evaluate_step,
+from gaitval.pipeline.steps import ANALYSIS_SECTIONS, register_step, study_config
+from gaitval.pipeline.mtst import (keep_every, load_targets, mtst_evaluate_step,
                                 mtst_tables_step, mtst_track_step)
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -178,7 +178,7 @@ def test_ingested_files_do_not_depend_on_where_the_study_folder_sits(tiny, tmp_p
     # the steps that have the sheet's row still name the C3D by its absolute path
     from gaitval.io.ingest import ingest_trial
     from gaitval.io.trialsheet import load_trial_sheet
-    from gaitval.steps import load_ingested
+    from gaitval.pipeline.steps import load_ingested
 
     moved = tmp_path / "elsewhere" / "tiny"
     shutil.copytree(tiny / "tiny", moved)

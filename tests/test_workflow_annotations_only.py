@@ -77,7 +77,7 @@ def build_study(out: Path, sim: Path | None = None) -> Path:
 
 def run_workflow(workdir: Path, configfile: Path, *extra: str) -> subprocess.CompletedProcess:
     cmd = [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(workdir),
-           "--cores", "2", "--configfile", str(configfile), *extra]
+           "--cores", "2", "--force-use-threads", "--configfile", str(configfile), *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
 
 

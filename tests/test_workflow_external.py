@@ -97,7 +97,7 @@ def positions_only(track: pd.DataFrame) -> pd.DataFrame:
 
 def snakemake(work: Path, *configfiles: Path) -> subprocess.CompletedProcess:
     cmd = [str(SNAKEMAKE), *TARGETS, "--snakefile", str(ROOT / "Snakefile"), "--directory",
-           str(work), "--cores", "2", "--configfile", *map(str, configfiles)]
+           str(work), "--cores", "2", "--force-use-threads", "--configfile", *map(str, configfiles)]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
 
 
@@ -279,7 +279,7 @@ def test_external_method_declared_wrongly_stops_at_start(tmp_path, where):
         words = ["study.yaml", "declared in the workflow config"]
     cf.write_text(yaml.safe_dump(doc))
     res = subprocess.run([str(SNAKEMAKE), "-n", "--snakefile", str(ROOT / "Snakefile"),
-                          "--directory", str(tmp_path), "--cores", "1", "--configfile",
+                          "--directory", str(tmp_path), "--cores", "1", "--force-use-threads", "--configfile",
                           str(cf)], capture_output=True, text=True, timeout=300)
     assert res.returncode != 0
     for w in words:

@@ -1,21 +1,25 @@
-"""How the workflow runs its jobs: locally in the warm fork server, sent from Snakemake's own
-job thread (workflow/rules/common.smk), or as the plain shell command -- with the same
-outputs, logs and error messages either way.
-
-One Snakemake run per mode on the tiny study's ingest step, one core: every trial's ingest,
-one trial with its C3D file overwritten by junk, that one last (``--prioritize`` the
-others, so by then the server that the run starts is listening).
-"""
+"""How the workflow runs its jobs (issue 38): one job per (study, stage[, method]) whose
+`run:` block runs each trial's gaitval verbs in a process pool of the rule's threads
+(gaitval.jobs.batch).  Here, on the tiny study's ingest (one job for its trials), one
+trial with its C3D file overwritten by junk: the job fails with one message naming the
+file, the trial and the problem, its log holds every trial's messages and the command
+that reruns each by hand, and its outputs are removed."""
 from __future__ import annotations
 
-import re
+import os
+import shlex
 import shutil
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pandas as pd
 import pytest
+
+from gaitval.errors import GaitvalError
+from gaitval.jobs.batch import BatchError, Task, by_size, run_batch, run_verbs
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = Path(sys.executable).parent / "snakemake"
@@ -29,104 +33,123 @@ def tiny_data(tmp_path_factory):
                     str(ROOT / "config" / "studies" / "tiny.yaml"), "--seed", "0",
                     "--out", str(data / "tiny")], check=True, capture_output=True, timeout=300)
     sheet = pd.read_csv(data / "tiny" / "trials.csv")
-    row = sheet.set_index("trial").loc[BAD]
-    (data / "tiny" / row["mocap_file"]).write_bytes(b"not a C3D file" * 100)
-    return data, sorted(sheet.loc[sheet["mocap_file"].notna(), "trial"])
+    return data, sheet
 
 
-def _run(tiny_data, tmp_path_factory, fork_server: bool):
-    data, trials = tiny_data
-    work = tmp_path_factory.mktemp(f"fork{int(fork_server)}")
+@pytest.fixture(scope="module")
+def bad_ingest(tiny_data, tmp_path_factory):
+    data, sheet = tiny_data
+    work = tmp_path_factory.mktemp("bad")
     shutil.copytree(data, work / "data")
-    good = [f"results/tiny/ingest/{t}/sensor.parquet" for t in trials if t != BAD]
+    row = sheet.set_index("trial").loc[BAD]
+    (work / "data" / "tiny" / row["mocap_file"]).write_bytes(b"not a C3D file" * 100)
     cmd = [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(work),
-           "--cores", "1", "--keep-going", "-p",
-           *good, f"results/tiny/ingest/{BAD}/sensor.parquet", "--prioritize", *good,
-           "--config", 'run=["tiny"]', f"data_dir={work / 'data'}", f"fork_server={fork_server}"]
+           "--cores", "2", "--force-use-threads", "results/tiny/ingest",
+           "--config", 'run=["tiny"]', f"data_dir={work / 'data'}"]
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
-    return work, trials, res
+    return work, res
 
 
-@pytest.fixture(scope="module")
-def with_server(tiny_data, tmp_path_factory):
-    return _run(tiny_data, tmp_path_factory, True)
-
-
-@pytest.fixture(scope="module")
-def without_server(tiny_data, tmp_path_factory):
-    return _run(tiny_data, tmp_path_factory, False)
-
-
-def test_jobs_go_to_the_server_from_snakemakes_thread(with_server):
-    work, trials, res = with_server
-    log = (work / "logs" / "forkserver.log").read_text()
-    ends = re.findall(r"^job \S+: exit (-?\d+), .*, via (\S+)$", log, re.M)
-    # the first jobs may run before the server has imported everything (the plain way);
-    # every job it ran came from Snakemake's thread, none through a shell and the client
-    assert ends, log
-    assert {via for _, via in ends} == {"snakemake"}, log
-    # the bad trial went last, to the server, and failed there
-    assert f"--trial {BAD} " in log.strip().splitlines()[-2] and ends[-1][0] == "1", log
-    # a dry run and the log show the rules' commands as before
-    assert re.search(r"forkclient\.py \S+ -- ingest --sheet", res.stdout + res.stderr)
-
-
-@pytest.mark.parametrize("mode", ["with_server", "without_server"])
-def test_a_failing_job_names_file_trial_and_problem(mode, request):
-    work, trials, res = request.getfixturevalue(mode)
+def test_a_failing_trial_names_file_trial_and_problem(bad_ingest):
+    work, res = bad_ingest
     out = res.stdout + res.stderr
     assert res.returncode != 0
-    job_log = (work / "logs" / "ingest" / "tiny" / f"{BAD}.log").read_text()
-    message = [line for line in job_log.splitlines() if "error" in line.lower()]
-    assert message and BAD in message[-1] and f"{BAD}.c3d" in message[-1], job_log
-    assert message[-1] in out                         # the log reaches Snakemake's output
-    assert "returned non-zero exit status 1" in out
-    assert not (work / "results" / "tiny" / "ingest" / BAD / "sensor.parquet").exists()
-
-def test_same_outputs_and_logs_with_and_without_the_server(with_server, without_server):
-    a, trials, _ = with_server
-    b, _, _ = without_server
-    for t in trials:
-        if t == BAD:
-            continue
-        for f in sorted((a / "results" / "tiny" / "ingest" / t).iterdir()):
-            assert f.read_bytes() == (b / f.relative_to(a)).read_bytes(), f
-        log = Path("logs") / "ingest" / "tiny" / f"{t}.log"
-        assert (a / log).read_text() == (b / log).read_text(), t
-    bad = Path("logs") / "ingest" / "tiny" / f"{BAD}.log"         # names the file: its folder
-    assert (a / bad).read_text().replace(str(a), "<run>") == \
-        (b / bad).read_text().replace(str(b), "<run>")
+    message = [ln for ln in out.splitlines() if ln.startswith("gaitval: error: ")]
+    assert message and f"[{BAD}]" in message[0] and f"{BAD}.c3d" in message[0], out[-3000:]
+    log = (work / "logs" / "ingest" / "tiny.log").read_text()
+    assert f"== {BAD}: FAILED: " in log and f"{BAD}.c3d" in log, log
+    assert not (work / "results" / "tiny" / "ingest").exists()   # the job's output removed
 
 
-def test_ctrl_c_stops_a_job_running_in_the_server(tmp_path):
-    """Ctrl-C (SIGINT to Snakemake) stops the jobs the server is running for it -- they are
-    in process groups of their own, which the terminal's signal does not reach -- instead of
-    letting them run to their end while Snakemake waits."""
-    import os
-    import signal
-    import time
+def test_the_log_gives_each_trials_command(tiny_data, tmp_path):
+    """A batch's log holds, per trial, the command that runs the same step by hand; run
+    by hand, it writes the same bytes."""
+    data, sheet = tiny_data
+    shutil.copytree(data, tmp_path / "data")
+    cmd = [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory",
+           str(tmp_path), "--cores", "2", "--force-use-threads", "results/tiny/ingest",
+           "--config", 'run=["tiny"]', f"data_dir={tmp_path / 'data'}"]
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr[-3000:]
+    log = (tmp_path / "logs" / "ingest" / "tiny.log").read_text()
+    trials = sorted(sheet.loc[sheet["mocap_file"].notna(), "trial"])
+    commands = [ln[2:] for ln in log.splitlines() if ln.startswith("$ gaitval ingest ")]
+    assert len(commands) == len(trials)
+    argv = shlex.split(commands[0])
+    trial = argv[argv.index("--trial") + 1]
+    out = tmp_path / "by_hand"
+    argv[argv.index("--out") + 1] = str(out)
+    subprocess.run([sys.executable, "-m", *argv], cwd=tmp_path, check=True,
+                   capture_output=True, timeout=300)
+    for f in sorted(out.iterdir()):
+        if f.name != "mocap.parquet":             # it names the C3D as the command gave it
+            assert f.read_bytes() == (tmp_path / "results" / "tiny" / "ingest" / trial
+                                      / f.name).read_bytes(), f
 
+
+def _fails(label):
+    raise GaitvalError(f"[file x.csv] trial {label}: broken")
+
+
+def _writes(path, text):
+    Path(path).write_text(text)
+
+
+def test_run_batch_stops_at_the_first_failure_and_says_which(tmp_path):
+    tasks = [Task("a", _writes, {"path": tmp_path / "a.txt", "text": "a"}),
+             Task("b", _fails, {"label": "b"})]
+    with pytest.raises(BatchError, match=r"\[b\] \[file x.csv\] trial b: broken"):
+        run_batch(tasks, 2, tmp_path / "batch.log")
+    log = (tmp_path / "batch.log").read_text()
+    assert "== b: FAILED: [file x.csv] trial b: broken" in log
+
+
+def test_run_batch_runs_every_task_and_logs_by_label(tmp_path):
+    tasks = by_size([Task(f"t{i}", _writes, {"path": tmp_path / f"{i}.txt", "text": str(i)})
+                     for i in range(5)], sizes=[1, 5, 3, 2, 4])
+    assert [t.label for t in tasks] == ["t1", "t4", "t2", "t3", "t0"]   # largest first
+    run_batch(tasks, 2, tmp_path / "batch.log")
+    assert sorted(p.read_text() for p in tmp_path.glob("*.txt")) == list("01234")
+    labels = [ln for ln in (tmp_path / "batch.log").read_text().splitlines()
+              if ln.startswith("== ")]
+    assert labels == [f"== t{i}" for i in range(5)]
+
+
+def test_a_usage_error_of_a_verb_fails_its_task(tmp_path):
+    with pytest.raises(BatchError, match=r"\[x\] unrecognized arguments: --no-such-option"):
+        argv = ["ingest", "--sheet", "s.csv", "--trial", "t", "--out", "o", "--no-such-option"]
+        run_batch([Task("x", run_verbs, {"argvs": [argv]})], 1, tmp_path / "batch.log")
+
+
+def test_ctrl_c_stops_a_batch_job(tiny_data, tmp_path):
+    """Ctrl-C (SIGINT to Snakemake's process group, as a terminal sends it) stops a batch
+    job's workers too: nothing keeps running once Snakemake has exited."""
+    data, _ = tiny_data
+    shutil.copytree(data, tmp_path / "data")
     cmd = [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(tmp_path),
-           "--cores", "2", "--config", 'run=["tiny"]', f"data_dir={tmp_path / 'data'}"]
+           "--profile", str(ROOT / "workflow" / "profiles" / "default"),
+           "--cores", "2", "--force-use-threads", "--config", 'run=["tiny"]', f"data_dir={tmp_path / 'data'}"]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    log = tmp_path / "logs" / "forkserver.log"
-    job = None
+                            start_new_session=True)
     deadline = time.time() + 300
     try:
-        # the ultrasonic tables: the tiny study's longest job (~3 s)
-        while job is None and proc.poll() is None and time.time() < deadline:
+        # the registration: its batch runs for a few seconds
+        while not (tmp_path / "results" / "tiny" / "register").is_dir():
+            assert proc.poll() is None and time.time() < deadline, "no registration started"
             time.sleep(0.05)
-            text = log.read_text() if log.is_file() else ""
-            m = re.search(r"^job (\S+): gaitval ultrasonic-tables ", text, re.M)
-            if m and f"job {m.group(1)}: exit" not in text:
-                job = m.group(1)
-        assert job is not None, "the run ended before its ultrasonic tables started"
-        os.kill(proc.pid, signal.SIGINT)
-        rc = proc.wait(timeout=60)
+        os.killpg(proc.pid, signal.SIGINT)
+        rc = proc.wait(timeout=120)
     finally:
         if proc.poll() is None:
-            proc.kill()
+            os.killpg(proc.pid, signal.SIGKILL)
     assert rc != 0
-    end = re.search(rf"^job {re.escape(job)}: exit (-?\d+),", log.read_text(), re.M)
-    assert end and end.group(1) != "0", "the running job was stopped, not finished"
+    # the pool's workers and forkserver end when they see Snakemake gone (their pipes to
+    # it closed): give them a moment on a loaded machine
+    left = "?"
+    for _ in range(60):
+        left = subprocess.run(["pgrep", "-a", "-s", str(proc.pid)], capture_output=True,
+                              text=True).stdout.strip()
+        if not left:
+            break
+        time.sleep(0.5)
+    assert left == "", f"processes left running: {left}"

@@ -2,7 +2,7 @@
 
 :func:`evaluate_mtst_trial` takes objects (the track, the sensor pose, the trial's
 targets, annotations, clock and, where there is one, the mocap truth) and returns tidy
-tables; :mod:`gaitval.steps_mtst` reads and writes the files.  :data:`DEFAULTS` is the
+tables; :mod:`gaitval.pipeline.mtst` reads and writes the files.  :data:`DEFAULTS` is the
 ``mtst:`` section of the config with every default (``workflow/schemas``; the rules and
 their reasons are in :mod:`gaitval.gait.mtst`, :mod:`gaitval.evaluate.mtst` and
 :mod:`gaitval.evaluate.mtst_tracking`).

@@ -4,7 +4,7 @@ judgement and cross-step detection.
 Inputs are plain arrays or the tidy track table of :func:`gaitval.methods.track_trial`
 (one row per scan and side: ``k, t_sensor_s, side, x_m, y_m, vx_mps, vy_mps, swing, ...``);
 positions may be in any planar frame as long as the targets, the walking direction and the
-contacts share it (the pipeline uses the field frame, :mod:`gaitval.steps_mtst`).
+contacts share it (the pipeline uses the field frame, :mod:`gaitval.pipeline.mtst`).
 
 Foot contact (§2.5.1)
     "the foot contact time is extracted as the time when the leg speed is at a minimum value

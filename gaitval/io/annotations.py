@@ -22,7 +22,6 @@ Columns (header row required; order free):
 """
 from __future__ import annotations
 
-import copy
 import io
 from pathlib import Path
 
@@ -32,7 +31,6 @@ import pandas as pd
 from gaitval.errors import FileFormatError
 from gaitval.io.atomic import write_text
 from gaitval.io.guard import loader, number
-from gaitval.io.filememo import FileMemo
 
 MAGIC = "# gaitval-annotations v1"
 COLUMNS = ["t_s", "event", "side", "target", "value", "rater"]
@@ -56,9 +54,6 @@ def write_annotations(path: str | Path, events: pd.DataFrame, *, time_base: str 
     return write_text(path, "\n".join(head) + "\n" + body)
 
 
-#: Annotation files read in this process (the four MTST methods of a trial read the same
-#: one), by file identity; a caller gets its own copy.
-_READ = FileMemo(32 * 2 ** 20)
 
 
 @loader("annotation file")
@@ -74,9 +69,7 @@ def read_annotations(path: str | Path, *, trial: str | None = None
     meta : dict
         The ``# key: value`` header.
     """
-    events, meta = _READ.fetch(_READ.key(path), lambda: _read_annotations(Path(path), trial),
-                               lambda got: int(got[0].memory_usage(deep=True).sum()))
-    return events.copy(deep=True), copy.deepcopy(meta)
+    return _read_annotations(Path(path), trial)
 
 
 def _read_annotations(path: Path, trial: str | None) -> tuple[pd.DataFrame, dict]:

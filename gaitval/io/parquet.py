@@ -5,8 +5,7 @@ calling thread: for the small files of a run (a track, a trial's ground truth, o
 a summary) it costs about half of ``pandas.read_parquet`` (which goes through pyarrow's
 dataset layer and its thread pool: 2.2 against 1.3 ms for a 800-row track).  The values
 and dtypes are those of ``pandas.read_parquet`` (the same ``Table.to_pandas`` with the
-pandas metadata).  Tables are immutable, so a warm worker keeps the last ones it read
-(:class:`~gaitval.io.filememo.FileMemo`, 128 MB) and hands each caller a new DataFrame.
+pandas metadata).
 """
 from __future__ import annotations
 
@@ -14,31 +13,20 @@ import os
 
 import pandas as pd
 
-from gaitval.io.filememo import FileMemo
-
-#: Arrow tables read in this process, by file identity and column selection.
-TABLES = FileMemo(128 * 2 ** 20)
-
 
 def read_table(path: str | os.PathLike, columns: list[str] | None = None, *,
-               pandas_metadata: bool = False, remember: bool = True):
+               pandas_metadata: bool = False):
     """The ``pyarrow.Table`` of a Parquet file (``columns``: only these).
 
     ``pandas_metadata``: also read the index columns the pandas metadata names (as
-    ``pandas.read_parquet`` does).  ``remember``: keep the table in :data:`TABLES` (a
-    reader that remembers what it builds from the table says False).  Raises what pyarrow
-    raises (OSError, ArrowInvalid): the callers name the file in their own error.
+    ``pandas.read_parquet`` does).  Raises what pyarrow raises (OSError, ArrowInvalid):
+    the callers name the file in their own error.
     """
     import pyarrow.parquet as pq
 
-    def read():
-        with pq.ParquetFile(path) as pf:
-            return pf.read(columns=columns, use_threads=False,
-                           use_pandas_metadata=pandas_metadata)
-
-    key = (TABLES.key(path, None if columns is None else tuple(columns), pandas_metadata)
-           if remember else None)
-    return TABLES.fetch(key, read, lambda tab: tab.nbytes)
+    with pq.ParquetFile(path) as pf:
+        return pf.read(columns=columns, use_threads=False,
+                       use_pandas_metadata=pandas_metadata)
 
 
 def read_parquet(path: str | os.PathLike, columns: list[str] | None = None) -> pd.DataFrame:

@@ -31,7 +31,6 @@ Reading it without gaitval::
 """
 from __future__ import annotations
 
-import copy
 import json
 from pathlib import Path
 
@@ -40,7 +39,6 @@ import pandas as pd
 
 from gaitval.errors import FileFormatError
 from gaitval.io.atomic import atomic_path
-from gaitval.io.filememo import FileMemo
 from gaitval.io.guard import (column_kind, column_names, enough_rows, json_meta, loader,
                               number, text_field, version_field)
 from gaitval.types import ScanSeries
@@ -76,9 +74,6 @@ def check_scan_geometry(where: str, n_beams: int, angle_min: float, angle_increm
         raise FileFormatError(f"{where}: time_increment is {time_increment!r} s; over "
                               f"{n_beams} beams a scan must take a finite time of at most "
                               f"{MAX_SWEEP_S:g} s", path=path, trial=trial)
-#: Scan logs read in this process (a warm worker runs every method of a trial: seed 000's
-#: six tracks read the same log), by file identity; a caller gets its own copy.
-_READ = FileMemo(256 * 2 ** 20)
 
 
 def clean_ranges(ranges: np.ndarray, range_min: float, range_max: float
@@ -170,11 +165,7 @@ def read_scanlog(path: str | Path, *, trial: str | None = None) -> ScanSeries:
         timestamp), non-finite timestamps, or a ``ranges`` column whose length does not
         match ``n_beams`` or whose type does not match ``range_unit``.
     """
-    path = Path(path)
-    series = _READ.fetch(_READ.key(path, str(path)),           # str(path): the series' source
-                         lambda: _read_scanlog(path, trial),
-                         lambda got: got.ranges.nbytes + got.t.nbytes)
-    return copy.deepcopy(series)
+    return _read_scanlog(Path(path), trial)
 
 
 def _read_scanlog(path: Path, trial: str | None) -> ScanSeries:
@@ -183,7 +174,7 @@ def _read_scanlog(path: Path, trial: str | None) -> ScanSeries:
     if not path.is_file():
         raise FileFormatError("scan log not found", path=path, trial=trial)
     try:
-        tab = read_table(path, remember=False)
+        tab = read_table(path)
     except Exception as exc:  # noqa: BLE001 - pyarrow: ArrowInvalid, OSError, ...
         raise FileFormatError(f"not a readable Parquet scan log: {exc}", path=path,
                               trial=trial) from None

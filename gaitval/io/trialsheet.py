@@ -14,20 +14,16 @@ topic for every ROS bag.  It returns *every* problem (``gaitval validate`` lists
 :func:`load_trial_sheet` raises them as one :class:`~gaitval.errors.TrialSheetError`, each
 naming the file, the row (line number and trial id) and the column.
 
-A process that runs many jobs (a warm worker of :mod:`gaitval.forkserver`) validates a
-trial's row and a subject table once: :func:`load_trial_row` (without the file checks), the
-subject-table validation and the parsed CSVs are remembered under the files' contents
-(SHA-1 of the sheet, the subject table and the ``study.yaml`` beside the sheet), so an
-edited file is read and validated again and an invalid one raises every time.
+Every call reads and validates the files again (nothing is kept between calls): a caller
+that asks for many trials' rows keeps the validated sheet itself (:func:`clean_sheet`,
+:func:`row_of`; :func:`gaitval.pipeline.steps.trial_row`).
 """
 from __future__ import annotations
 
 import copy
 import difflib
-import hashlib
 import math
 import warnings
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -42,7 +38,6 @@ FALSE = {"false", "no", "0", "n", "f"}
 _YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)   # libyaml when built with it
 
 
-@lru_cache(maxsize=None)
 def load_schema(name: str) -> dict:
     """Load ``workflow/schemas/<name>.schema.yaml``."""
     path = SCHEMA_DIR / f"{name}.schema.yaml"
@@ -113,19 +108,8 @@ def _coerce(value: str, spec: dict):
 
 
 def _read_csv(path: Path, kind: str) -> pd.DataFrame:
-    """The table as strings; TrialSheetError when it is missing or not UTF-8 CSV.
-
-    A table read before (same path, same bytes) is a copy of what was parsed then: a job
-    of a warm worker that misses :func:`load_trial_row`'s memo still parses the sheet and
-    the subject table only once per worker (~2.5 ms each, hundreds of jobs).
-    """
-    key = _content_key(("csv", kind), [path])
-    hit = _MEMO.get(key) if key[2] is not None else None
-    if hit is None:
-        hit = _parse_csv(path, kind)
-        if key[2] is not None:
-            _remember(key, hit)
-    return hit.copy()
+    """The table as strings; TrialSheetError when it is missing or not UTF-8 CSV."""
+    return _parse_csv(path, kind)
 
 
 def _parse_csv(path: Path, kind: str) -> pd.DataFrame:
@@ -261,20 +245,8 @@ def _frame(records: list[dict], schema: dict, columns: list[str]) -> pd.DataFram
 
 def _subject_problems(path: Path, problems: list, only: str | None = None) -> pd.DataFrame:
     """The subject table's valid rows (index: subject; ``attrs['all_ids']``: every subject
-    named), its problems appended to ``problems``.  A table without problems is validated
-    once per process and contents (a copy of the result after that)."""
-    key = _content_key("subject_problems", [path], only)
-    hit = _MEMO.get(key) if key[2] is not None else None
-    if hit is None:
-        found: list = []
-        hit = _subject_frame(path, found, only)
-        problems.extend(found)
-        if found or key[2] is None:
-            return hit
-        _remember(key, hit)
-    df = hit.copy(deep=True)
-    df.attrs = copy.deepcopy(hit.attrs)
-    return df
+    named), its problems appended to ``problems``."""
+    return _subject_frame(path, problems, only)
 
 
 def _subject_frame(path: Path, problems: list, only: str | None) -> pd.DataFrame:
@@ -290,29 +262,6 @@ def _subject_frame(path: Path, problems: list, only: str | None) -> pd.DataFrame
     # subjects on rows with a problem still exist: the sheet's rows need not say so again
     df.attrs["all_ids"] = set(raw["subject"]) if "subject" in raw.columns else set(df.index)
     return df
-
-
-#: Parsed tables and validation results, by the files' contents (module docstring).
-_MEMO: dict[tuple, object] = {}
-_MEMO_MAX = 2048
-
-
-def _content_key(kind: str, paths, *rest) -> tuple:
-    """(kind, each file's resolved path and SHA-1 of its bytes or None, *rest)."""
-    key: list = [kind]
-    for p in paths:
-        p = Path(p).resolve()
-        try:
-            key += [str(p), hashlib.sha1(p.read_bytes()).digest()]
-        except OSError:
-            key += [str(p), None]
-    return (*key, *rest)
-
-
-def _remember(key: tuple, value) -> None:
-    if len(_MEMO) >= _MEMO_MAX:
-        _MEMO.clear()
-    _MEMO[key] = value
 
 
 def load_subjects(path: str | Path, only: str | None = None) -> pd.DataFrame:
@@ -341,15 +290,8 @@ def raise_all(problems: list[GaitvalError]) -> None:
 
 
 def _allows_outside(sheet: Path) -> bool:
-    """``allow_outside_paths: true`` in the study.yaml beside the sheet (remembered under
-    the file's contents)."""
-    cal = sheet.parent / "study.yaml"
-    key = _content_key("allows_outside", [cal])
-    if key in _MEMO:
-        return _MEMO[key]
-    value = _read_allows_outside(cal)
-    _remember(key, value)
-    return value
+    """``allow_outside_paths: true`` in the study.yaml beside the sheet."""
+    return _read_allows_outside(sheet.parent / "study.yaml")
 
 
 def _read_allows_outside(cal: Path) -> bool:
@@ -523,19 +465,26 @@ def load_trial_sheet(path: str | Path, subjects: str | Path | None = None, *,
 
 def _row_of_clean_sheet(path, subjects, trial: str, check_files: bool) -> dict | None:
     """``trial``'s row when the whole sheet, its subject table and study.yaml have no
-    problem (validated once per process and contents: ~35 ms for the default study's 127
-    rows, against ~13 ms for one row alone) and, with ``check_files``, the row's files
-    exist; else None, and :func:`load_trial_row` checks the row alone and names its
-    problems as before."""
+    problem (:func:`clean_sheet`) and, with ``check_files``, the row's files exist; else
+    None, and :func:`load_trial_row` checks the row alone and names its problems."""
+    return row_of(clean_sheet(path, subjects), path, trial, check_files)
+
+
+def clean_sheet(path, subjects) -> pd.DataFrame | None:
+    """The validated sheet (:func:`sheet_problems`, its files not checked) when it, its
+    subject table and study.yaml have no problem, else None.  ~35 ms for the default
+    study's 127 rows: a caller asking for many trials' rows keeps it
+    (:func:`gaitval.pipeline.steps.trial_and_subject`) and picks them with
+    :func:`row_of`."""
+    df, problems = sheet_problems(Path(path).resolve(), subjects, check_files=False)
+    return None if problems else df
+
+
+def row_of(clean: pd.DataFrame | None, path, trial: str, check_files: bool) -> dict | None:
+    """``trial``'s row of a :func:`clean_sheet` (a copy), None when there is none or, with
+    ``check_files``, one of its files is missing."""
     sheet = Path(path).resolve()
-    sub_path = Path(subjects) if subjects is not None else sheet.parent / "subjects.csv"
-    key = _content_key("clean_sheet", [sheet, sub_path, sheet.parent / "study.yaml"])
-    clean = _MEMO.get(key)
-    if clean is None:
-        df, problems = sheet_problems(sheet, subjects, check_files=False)
-        clean = False if problems else df
-        _remember(key, clean)
-    if clean is False or trial not in clean.index:
+    if clean is None or trial not in clean.index:
         return None
     row = copy.deepcopy(clean.loc[trial].to_dict())
     if check_files:
@@ -568,20 +517,9 @@ def load_trial_row(path: str | Path, subjects: str | Path | None, trial: str, *,
     row = _row_of_clean_sheet(path, subjects, trial, check_files)
     if row is not None:
         return row
-    key = None
-    if not check_files:                  # a file's existence may change: checked each time
-        sheet = Path(path).resolve()
-        key = _content_key("row", [sheet, subjects if subjects is not None
-                                   else sheet.parent / "subjects.csv",
-                                   sheet.parent / "study.yaml"], trial)
-        if key in _MEMO:
-            return copy.deepcopy(_MEMO[key])
     df, problems = sheet_problems(path, subjects, check_files=check_files, only=trial)
     raise_all(problems)
     if trial not in df.index:
         raise TrialSheetError(f"trial {trial!r} is not in the trial sheet", path=path,
                               trial=trial)
-    row = df.loc[trial].to_dict()
-    if key is not None:
-        _remember(key, copy.deepcopy(row))
-    return row
+    return df.loc[trial].to_dict()

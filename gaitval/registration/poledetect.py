@@ -74,16 +74,9 @@ def nanmedian0(a: np.ndarray) -> np.ndarray:
     return med
 
 
-_BACKGROUND: dict = {}
-
-
 def static_background(sensor: ScanSeries, cfg: dict | None = None
                       ) -> tuple[np.ndarray, np.ndarray]:
     """Per-beam median range and static fraction over the calibration window.
-
-    Registration asks for it up to three times per trial with the same window (pole
-    detection, pole registration, the clock's background): the last result is kept per
-    scan series and window, and copies are returned.
 
     Returns
     -------
@@ -92,13 +85,7 @@ def static_background(sensor: ScanSeries, cfg: dict | None = None
     static_fraction : ndarray (n_beams,)
         Fraction of scans within ``pole_static_tol_m`` of the median.
     """
-    c = pole_cfg(cfg)
-    key = (id(sensor), c["pole_window_s"], c["pole_max_scans"], c["pole_static_tol_m"])
-    hit = _BACKGROUND.get(key)
-    if hit is None or hit[0] is not sensor:
-        _BACKGROUND.clear()                                  # one scan series at a time
-        hit = _BACKGROUND[key] = (sensor, *_static_background(sensor, c))
-    return hit[1].copy(), hit[2].copy()
+    return _static_background(sensor, pole_cfg(cfg))
 
 
 def _static_background(sensor: ScanSeries, c: dict) -> tuple[np.ndarray, np.ndarray]:

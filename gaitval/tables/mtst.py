@@ -1,6 +1,6 @@
 """Seed 001 (MTST) Tables 1, 3 and 4, published values beside the reproduced ones.
 
-Inputs are the per-(trial, method) tables of :mod:`gaitval.steps_mtst` concatenated
+Inputs are the per-(trial, method) tables of :mod:`gaitval.pipeline.mtst` concatenated
 (``summary``, ``gates``), so this module only counts and renders.
 
 * ``mtst_table1``: the variable validation region — Table 1's four formulas, how often the

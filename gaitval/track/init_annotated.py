@@ -22,7 +22,7 @@ midpoint is nearest the annotated person position ``(x_m, y_m)`` at scan ``k``:
 The left leg is the one at the larger bearing (the ``closest_pair`` convention; the
 tracker may decide the sides from the walking direction afterwards).  The workflow sets
 ``k``, ``x_m`` and ``y_m`` from the trial's first annotation (``legbench.inits``
-``annotation``; :mod:`gaitval.steps_legbench`).
+``annotation``; :mod:`gaitval.pipeline.legbench`).
 
 References
 ----------

@@ -34,7 +34,7 @@ from the first scan to the last.  ``require_motion: false`` gives the rule above
 
 ``lane`` is the centreline ``[[x_start, y_start], [x_goal, y_goal]]`` *in the sensor
 frame*: a trial's value comes from the registered sensor pose and the mat geometry
-(``mtst.mat`` in the config; :mod:`gaitval.steps_mtst` sets it as the override
+(``mtst.mat`` in the config; :mod:`gaitval.pipeline.mtst` sets it as the override
 ``init__lane``).  Without it the sensor's own x axis is the lane (any direction, no
 limits along it), the sensor standing on the mat's axis (seed 001 Figure 1a) — reliable
 only when the sensor's yaw is known to within a degree or two, since 3° at 7 m is 0.37 m

@@ -356,8 +356,8 @@ def warm_up() -> None:
     numba's cache, on a tiny problem: a transmitter in front of four coplanar receivers,
     one range missing.
 
-    Called where :func:`gaitval.track.pf.warm_up` is (the fork server before it forks its
-    workers; ``run.py`` after installing), with the argument types of :meth:`ToaUkf.track`,
+    Called where :func:`gaitval.track.pf.warm_up` is (a batch job's pool before it forks
+    its workers, ``gaitval/jobs/preload.py``; ``run.py`` after installing), with the argument types of :meth:`ToaUkf.track`,
     so a track afterwards finds its specialisation (tests/test_ukf.py checks it adds none).
     """
     anchors = np.array([[0.0, 0.0, 0.0], [0.3, 0.0, 0.0], [0.0, 0.2, 0.0], [0.3, 0.2, 0.0]])

@@ -23,9 +23,12 @@ from pathlib import Path
 
 
 def files_under(root: Path) -> set[str]:
+    """Every file under ``root`` but Snakemake's own marker of a `directory()` output
+    (``.snakemake_timestamp``: when the job ended)."""
     if not root.is_dir():
         return set()
-    return {str(p.relative_to(root)) for p in root.rglob("*") if p.is_file()}
+    return {str(p.relative_to(root)) for p in root.rglob("*")
+            if p.is_file() and p.name != ".snakemake_timestamp"}
 
 
 def compare_tree(a: Path, b: Path) -> tuple[list[str], list[str], list[str], list[str]]:

@@ -60,14 +60,13 @@ else
 fi
 
 # --- SLURM run --------------------------------------------------------------------------
-# A --config on the command line replaces the profile's `config:` list, so fork_server=False
-# is given again.  A short first status check: the tiny study's jobs take seconds.
+# A short first status check: the tiny study's jobs take seconds.
 SL="$OUT/slurm"
 rm -rf "$SL"; mkdir -p "$SL/work"
 echo "== SLURM run (profile slurm) -> $SL"
 t0=$(date +%s)
 nice -n 10 "$SM" -s "$REPO/Snakefile" --directory "$SL/work" --profile "$PROFILE" \
-    --config 'run=["tiny"]' fork_server=False "results_dir=$SL/results" "reports_dir=$SL/reports" \
+    --config 'run=["tiny"]' "results_dir=$SL/results" "reports_dir=$SL/reports" \
     --slurm-init-seconds-before-status-checks 5 "${EXTRA[@]}" \
     --slurm-logdir "$SL/slurm-logs" --slurm-keep-successful-logs \
     > "$OUT/slurm.log" 2>&1 || { echo "SLURM run failed, tail of $OUT/slurm.log:"; tail -n 40 "$OUT/slurm.log"; exit 1; }
@@ -78,14 +77,14 @@ echo "SLURM wall time: $wall s"
 echo "Snakemake jobs run locally by the main Snakemake (localrules): $(grep -c "^localrule " "$OUT/slurm.log" || true)"
 echo "slurmctld job completion log: $(grep -c "JobState=COMPLETED" "$GAITVAL_SLURM_DIR/jobcomp.log" || true) COMPLETED, $(grep -v -c "JobState=COMPLETED" "$GAITVAL_SLURM_DIR/jobcomp.log" || true) other"
 "$PY" "$REPO/tests/cluster/slurm_job_report.py" "$OUT/slurm.log"
-# No SLURM job ran in a fork server: jobs either run `python -m gaitval` or go through
-# gaitval/forkclient.py, which runs `python -m gaitval` itself when no server listens -- and
-# none was started for this run (no logs/forkserver.log in its working directory).
-plain=$(grep -rh "^Shell command: " "$SL/slurm-logs" | grep -c -- " -m gaitval " || true)
-client=$(grep -rh "^Shell command: " "$SL/slurm-logs" | grep -c "forkclient.py" || true)
-echo "job commands: $plain plain 'python -m gaitval', $client via forkclient.py"
-if [ -s "$SL/work/logs/forkserver.log" ]; then
-    echo "ERROR: a fork server ran for the SLURM run ($SL/work/logs/forkserver.log)"; exit 1
+# Every batch job ran its trials in its own process pool on the node: each batch job's log
+# (logs/<rule>/...) starts with "N task(s) in P process(es)".
+batches=$(grep -rl "task(s) in [0-9]* process(es)" "$SL/work/logs" | wc -l)
+echo "batch job logs: $batches"
+[ "$batches" -gt 0 ] || { echo "ERROR: no batch job log in $SL/work/logs"; exit 1; }
+# sacct (with GAITVAL_SLURM_DBD=1): every job of the run, its state and elapsed time
+if [ "${GAITVAL_SLURM_DBD:-0}" = 1 ]; then
+    sacct --allusers --format=JobID,JobName%40,State,Elapsed,MaxRSS,AllocCPUS -X | tee "$OUT/sacct.txt"
 fi
 
 # --- byte-for-byte comparison ----------------------------------------------------------

@@ -15,7 +15,7 @@ from gaitval.errors import ConfigError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash
 from gaitval.methods import METHODS, get_method, override_problems, set_params
-from gaitval.steps import (ALL_SCOPE, ANALYSIS_SECTIONS, PROTOCOL_SCOPE, SCOPES, STUDY_VIEW,
+from gaitval.pipeline.steps import (ALL_SCOPE, ANALYSIS_SECTIONS, PROTOCOL_SCOPE, SCOPES, STUDY_VIEW,
                            method_definition, method_view)
 from gaitval.tables.tug_evidence import method_reading
 
@@ -117,159 +117,73 @@ PRESETS = Path(workflow.basedir) / "config" / "studies"
 RUN_NAME = "+".join(config["run"])
 REPORTS_ROOT = config.get("reports_dir", "reports")
 REPORTS = f"{REPORTS_ROOT}/{RUN_NAME}"
-# The library is called as `python -m gaitval` with the interpreter running Snakemake, so
-# rules work whether or not the venv's bin/ is on PATH.
-_METHODS = getattr(getattr(workflow, "deployment_settings", None), "deployment_method", ())
-_CONDA = any(str(m).lower().endswith("conda") for m in _METHODS)
-GV = (
-    "python -m gaitval"
-    if _CONDA
-    else f"{shlex.quote(sys.executable)} -m gaitval"  # a checkout path with a space
-)
-# Local runs: the rules' jobs run in a warm fork server (workflow/rules/forkserver.smk,
-# gaitval/forkserver.py) instead of each starting Python and importing numpy, pandas,
-# scipy and gaitval again.  Same verbs, same arguments, same files; one job per trial as
-# before.  Every rule's command calls gaitval through the small client
-# (gaitval/forkclient.py); locally, with the server listening, the workflow's `shell` (below)
-# hands the job to the server itself and neither bash nor the client runs.  Where no server
-# listens -- `fork_server: false`, a cluster executor, a job on a compute node -- the client
-# runs the plain `python -m gaitval`.  So GV, a parameter of every rule, is one
-# string whatever the mode and from run to run (the socket path depends only on the working
-# directory): switching the server on or off, a new run, or a cluster job that records its
-# own params reruns nothing.  The server is started only by a local, non-dry run
-# (forkserver.smk).  Under conda deployment the plain command is used.
-FORK_SERVER = bool(config.get("fork_server", True)) and not _CONDA
-if not _CONDA:
-    import hashlib as _hashlib
-    import os as _os
-    import tempfile as _tempfile
-
-    _WORKDIR_KEY = _hashlib.sha256(str(Path.cwd().resolve()).encode()).hexdigest()[:16]
-    FORK_SOCKET = f"{_tempfile.gettempdir()}/gaitval-{_os.getuid()}/{_WORKDIR_KEY}.sock"
-    GV = (
-        f"{shlex.quote(sys.executable)} -I -S "
-        f"{shlex.quote(str(Path(workflow.basedir) / 'gaitval' / 'forkclient.py'))} "
-        f"{shlex.quote(FORK_SOCKET)} --"
-    )
-# Local jobs without a shell.  Every gaitval step's `shell` command reads
-# "{params.gv} VERB ARGS > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)" (or with `{log}`), or
-# chains steps: "{params.gv} A > {log:q} 2>&1 && {params.gv} B >> {log:q} 2>&1 || (...)"
-# (a trial's tracking and its evaluation: one job instead of two, issue 13).
-# With the fork server listening, the `shell` below sends VERB ARGS to it straight from
-# Snakemake's job thread (gaitval.forkclient.submit), standard output and error to the log:
-# no bash and no client process, which cost ~10 ms of CPU a job, ~11 CPU-s over the ~1,100
-# jobs of the default report (issue 13; benchmarks/report_end_to_end.py).  Anything else --
-# no server yet or any more, `fork_server: false`, a cluster job, conda deployment, another
-# command -- goes to Snakemake's own shell() unchanged.  The rules keep their `shell:`
-# directives, so a dry run (-n -p) and the log show the very commands, Snakemake's code
-# trigger sees the same text, and on a cluster nothing differs.  (Snakemake's compiled
-# `shell:` rules call the name `shell` of the Snakefile's namespace; should a later
-# Snakemake not, every job simply takes the shell and the client again.)
-from snakemake.shell import shell as _snakemake_shell
-
-_GV_HEAD = "{params.gv} "
+# HOW JOBS RUN (issue 38; docs/speed.md).  One Snakemake job per (study, stage) or
+# (study, stage, method), not per trial: its `run:` block hands the trials to
+# gaitval.jobs.batch.run_batch, which runs each trial's gaitval verbs (the CLI's, with
+# the same arguments as `python -m gaitval VERB ...` by hand) in a process pool of the
+# rule's `threads`, forked from the standard library's forkserver that imported numpy,
+# pandas, scipy and gaitval once.  Every trial still writes its own files, in the same
+# places; a job's outputs are the stage's folders (`directory()`), and its log lists every
+# trial's messages.  The simulation runs through Snakemake's `shell:`, with GV, the
+# interpreter running Snakemake (so a venv's bin/ need not be on PATH).
+GV = f"{shlex.quote(sys.executable)} -m gaitval"   # a checkout path with a space
 
 
-def _gv_steps(cmd):
-    """The gaitval steps (VERB ARGS, unformatted) of a rule's command of the forms above,
-    in order; None for any other command."""
-    if not cmd.startswith(_GV_HEAD):
-        return None
-    for q in (":q", ""):
-        fail = f" || (cat {{log{q}}} >&2; exit 1)"
-        if not cmd.endswith(fail):
-            continue
-        steps = []
-        for i, part in enumerate(cmd[len(_GV_HEAD):-len(fail)].split(f" && {_GV_HEAD}")):
-            redirect = f" {'>' if i == 0 else '>>'} {{log{q}}} 2>&1"
-            if not part.endswith(redirect) or "{params.gv}" in part:
-                return None
-            steps.append(part[:-len(redirect)])
-        return steps
-    return None
-
-# what a rule function hands on to Snakemake's shell() (conda env, container, job id, ...)
-_SHELL_CONTEXT = ("conda_env", "conda_base_path", "container_img", "env_modules",
-                  "shadow_dir", "resources", "singularity_args", "threads", "runtime_paths",
-                  "jobid", "is_shell")
-# what Snakemake's shell() puts in a job's environment: its thread count for the numeric
-# libraries (the fork server's job gets the same environment)
-_THREAD_VARS = ("OMP_NUM_THREADS", "GOTO_NUM_THREADS", "OPENBLAS_NUM_THREADS",
-                "MKL_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
-
-
-class shell(_snakemake_shell):
-    """Snakemake's shell(), except that a gaitval step's command runs in the fork server
-    when one listens (see above)."""
-
-    def __new__(cls, cmd, *args, **kwargs):
-        from snakemake.common import RULEFUNC_CONTEXT_MARKER
-        from snakemake.utils import format as sm_format
-
-        ctx = sys._getframe(1).f_locals
-        from_rule = bool(ctx.get(RULEFUNC_CONTEXT_MARKER))
-        steps = _gv_steps(cmd) if FORK_SERVER and from_rule and not args else None
-        if steps and len(ctx["log"]) == 1:
-            # each step in turn, the first truncating the log and the others appending,
-            # as the shell would; no server (at the start or gone since): the whole
-            # command the shell's way (its steps write their outputs atomically)
-            for i, step in enumerate(steps):
-                rc = _in_fork_server(sm_format(step, stepout=2), str(ctx["log"][0]), ctx,
-                                     append=i > 0)
-                if rc != 0:
-                    break
-            if rc == 0:
-                return None
-            if rc is not None:
-                with open(str(ctx["log"][0]), errors="replace") as fh:
-                    sys.stderr.write(fh.read())                # what `cat log >&2` shows
-                import subprocess
-                raise subprocess.CalledProcessError(rc, sm_format(cmd, stepout=2))
-        # Snakemake's own, with the rule's context (it reads it from its caller's frame,
-        # which is now this one) and the command formatted in the caller's namespace
-        context = {k: ctx[k] for k in _SHELL_CONTEXT if k in ctx} if from_rule else {}
-        context.update(kwargs)
-        return _snakemake_shell.__new__(
-            cls, sm_format(cmd, *args, stepout=2, **kwargs).replace("{", "{{")
-            .replace("}", "}}"), **context)
-
-
-# The fork server's workers (process group leaders) running a job sent from here: Ctrl-C
-# is passed on to them (forkserver.smk), as the terminal passes it to a shell job.
-FORK_JOBS = set()
-
-
-def _in_fork_server(args, log, ctx, append=False):
-    """The job's exit code from the fork server, or None when none listens.  ``append``:
-    add to the log (a later step of a chain) instead of starting it."""
-    import os
-    import struct
-    from gaitval.forkclient import submit
-
-    env = dict(os.environ)
-    env.update(dict.fromkeys(_THREAD_VARS, str(ctx.get("threads", 1))))
-    tmp = (ctx.get("resources") or {}).get("tmpdir")
-    if tmp:
-        env.update(dict.fromkeys(("TMPDIR", "TMP", "TEMPDIR", "TEMP"), str(tmp)))
-    mode = os.O_APPEND if append else os.O_TRUNC
-    out = os.open(log, os.O_WRONLY | os.O_CREAT | mode | os.O_CLOEXEC, 0o666)
+def batch_threads():
+    """The threads of a batch rule: every core Snakemake has (--cores; a cluster job: its
+    cpus_per_task, set per rule by the profile)."""
     try:
-        nul = os.open(os.devnull, os.O_RDONLY | os.O_CLOEXEC)
-        workers = []
+        return max(1, int(workflow.cores))
+    except Exception:                  # cores not set (a dry run, --list): Snakemake's default
+        return 1
 
-        def started(pid):
-            workers.append(pid)
-            FORK_JOBS.add(pid)
 
-        try:
-            return submit(FORK_SOCKET, shlex.split(args), cwd=os.getcwd(), env=env,
-                          fds=struct.pack("3i", nul, out, out), via="snakemake",
-                          on_start=started)
-        finally:
-            FORK_JOBS.difference_update(workers)
-            os.close(nul)
-    finally:
-        os.close(out)
+BATCH_THREADS = batch_threads()
+
+
+def verb(*words):
+    """One gaitval verb's command line, as a list of words (nested lists flattened, so an
+    optional ``[flag, value]`` param goes in as is)."""
+    out = []
+    for w in words:
+        if isinstance(w, (list, tuple)):
+            out.extend(verb(*w))
+        else:
+            out.append(str(w))
+    return out
+
+
+def run_trials(tasks, threads, log, sizes=None, outdirs=()):
+    """Run a batch job's tasks (label, [verb, ...]) in the pool (gaitval.jobs.batch),
+    largest first when their ``sizes`` are given.  ``outdirs``: the job's `directory()`
+    outputs, written atomically (gaitval.jobs.batch.staged: the tasks write into a
+    `.partial` twin that replaces the folder when all succeeded)."""
+    from gaitval.jobs.batch import Task, by_size, run_batch, run_verbs, staged
+
+    with staged(outdirs) as swap:
+        tasks = [Task(label, run_verbs, {"argvs": [[swap(w) for w in argv] for argv in argvs],
+                                         "shown": argvs})
+                 for label, argvs in tasks]
+        if sizes is not None:
+            tasks = by_size(tasks, sizes)
+        run_batch(tasks, threads, log)
+
+
+def run_verb_job(argv, log):
+    """A job of one verb (a table, the report): in one process of the pool."""
+    run_trials([(argv[0], [argv])], 1, log)
+
+
+def size_of(path):
+    from gaitval.jobs.batch import file_size
+
+    return file_size(path)
+
+
+wildcard_constraints:
+    study=r"[^/]+",
+    method=r"[^/]+",
+    trial=r"[^/]+",
 
 
 # Hash of the analysis sections only: changing `run` or paths must not rerun the tables.
@@ -279,7 +193,7 @@ CONFIG_HASH = config_hash({k: config[k] for k in ANALYSIS_SECTIONS if k in confi
 
 def analysis_sections_json(view=None, scope=ALL_SCOPE):
     """The analysis sections as canonical JSON (sorted keys), or one view of them
-    (gaitval.steps.method_view): the params of rules study_config and config_view."""
+    (gaitval.pipeline.steps.method_view): the params of rules study_config and config_view."""
     sections = {k: config[k] for k in ANALYSIS_SECTIONS if k in config}
     if view is not None:
         sections = method_view(sections, view, scope)
@@ -321,7 +235,7 @@ def study_views(views, scope):
 def config_view_file(wildcards, scope=None):
     """Input function: the config view a job reads (made by the config_view rule), its
     {method}'s, or the study view for a job without a method, in the scope of its trial's
-    protocol (gaitval.steps.PROTOCOL_SCOPE) unless `scope` is given."""
+    protocol (gaitval.pipeline.steps.PROTOCOL_SCOPE) unless `scope` is given."""
     view = getattr(wildcards, "method", None) or STUDY_VIEW
     if scope is None:
         protocol = trial_row(wildcards.study, wildcards.trial)["protocol"]
@@ -433,17 +347,33 @@ def mocap_trial_ids(study):
     return [t for t in trial_ids(study) if has_mocap(study, t)]
 
 
-def ingest_inputs(wildcards):
-    """Raw files of one trial (the sheet too, so editing it reruns the trial)."""
-    row = trial_row(wildcards.study, wildcards.trial)
-    files = {
-        "sheet": sheet_path(wildcards.study),
-        "mocap": row["mocap_path"],
-        "sensor": row["sensor_path"],
-    }
-    if row["annotation_path"]:
-        files["annotations"] = row["annotation_path"]
+def trial_wildcards(study, trial, method=None):
+    """What a per-trial input function reads from its wildcards, for one trial of a batch
+    job (study, trial and, when given, method)."""
+    from types import SimpleNamespace
+
+    w = SimpleNamespace(study=study, trial=trial)
+    if method is not None:
+        w.method = method
+    return w
+
+
+def study_raw_files(study):
+    """The raw files of every trial with mocap (what `ingest` reads): a new or edited file
+    reruns the study's ingest."""
+    files = []
+    for t in mocap_trial_ids(study):
+        row = trial_row(study, t)
+        files += [p for p in (row["mocap_path"], row["sensor_path"], row["annotation_path"])
+                  if p]
     return files
+
+
+def trial_bytes(study, trial):
+    """A trial's raw mocap and sensor bytes: how long its steps take, roughly (a batch
+    starts the largest trials first)."""
+    row = trial_row(study, trial)
+    return sum(size_of(p) for p in (row["mocap_path"], row["sensor_path"]) if p)
 
 
 def report_items(wildcards):
@@ -504,7 +434,7 @@ EXTERNAL_PROTOCOLS = ("tug", "mtst")
 def external_tracks_file(wildcards):
     """Input function: the external method's track file of one trial (its path relative to
     the trial sheet's folder, {trial} replaced)."""
-    from gaitval.steps import external_track_path
+    from gaitval.pipeline.steps import external_track_path
 
     entry = config["tracking"]["external"][wildcards.method]
     return str(external_track_path(sheet_path(wildcards.study), entry, wildcards.trial,
@@ -525,4 +455,3 @@ def treadmill_trials():
     return [(s, t) for s in config["run"] for t in trial_ids(s, ["treadmill"])]
 
 
-include: "forkserver.smk"

@@ -1,43 +1,45 @@
 # External methods on the rollator (tracking.external.<m>.protocols: [rollator], issue 37):
 # another tracker's tracks of each rollator trial, in the laser's frame (the laser moves with
 # the rollator), converted to gaitval's per-scan track and evaluated like the KF and PF
-# (seed 002 Tables I-II get its columns and rows).  The TUG and MTST external rules are
-# track_external (tug.smk) and mtst_track_external (mtst.smk).
+# (seed 002 Tables I-II get its columns and rows).  One job per (study, method), its
+# trials in a process pool like rollator_track (HOW JOBS RUN in common.smk).  The TUG and
+# MTST external rules are track_external (tug.smk) and mtst_track_external (mtst.smk).
 ruleorder: rollator_track_external > rollator_track
 
 
 rule rollator_track_external:
     input:
-        tracks=external_tracks_file,
-        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
-        gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
-        reg=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
-        mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
-        config=config_view_file,
+        tracks=lambda w: [external_tracks_file(trial_wildcards(w.study, t, w.method))
+                          for t in trial_ids(w.study, ["rollator"])],
+        ingest=f"{RESULTS}/{{study}}/ingest",
+        register=f"{RESULTS}/{{study}}/register",
+        config=f"{RESULTS}/{{study}}/config_views/rollator/{{method}}.json",
         sheet=lambda w: sheet_path(w.study),
     output:
-        track=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}.track.parquet",
-        summary=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}/summary.parquet",
-        frames=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}/frames.parquet",
+        directory(f"{RESULTS}/{{study}}/rollator/{{method}}"),
     wildcard_constraints:
         study="[^/]+",
-        trial="[^/]+",
         method="|".join(re.escape(m) for m in external_methods("rollator")) or "(?!x)x",
+    threads: BATCH_THREADS
     params:
-        gv=GV,
         subjects=lambda w: subjects_path(w.study),
-        ingest=lambda w, input: str(Path(input.mocap).parent),
-        out=parent_of("summary"),
-    conda:
-        "../envs/gaitval.yaml"
+        trials=lambda w: trial_ids(w.study, ["rollator"]),
     log:
-        "logs/rollator_track/{study}/{method}/{trial}.log",
-    shell:
-        "{params.gv} import-tracks --tracks {input.tracks:q} --sensor {input.sensor:q}"
-        " --registration {input.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} --moving-sensor --out {output.track:q} > {log:q} 2>&1"
-        " && {params.gv} rollator-evaluate --track {output.track:q} --groundtruth {input.gt:q}"
-        " --registration {input.reg:q} --ingest {params.ingest:q} --sheet {input.sheet:q}"
-        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} --out {params.out:q} >> {log:q} 2>&1"
-        " || (cat {log:q} >&2; exit 1)"
+        "logs/rollator_track/{study}/{method}.log",
+    run:
+        run_trials(
+            [(t, [verb("import-tracks", "--tracks", tracks,
+                       "--sensor", f"{input.ingest}/{t}/sensor.parquet",
+                       "--registration", f"{input.register}/{t}/registration.json",
+                       "--trial", t, "--method", wildcards.method, "--config", input.config,
+                       "--moving-sensor", "--out", f"{output[0]}/{t}.track.parquet"),
+                  verb("rollator-evaluate", "--track", f"{output[0]}/{t}.track.parquet",
+                       "--groundtruth", f"{input.register}/{t}/groundtruth.parquet",
+                       "--registration", f"{input.register}/{t}/registration.json",
+                       "--ingest", f"{input.ingest}/{t}", "--sheet", input.sheet,
+                       "--subjects", params.subjects, "--trial", t,
+                       "--method", wildcards.method, "--config", input.config,
+                       "--out", f"{output[0]}/{t}")])
+             for t, tracks in zip(params.trials, input.tracks)],
+            threads, log[0], outdirs=output,
+        )

@@ -1,37 +1,35 @@
-# Raw trial files -> tidy per-trial files (one job per trial), and a per-study summary.
+# Raw trial files -> tidy per-trial files, and a per-study summary.  One job per study:
+# every trial with mocap ingested into results/<study>/ingest/<trial>/ (HOW JOBS RUN in
+# common.smk).
 
 
 rule ingest:
     input:
-        unpack(ingest_inputs),
+        sheet=lambda w: sheet_path(w.study),
+        raw=lambda w: study_raw_files(w.study),   # editing a trial's file reruns the study's
     output:
-        mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
-        events=f"{RESULTS}/{{study}}/ingest/{{trial}}/events.csv",
-        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
-        annotations=f"{RESULTS}/{{study}}/ingest/{{trial}}/annotations.csv",
-        summary=f"{RESULTS}/{{study}}/ingest/{{trial}}/ingest.json",
-    priority: 20  # critical path first (PRIORITIES in common.smk)
+        directory(f"{RESULTS}/{{study}}/ingest"),
+    threads: BATCH_THREADS
+    priority: 20  # everything reads it
     params:
-        gv=GV,
         subjects=lambda w: subjects_path(w.study),
-        out=parent_of("mocap"),
-    conda:
-        "../envs/gaitval.yaml"
+        trials=lambda w: mocap_trial_ids(w.study),
     log:
-        "logs/ingest/{study}/{trial}.log",
-    shell:
-        "{params.gv} ingest --sheet {input.sheet:q} --subjects {params.subjects:q}"
-        " --trial {wildcards.trial:q} --out {params.out:q}"
-        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+        "logs/ingest/{study}.log",
+    run:
+        run_trials(
+            [(t, [verb("ingest", "--sheet", input.sheet, "--subjects", params.subjects,
+                       "--trial", t, "--out", f"{output[0]}/{t}")])
+             for t in params.trials],
+            threads, log[0], outdirs=output,
+            sizes=[trial_bytes(wildcards.study, t) for t in params.trials],
+        )
 
 
 rule ingest_summary:
     input:
-        lambda w: expand(
-            f"{RESULTS}/{{study}}/ingest/{{trial}}/ingest.json",
-            study=w.study,
-            trial=mocap_trial_ids(w.study),
-        ),
+        f"{RESULTS}/{{study}}/ingest",
+        sheet=lambda w: sheet_path(w.study),  # the params list its trials
     output:
         csv=report(
             f"{REPORTS}/tables/study_ingest_{{study}}.csv",
@@ -41,18 +39,19 @@ rule ingest_summary:
         md=f"{REPORTS}/tables/study_ingest_{{study}}.md",
         tex=f"{REPORTS}/tables/study_ingest_{{study}}.tex",
     params:
-        gv=GV,
+        trials=lambda w: mocap_trial_ids(w.study),
         stem=lambda w, output: output.csv[: -len(".csv")],
         reports=parent_of("csv", up=1),
         chash=config_hash_when_run,
-    conda:
-        "../envs/gaitval.yaml"
     log:
         "logs/ingest_summary/{study}.log",
-    shell:
-        "{params.gv} ingest-summary {input:q} --study {wildcards.study:q} --out-stem {params.stem:q}"
-        " --reports-dir {params.reports:q} --config-hash {params.chash:q}"
-        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+    run:
+        run_verb_job(
+            verb("ingest-summary", [f"{input[0]}/{t}/ingest.json" for t in params.trials],
+                 "--study", wildcards.study, "--out-stem", params.stem,
+                 "--reports-dir", params.reports, "--config-hash", params.chash),
+            log[0],
+        )
 
 
 # Ingest reads mocap: a study whose trials all have annotations only has no ingest table.

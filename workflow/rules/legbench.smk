@@ -6,64 +6,46 @@ include: "legbench_common.smk"
 
 
 rule legbench_track:
+    # one job per (study, method, init): each trial tracked, then scored with CLEAR-MOT
+    # against its annotations (two verbs of one task; HOW JOBS RUN in common.smk)
     input:
-        sensor=lambda w: trial_row(w.study, w.trial)["sensor_path"],
-        annotations=lambda w: legbench_annotations(w.study, w.trial),
-        config=config_view_file,
+        sensors=lambda w: [trial_row(w.study, t)["sensor_path"] for t in legbench_trials(w.study)],
+        annotations=lambda w: [legbench_annotations(w.study, t) for t in legbench_trials(w.study)],
+        config=f"{RESULTS}/{{study}}/config_views/{ALL_SCOPE}/{{method}}.json",
     output:
-        f"{RESULTS}/{{study}}/legbench/{{method}}/{{init}}/{{trial}}/track.parquet",
+        track=directory(f"{RESULTS}/{{study}}/legbench/{{method}}/{{init}}"),
+        evaluate=directory(f"{RESULTS}/{{study}}/legbench_eval/{{method}}/{{init}}"),
     wildcard_constraints:
         **LEGBENCH_WC,
+    threads: BATCH_THREADS
     params:
-        gv=GV,
-        topics=legbench_args,
-        leg_width=legbench_leg_width,
-    conda:
-        "../envs/gaitval.yaml"
-    log:
-        "logs/legbench_track/{study}/{method}/{init}/{trial}.log",
-    shell:
-        "{params.gv} legbench-track --sensor {input.sensor:q} --annotations {input.annotations:q}"
-        " {params.topics:q} --method {wildcards.method:q} --init {wildcards.init:q}"
-        " --leg-width-m {params.leg_width:q} --config {input.config:q}"
-        " --trial {wildcards.trial:q} --out {output:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
-
-
-rule legbench_evaluate:
-    input:
-        track=f"{RESULTS}/{{study}}/legbench/{{method}}/{{init}}/{{trial}}/track.parquet",
-        annotations=lambda w: legbench_annotations(w.study, w.trial),
-    output:
-        summary=f"{RESULTS}/{{study}}/legbench_eval/{{method}}/{{init}}/{{trial}}/summary.parquet",
-        frames=f"{RESULTS}/{{study}}/legbench_eval/{{method}}/{{init}}/{{trial}}/frames.parquet",
-    wildcard_constraints:
-        **LEGBENCH_WC,
-    params:
-        gv=GV,
-        topics=legbench_args,
-        score=legbench_score_args,
-        out=parent_of("summary"),
+        trials=lambda w: legbench_trials(w.study),
+        topics=lambda w: [legbench_args(trial_wildcards(w.study, t))
+                          for t in legbench_trials(w.study)],
+        score=lambda w: [legbench_score_args(trial_wildcards(w.study, t))
+                         for t in legbench_trials(w.study)],
+        leg_width=lambda w: [legbench_leg_width(trial_wildcards(w.study, t))
+                             for t in legbench_trials(w.study)],
         match_m=legbench_cfg()["match_m"],
         min_false_s=legbench_cfg()["min_false_s"],
-    conda:
-        "../envs/gaitval.yaml"
     log:
-        "logs/legbench_evaluate/{study}/{method}/{init}/{trial}.log",
-    shell:
-        "{params.gv} legbench-evaluate --track {input.track:q} --annotations {input.annotations:q}"
-        " {params.topics:q} {params.score:q} --match-m {params.match_m:q}"
-        " --min-false-s {params.min_false_s:q}"
-        " --trial {wildcards.trial:q} --out {params.out:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+        "logs/legbench_track/{study}/{method}/{init}.log",
+    run:
+        run_trials(legbench_tasks(wildcards, input, output, params), threads, log[0],
+                   outdirs=output, sizes=[size_of(p) for p in input.sensors])
 
 
 rule legbench_tables:
     input:
-        evals=lambda w: [
-            f"{d}/summary.parquet" for study in config["run"] for d in legbench_eval_dirs(study)
-        ],
+        evals=lambda w: [f"{RESULTS}/{study}/legbench_eval/{m}/{i}"
+                         for study in config["run"] if legbench_trials(study)
+                         for m in legbench_cfg()["methods"] for i in legbench_cfg()["inits"]],
         # the method views the tracks ran with: a method run with tracking.overrides is
         # named with its changes in the table
         views=study_views(legbench_cfg()["methods"], ALL_SCOPE),
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
         table=report(
             f"{REPORTS}/tables/legbench_clearmot.csv",
@@ -77,8 +59,7 @@ rule legbench_tables:
             category="Annotated recordings",
         ),
     params:
-        gv=GV,
-        dirs=lambda w, input: [str(Path(p).parent) for p in input.evals],
+        dirs=lambda w: [d for study in config["run"] for d in legbench_eval_dirs(study)],
         views=lambda w, input: str(Path(input.views[0]).parent),
         methods=legbench_cfg()["methods"],
         inits=legbench_cfg()["inits"],
@@ -86,15 +67,16 @@ rule legbench_tables:
         figures=parent_of("fig"),
         reports=parent_of("table", up=1),
         chash=LEGBENCH_HASH,
-    conda:
-        "../envs/gaitval.yaml"
     log:
         "logs/legbench_tables.log",
-    shell:
-        "{params.gv} legbench-tables {params.dirs:q} --methods {params.methods:q}"
-        " --inits {params.inits:q} --views-dir {params.views:q} --tables-dir {params.tables:q}"
-        " --figures-dir {params.figures:q} --reports-dir {params.reports:q}"
-        " --config-hash {params.chash:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+    run:
+        run_verb_job(
+            verb("legbench-tables", params.dirs, "--methods", params.methods,
+                 "--inits", params.inits, "--views-dir", params.views,
+                 "--tables-dir", params.tables, "--figures-dir", params.figures,
+                 "--reports-dir", params.reports, "--config-hash", params.chash),
+            log[0],
+        )
 
 
 REPORT_ITEM_FUNCS.append(

@@ -72,3 +72,23 @@ def legbench_eval_dirs(study):
         for m in lb["methods"]
         for i in lb["inits"]
     ]
+
+
+def legbench_tasks(wildcards, input, output, params):
+    """A (study, method, init) job's tasks: per trial, its track and then its CLEAR-MOT
+    scores against its annotations."""
+    tasks = []
+    for t, sensor, ann, topics, score, width in zip(
+            params.trials, input.sensors, input.annotations, params.topics, params.score,
+            params.leg_width):
+        track = f"{output.track}/{t}/track.parquet"
+        tasks.append((t, [
+            verb("legbench-track", "--sensor", sensor, "--annotations", ann, topics,
+                 "--method", wildcards.method, "--init", wildcards.init,
+                 "--leg-width-m", width, "--config", input.config, "--trial", t,
+                 "--out", track),
+            verb("legbench-evaluate", "--track", track, "--annotations", ann, topics, score,
+                 "--match-m", params.match_m, "--min-false-s", params.min_false_s,
+                 "--trial", t, "--out", f"{output.evaluate}/{t}"),
+        ]))
+    return tasks

@@ -1,44 +1,30 @@
-# Multi-target stepping task (seed 001): one job per (trial, method) that tracks and
-# evaluates, then Tables 1, 3, 4 and the trial figure.  A trial without mocap (annotations
+# Multi-target stepping task (seed 001): one job per (study, method) that tracks and
+# evaluates each trial, then Tables 1, 3, 4 and the trial figure.  A trial without mocap (annotations
 # only) is tracked from its raw scan log; its pose comes from mtst.poles_m and its clock
-# from the trial sheet (gaitval.steps_mtst).
+# from the trial sheet (gaitval.pipeline.mtst).
 include: "mtst_common.smk"
 
 
 rule mtst_track:
-    # the tracking and then its evaluation: two gaitval steps in one job (see rule track)
+    # one job per (study, method): each MTST trial tracked, then evaluated (two verbs of one
+    # task; HOW JOBS RUN in common.smk)
     input:
-        unpack(mtst_inputs),
+        unpack(mtst_batch_inputs),
     output:
-        track=f"{RESULTS}/{{study}}/mtst_track/{{method}}/{{trial}}.parquet",
-        summary=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/summary.parquet",
-        contacts=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/contacts.parquet",
-        steps=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/steps.parquet",
-        events=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/events.parquet",
-        gates=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/gates.parquet",
-        track_field=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/track_field.parquet",
-        targets=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/targets.parquet",
+        track=directory(f"{RESULTS}/{{study}}/mtst_track/{{method}}"),
+        evaluate=directory(f"{RESULTS}/{{study}}/mtst_eval/{{method}}"),
+    threads: BATCH_THREADS
     params:
-        gv=GV,
         subjects=lambda w: subjects_path(w.study),
-        out=parent_of("summary"),
-        reg=mtst_optional("reg", "--registration"),
-        gt=mtst_optional("gt", "--groundtruth"),
-    conda:
-        "../envs/gaitval.yaml"
+        trials=lambda w: trial_ids(w.study, ["mtst"]),
     log:
-        "logs/mtst_track/{study}/{method}/{trial}.log",
-    shell:
-        "{params.gv} mtst-track --sensor {input.sensor:q} --sheet {input.sheet:q}"
-        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} {params.reg:q} --out {output.track:q} > {log:q} 2>&1"
-        " && {params.gv} mtst-evaluate --track {output.track:q} --sheet {input.sheet:q}"
-        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} {params.reg:q} {params.gt:q} --out {params.out:q}"
-        " >> {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+        "logs/mtst_track/{study}/{method}.log",
+    run:
+        run_trials(mtst_tasks(wildcards, input, output, params), threads, log[0],
+                   outdirs=output, sizes=mtst_sizes(wildcards, params.trials))
 
 
-# An external method (tracking.external, issue 37): the other tracker's file of the trial,
+# An external method (tracking.external, issue 37): the other tracker's file of each trial,
 # converted to gaitval's track (sensor clock and frame; a trial with mocap: with its
 # registration), then the same evaluation as above.
 ruleorder: mtst_track_external > mtst_track
@@ -46,43 +32,34 @@ ruleorder: mtst_track_external > mtst_track
 
 rule mtst_track_external:
     input:
-        unpack(mtst_inputs),
-        tracks=external_tracks_file,
+        unpack(mtst_batch_inputs),
+        tracks=lambda w: [external_tracks_file(trial_wildcards(w.study, t, w.method))
+                          for t in trial_ids(w.study, ["mtst"])],
     output:
-        track=f"{RESULTS}/{{study}}/mtst_track/{{method}}/{{trial}}.parquet",
-        summary=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/summary.parquet",
-        contacts=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/contacts.parquet",
-        steps=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/steps.parquet",
-        events=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/events.parquet",
-        gates=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/gates.parquet",
-        track_field=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/track_field.parquet",
-        targets=f"{RESULTS}/{{study}}/mtst_eval/{{method}}/{{trial}}/targets.parquet",
+        track=directory(f"{RESULTS}/{{study}}/mtst_track/{{method}}"),
+        evaluate=directory(f"{RESULTS}/{{study}}/mtst_eval/{{method}}"),
     wildcard_constraints:
         method="|".join(re.escape(m) for m in external_methods("mtst")) or "(?!x)x",
+    threads: BATCH_THREADS
     params:
-        gv=GV,
         subjects=lambda w: subjects_path(w.study),
-        out=parent_of("summary"),
-        reg=mtst_optional("reg", "--registration"),
-        gt=mtst_optional("gt", "--groundtruth"),
-    conda:
-        "../envs/gaitval.yaml"
+        trials=lambda w: trial_ids(w.study, ["mtst"]),
     log:
-        "logs/mtst_track/{study}/{method}/{trial}.log",
-    shell:
-        "{params.gv} import-tracks --tracks {input.tracks:q} --sensor {input.sensor:q}"
-        " {params.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} --out {output.track:q} > {log:q} 2>&1"
-        " && {params.gv} mtst-evaluate --track {output.track:q} --sheet {input.sheet:q}"
-        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} {params.reg:q} {params.gt:q} --out {params.out:q}"
-        " >> {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+        "logs/mtst_track/{study}/{method}.log",
+    run:
+        run_trials(mtst_tasks(wildcards, input, output, params, external=True), threads,
+                   log[0], outdirs=output)
 
 
 rule mtst_tables:
     input:
-        evals=mtst_summaries,
+        evals=lambda w: [f"{RESULTS}/{study}/mtst_eval/{method}"
+                         for study in config["run"] if trial_ids(study, ["mtst"])
+                         for method in mtst_methods() + external_methods("mtst")],
         configs=study_views([STUDY_VIEW], "mtst"),  # the mtst: section
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
         t3=report(
             f"{REPORTS}/tables/mtst_table3.csv",
@@ -97,23 +74,22 @@ rule mtst_tables:
             category="MTST",
         ),
     params:
-        gv=GV,
-        dirs=lambda w, input: [str(Path(p).parent) for p in input.evals],
+        dirs=lambda w: [str(Path(p).parent) for p in mtst_summaries(w)],
         methods=mtst_methods() + external_methods("mtst"),
-        config=lambda w, input: input.configs[0],
         tables=parent_of("t3"),
         figures=parent_of("fig"),
         reports=parent_of("t3", up=1),
         chash=config_hash_when_run,
-    conda:
-        "../envs/gaitval.yaml"
     log:
         "logs/mtst_tables.log",
-    shell:
-        "{params.gv} mtst-tables {params.dirs:q} --methods {params.methods:q}"
-        " --config {params.config:q} --tables-dir {params.tables:q}"
-        " --figures-dir {params.figures:q} --reports-dir {params.reports:q}"
-        " --config-hash {params.chash:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+    run:
+        run_verb_job(
+            verb("mtst-tables", params.dirs, "--methods", params.methods,
+                 "--config", input.configs[0], "--tables-dir", params.tables,
+                 "--figures-dir", params.figures, "--reports-dir", params.reports,
+                 "--config-hash", params.chash),
+            log[0],
+        )
 
 
 REPORT_ITEM_FUNCS.append(

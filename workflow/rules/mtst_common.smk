@@ -56,27 +56,61 @@ def mtst_targets_file(wildcards):
     return [str(path)] if path.is_file() else []
 
 
-def mtst_inputs(wildcards):
-    """What a trial's tracking and evaluation read: the scan log, the method's config view,
-    the sheet, the registration and ground truth (a trial with mocap), the target layout and
-    the rater annotations (when there are)."""
-    files = {
-        "sensor": mtst_sensor(wildcards),
-        "config": config_view_file(wildcards),
-        "sheet": sheet_path(wildcards.study),
-        "targets": mtst_targets_file(wildcards),
-        **mtst_registration(wildcards),
+def mtst_trial_files(study, trial):
+    """One trial's paths for its verbs: the scan log, ``[--registration, path]`` and
+    ``[--groundtruth, path]`` (empty for a trial without mocap)."""
+    w = trial_wildcards(study, trial)
+    reg = mtst_registration(w)
+    return {
+        "sensor": mtst_sensor(w),
+        "reg": ["--registration", reg["reg"]] if reg else [],
+        "gt": ["--groundtruth", reg["gt"]] if reg else [],
     }
-    ann = trial_row(wildcards.study, wildcards.trial)["annotation_path"]
-    if ann:
-        files["annotations"] = ann
+
+
+def mtst_batch_inputs(wildcards):
+    """What a (study, method) job reads: the method's view, the sheet, the study's ingest
+    and register folders (when a trial has mocap), the raw scan logs of the trials without,
+    the target layouts and the rater annotations."""
+    study = wildcards.study
+    trials = trial_ids(study, ["mtst"])
+    files = {
+        "config": f"{RESULTS}/{study}/config_views/mtst/{wildcards.method}.json",
+        "sheet": sheet_path(study),
+        "targets": [p for t in trials for p in mtst_targets_file(trial_wildcards(study, t))],
+        "annotations": [trial_row(study, t)["annotation_path"] for t in trials
+                        if trial_row(study, t)["annotation_path"]],
+        "raw": [trial_row(study, t)["sensor_path"] for t in trials if not has_mocap(study, t)],
+    }
+    if any(has_mocap(study, t) for t in trials):
+        files["ingest"] = f"{RESULTS}/{study}/ingest"
+        files["register"] = f"{RESULTS}/{study}/register"
     return files
 
 
-def mtst_optional(name, flag):
-    """Param function: ``[--flag, path]`` when input `name` is there, else nothing (a list,
-    so the rule's ``{params.x:q}`` quotes each word)."""
-    return lambda wildcards, input: [flag, str(input[name])] if name in input.keys() else []
+def mtst_tasks(wildcards, input, output, params, external=False):
+    """A (study, method) job's tasks: per trial, its tracking (or, for an external method,
+    the conversion of the other tracker's file) and then its evaluation."""
+    tasks = []
+    for i, t in enumerate(params.trials):
+        f = mtst_trial_files(wildcards.study, t)
+        track = f"{output.track}/{t}.parquet"
+        common = ["--sheet", input.sheet, "--subjects", params.subjects, "--trial", t,
+                  "--method", wildcards.method, "--config", input.config, f["reg"]]
+        if external:
+            first = verb("import-tracks", "--tracks", input.tracks[i], "--sensor",
+                         f["sensor"], f["reg"], "--trial", t, "--method", wildcards.method,
+                         "--config", input.config, "--out", track)
+        else:
+            first = verb("mtst-track", "--sensor", f["sensor"], common, "--out", track)
+        tasks.append((t, [first, verb("mtst-evaluate", "--track", track, common, f["gt"],
+                                      "--out", f"{output.evaluate}/{t}")]))
+    return tasks
+
+
+def mtst_sizes(wildcards, trials):
+    """Each trial's scan log bytes (a batch starts the largest first)."""
+    return [size_of(mtst_trial_files(wildcards.study, t)["sensor"]) for t in trials]
 
 
 def mtst_summaries(wildcards):

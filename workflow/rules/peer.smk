@@ -14,17 +14,17 @@ rule peer_agreement:
         md=f"{REPORTS}/tables/peer_agreement.md",
         tex=f"{REPORTS}/tables/peer_agreement.tex",
     params:
-        gv=GV,
         stem=lambda w, output: output.csv[: -len(".csv")],
         reports=parent_of("csv", up=1),
         chash=config_hash_when_run,
-    conda:
-        "../envs/gaitval.yaml"
     log:
         "logs/peer_agreement.log",
-    shell:
-        "{params.gv} peer {input:q} --out-stem {params.stem:q} --reports-dir {params.reports:q}"
-        " --config-hash {params.chash:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+    run:
+        run_verb_job(
+            verb("peer", input[0], "--out-stem", params.stem, "--reports-dir", params.reports,
+                 "--config-hash", params.chash),
+            log[0],
+        )
 
 
 REPORT_ITEM_FUNCS.append(

@@ -1,5 +1,5 @@
-# Per-study analysis config, then registration + ground truth per trial, then the
-# registration table reviewers read first.
+# Per-study analysis config, then registration + ground truth of every trial with mocap
+# (one job per study), then the registration table reviewers read first.
 
 
 rule study_config:
@@ -14,12 +14,12 @@ rule study_config:
     log:
         "logs/study_config/{study}.log",
     run:
-        from gaitval.steps import study_config
+        from gaitval.pipeline.steps import study_config
 
         study_config(json.loads(params.sections), input.sheet, output[0])
 
 
-# The config as the per-trial jobs of one method read it (gaitval.steps.method_view): every
+# The config as the per-trial jobs of one method read it (gaitval.pipeline.steps.method_view): every
 # per-trial job takes its view (config_view_file, common.smk) instead of config.json, so a
 # change of one method's parameter reruns that method's tracking and evaluation and the
 # tables of its study section (the pooled tables read the views too: study_views), not
@@ -39,7 +39,7 @@ rule config_view:
     log:
         "logs/config_view/{study}/{scope}/{view}.log",
     run:
-        from gaitval.steps import study_config
+        from gaitval.pipeline.steps import study_config
 
         study_config(
             json.loads(params.sections), input.sheet, output[0], view=wildcards.view,
@@ -48,37 +48,38 @@ rule config_view:
 
 
 rule register:
+    # one job per study: every trial with mocap (HOW JOBS RUN in common.smk); each trial
+    # reads the study view of its protocol family's scope (config_view_file)
     input:
-        mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
-        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
-        config=config_view_file,
+        ingest=f"{RESULTS}/{{study}}/ingest",
+        configs=lambda w: sorted({config_view_file(trial_wildcards(w.study, t))
+                                  for t in mocap_trial_ids(w.study)}),
         sheet=lambda w: sheet_path(w.study),
     output:
-        record=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
-        gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
-    priority: 20  # critical path first (PRIORITIES in common.smk)
+        directory(f"{RESULTS}/{{study}}/register"),
+    threads: BATCH_THREADS
+    priority: 20  # everything after ingest reads it
     params:
-        gv=GV,
         subjects=lambda w: subjects_path(w.study),
-        ingest=lambda w, input: str(Path(input.mocap).parent),
-        out=parent_of("record"),
-    conda:
-        "../envs/gaitval.yaml"
+        trials=lambda w: mocap_trial_ids(w.study),
     log:
-        "logs/register/{study}/{trial}.log",
-    shell:
-        "{params.gv} register --ingest {params.ingest:q} --sheet {input.sheet:q}"
-        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --config {input.config:q}"
-        " --out {params.out:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+        "logs/register/{study}.log",
+    run:
+        run_trials(
+            [(t, [verb("register", "--ingest", f"{input.ingest}/{t}", "--sheet", input.sheet,
+                       "--subjects", params.subjects, "--trial", t,
+                       "--config", config_view_file(trial_wildcards(wildcards.study, t)),
+                       "--out", f"{output[0]}/{t}")])
+             for t in params.trials],
+            threads, log[0], outdirs=output,
+            sizes=[trial_bytes(wildcards.study, t) for t in params.trials],
+        )
 
 
 rule registration_summary:
     input:
-        lambda w: expand(
-            f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
-            study=w.study,
-            trial=mocap_trial_ids(w.study),
-        ),
+        f"{RESULTS}/{{study}}/register",
+        sheet=lambda w: sheet_path(w.study),  # the params list its trials
     output:
         csv=f"{RESULTS}/{{study}}/registration.csv",
         table=report(
@@ -89,18 +90,21 @@ rule registration_summary:
         md=f"{REPORTS}/tables/study_registration_{{study}}.md",
         tex=f"{REPORTS}/tables/study_registration_{{study}}.tex",
     params:
-        gv=GV,
+        trials=lambda w: mocap_trial_ids(w.study),
         stem=lambda w, output: output.table[: -len(".csv")],
         reports=parent_of("table", up=1),
         chash=config_hash_when_run,
-    conda:
-        "../envs/gaitval.yaml"
     log:
         "logs/registration_summary/{study}.log",
-    shell:
-        "{params.gv} registration-summary {input:q} --study {wildcards.study:q}"
-        " --out-csv {output.csv:q} --out-stem {params.stem:q} --reports-dir {params.reports:q}"
-        " --config-hash {params.chash:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+    run:
+        run_verb_job(
+            verb("registration-summary",
+                 [f"{input[0]}/{t}/registration.json" for t in params.trials],
+                 "--study", wildcards.study, "--out-csv", output.csv,
+                 "--out-stem", params.stem, "--reports-dir", params.reports,
+                 "--config-hash", params.chash),
+            log[0],
+        )
 
 
 # Registration needs mocap: likewise absent for a study without any.

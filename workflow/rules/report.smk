@@ -49,13 +49,10 @@ rule report:
         html=f"{REPORTS}/index.html",
         verdicts=multiext(f"{REPORTS}/verdicts", ".csv", ".md", ".tex"),
     params:
-        gv=GV,
         reports=parent_of("md"),
         studies=list(config["run"]),
-    conda:
-        "../envs/gaitval.yaml"
     log:
         f"logs/report/{RUN_NAME}.log",
-    shell:
-        "{params.gv} report --reports-dir {params.reports:q} --studies {params.studies:q}"
-        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+    run:
+        run_verb_job(verb("report", "--reports-dir", params.reports, "--studies",
+                          params.studies), log[0])

@@ -1,6 +1,6 @@
 # Robotic rollator (seed 002): the PF's parameters learned leave-one-subject-out, one job
-# per (trial, method) for the KF and the PF that tracks and evaluates against the registered
-# ground truth in the moving laser frame, then Tables I, II and the turning-trial figure.
+# per (study, method) for the KF and the PF that tracks and evaluates each trial against its
+# registered ground truth in the moving laser frame, then Tables I, II and the turning-trial figure.
 # Paths stay under results/<study>/rollator/ with no "track/" or "evaluate/" folder, so the
 # TUG rules' unconstrained patterns never match them.
 
@@ -9,81 +9,71 @@ include: "rollator_common.smk"
 
 
 rule rollator_train:
+    # one job per study: the PF model of each held-out subject, learned from the others'
+    # trials (leave-one-subject-out; HOW JOBS RUN in common.smk)
     input:
-        others=rollator_training_inputs,
-        config=config_view_in("rollator"),
+        ingest=f"{RESULTS}/{{study}}/ingest",
+        register=f"{RESULTS}/{{study}}/register",
+        config=f"{RESULTS}/{{study}}/config_views/rollator/{STUDY_VIEW}.json",
         sheet=lambda w: sheet_path(w.study),
     output:
-        f"{RESULTS}/{{study}}/rollator/model/{{subject}}.json",
+        directory(f"{RESULTS}/{{study}}/rollator/model"),
     wildcard_constraints:
         **ROLLATOR_WC,
-    priority: 100  # critical path first (PRIORITIES in common.smk)
+    threads: BATCH_THREADS
+    priority: 100  # the PF tracks wait for it
     params:
-        gv=GV,
         subjects=lambda w: subjects_path(w.study),
         results=lambda w: f"{RESULTS}/{w.study}",
-    conda:
-        "../envs/gaitval.yaml"
+        held_out=lambda w: rollator_subjects(w.study),
     log:
-        "logs/rollator_train/{study}/{subject}.log",
-    shell:
-        "{params.gv} rollator-train --results {params.results:q} --sheet {input.sheet:q}"
-        " --subjects {params.subjects:q} --subject {wildcards.subject:q}"
-        " --config {input.config:q} --out {output:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+        "logs/rollator_train/{study}.log",
+    run:
+        run_trials(
+            [(s, [verb("rollator-train", "--results", params.results, "--sheet", input.sheet,
+                       "--subjects", params.subjects, "--subject", s,
+                       "--config", input.config, "--out", f"{output[0]}/{s}.json")])
+             for s in params.held_out],
+            threads, log[0], outdirs=output,
+        )
 
 
 rule rollator_track:
-    # the track and then its evaluation: two gaitval steps in one job (see rule track)
+    # one job per (study, method): each rollator trial tracked (the KF, or the PF with its
+    # held-out subject's model), then evaluated (two verbs of one task)
     input:
-        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
-        gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
-        reg=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
-        mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
-        config=config_view_file,
+        ingest=f"{RESULTS}/{{study}}/ingest",
+        register=f"{RESULTS}/{{study}}/register",
+        config=f"{RESULTS}/{{study}}/config_views/rollator/{{method}}.json",
         sheet=lambda w: sheet_path(w.study),
-        model=rollator_model,
+        models=rollator_models,
     output:
-        track=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}.track.parquet",
-        summary=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}/summary.parquet",
-        frames=f"{RESULTS}/{{study}}/rollator/{{method}}/{{trial}}/frames.parquet",
-    priority: -10  # last: fills both cores at the end (PRIORITIES in common.smk)
+        directory(f"{RESULTS}/{{study}}/rollator/{{method}}"),
     wildcard_constraints:
         **ROLLATOR_WC,
+    threads: BATCH_THREADS
     params:
-        gv=GV,
         subjects=lambda w: subjects_path(w.study),
-        model=lambda w, input: ["--model", str(input.model)] if input.model else [],
-        ingest=lambda w, input: str(Path(input.mocap).parent),
-        out=parent_of("summary"),
-    conda:
-        "../envs/gaitval.yaml"
+        trials=lambda w: trial_ids(w.study, ["rollator"]),
     log:
-        "logs/rollator_track/{study}/{method}/{trial}.log",
-    shell:
-        "{params.gv} rollator-track --sensor {input.sensor:q} --sheet {input.sheet:q}"
-        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} {params.model:q} --out {output.track:q} > {log:q} 2>&1"
-        " && {params.gv} rollator-evaluate --track {output.track:q} --groundtruth {input.gt:q}"
-        " --registration {input.reg:q} --ingest {params.ingest:q} --sheet {input.sheet:q}"
-        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} --out {params.out:q} >> {log:q} 2>&1"
-        " || (cat {log:q} >&2; exit 1)"
+        "logs/rollator_track/{study}/{method}.log",
+    run:
+        run_trials(rollator_tasks(wildcards, input, output, params), threads, log[0],
+                   outdirs=output,
+                   sizes=[trial_bytes(wildcards.study, t) for t in params.trials])
 
 
 rule rollator_tables:
     input:
-        evals=lambda w: [
-            f"{RESULTS}/{study}/rollator/{method}/{trial}/summary.parquet"
-            for study in config["run"]
-            for method in rollator_methods() + external_methods("rollator")
-            for trial in trial_ids(study, ["rollator"])
-        ],
-        models=lambda w: [
-            f"{RESULTS}/{study}/rollator/model/{subject}.json"
-            for study in config["run"]
-            for subject in rollator_subjects(study)
-        ],
+        evals=lambda w: [f"{RESULTS}/{study}/rollator/{method}"
+                         for study in config["run"] if trial_ids(study, ["rollator"])
+                         for method in rollator_methods() + external_methods("rollator")],
+        models=lambda w: [f"{RESULTS}/{study}/rollator/model"
+                          for study in config["run"] if trial_ids(study, ["rollator"])],
         config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/rollator/{STUDY_VIEW}.json",
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
         t1=report(
             f"{REPORTS}/tables/rollator_table1.csv",
@@ -98,24 +88,29 @@ rule rollator_tables:
             category="Rollator",
         ),
     params:
-        gv=GV,
-        dirs=lambda w, input: [str(Path(p).parent) for p in input.evals],
+        dirs=lambda w: [f"{RESULTS}/{study}/rollator/{method}/{trial}"
+                        for study in config["run"]
+                        for method in rollator_methods() + external_methods("rollator")
+                        for trial in trial_ids(study, ["rollator"])],
+        models=lambda w: [f"{RESULTS}/{study}/rollator/model/{subject}.json"
+                          for study in config["run"]
+                          for subject in rollator_subjects(study)],
         kf=lambda w: rollator_cfg()["kf_method"],
         pf=lambda w: rollator_cfg()["pf_method"],
         tables=parent_of("t1"),
         figures=parent_of("fig"),
         reports=parent_of("t1", up=1),
         chash=config_hash_when_run,
-    conda:
-        "../envs/gaitval.yaml"
     log:
         "logs/rollator_tables.log",
-    shell:
-        "{params.gv} rollator-tables {params.dirs:q} --kf {params.kf:q} --pf {params.pf:q}"
-        " --models {input.models:q} --config {input.config:q}"
-        " --tables-dir {params.tables:q} --figures-dir {params.figures:q}"
-        " --reports-dir {params.reports:q} --config-hash {params.chash:q}"
-        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+    run:
+        run_verb_job(
+            verb("rollator-tables", params.dirs, "--kf", params.kf, "--pf", params.pf,
+                 "--models", params.models, "--config", input.config,
+                 "--tables-dir", params.tables, "--figures-dir", params.figures,
+                 "--reports-dir", params.reports, "--config-hash", params.chash),
+            log[0],
+        )
 
 
 REPORT_ITEM_FUNCS.append(

@@ -12,8 +12,6 @@ checkpoint simulate:
         gv=GV,
         seed=lambda w: study_cfg(w.study)["simulate"].get("seed", 0),
         out=parent_of("sheet"),
-    conda:
-        "../envs/gaitval.yaml"
     log:
         "logs/simulate/{study}.log",
     shell:

@@ -1,41 +1,43 @@
-# TUG leg tracking (seed 000): one job per (trial, method) that tracks and evaluates
-# against the registered ground truth, then Tables 2-5 and the figures.  The methods run are
+# TUG leg tracking (seed 000): one job per (study, method) that tracks and evaluates each
+# trial against its registered ground truth, then Tables 2-5 and the figures.  The methods run are
 # tug_runs() (common.smk): tug.methods and their reading variants (tug.phase_readings).
 
 
 rule track:
-    # the tracking and then its evaluation against the registered ground truth: two gaitval
-    # steps in one job (one job fewer per (trial, method) for Snakemake to schedule and
-    # record, issue 13); on a cluster the same two commands run in one job's shell
+    # one job per (study, method): each TUG trial tracked, then evaluated against its
+    # registered ground truth (two verbs of one task; HOW JOBS RUN in common.smk)
     input:
-        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
-        gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
-        reg=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
-        config=config_view_file,
+        ingest=f"{RESULTS}/{{study}}/ingest",
+        register=f"{RESULTS}/{{study}}/register",
+        config=f"{RESULTS}/{{study}}/config_views/tug/{{method}}.json",
         sheet=lambda w: sheet_path(w.study),
     output:
-        track=f"{RESULTS}/{{study}}/track/{{method}}/{{trial}}.parquet",
-        summary=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/summary.parquet",
-        frames=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/frames.parquet",
+        track=directory(f"{RESULTS}/{{study}}/track/{{method}}"),
+        evaluate=directory(f"{RESULTS}/{{study}}/evaluate/{{method}}"),
+    threads: BATCH_THREADS
     params:
-        gv=GV,
         subjects=lambda w: subjects_path(w.study),
-        out=parent_of("summary"),
-    conda:
-        "../envs/gaitval.yaml"
+        trials=lambda w: trial_ids(w.study, ["tug"]),
     log:
-        "logs/track/{study}/{method}/{trial}.log",
-    shell:
-        "{params.gv} track --sensor {input.sensor:q} --sheet {input.sheet:q}"
-        " --subjects {params.subjects:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} --out {output.track:q} > {log:q} 2>&1"
-        " && {params.gv} evaluate-tug --track {output.track:q} --groundtruth {input.gt:q}"
-        " --registration {input.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} --out {params.out:q} >> {log:q} 2>&1"
-        " || (cat {log:q} >&2; exit 1)"
+        "logs/track/{study}/{method}.log",
+    run:
+        run_trials(
+            [(t, [verb("track", "--sensor", f"{input.ingest}/{t}/sensor.parquet",
+                       "--sheet", input.sheet, "--subjects", params.subjects, "--trial", t,
+                       "--method", wildcards.method, "--config", input.config,
+                       "--out", f"{output.track}/{t}.parquet"),
+                  verb("evaluate-tug", "--track", f"{output.track}/{t}.parquet",
+                       "--groundtruth", f"{input.register}/{t}/groundtruth.parquet",
+                       "--registration", f"{input.register}/{t}/registration.json",
+                       "--trial", t, "--method", wildcards.method, "--config", input.config,
+                       "--out", f"{output.evaluate}/{t}")])
+             for t in params.trials],
+            threads, log[0], outdirs=output,
+            sizes=[trial_bytes(wildcards.study, t) for t in params.trials],
+        )
 
 
-# An external method (tracking.external, issue 37): the other tracker's file of the trial,
+# An external method (tracking.external, issue 37): the other tracker's file of each trial,
 # converted to gaitval's track (sensor clock and frame, with the trial's registration), then
 # the same evaluation as above.
 ruleorder: track_external > track
@@ -43,43 +45,48 @@ ruleorder: track_external > track
 
 rule track_external:
     input:
-        tracks=external_tracks_file,
-        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
-        gt=f"{RESULTS}/{{study}}/register/{{trial}}/groundtruth.parquet",
-        reg=f"{RESULTS}/{{study}}/register/{{trial}}/registration.json",
-        config=config_view_file,
+        tracks=lambda w: [external_tracks_file(trial_wildcards(w.study, t, w.method))
+                          for t in trial_ids(w.study, ["tug"])],
+        ingest=f"{RESULTS}/{{study}}/ingest",
+        register=f"{RESULTS}/{{study}}/register",
+        config=f"{RESULTS}/{{study}}/config_views/tug/{{method}}.json",
+        sheet=lambda w: sheet_path(w.study),  # the params list its trials
     output:
-        track=f"{RESULTS}/{{study}}/track/{{method}}/{{trial}}.parquet",
-        summary=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/summary.parquet",
-        frames=f"{RESULTS}/{{study}}/evaluate/{{method}}/{{trial}}/frames.parquet",
+        track=directory(f"{RESULTS}/{{study}}/track/{{method}}"),
+        evaluate=directory(f"{RESULTS}/{{study}}/evaluate/{{method}}"),
     wildcard_constraints:
         method="|".join(re.escape(m) for m in external_methods("tug")) or "(?!x)x",
+    threads: BATCH_THREADS
     params:
-        gv=GV,
-        out=parent_of("summary"),
-    conda:
-        "../envs/gaitval.yaml"
+        trials=lambda w: trial_ids(w.study, ["tug"]),
     log:
-        "logs/track/{study}/{method}/{trial}.log",
-    shell:
-        "{params.gv} import-tracks --tracks {input.tracks:q} --sensor {input.sensor:q}"
-        " --registration {input.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} --out {output.track:q} > {log:q} 2>&1"
-        " && {params.gv} evaluate-tug --track {output.track:q} --groundtruth {input.gt:q}"
-        " --registration {input.reg:q} --trial {wildcards.trial:q} --method {wildcards.method:q}"
-        " --config {input.config:q} --out {params.out:q} >> {log:q} 2>&1"
-        " || (cat {log:q} >&2; exit 1)"
+        "logs/track/{study}/{method}.log",
+    run:
+        run_trials(
+            [(t, [verb("import-tracks", "--tracks", tracks,
+                       "--sensor", f"{input.ingest}/{t}/sensor.parquet",
+                       "--registration", f"{input.register}/{t}/registration.json",
+                       "--trial", t, "--method", wildcards.method, "--config", input.config,
+                       "--out", f"{output.track}/{t}.parquet"),
+                  verb("evaluate-tug", "--track", f"{output.track}/{t}.parquet",
+                       "--groundtruth", f"{input.register}/{t}/groundtruth.parquet",
+                       "--registration", f"{input.register}/{t}/registration.json",
+                       "--trial", t, "--method", wildcards.method, "--config", input.config,
+                       "--out", f"{output.evaluate}/{t}")])
+             for t, tracks in zip(params.trials, input.tracks)],
+            threads, log[0], outdirs=output,
+        )
 
 
 rule tug_tables:
     input:
-        evals=lambda w: [
-            f"{RESULTS}/{study}/evaluate/{method}/{trial}/summary.parquet"
-            for study in config["run"]
-            for method in tug_runs()
-            for trial in trial_ids(study, ["tug"])
-        ],
+        evals=lambda w: [f"{RESULTS}/{study}/evaluate/{method}"
+                         for study in config["run"] if trial_ids(study, ["tug"])
+                         for method in tug_runs()],
         configs=study_views(tug_runs(), "tug"),  # Table 2: each study's method definitions
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
         t4=report(
             f"{REPORTS}/tables/tug_table4.csv",
@@ -96,22 +103,25 @@ rule tug_tables:
             category="TUG",
         ),
     params:
-        gv=GV,
-        dirs=lambda w, input: [str(Path(p).parent) for p in input.evals],
+        dirs=lambda w: [f"{RESULTS}/{study}/evaluate/{method}/{trial}"
+                        for study in config["run"]
+                        for method in tug_runs()
+                        for trial in trial_ids(study, ["tug"])],
         methods=tug_runs(),
         tables=parent_of("t4"),
         figures=parent_of("fig"),
         reports=parent_of("t4", up=1),
         chash=config_hash_when_run,
-    conda:
-        "../envs/gaitval.yaml"
     log:
         "logs/tug_tables.log",
-    shell:
-        "{params.gv} tug-tables {params.dirs:q} --methods {params.methods:q}"
-        " --tables-dir {params.tables:q} --figures-dir {params.figures:q}"
-        " --reports-dir {params.reports:q} --config-hash {params.chash:q}"
-        " --configs {input.configs:q} > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+    run:
+        run_verb_job(
+            verb("tug-tables", params.dirs, "--methods", params.methods,
+                 "--tables-dir", params.tables, "--figures-dir", params.figures,
+                 "--reports-dir", params.reports, "--config-hash", params.chash,
+                 "--configs", input.configs),
+            log[0],
+        )
 
 
 REPORT_ITEM_FUNCS.append(

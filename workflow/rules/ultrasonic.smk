@@ -6,12 +6,13 @@
 
 rule ultrasonic_noise:
     input:
-        ingest=lambda w: [
-            f"{RESULTS}/{s}/ingest/{t}/sensor.parquet" for s, t in pendulum_trials()
-        ],
+        ingest=lambda w: sorted({f"{RESULTS}/{s}/ingest" for s, _ in pendulum_trials()}),
         # the study view (no method's definition): a tracker parameter changed elsewhere
         # does not rerun the noise identification and every ultrasonic track after it
         config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/ultrasonic/{STUDY_VIEW}.json",
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
         noise=f"{RESULTS}/ultrasonic_noise.json",
         table=report(
@@ -19,10 +20,9 @@ rule ultrasonic_noise:
             caption="../report/ultrasonic.rst",
             category="Ultrasonic",
         ),
-    priority: 100  # critical path first (PRIORITIES in common.smk)
+    priority: 100  # the ultrasonic tracks wait for it
     params:
-        gv=GV,
-        dirs=lambda w, input: [str(Path(p).parent) for p in input.ingest],
+        dirs=lambda w: [f"{RESULTS}/{s}/ingest/{t}" for s, t in pendulum_trials()],
         trials=lambda w: [t for _, t in pendulum_trials()],
         stem=lambda w, output: output.table[: -len(".csv")],
         reports=parent_of("table", up=1),
@@ -30,54 +30,58 @@ rule ultrasonic_noise:
         # `input`, so Snakemake does not rerun the job when only the hash changed (its
         # "derived" params are not compared); the config it reads is its input above.
         chash=config_hash_when_run,
-    conda:
-        "../envs/gaitval.yaml"
     log:
         "logs/ultrasonic_noise.log",
-    shell:
-        "{params.gv} ultrasonic-noise --ingest {params.dirs:q} --trials {params.trials:q}"
-        " --config {input.config:q} --out {output.noise:q} --table-stem {params.stem:q}"
-        " --reports-dir {params.reports:q} --config-hash {params.chash:q}"
-        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+    run:
+        run_verb_job(
+            verb("ultrasonic-noise", "--ingest", params.dirs, "--trials", params.trials,
+                 "--config", input.config, "--out", output.noise,
+                 "--table-stem", params.stem, "--reports-dir", params.reports,
+                 "--config-hash", params.chash),
+            log[0],
+        )
 
 
 rule ultrasonic_track:
-    # the UKF track and then its gait parameters: two gaitval steps in one job (rule track)
+    # one job per study: each treadmill trial's UKF track, then its gait parameters (two
+    # verbs of one task; HOW JOBS RUN in common.smk)
     input:
-        sensor=f"{RESULTS}/{{study}}/ingest/{{trial}}/sensor.parquet",
-        mocap=f"{RESULTS}/{{study}}/ingest/{{trial}}/mocap.parquet",
-        config=config_view_file,
+        ingest=f"{RESULTS}/{{study}}/ingest",
+        config=f"{RESULTS}/{{study}}/config_views/ultrasonic/{STUDY_VIEW}.json",
         noise=f"{RESULTS}/ultrasonic_noise.json",
         sheet=lambda w: sheet_path(w.study),
     output:
-        track=f"{RESULTS}/{{study}}/ultrasonic/track/{{trial}}.parquet",
-        gait=f"{RESULTS}/{{study}}/ultrasonic/gait/{{trial}}.parquet",
-    priority: 50  # critical path first (PRIORITIES in common.smk)
+        directory(f"{RESULTS}/{{study}}/ultrasonic"),
+    threads: BATCH_THREADS
+    priority: 50  # the ultrasonic tables, the longest table job, wait for it
     params:
-        gv=GV,
-        ingest=lambda w, input: str(Path(input.sensor).parent),
         subjects=lambda w: subjects_path(w.study),
-    conda:
-        "../envs/gaitval.yaml"
+        trials=lambda w: trial_ids(w.study, ["treadmill"]),
     log:
-        "logs/ultrasonic_track/{study}/{trial}.log",
-    shell:
-        "{params.gv} ultrasonic-track --ingest {params.ingest:q} --trial {wildcards.trial:q}"
-        " --config {input.config:q} --noise {input.noise:q} --out {output.track:q}"
-        " > {log:q} 2>&1"
-        " && {params.gv} gait-parameters --track {output.track:q} --ingest {params.ingest:q}"
-        " --sheet {input.sheet:q} --subjects {params.subjects:q} --trial {wildcards.trial:q}"
-        " --config {input.config:q} --out {output.gait:q} >> {log:q} 2>&1"
-        " || (cat {log:q} >&2; exit 1)"
+        "logs/ultrasonic_track/{study}.log",
+    run:
+        run_trials(
+            [(t, [verb("ultrasonic-track", "--ingest", f"{input.ingest}/{t}", "--trial", t,
+                       "--config", input.config, "--noise", input.noise,
+                       "--out", f"{output[0]}/track/{t}.parquet"),
+                  verb("gait-parameters", "--track", f"{output[0]}/track/{t}.parquet",
+                       "--ingest", f"{input.ingest}/{t}", "--sheet", input.sheet,
+                       "--subjects", params.subjects, "--trial", t, "--config", input.config,
+                       "--out", f"{output[0]}/gait/{t}.parquet")])
+             for t in params.trials],
+            threads, log[0], outdirs=output,
+            sizes=[trial_bytes(wildcards.study, t) for t in params.trials],
+        )
 
 
 rule ultrasonic_tables:
     input:
-        gait=lambda w: [
-            f"{RESULTS}/{s}/ultrasonic/gait/{t}.parquet" for s, t in treadmill_trials()
-        ],
+        tracks=lambda w: sorted({f"{RESULTS}/{s}/ultrasonic" for s, _ in treadmill_trials()}),
         # ultrasonic.tables: the strides the tables use (the study view, as the noise rule)
         config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/ultrasonic/{STUDY_VIEW}.json",
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
         t2=report(
             f"{REPORTS}/tables/ultrasonic_table2.csv",
@@ -91,20 +95,21 @@ rule ultrasonic_tables:
             category="Ultrasonic",
         ),
     params:
-        gv=GV,
+        gait=lambda w: [f"{RESULTS}/{s}/ultrasonic/gait/{t}.parquet"
+                        for s, t in treadmill_trials()],
         tables=parent_of("t2"),
         figures=parent_of("fig"),
         reports=parent_of("t2", up=1),
         chash=config_hash_when_run,
-    conda:
-        "../envs/gaitval.yaml"
     log:
         "logs/ultrasonic_tables.log",
-    shell:
-        "{params.gv} ultrasonic-tables {input.gait:q} --tables-dir {params.tables:q}"
-        " --figures-dir {params.figures:q} --reports-dir {params.reports:q}"
-        " --config {input.config:q} --config-hash {params.chash:q}"
-        " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"
+    run:
+        run_verb_job(
+            verb("ultrasonic-tables", params.gait, "--tables-dir", params.tables,
+                 "--figures-dir", params.figures, "--reports-dir", params.reports,
+                 "--config", input.config, "--config-hash", params.chash),
+            log[0],
+        )
 
 
 REPORT_ITEM_FUNCS.append(

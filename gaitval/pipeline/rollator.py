@@ -1,6 +1,6 @@
 """Pipeline steps of the rollator study (seed 002): train, track, evaluate, tables.
 
-File-level wrappers like :mod:`gaitval.steps` (whose helpers they use): each reads the
+File-level wrappers like :mod:`gaitval.pipeline.steps` (whose helpers they use): each reads the
 files of one Snakemake rule, calls the library and writes files.  Per study, under
 ``results/<study>/rollator/``:
 
@@ -29,9 +29,9 @@ import pandas as pd
 
 from gaitval.errors import GaitvalError
 from gaitval.io.atomic import write_parquet, write_text
-from gaitval.io.filememo import FileMemo, file_identity
+from gaitval.pipeline.memo import FileMemo, file_identity
 from gaitval.io.parquet import read_parquet
-from gaitval.steps import (load_json, method_definition, method_display_names,
+from gaitval.pipeline.steps import (load_json, method_definition, method_display_names,
                            trial_and_subject)
 
 #: defaults of the ``rollator:`` keys read here

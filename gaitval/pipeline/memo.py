@@ -1,22 +1,18 @@
-"""What a warm process read from a file, remembered under the file's identity (issue 13).
+"""What a step read from a file, kept for the process's next step, under the file's
+identity (issues 13, 38).
 
-A worker of :mod:`gaitval.forkserver` runs job after job, and the jobs of one trial read
-the same inputs again: the six TUG tracks of a trial read its scan log, the evaluations of
-its methods its ground truth.  :class:`FileMemo` keeps what was read under the file's
-**identity** — resolved path, device, inode, size, and modification and status-change
-times in nanoseconds — so a file rewritten in any way is read again: gaitval replaces its
-outputs by renaming a new file over them (a new inode), and an edit in place changes the
-times.
+A batch job's worker (:mod:`gaitval.jobs.batch`) runs trial after trial of one stage, and
+a trial's second verb reads what its first read (the MTST evaluation the scan log and
+annotations its tracking read; every step the trial sheet).  :class:`FileMemo` keeps what
+was read under the file's **identity** — resolved path, device, inode, size, and
+modification and status-change times in nanoseconds — so a file rewritten in any way is
+read again: gaitval replaces its outputs by renaming a new file over them (a new inode),
+and an edit in place changes the times.
 
 Entries are evicted oldest first past a byte budget.  A value handed out must not be
-changed by the caller: keep immutable values (an Arrow table), or give the caller a copy
-(:func:`gaitval.io.scanlog.read_scanlog` does).  A process that runs one job (a cluster
-job, a plain ``gaitval`` command) pays one ``stat`` per read and never hits.
-
-The budgets are per process, so a fork server with many workers would multiply them: it
-caps every memo's budget (:func:`set_cap`) at an eighth of the machine's memory shared
-among its workers (:func:`worker_budget_mb`; on a 24 GB machine with two workers the cap,
-1.5 GB, is above every budget; with 64 workers on 64 GB it is 128 MB).
+changed by the caller: keep immutable values, or give the caller a copy.  A process that
+runs one step (``gaitval VERB`` by hand) pays one ``stat`` per read and never hits.  Only
+the steps (this package) keep anything: the library they call keeps nothing between calls.
 """
 from __future__ import annotations
 
@@ -24,14 +20,6 @@ import os
 from collections import OrderedDict
 from pathlib import Path
 from typing import Any, Callable
-
-_CAP: list[int] = []          # the most bytes any one memo of this process may keep
-
-
-def set_cap(mb: float | None) -> None:
-    """Cap every memo's budget at ``mb`` megabytes (None: no cap)."""
-    _CAP[:] = [] if mb is None else [int(mb * 2 ** 20)]
-
 
 def file_identity(path: str | os.PathLike) -> tuple | None:
     """``(resolved path, st_dev, st_ino, st_size, st_mtime_ns, st_ctime_ns)``, or None
@@ -58,8 +46,8 @@ class FileMemo:
 
     @property
     def max_bytes(self) -> int:
-        """The budget: the one given, capped by :func:`set_cap`."""
-        return min([self._own, *_CAP])
+        """The budget."""
+        return self._own
 
     def key(self, path: str | os.PathLike, *options) -> tuple | None:
         """The key of ``path`` read with ``options``; None: do not remember."""
@@ -98,13 +86,3 @@ class FileMemo:
             hit = read()
             self.put(key, hit, size(hit))
         return hit
-
-
-def worker_budget_mb(workers: int) -> float:
-    """The cap a fork server with ``workers`` workers sets (:func:`set_cap`): an eighth
-    of the machine's physical memory divided among the workers, at least 16 MB."""
-    try:
-        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        total = 8 * 2 ** 30
-    return max(16.0, total / 8 / max(1, workers) / 2 ** 20)

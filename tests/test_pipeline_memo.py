@@ -1,4 +1,4 @@
-"""What a warm worker remembers of the files it read (gaitval.io.filememo, issue 13): a
+"""What a warm worker remembers of the files it read (gaitval.pipeline.memo, issue 13): a
 file rewritten in any way is read again, and a caller can never change what the next
 caller gets."""
 from __future__ import annotations
@@ -8,10 +8,13 @@ import os
 import numpy as np
 import pandas as pd
 
+import pytest
+
 from gaitval.io.atomic import write_parquet
-from gaitval.io.filememo import FileMemo
+from gaitval.pipeline.memo import FileMemo
 from gaitval.io.parquet import read_parquet
 from gaitval.io.scanlog import read_scanlog, write_scanlog
+from gaitval.pipeline.mtst import read_scans
 from gaitval.types import ScanSeries
 
 
@@ -47,9 +50,11 @@ def test_a_rewritten_parquet_file_is_read_again(tmp_path):
     assert read_parquet(p)["x_m"].tolist() == [2.0]
 
 
-def test_a_scan_log_edited_in_place_is_read_again(tmp_path):
+@pytest.mark.parametrize("read", [read_scanlog, lambda p: read_scans(p, {"trial": "t"})],
+                         ids=["io", "step"])
+def test_a_scan_log_edited_in_place_is_read_again(tmp_path, read):
     p = write_scanlog(tmp_path / "a.scan.parquet", _series())
-    before = read_scanlog(p)
+    before = read(p)
     other = write_scanlog(tmp_path / "b.scan.parquet", _series(1.1))
     data = other.read_bytes()
     st = os.stat(p)
@@ -57,19 +62,20 @@ def test_a_scan_log_edited_in_place_is_read_again(tmp_path):
         fh.write(data)
         fh.truncate()
     os.utime(p, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000))
-    after = read_scanlog(p)
+    after = read(p)
     assert not np.allclose(before.ranges, after.ranges)
     assert np.allclose(after.ranges, read_scanlog(other).ranges)
 
 
-def test_a_scan_log_read_twice_gives_independent_equal_copies(tmp_path):
+def test_a_scan_log_read_twice_by_a_step_gives_independent_equal_copies(tmp_path):
     p = write_scanlog(tmp_path / "a.scan.parquet", _series())
-    a = read_scanlog(p)
+    a = read_scans(p, {"trial": "t"})
     a.ranges[:] = 0.0
     a.meta["range_unit"] = "changed"
-    b = read_scanlog(p)
+    b = read_scans(p, {"trial": "t"})
     assert np.nanmin(b.ranges) > 0.4 and b.meta["range_unit"] == "mm"
-    assert b.ranges is not read_scanlog(p).ranges
+    assert b.ranges is not read_scans(p, {"trial": "t"}).ranges
+    assert np.array_equal(b.ranges, read_scanlog(p).ranges, equal_nan=True)
 
 
 def test_the_memo_keeps_to_its_byte_budget_oldest_out_first(tmp_path):
@@ -86,15 +92,17 @@ def test_the_memo_keeps_to_its_byte_budget_oldest_out_first(tmp_path):
     assert memo.key(tmp_path / "missing") is None and memo.get(None) is None
 
 
-def test_annotations_read_twice_are_independent_copies(tmp_path):
-    from gaitval.io.annotations import read_annotations, write_annotations
+def test_annotations_read_twice_by_a_step_are_independent_copies(tmp_path):
+    from gaitval.io.annotations import write_annotations
+    from gaitval.pipeline.mtst import _annotations
 
     ev = pd.DataFrame({"t_s": [1.0, 2.5], "event": ["contact", "contact"], "side": ["L", "R"]})
     p = write_annotations(tmp_path / "a.annotations.csv", ev, time_offset_s=0.5)
-    a, meta = read_annotations(p, trial="t1")
+    row, s = {"annotation_path": str(p)}, {"require_annotations": True}
+    a, meta, _ = _annotations(row, s, "t1", tmp_path / "trials.csv")
     a.loc[0, "t_s"] = -1.0
     meta["rater"] = "changed"
-    b, meta_b = read_annotations(p, trial="t1")
+    b, meta_b, _ = _annotations(row, s, "t1", tmp_path / "trials.csv")
     assert b["t_s"].tolist() == [1.0, 2.5] and b["t_mocap_s"].tolist() == [1.5, 3.0]
     assert meta_b["rater"] == "R1"
 
@@ -105,7 +113,7 @@ def test_a_target_layout_without_the_trial_is_none_or_an_error_as_asked(tmp_path
     import pytest
 
     from gaitval.errors import FileFormatError
-    from gaitval.steps_mtst import load_targets
+    from gaitval.pipeline.mtst import load_targets
 
     (tmp_path / "targets.csv").write_text(
         "trial,target,x_m,y_m,color,assigned\nother,T1,0.5,0.2,red,true\n")
@@ -118,20 +126,3 @@ def test_a_target_layout_without_the_trial_is_none_or_an_error_as_asked(tmp_path
     got = load_targets(s, sheet, "other", required=True)
     got.loc[0, "x_m"] = 9.0
     assert load_targets(s, sheet, "other", required=True)["x_m"].tolist() == [0.5]
-
-
-def test_a_cap_bounds_every_memo_and_shrinks_with_more_workers(tmp_path):
-    from gaitval.io.filememo import set_cap, worker_budget_mb
-
-    memo = FileMemo(10 * 2 ** 20)
-    f = tmp_path / "a.bin"
-    f.write_bytes(b"x")
-    try:
-        set_cap(1)                                           # 1 MB
-        assert memo.max_bytes == 2 ** 20
-        memo.put(memo.key(f), "big", 2 * 2 ** 20)
-        assert memo.get(memo.key(f)) is None
-    finally:
-        set_cap(None)
-    assert memo.max_bytes == 10 * 2 ** 20
-    assert worker_budget_mb(64) < worker_budget_mb(2) and worker_budget_mb(10 ** 6) == 16.0

@@ -1,6 +1,6 @@
 """MTST (seed 001) pipeline steps at file level: track, evaluate, tables.
 
-Sits with :mod:`gaitval.steps` (same layer: reads the files of one rule, calls the library,
+Sits with :mod:`gaitval.pipeline.steps` (same layer: reads the files of one rule, calls the library,
 writes files) and borrows its helpers.  Three steps, one Snakemake rule each
 (``workflow/rules/mtst.smk``):
 
@@ -36,9 +36,9 @@ import pandas as pd
 
 from gaitval.errors import ConfigError, FileFormatError, GaitvalError
 from gaitval.io.atomic import write_parquet
-from gaitval.io.filememo import FileMemo
+from gaitval.pipeline.memo import FileMemo
 from gaitval.io.parquet import read_parquet
-from gaitval.steps import (load_json, method_definition, method_display_names,
+from gaitval.pipeline.steps import (load_json, method_definition, method_display_names,
                            trial_and_subject)
 
 TARGET_COLUMNS = ("target", "x_m", "y_m", "color", "assigned")
@@ -115,14 +115,29 @@ def _registration(path) -> dict | None:
     return load_json(path) if path and Path(path).is_file() else None
 
 
+#: Scan logs and annotation files this process read, by file identity: a trial's
+#: tracking reads them, then its evaluation, one after the other in the same batch worker
+#: (gaitval.jobs.batch).  A caller gets its own copy.
+_SCANS = FileMemo(256 * 2 ** 20)
+_ANNOTATIONS = FileMemo(32 * 2 ** 20)
+
+
 def read_scans(path, row: dict):
     """A scan log: gaitval's own Parquet (raw or ingested) or any format the trial sheet's
     reader knows (ROS bags)."""
+    import copy
+
     from gaitval.io.ingest import read_sensor
     from gaitval.io.scanlog import read_scanlog
-    if str(path).endswith(".parquet"):
-        return read_scanlog(path, trial=row["trial"])
-    return read_sensor({**row, "sensor_path": str(path)})
+
+    def read():
+        if str(path).endswith(".parquet"):
+            return read_scanlog(path, trial=row["trial"])
+        return read_sensor({**row, "sensor_path": str(path)})
+
+    scans = _SCANS.fetch(_SCANS.key(path, str(path), row["trial"]), read,
+                         lambda got: got.ranges.nbytes + got.t.nbytes)
+    return copy.deepcopy(scans)
 
 
 def mtst_track_step(sensor, sheet, subjects, trial: str, method: str, config_json,
@@ -220,8 +235,12 @@ def _annotations(row: dict, s: dict, trial: str, sheet):
                                   hint="add its *.annotations.csv, or set "
                                        "mtst.require_annotations: false")
         return None
-    ann, meta = read_annotations(path, trial=trial)
-    return ann, meta, path
+    import copy
+
+    ann, meta = _ANNOTATIONS.fetch(_ANNOTATIONS.key(path, trial),
+                                   lambda: read_annotations(path, trial=trial),
+                                   lambda got: int(got[0].memory_usage(deep=True).sum()))
+    return ann.copy(deep=True), copy.deepcopy(meta), path
 
 
 def _gate(cfg: dict, method: str):

@@ -33,7 +33,7 @@ import pandas as pd
 from gaitval.errors import ConfigError, GaitvalError
 from gaitval.io.atomic import write_parquet
 from gaitval.io.parquet import read_parquet
-from gaitval.steps import load_json, method_definition
+from gaitval.pipeline.steps import load_json, method_definition
 
 INITS = ("own", "annotation")
 #: How many of the person's later clicks the annotation initialiser is given: at least its
@@ -321,7 +321,7 @@ def legbench_tables_step(inputs, tables_dir, figures_dir, reports_dir, config_ha
 
     ``views_dir``: the folder of the method config views the tracks ran with; a method run
     with ``tracking.overrides`` is then named with its changes in the tables
-    (:func:`gaitval.steps.method_display_names`)."""
+    (:func:`gaitval.pipeline.steps.method_display_names`)."""
     from gaitval.report.legbench_figures import write_legbench_figure
     from gaitval.report.provenance import stamp
     from gaitval.tables.legbench import write_legbench_table
@@ -334,7 +334,7 @@ def legbench_tables_step(inputs, tables_dir, figures_dir, reports_dir, config_ha
         frames[(r["trial"], r["method"], r["init"])] = read_parquet(d / FRAMES_FILE)
     summary = pd.concat(summaries, ignore_index=True)
     if views_dir:
-        from gaitval.steps import method_display_names
+        from gaitval.pipeline.steps import method_display_names
         shown = method_display_names(views_dir, list(dict.fromkeys(summary["method"])))
         if any(shown.get(m, m) != m for m in shown):
             summary["method"] = summary["method"].map(lambda m: shown.get(m, m))

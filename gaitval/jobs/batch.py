@@ -1,0 +1,240 @@
+"""One job, many trials: a rule's per-trial steps in a process pool (issue 38).
+
+The workflow runs one Snakemake job per (study, stage) or (study, stage, method) instead
+of one per trial.  The job's ``run:`` block hands its trials to :func:`run_batch`, which
+calls the step function of each trial in a :class:`concurrent.futures.ProcessPoolExecutor`
+of the rule's ``threads`` processes and writes every trial's output files as before (one
+file, or folder, per trial).  Why, and what it costs: docs/speed.md.
+
+The pool's processes start from the standard library's *forkserver*
+(:mod:`multiprocessing`, ``forkserver`` start method): one clean process, started the
+first time a batch runs in this Python process, that has already imported the modules in
+:data:`PRELOAD` (numpy, pandas, scipy, the trackers' compiled kernels: ~1 CPU-s) and forks
+each worker from there.  So a batch's workers pay no import, and the Snakemake process
+that waits on them imports none of the analysis.  Each batch has its own workers; they
+exit when the batch ends, and nothing a worker holds outlives its batch.
+
+Determinism: a trial's files depend on its inputs only, not on which worker ran it or
+in which order; the job's log lists the trials in the order given, whatever the order they
+finished in.
+"""
+from __future__ import annotations
+
+import concurrent.futures as cf
+import contextlib
+import copy
+import io
+import logging
+import multiprocessing
+import shlex
+import sys
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+from gaitval.errors import GaitvalError
+
+#: what the forkserver imports once before it forks a worker: every step module and what
+#: they import (a module not listed is imported by the worker that needs it)
+PRELOAD = ("gaitval.jobs.preload",)
+
+
+@dataclass
+class Task:
+    """One trial's call: ``func(**kwargs)``; ``label`` names it in the log and errors."""
+
+    label: str
+    func: Callable[..., Any]
+    kwargs: dict = field(default_factory=dict)
+
+
+class BatchError(GaitvalError):
+    """A task of a batch failed; the message is the task's own error, its label first."""
+
+
+def _context():
+    ctx = multiprocessing.get_context("forkserver")
+    ctx.set_forkserver_preload(list(PRELOAD))
+    return ctx
+
+
+def _call(func, kwargs) -> tuple[bool, str, str, float]:
+    """Run one task in a worker: (ok, its printed output and log messages, the error, its
+    CPU seconds)."""
+    cpu0 = time.process_time()
+    ok, text, err = _call_captured(func, kwargs)
+    return ok, text, err, time.process_time() - cpu0
+
+
+def _call_captured(func, kwargs) -> tuple[bool, str, str]:
+    out = io.StringIO()
+    handler = logging.StreamHandler(out)
+    handler.setFormatter(logging.Formatter("gaitval: %(message)s"))
+    log = logging.getLogger("gaitval")
+    log.addHandler(handler)
+    log.setLevel(logging.INFO)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
+            try:
+                func(**kwargs)
+            except GaitvalError as exc:
+                return False, out.getvalue(), _message(out.getvalue(), exc)
+            except (Exception, SystemExit) as exc:          # a bug or a usage error
+                if not isinstance(exc, (SystemExit, VerbFailed)):
+                    traceback.print_exc(file=out)
+                return False, out.getvalue(), _message(out.getvalue(), exc)
+        return True, out.getvalue(), ""
+    finally:
+        log.removeHandler(handler)
+
+
+def _message(text: str, exc: BaseException) -> str:
+    """The task's error: the last ``gaitval[ VERB]: error: ...`` line it printed (the CLI's
+    one message naming file, trial and problem, or argparse's usage error), else the
+    exception's own message."""
+    import re
+
+    lines = [m.group(1) for m in re.finditer(r"^gaitval(?: \S+)?: error: (.*)$", text, re.M)]
+    if lines:
+        return lines[-1]
+    if isinstance(exc, GaitvalError):
+        return str(exc)
+    return f"{type(exc).__name__}: {exc}"
+
+
+class VerbFailed(GaitvalError):
+    """A verb of :func:`run_verbs` exited with a non-zero status (its message printed)."""
+
+
+def run_verbs(argvs: list[list[str]], shown: list[list[str]] | None = None) -> None:
+    """A task: gaitval verbs one after the other, each as ``gaitval ARGV`` on the command
+    line would run it (:func:`gaitval.cli.main`'s parser and exit codes); the first that
+    fails stops the task.  Each verb's command line goes to the log first (``$ gaitval
+    ...``, quoted as a shell would need it; ``shown``: the command lines to show instead,
+    the job's final paths where it writes into a staging folder, :func:`staged`): the
+    same step, by hand."""
+    from gaitval.cli import parser
+    from gaitval.cli_exit import run_verb
+
+    saved = sys.argv
+    try:
+        for i, argv in enumerate(argvs):
+            sys.argv = ["gaitval", *argv]        # what a table's provenance records
+            show = ["gaitval", *(shown[i] if shown else argv)]
+            print(f"$ {shlex.join(show)}", flush=True)        # the same step by hand
+            args = copy.deepcopy(parser().parse_args(list(argv)))
+            rc = run_verb(args.func, args)
+            if rc:
+                raise VerbFailed(f"gaitval {argv[0]} exited with status {rc}")
+    finally:
+        sys.argv = saved
+
+
+def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None) -> None:
+    """Run every task, ``processes`` at a time, each in a worker process.
+
+    The log (``log``) starts with the task count, the wall time and the tasks' CPU, then
+    gives each task's output under a ``== <label>`` line, by label.  The first task that
+    fails stops the batch: the tasks not started are cancelled, the log is written, and
+    :class:`BatchError` is raised with that task's label and error (the data problem
+    named as the step named it: file, trial, problem).  Give the longest tasks first: the
+    pool starts them in this order.
+    """
+    if not tasks:
+        if log is not None:
+            Path(log).parent.mkdir(parents=True, exist_ok=True)
+            Path(log).write_text("0 task(s) in 0 process(es), 0.00 s wall, 0.00 s cpu\n",
+                                 encoding="utf-8")
+        return
+    processes = max(1, min(int(processes), len(tasks)))
+    results: list[tuple[bool, str, str, float] | None] = [None] * len(tasks)
+    failed: int | None = None
+    t0 = time.perf_counter()
+    with cf.ProcessPoolExecutor(max_workers=processes, mp_context=_context()) as pool:
+        futures = {pool.submit(_call, t.func, t.kwargs): i for i, t in enumerate(tasks)}
+        for fut in cf.as_completed(futures):
+            i = futures[fut]
+            try:
+                results[i] = fut.result()
+            except cf.CancelledError:
+                continue
+            except Exception as exc:                      # the worker died (killed, OOM)
+                results[i] = (False, "", f"worker process failed: {exc!r}", 0.0)
+            if not results[i][0] and failed is None:
+                failed = i
+                for f in futures:
+                    f.cancel()
+    wall = time.perf_counter() - t0
+    if log is not None:
+        _write_log(log, tasks, results, processes, wall)
+    if failed is not None:
+        label, message = tasks[failed].label, results[failed][2]
+        print(f"gaitval: error: [{label}] {message}", file=sys.stderr)
+        raise BatchError(f"[{label}] {message}")
+
+
+def _write_log(log, tasks, results, processes, wall) -> None:
+    cpu = sum(r[3] for r in results if r is not None)
+    lines = [f"{len(tasks)} task(s) in {processes} process(es), {wall:.2f} s wall, "
+             f"{cpu:.2f} s cpu"]
+    for t, r in sorted(zip(tasks, results), key=lambda tr: tr[0].label):
+        if r is None:
+            lines.append(f"== {t.label}: not run (an earlier task failed)")
+            continue
+        ok, text, err, _ = r
+        lines.append(f"== {t.label}" + ("" if ok else f": FAILED: {err}"))
+        if text:
+            lines.append(text.rstrip("\n"))
+    Path(log).parent.mkdir(parents=True, exist_ok=True)
+    Path(log).write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+@contextlib.contextmanager
+def staged(outdirs):
+    """Write a job's output folders atomically: the tasks write into ``<folder>.partial``
+    (``swap`` maps a word of a command line naming a path in a folder to the same path in
+    its ``.partial`` twin), and only when every task succeeded does each twin replace its
+    folder (a rename).  A job killed half-way leaves no folder that looks finished, whatever
+    Snakemake's own record of it."""
+    import os
+    import shutil
+
+    pairs = [(Path(d), Path(f"{d}.partial")) for d in outdirs]
+    for _, tmp in pairs:
+        shutil.rmtree(tmp, ignore_errors=True)
+        tmp.mkdir(parents=True)
+
+    def swap(word: str) -> str:
+        for final, tmp in pairs:
+            head = str(final)
+            if word == head or word.startswith(head + "/"):
+                return str(tmp) + word[len(head):]
+        return word
+
+    try:
+        yield swap
+    except BaseException:
+        for _, tmp in pairs:
+            shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    for final, tmp in pairs:
+        if final.exists():
+            shutil.rmtree(final)
+        os.replace(tmp, final)
+
+
+def by_size(tasks: list[Task], sizes: list[float]) -> list[Task]:
+    """``tasks`` largest first (``sizes``: e.g. the bytes of each task's main input), the
+    original order among equals: the longest trials start first, so the batch does not
+    end with one process busy and the others idle."""
+    order = sorted(range(len(tasks)), key=lambda i: -sizes[i])
+    return [tasks[i] for i in order]
+
+
+def file_size(path) -> int:
+    try:
+        return Path(path).stat().st_size
+    except OSError:
+        return 0
