@@ -39,7 +39,7 @@ from gaitval.io.atomic import write_parquet
 from gaitval.pipeline.memo import FileMemo
 from gaitval.io.parquet import read_parquet
 from gaitval.pipeline.steps import (load_json, method_definition, method_display_names,
-                           trial_and_subject)
+                                    track_and_write, trial_and_subject)
 
 TARGET_COLUMNS = ("target", "x_m", "y_m", "color", "assigned")
 EVAL_TABLES = ("contacts", "steps", "events", "gates", "track_field", "summary", "targets")
@@ -143,7 +143,7 @@ def read_scans(path, row: dict):
 def mtst_track_step(sensor, sheet, subjects, trial: str, method: str, config_json,
                     registration_json, out_parquet) -> pd.DataFrame:
     """Track one MTST trial with one method (module notes); sensor frame, sensor clock."""
-    from gaitval.methods import get_method, track_trial
+    from gaitval.methods import get_method
 
     cfg, s = mtst_config(config_json)
     row, subj = trial_and_subject(sheet, subjects, trial)
@@ -153,14 +153,8 @@ def mtst_track_step(sensor, sheet, subjects, trial: str, method: str, config_jso
     mdef = method_definition(cfg, method)
     if "init" in get_method(mdef):      # the papers' methods start on the mat's lane; the
         overrides.setdefault("init__lane", mat_lane(pose, s["mat"]))   # people tracker: own
-    try:
-        track = track_trial(scans, mdef, float(subj["leg_width_m"]), {"overrides": overrides})
-    except GaitvalError as exc:
-        raise exc.with_context(path=sensor, trial=trial) from None
-    track.insert(0, "method", method)
-    track.insert(0, "trial", trial)
-    write_parquet(track, out_parquet)
-    return track
+    return track_and_write(scans, mdef, float(subj["leg_width_m"]), overrides, trial=trial,
+                           method=method, source=sensor, out_parquet=out_parquet)
 
 
 def load_targets(s: dict, sheet, trial: str, *, required: bool) -> pd.DataFrame | None:

@@ -271,7 +271,6 @@ def track_step(sensor_parquet, sheet, subjects, trial: str, method: str, config_
                out_parquet) -> pd.DataFrame:
     """Run one tracker method on one LRS trial; write the per-scan track (sensor frame)."""
     from gaitval.io.scanlog import read_scanlog
-    from gaitval.methods import track_trial
 
     cfg = load_json(config_json)
     row, subj = trial_and_subject(sheet, subjects, trial)
@@ -280,11 +279,21 @@ def track_step(sensor_parquet, sheet, subjects, trial: str, method: str, config_
     if w is None or not np.isfinite(w):
         w = float((cfg.get("registration") or {}).get("default_leg_width_m", 0.10))
     overrides = ((cfg.get("tracking") or {}).get("overrides") or {}).get(method)
+    return track_and_write(scans, method_definition(cfg, method), float(w), overrides,
+                           trial=trial, method=method, source=sensor_parquet,
+                           out_parquet=out_parquet)
+
+
+def track_and_write(scans, mdef, leg_width_m: float, overrides, *, trial: str, method: str,
+                    source, out_parquet) -> pd.DataFrame:
+    """One method's per-scan track of one trial, tagged with trial and method and written
+    atomically; a tracker's error names the scan file and the trial."""
+    from gaitval.methods import track_trial
+
     try:
-        track = track_trial(scans, method_definition(cfg, method), float(w),
-                            {"overrides": overrides})
+        track = track_trial(scans, mdef, leg_width_m, {"overrides": overrides})
     except GaitvalError as exc:
-        raise exc.with_context(path=sensor_parquet, trial=trial) from None
+        raise exc.with_context(path=source, trial=trial) from None
     track.insert(0, "method", method)
     track.insert(0, "trial", trial)
     write_parquet(track, out_parquet)
