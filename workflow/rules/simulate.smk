@@ -1,4 +1,8 @@
 # The embedded default study: generated once, unless its files are already there.
+# No conda: directive (snakemake --lint asks for one): Snakemake 8.30 runs `conda info` for
+# it even without --use-conda, which fails where conda is absent, and the batch rules'
+# run: blocks cannot use conda at all; the software is pinned by requirements.lock,
+# which run.py installs into .venv/ (README, docs/speed.md).
 
 
 checkpoint simulate:
