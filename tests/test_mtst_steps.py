@@ -189,3 +189,35 @@ def test_ingested_files_do_not_depend_on_where_the_study_folder_sits(tiny, tmp_p
             (tiny / "ingest" / name).read_bytes(), name
     mocap, _ = load_ingested(tmp_path / "ingest", row)
     assert mocap.path == row["mocap_path"] == str((moved / row["mocap_file"]).resolve())
+
+
+def test_a_refused_registration_leaves_the_trial_out_with_its_reason(tiny):
+    """A trial whose registration was refused, with no mtst.poles_m pose or no sheet clock
+    offset to place it otherwise, gets an empty track and a ``not_registered`` evaluation
+    instead of stopping its batch job; the tables leave it out and say why."""
+    rec = json.loads((tiny / "register" / "registration.json").read_text())
+    rec.update(status="refused", reason="[trial mtst_E01_t1] pole POLE2 not found",
+               x_m=None, y_m=None, yaw_rad=None, clock_offset_s=None)
+    reg = tiny / "refused" / "registration.json"
+    reg.parent.mkdir(parents=True)
+    reg.write_text(json.dumps(rec))
+    subjects = tiny / "tiny" / "subjects.csv"
+    sheet = tiny / "tiny" / "trials.csv"
+    sensor = tiny / "tiny" / "lrs" / f"{TRIAL}.scan.parquet"
+    track = mtst_track_step(sensor, sheet, subjects, TRIAL, "mtst_m1", tiny / "config.json",
+                            reg, tiny / "refused" / "track.parquet")
+    assert track.empty and list(track.columns[:2]) == ["trial", "method"]
+    s = mtst_evaluate_step(tiny / "refused" / "track.parquet", sheet, subjects, TRIAL,
+                           "mtst_m1", tiny / "config.json", reg, None,
+                           tiny / "refused" / "eval").iloc[0]
+    assert s["category_mocap"] == "not_registered" and not s["has_annotations"]
+    if not (tiny / "mocap" / "eval" / "summary.parquet").is_file():
+        _run(tiny, sheet, tiny / "config.json", tiny / "register" / "registration.json",
+             tiny / "register" / "groundtruth.parquet", "mocap")
+    mtst_tables_step([tiny / "mocap" / "eval", tiny / "refused" / "eval"],
+                     tiny / "rep2" / "tables", tiny / "rep2" / "figures", tiny / "rep2",
+                     methods=[METHOD, "mtst_m1"], config_json=tiny / "config.json")
+    t3 = pd.read_csv(tiny / "rep2" / "tables" / "mtst_table3.csv")
+    assert set(t3["method"]) == {METHOD}             # the refused (trial, method) has no row
+    md = (tiny / "rep2" / "tables" / "mtst_table3.md").read_text()
+    assert f"1 trial(s) left out of every row: {TRIAL} (registration refused)" in md

@@ -115,6 +115,22 @@ def _registration(path) -> dict | None:
     return load_json(path) if path and Path(path).is_file() else None
 
 
+def refused_without_fallback(rec: dict | None, row: dict, s: dict) -> str | None:
+    """The reason a trial cannot be evaluated because its registration was refused, or
+    None.  A refused trial is left out (as in the TUG tables) when nothing else places
+    it: no pole centres in ``mtst.poles_m`` for the pose, or no trial-sheet
+    ``clock_offset_s`` to put its rater annotations on the sensor clock (its mocap truth
+    is gone with the registration).  A study without mocap (no registration record) is
+    not a refusal: a missing pose or clock there stays an error."""
+    if not rec or rec.get("status") == "ok":
+        return None
+    manual = row.get("clock_offset_s")
+    has_clock = manual is not None and np.isfinite(manual)
+    if s["poles_m"] is not None and has_clock:
+        return None
+    return str(rec.get("reason") or "registration refused")
+
+
 #: Scan logs and annotation files this process read, by file identity: a trial's
 #: tracking reads them, then its evaluation, one after the other in the same batch worker
 #: (gaitval.jobs.batch).  A caller gets its own copy.
@@ -145,10 +161,19 @@ def mtst_track_step(sensor, sheet, subjects, trial: str, method: str, config_jso
     """Track one MTST trial with one method (module notes); sensor frame, sensor clock."""
     from gaitval.methods import get_method
 
+    from gaitval.io.tracks import TRACK_COLUMNS
+
     cfg, s = mtst_config(config_json)
     row, subj = trial_and_subject(sheet, subjects, trial)
+    rec = _registration(registration_json)
+    if refused_without_fallback(rec, row, s):      # left out (its evaluation says why)
+        track = pd.DataFrame(columns=list(TRACK_COLUMNS))
+        track.insert(0, "method", method)
+        track.insert(0, "trial", trial)
+        write_parquet(track, out_parquet)
+        return track
     scans = keep_every(read_scans(sensor, row), float(s["scan_period_s"]), trial=trial)
-    pose, _ = pose_and_clock(_registration(registration_json), row, scans, s, cfg, trial)
+    pose, _ = pose_and_clock(rec, row, scans, s, cfg, trial)
     overrides = dict(((cfg.get("tracking") or {}).get("overrides") or {}).get(method) or {})
     mdef = method_definition(cfg, method)
     if "init" in get_method(mdef):      # the papers' methods start on the mat's lane; the
@@ -260,9 +285,23 @@ def mtst_evaluate_step(track_parquet, sheet, subjects, trial: str, method: str, 
     """
     from gaitval.evaluate.mtst_trial import evaluate_mtst_trial
 
+    from gaitval.evaluate.mtst_trial import SUMMARY_COLUMNS
+
     cfg, s = mtst_config(config_json)
     row, subj = trial_and_subject(sheet, subjects, trial)
     rec = _registration(registration_json)
+    out = Path(out_dir)
+    if refused_without_fallback(rec, row, s):
+        summary = pd.DataFrame([{
+            "trial": trial, "method": method, "stick": bool(row.get("stick", False)),
+            "has_mocap": False, "has_annotations": False, "has_targets": False,
+            "category_mocap": "not_registered", "category_annotations": "not_registered",
+            "category_mocap_persistent_swap": "not_registered"}]
+        ).reindex(columns=list(SUMMARY_COLUMNS))
+        for name in EVAL_TABLES:
+            write_parquet(summary if name == "summary" else pd.DataFrame(columns=["trial"]),
+                          out / f"{name}.parquet")
+        return summary
     scans = None
     if not (rec and rec.get("status") == "ok") and s["poles_m"] is not None:
         scans = keep_every(read_scans(row["sensor_path"], row), float(s["scan_period_s"]),
@@ -284,7 +323,6 @@ def mtst_evaluate_step(track_parquet, sheet, subjects, trial: str, method: str, 
         gate=_gate(cfg, method), cfg=s, annotation_path=None if ann is None else ann[2])
     res["targets"] = (targets if targets is not None else
                       pd.DataFrame(columns=list(TARGET_COLUMNS))).assign(trial=trial)
-    out = Path(out_dir)
     for name in EVAL_TABLES:
         write_parquet(res[name].reset_index(drop=True), out / f"{name}.parquet")
     return res["summary"]
@@ -308,6 +346,12 @@ def mtst_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, repor
                     parts[name].append(df)
     data = {n: (pd.concat(v, ignore_index=True) if v else pd.DataFrame())
             for n, v in parts.items()}
+    left_out: dict[str, str] = {}              # trials whose registration was refused
+    if not data["summary"].empty:
+        gone = data["summary"]["category_mocap"].astype(str) == "not_registered"
+        left_out = {str(t): "registration refused" for t in
+                    sorted(data["summary"].loc[gone, "trial"].astype(str).unique())}
+        data["summary"] = data["summary"][~gone].reset_index(drop=True)
     s = mtst_config(config_json)[1] if config_json else None
     methods = list(methods or (s or {}).get("methods") or
                    ["mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed"])
@@ -315,7 +359,7 @@ def mtst_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, repor
     own = set((s or {}).get("methods") or ("mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed"))
     external = [m for m in methods if m not in own]    # tracking.external (issue 37)
     paths = write_mtst_tables(data, tables_dir, methods=methods, shown=shown,
-                              external=external)
+                              external=external, left_out=left_out)
     stamp("mtst_tables", paths, reports_dir, config_hash_=config_hash)
     figs = write_mtst_figure(data, figures_dir, trial=(s or {}).get("figure_trial"),
                              methods=methods)

@@ -235,12 +235,15 @@ def table4_external(summary: pd.DataFrame, t4: pd.DataFrame, external: list[str]
 
 def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
                       methods: list[str], shown: dict[str, str] | None = None,
-                      external: list[str] = ()) -> list[Path]:
+                      external: list[str] = (), left_out: dict[str, str] | None = None
+                      ) -> list[Path]:
     """Write ``mtst_table1``, ``mtst_table3``, ``mtst_table4`` (csv, md, tex) from the
     concatenated per-trial tables ``data`` (``summary``, ``gates``).  ``shown``: method ->
     the name the tables print (a method run with overrides,
     :func:`gaitval.methods.display_name`).  ``external``: external methods (issue 37),
-    which get rows in Tables 3 and 4 (Table 4 then has a ``method`` column)."""
+    which get rows in Tables 3 and 4 (Table 4 then has a ``method`` column).
+    ``left_out``: trial -> why it is not in the tables (a refused registration with
+    nothing else to place it); Tables 3 and 4 say so in a note."""
     td = Path(tables_dir)
     summary = data.get("summary", pd.DataFrame())
     if summary.empty:
@@ -250,7 +253,12 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
     t1 = table1(data.get("gates", pd.DataFrame()))
     t3 = table3(summary, methods)
     t4 = table4(summary)
-    notes3 = mocap_notes(summary) + [judging_rules_note(t3)] + table3_notes(
+    gone = ([f"{len(left_out)} trial(s) left out of every row: "
+             + "; ".join(f"{t} ({why})" for t, why in left_out.items())
+             + " -- the registration table gives each reason; with no mocap truth, no "
+             "mtst.poles_m pose or no trial-sheet clock_offset_s nothing else places the "
+             "trial's tracks or rater contacts."] if left_out else [])
+    notes3 = gone + mocap_notes(summary) + [judging_rules_note(t3)] + table3_notes(
         t3, data.get("events"), data.get("track_field"))
     if shown:                                  # a method run with overrides says so
         t1, t3 = (t.assign(method=t["method"].map(lambda m: shown.get(m, m)))
@@ -270,7 +278,7 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
         "track against the mocap leg points (stands in for the paper's video check); "
         "'rater events': from the rater's contacts only (what a study without mocap "
         "has)."), notes=notes3)
-    notes4 = mocap_notes(summary) + table4_notes(t4, table4_trials(summary))
+    notes4 = gone + mocap_notes(summary) + table4_notes(t4, table4_trials(summary))
     if external:
         t4 = table4_external(summary, t4, list(external))
         notes4.append(f"External method{'s' * (len(external) > 1)} {', '.join(external)}: "
