@@ -114,6 +114,7 @@ rule tug_tables:
         figures=parent_of("fig"),
         reports=parent_of("t4", up=1),
         chash=config_hash_when_run,
+    priority: -10  # after every track job, beside the other tables (PRIORITIES in common.smk)
     log:
         "logs/tug_tables.log",
     run:
