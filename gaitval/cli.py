@@ -120,7 +120,14 @@ def cmd_registration_summary(a) -> int:
 
 def cmd_track(a) -> int:
     from gaitval.pipeline.steps import track_step
-    track_step(a.sensor, a.sheet, a.subjects, a.trial, a.method, a.config, a.out)
+    track_step(a.sensor, a.sheet, a.subjects, a.trial, a.method, a.config, a.out,
+               detections=a.detections)
+    return 0
+
+
+def cmd_detect(a) -> int:
+    from gaitval.pipeline.steps import detect_step
+    detect_step(a.sensor, a.sheet, a.subjects, a.trial, a.detector, a.config, a.out)
     return 0
 
 
@@ -286,8 +293,24 @@ def _add_lrs_verbs(sub) -> None:
     s.add_argument("--trial", required=True)
     s.add_argument("--method", required=True, help="e.g. tug_m1, tug_m2, tug_m3")
     s.add_argument("--config", required=True, help="results/<study>/config.json")
+    s.add_argument("--detections", default=None,
+                   help="the trial's observations by this method's detector (gaitval "
+                        "detect), used instead of detecting again")
     s.add_argument("--out", required=True)
     s.set_defaults(func=cmd_track)
+
+    s = sub.add_parser("detect", help="one TUG trial's leg observations by one detector, "
+                                      "for every method with that detector")
+    s.add_argument("--sensor", required=True, help="ingested sensor.parquet")
+    s.add_argument("--sheet", required=True)
+    s.add_argument("--subjects", required=True)
+    s.add_argument("--trial", required=True)
+    s.add_argument("--detector", required=True, help="the detector spec as JSON, e.g. "
+                   "'{\"name\": \"leg_patterns\", \"use_fs_u\": true}'")
+    s.add_argument("--config", required=True,
+                   help="a config (view) JSON: registration.default_leg_width_m")
+    s.add_argument("--out", required=True)
+    s.set_defaults(func=cmd_detect)
 
     s = sub.add_parser("evaluate-tug", help="evaluate one tracked TUG trial")
     s.add_argument("--track", required=True)
@@ -390,7 +413,10 @@ def _add_mtst_verbs(sub) -> None:
         from gaitval.pipeline import mtst as S
         if a.verb == "mtst-track":
             S.mtst_track_step(a.sensor, a.sheet, a.subjects, a.trial, a.method, a.config,
-                              a.registration, a.out)
+                              a.registration, a.out, detections=a.detections)
+        elif a.verb == "mtst-detect":
+            S.mtst_detect_step(a.sensor, a.sheet, a.subjects, a.trial, a.detector,
+                               a.config, a.out)
         elif a.verb == "mtst-evaluate":
             s = S.mtst_evaluate_step(a.track, a.sheet, a.subjects, a.trial, a.method,
                                      a.config, a.registration, a.groundtruth, a.out)
@@ -407,7 +433,14 @@ def _add_mtst_verbs(sub) -> None:
 
     s = sub.add_parser("mtst-track", help="track one MTST trial (every scan at Δt = 0.05 s)")
     s.add_argument("--registration", help="registration.json (none: mtst.poles_m)")
+    s.add_argument("--detections", default=None,
+                   help="the trial's observations by this method's detector (gaitval "
+                        "mtst-detect), used instead of detecting again")
     common(s, "sensor", "sheet", "subjects", "trial", "method", "config", "out")
+    s = sub.add_parser("mtst-detect", help="one MTST trial's leg observations by one "
+                                           "detector, for every method with that detector")
+    s.add_argument("--detector", required=True, help="the detector spec as JSON")
+    common(s, "sensor", "sheet", "subjects", "trial", "config", "out")
     s = sub.add_parser("mtst-evaluate", help="contacts, target and cross steps of one trial, "
                                              "against annotations (and mocap)")
     s.add_argument("--registration", help="registration.json (none: mtst.poles_m)")

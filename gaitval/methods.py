@@ -379,8 +379,32 @@ def build_method(method: str | dict[str, Any], overrides: dict[str, Any] | None 
     return TRACKER_KINDS.build(m["kind"])
 
 
+def trial_detector(method: str | dict[str, Any], overrides: dict[str, Any] | None = None
+                   ) -> str | dict[str, Any] | None:
+    """The spec of the detector a method runs once over all of a trial's scans before it
+    tracks, or None when it has none (a tracker of raw scans, a detector that looks scan
+    by scan where the tracker predicts the legs).  Two methods with the same spec make
+    the same observation table of a trial, so a workflow detects once for both and hands
+    the table to each (``observations`` of :func:`track_trial`; docs/speed.md)."""
+    m = set_params(get_method(method), overrides)
+    if _kind_name(m) == DEFAULT_KIND:
+        spec = m["detector"]
+    else:
+        kind = m["kind"] if isinstance(m["kind"], dict) else {"name": m["kind"]}
+        if not getattr(TRACKER_KINDS[kind["name"]], "accepts_observations", False):
+            return None
+        spec = kind.get("detector")
+        if spec is None:                # the kind's own default detector: not shared
+            return None
+    name = spec if isinstance(spec, str) else spec["name"]
+    if getattr(DETECTORS[name], "windowed", False):
+        return None
+    return copy.deepcopy(spec)
+
+
 def track_trial(scans: ScanSeries, method: str | dict[str, Any], leg_width_m: float,
-                cfg: dict[str, Any] | None = None) -> pd.DataFrame:
+                cfg: dict[str, Any] | None = None, observations: pd.DataFrame | None = None
+                ) -> pd.DataFrame:
     """Detect and track both legs of one trial.
 
     Parameters
@@ -393,6 +417,9 @@ def track_trial(scans: ScanSeries, method: str | dict[str, Any], leg_width_m: fl
         The subject's shank width at sensor height, w_l (subjects.csv ``leg_width_m``).
     cfg : dict, optional
         ``{"overrides": {"role__param": value}}`` (e.g. from the workflow config).
+    observations : DataFrame, optional
+        The method's detector's observation table of these scans, made earlier (the
+        same detector spec, :func:`trial_detector`, and leg width); None: detect.
 
     Returns
     -------
@@ -404,7 +431,10 @@ def track_trial(scans: ScanSeries, method: str | dict[str, Any], leg_width_m: fl
         NaN before the track is initialised.
     """
     cfg = cfg or {}
-    return build_method(method, cfg.get("overrides")).track(scans, leg_width_m).to_frame()
+    kind = build_method(method, cfg.get("overrides"))
+    if observations is None:
+        return kind.track(scans, leg_width_m).to_frame()
+    return kind.track(scans, leg_width_m, observations=observations).to_frame()
 
 # -- issue 36: a people tracker (several persons, two legs each, with a life cycle) -------
 # Not a paper's method: the seed papers' leg model (seed 000's KF and χ² gate, Table 2;

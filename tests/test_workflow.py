@@ -156,8 +156,8 @@ def test_one_methods_parameter_reruns_only_that_methods_trials(tiny_run):
     assert planned["track"] == 2          # tug_m1 + variant: one job each for the study's trials
     assert "evaluate_tug" not in planned          # no such rule since the track job evaluates
     assert planned["config_view"] == 2
-    for rule in ("register", "ingest", "mtst_track", "rollator_track", "ultrasonic_noise",
-                 "ultrasonic_track", "rollator_train", "mtst_tables",
+    for rule in ("register", "ingest", "detect", "mtst_track", "rollator_track",
+                 "ultrasonic_noise", "ultrasonic_track", "rollator_train", "mtst_tables",
                  "rollator_tables", "ultrasonic_tables", "ingest_summary",
                  "registration_summary"):
         assert rule not in planned, (rule, planned)
@@ -165,6 +165,27 @@ def test_one_methods_parameter_reruns_only_that_methods_trials(tiny_run):
     out = res.stdout + res.stderr
     import re
     assert re.search(r"track/tug_m1\b", out) and not re.search(r"track/tug_m2\b", out)
+
+
+@pytest.mark.slow
+def test_a_detector_parameter_detects_once_more_for_its_methods_only(tiny_run):
+    """Issue 38: the TUG methods share one detection job per detector spec
+    (workflow/rules/detect.smk); a new detector parameter of tug_m1 plans one detection
+    with the new spec (tug_m1 and its reading variant share it) and those two tracks, no
+    other method's track and no other detection."""
+    res = run_workflow(tiny_run, tiny_run / "data",
+                       'tracking={"overrides": {"tug_m1": {"detector__max_occluder_m": 0.2}}}',
+                       "-n")
+    assert res.returncode == 0, res.stderr[-3000:]
+    planned = _planned(res)
+    assert planned["detect"] == 1 and planned["track"] == 2, planned
+    assert "mtst_track" not in planned and "register" not in planned, planned
+    shared = list((tiny_run / "results" / "tiny" / "detect" / "tug").iterdir())
+    assert len(shared) == 1                 # the tiny run: every TUG method, one detector
+    out = res.stdout + res.stderr
+    import re
+    new = set(re.findall(r"detect/tug/(leg_patterns-[0-9a-f]+)", out))
+    assert new and shared[0].name not in new
 
 
 @pytest.mark.slow

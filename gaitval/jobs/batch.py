@@ -136,7 +136,8 @@ def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None) 
     """Run every task, ``processes`` at a time, each in a worker process.
 
     The log (``log``) starts with the task count, the wall time and the tasks' CPU, then
-    gives each task's output under a ``== <label>`` line, by label.  The first task that
+    gives each task's output under a ``== <label>`` line, by label, ending with its CPU
+    seconds (``-- 0.123 s cpu``).  The first task that
     fails stops the batch: the tasks not started are cancelled, the log is written, and
     :class:`BatchError` is raised with that task's label and error (the data problem
     named as the step named it: file, trial, problem).  Give the longest tasks first: the
@@ -183,10 +184,11 @@ def _write_log(log, tasks, results, processes, wall) -> None:
         if r is None:
             lines.append(f"== {t.label}: not run (an earlier task failed)")
             continue
-        ok, text, err, _ = r
+        ok, text, err, task_cpu = r
         lines.append(f"== {t.label}" + ("" if ok else f": FAILED: {err}"))
         if text:
             lines.append(text.rstrip("\n"))
+        lines.append(f"-- {task_cpu:.3f} s cpu")
     Path(log).parent.mkdir(parents=True, exist_ok=True)
     Path(log).write_text("\n".join(lines) + "\n", encoding="utf-8")
 

@@ -157,8 +157,10 @@ def read_scans(path, row: dict):
 
 
 def mtst_track_step(sensor, sheet, subjects, trial: str, method: str, config_json,
-                    registration_json, out_parquet) -> pd.DataFrame:
-    """Track one MTST trial with one method (module notes); sensor frame, sensor clock."""
+                    registration_json, out_parquet, detections=None) -> pd.DataFrame:
+    """Track one MTST trial with one method (module notes); sensor frame, sensor clock.
+    ``detections``: the trial's observations made by :func:`mtst_detect_step` with this
+    method's detector (:mod:`gaitval.pipeline.detections`), instead of detecting again."""
     from gaitval.methods import get_method
 
     from gaitval.io.tracks import TRACK_COLUMNS
@@ -179,7 +181,24 @@ def mtst_track_step(sensor, sheet, subjects, trial: str, method: str, config_jso
     if "init" in get_method(mdef):      # the papers' methods start on the mat's lane; the
         overrides.setdefault("init__lane", mat_lane(pose, s["mat"]))   # people tracker: own
     return track_and_write(scans, mdef, float(subj["leg_width_m"]), overrides, trial=trial,
-                           method=method, source=sensor, out_parquet=out_parquet)
+                           method=method, source=sensor, out_parquet=out_parquet,
+                           detections=detections)
+
+
+def mtst_detect_step(sensor, sheet, subjects, trial: str, detector: str, config_json,
+                     out_parquet) -> pd.DataFrame:
+    """One MTST trial's observations by ``detector`` (a spec, as JSON text) on the scans
+    and with the leg width its track step uses (every n-th scan, mtst.scan_period_s), for
+    every method with that detector (:mod:`gaitval.pipeline.detections`)."""
+    import json
+
+    from gaitval.pipeline.detections import detect_and_write
+
+    _, s = mtst_config(config_json)
+    row, subj = trial_and_subject(sheet, subjects, trial)
+    scans = keep_every(read_scans(sensor, row), float(s["scan_period_s"]), trial=trial)
+    return detect_and_write(scans, json.loads(detector), float(subj["leg_width_m"]),
+                            out_parquet, trial=trial, source=sensor)
 
 
 def load_targets(s: dict, sheet, trial: str, *, required: bool) -> pd.DataFrame | None:

@@ -70,6 +70,24 @@ def method_view(cfg: dict, view: str, scope: str = ALL_SCOPE) -> dict:
     return out
 
 
+def analysis_config(config: dict, sheet: str | Path, *, check: bool = False) -> dict:
+    """A study's analysis config: the workflow config's :data:`ANALYSIS_SECTIONS`, with
+    ``study.yaml`` beside the trial sheet, when present, merged over them (``check``:
+    checked against the config schema first, :func:`gaitval.configcheck.check_study_file`)."""
+    from gaitval.configcheck import check_study_file
+
+    cfg = {k: config[k] for k in ANALYSIS_SECTIONS if k in config}
+    cal = Path(sheet).parent / "study.yaml"
+    if cal.is_file():
+        with open(cal, encoding="utf-8") as fh:
+            study = yaml.safe_load(fh) or {}
+        if check:
+            check_study_file(study, cal)
+        cfg = deep_merge(cfg, {k: v for k, v in study.items() if k in ANALYSIS_SECTIONS})
+        cfg["calibration_file"] = str(cal)
+    return cfg
+
+
 def study_config(config: dict, sheet: str | Path, out: str | Path,
                  view: str | None = None, scope: str = ALL_SCOPE) -> dict:
     """Write the effective analysis config of one study (JSON) and return it.
@@ -81,16 +99,7 @@ def study_config(config: dict, sheet: str | Path, out: str | Path,
     :data:`STUDY_VIEW`), only that view of it, in ``scope``, is written
     (:func:`method_view`).
     """
-    from gaitval.configcheck import check_study_file
-
-    cfg = {k: config[k] for k in ANALYSIS_SECTIONS if k in config}
-    cal = Path(sheet).parent / "study.yaml"
-    if cal.is_file():
-        with open(cal, encoding="utf-8") as fh:
-            study = yaml.safe_load(fh) or {}
-        check_study_file(study, cal)
-        cfg = deep_merge(cfg, {k: v for k, v in study.items() if k in ANALYSIS_SECTIONS})
-        cfg["calibration_file"] = str(cal)
+    cfg = analysis_config(config, sheet, check=True)
     if view is not None:
         cfg = method_view(cfg, view, scope)
     write_text(out, json.dumps(cfg, indent=1, sort_keys=True) + "\n")
@@ -267,31 +276,62 @@ def method_definition(cfg: dict, method: str):
     return custom.get(method, method)
 
 
+def tug_leg_width(subj: dict, cfg: dict) -> float:
+    """The subject's shank width w_l (subjects.csv), else ``registration.default_leg_width_m``."""
+    w = subj.get("leg_width_m")
+    if w is None or not np.isfinite(w):
+        w = float((cfg.get("registration") or {}).get("default_leg_width_m", 0.10))
+    return float(w)
+
+
 def track_step(sensor_parquet, sheet, subjects, trial: str, method: str, config_json,
-               out_parquet) -> pd.DataFrame:
-    """Run one tracker method on one LRS trial; write the per-scan track (sensor frame)."""
+               out_parquet, detections=None) -> pd.DataFrame:
+    """Run one tracker method on one LRS trial; write the per-scan track (sensor frame).
+    ``detections``: the trial's observations made by :func:`detect_step` with this
+    method's detector (:mod:`gaitval.pipeline.detections`), instead of detecting again."""
     from gaitval.io.scanlog import read_scanlog
 
     cfg = load_json(config_json)
     row, subj = trial_and_subject(sheet, subjects, trial)
     scans = read_scanlog(sensor_parquet, trial=trial)
-    w = subj.get("leg_width_m")
-    if w is None or not np.isfinite(w):
-        w = float((cfg.get("registration") or {}).get("default_leg_width_m", 0.10))
+    w = tug_leg_width(subj, cfg)
     overrides = ((cfg.get("tracking") or {}).get("overrides") or {}).get(method)
-    return track_and_write(scans, method_definition(cfg, method), float(w), overrides,
+    return track_and_write(scans, method_definition(cfg, method), w, overrides,
                            trial=trial, method=method, source=sensor_parquet,
-                           out_parquet=out_parquet)
+                           out_parquet=out_parquet, detections=detections)
+
+
+def detect_step(sensor_parquet, sheet, subjects, trial: str, detector: str, config_json,
+                out_parquet) -> pd.DataFrame:
+    """One TUG trial's observations by ``detector`` (a spec, as JSON text) with the leg
+    width its track step uses, for every method with that detector
+    (:mod:`gaitval.pipeline.detections`)."""
+    from gaitval.io.scanlog import read_scanlog
+    from gaitval.pipeline.detections import detect_and_write
+
+    cfg = load_json(config_json)
+    _, subj = trial_and_subject(sheet, subjects, trial)
+    scans = read_scanlog(sensor_parquet, trial=trial)
+    return detect_and_write(scans, json.loads(detector), tug_leg_width(subj, cfg),
+                            out_parquet, trial=trial, source=sensor_parquet)
 
 
 def track_and_write(scans, mdef, leg_width_m: float, overrides, *, trial: str, method: str,
-                    source, out_parquet) -> pd.DataFrame:
+                    source, out_parquet, detections=None) -> pd.DataFrame:
     """One method's per-scan track of one trial, tagged with trial and method and written
-    atomically; a tracker's error names the scan file and the trial."""
-    from gaitval.methods import track_trial
+    atomically; a tracker's error names the scan file and the trial.  ``detections``: a
+    file of the method's detector's observations of these scans, checked and used instead
+    of detecting (:mod:`gaitval.pipeline.detections`)."""
+    from gaitval.methods import track_trial, trial_detector
+    from gaitval.pipeline.detections import detections_or_none
 
+    obs = None
+    if detections:
+        obs = detections_or_none(detections, trial_detector(mdef, overrides), leg_width_m,
+                                 scans, trial=trial, method=method)
     try:
-        track = track_trial(scans, mdef, leg_width_m, {"overrides": overrides})
+        track = track_trial(scans, mdef, leg_width_m, {"overrides": overrides},
+                            observations=obs)
     except GaitvalError as exc:
         raise exc.with_context(path=source, trial=trial) from None
     track.insert(0, "method", method)

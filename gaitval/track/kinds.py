@@ -27,9 +27,18 @@ TRACKER_KINDS = Registry("tracker kind")
 
 
 class TrackerKind:
-    """Role base."""
+    """Role base.
 
-    def track(self, scans: ScanSeries, leg_width_m: float) -> TrackResult:
+    ``accepts_observations``: the kind runs its detector once over all of a trial's scans
+    before it tracks, and ``track`` takes that detector's observation table made earlier
+    (``observations``, :mod:`gaitval.detect.base`) instead of detecting again: methods
+    that share a detector configuration share its observations
+    (:func:`gaitval.methods.trial_detector`).
+    """
+
+    accepts_observations = False
+
+    def track(self, scans: ScanSeries, leg_width_m: float, observations=None) -> TrackResult:
         raise NotImplementedError
 
 
@@ -46,10 +55,15 @@ class DetectThenTrack(TrackerKind):
         self.tracker = tracker
         self.detector_spec = detector_spec
 
-    def track(self, scans, leg_width_m):
+    accepts_observations = True
+
+    def track(self, scans, leg_width_m, observations=None):
+        """``observations``: this method's detector's table of these scans, made earlier
+        (None: detect now; ignored by a windowed detector, which looks scan by scan)."""
         if getattr(self.detector, "windowed", False):
             return self.tracker.run_windowed(scans, self.detector, leg_width_m)
-        obs = self.detector.detect(scans, leg_width_m)
+        obs = (self.detector.detect(scans, leg_width_m) if observations is None
+               else observations)
         xy, pats = split_observations(obs, scans.n_scans)
         return self.tracker.run(scans.t, xy, pats, leg_width_m)
 

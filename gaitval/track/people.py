@@ -183,8 +183,13 @@ class PeopleTracker(TrackerKind):
         self.sides = sides
 
     # -- the loop ----------------------------------------------------------------------------
-    def track(self, scans, leg_width_m: float) -> PeopleResult:
-        obs_df = self.detector.detect(scans, leg_width_m)
+    accepts_observations = True
+
+    def track(self, scans, leg_width_m: float, observations=None) -> PeopleResult:
+        """``observations``: the detector's table of these scans made earlier (None:
+        detect now; :class:`~gaitval.track.kinds.TrackerKind`)."""
+        obs_df = (self.detector.detect(scans, leg_width_m) if observations is None
+                  else observations)
         xy, pats = split_observations(obs_df, scans.n_scans)
         return self.run(scans, xy, pats, leg_width_m)
 

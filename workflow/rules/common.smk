@@ -258,10 +258,12 @@ def config_view_in(scope):
 # started only when every other trial was done, then its 30 tracks, gait parameters and
 # tables ran alone for ~90 s; the rollator PF likewise waited for its trained models.  So:
 # ultrasonic_noise and rollator_train 100, ultrasonic_track (with the gait parameters) 50,
-# ingest and register (everything's inputs) 20; rollator_track -10: once the UKF ran
-# compiled (2026-11-27) the run ended with the TUG tracks and then `tug_tables` (~2.2 s)
-# alone on one core; the rollator tracks (32 jobs of ~0.3 s) now run last, beside the
-# other studies' tables, and only `rollator_tables` (~0.9 s) and the report end alone.
+# ingest, register and detect (everything's inputs) 20.  The tables are one process each
+# (tug 2.4, mtst 2.3, rollator 1.1, ultrasonic 5.8 CPU-s), and a batch job takes every
+# core, so a table started while batch jobs wait ran with the other core idle (~7 core-s
+# in a default run, benchmarks/batch_tails.py and the run's Snakemake log); at -10 they
+# wait until no batch job is left and then run two at a time, ultrasonic_tables (-5, the
+# longest) beside the three others in turn: 5.8 against 5.8 CPU-s.
 # Order only: same jobs, same files.  (Tried
 # and left out: config_view 200, so the views -- milliseconds each -- run before the
 # ingests; it made every registration ready at once, and the greedy scheduler's rounds over

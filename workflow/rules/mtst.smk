@@ -80,6 +80,7 @@ rule mtst_tables:
         figures=parent_of("fig"),
         reports=parent_of("t3", up=1),
         chash=config_hash_when_run,
+    priority: -10  # after every track job, beside the other tables (PRIORITIES in common.smk)
     log:
         "logs/mtst_tables.log",
     run:

@@ -85,6 +85,8 @@ def mtst_batch_inputs(wildcards):
     if any(has_mocap(study, t) for t in trials):
         files["ingest"] = f"{RESULTS}/{study}/ingest"
         files["register"] = f"{RESULTS}/{study}/register"
+    # the trials' observations, when another method shares this one's detector (detect.smk)
+    files["detections"] = detections_dir("mtst")(wildcards)
     return files
 
 
@@ -102,7 +104,8 @@ def mtst_tasks(wildcards, input, output, params, external=False):
                          f["sensor"], f["reg"], "--trial", t, "--method", wildcards.method,
                          "--config", input.config, "--out", track)
         else:
-            first = verb("mtst-track", "--sensor", f["sensor"], common, "--out", track)
+            first = verb("mtst-track", "--sensor", f["sensor"], common,
+                         detections_arg(input, t), "--out", track)
         tasks.append((t, [first, verb("mtst-evaluate", "--track", track, common, f["gt"],
                                       "--out", f"{output.evaluate}/{t}")]))
     return tasks

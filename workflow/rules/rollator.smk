@@ -101,6 +101,7 @@ rule rollator_tables:
         figures=parent_of("fig"),
         reports=parent_of("t1", up=1),
         chash=config_hash_when_run,
+    priority: -10  # after every track job, beside the other tables (PRIORITIES in common.smk)
     log:
         "logs/rollator_tables.log",
     run:

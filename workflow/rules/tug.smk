@@ -11,6 +11,8 @@ rule track:
         register=f"{RESULTS}/{{study}}/register",
         config=f"{RESULTS}/{{study}}/config_views/tug/{{method}}.json",
         sheet=lambda w: sheet_path(w.study),
+        # the trials' observations, when another method shares this one's detector
+        detections=detections_dir("tug"),
     output:
         track=directory(f"{RESULTS}/{{study}}/track/{{method}}"),
         evaluate=directory(f"{RESULTS}/{{study}}/evaluate/{{method}}"),
@@ -25,7 +27,7 @@ rule track:
             [(t, [verb("track", "--sensor", f"{input.ingest}/{t}/sensor.parquet",
                        "--sheet", input.sheet, "--subjects", params.subjects, "--trial", t,
                        "--method", wildcards.method, "--config", input.config,
-                       "--out", f"{output.track}/{t}.parquet"),
+                       detections_arg(input, t), "--out", f"{output.track}/{t}.parquet"),
                   verb("evaluate-tug", "--track", f"{output.track}/{t}.parquet",
                        "--groundtruth", f"{input.register}/{t}/groundtruth.parquet",
                        "--registration", f"{input.register}/{t}/registration.json",
@@ -112,6 +114,7 @@ rule tug_tables:
         figures=parent_of("fig"),
         reports=parent_of("t4", up=1),
         chash=config_hash_when_run,
+    priority: -10  # after every track job, beside the other tables (PRIORITIES in common.smk)
     log:
         "logs/tug_tables.log",
     run:

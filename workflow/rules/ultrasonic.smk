@@ -101,6 +101,7 @@ rule ultrasonic_tables:
         figures=parent_of("fig"),
         reports=parent_of("t2", up=1),
         chash=config_hash_when_run,
+    priority: -5  # the longest table job: the first of the tables (PRIORITIES, common.smk)
     log:
         "logs/ultrasonic_tables.log",
     run:
