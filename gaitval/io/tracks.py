@@ -58,8 +58,17 @@ def _err(path, problem: str, trial=None, hint=None) -> FileFormatError:
     return FileFormatError(problem, path=path, trial=trial, hint=hint)
 
 
-def _check_meta(meta: dict, path, trial) -> dict:
-    """The header, checked: format, version, units, frame, clock (each named when wrong)."""
+def _check_meta(meta: dict, path, trial, lines: dict | None = None) -> dict:
+    """The header, checked: format, version, units, frame, clock (each named when wrong,
+    with its line of a CSV: ``lines``, key -> line number, and ``lines[None]`` the last
+    header line; else the Parquet schema metadata)."""
+    def at(key):
+        if lines is None:
+            return f" (schema metadata {META_KEY.decode()!r})"
+        if key in lines:
+            return f" (line {lines[key]})"
+        return f" (no '# {key}: ...' line among header lines 1-{lines.get(None, 1)})"
+
     if meta.get("format") != FORMAT:
         raise _err(path, f"header field 'format' is {meta.get('format')!r}, not {FORMAT!r}",
                    trial, hint="the first line of a CSV is '# gaitval-tracks v1'")
@@ -69,23 +78,24 @@ def _check_meta(meta: dict, path, trial) -> dict:
     except (TypeError, ValueError):
         ok = False
     if not ok:
-        raise _err(path, f"header field 'version' is {v!r}; this gaitval reads version "
-                   f"{VERSION}", trial)
+        raise _err(path, f"header field 'version' is {v!r}{at('version')}; this gaitval "
+                   f"reads version {VERSION}", trial)
     for key, allowed in (("units", tuple(UNITS)), ("frame", FRAMES), ("clock", CLOCKS)):
         val = meta.get(key)
         if val is None:
-            raise _err(path, f"header field {key!r} is missing (one of "
-                       f"{', '.join(allowed)})", trial)
+            raise _err(path, f"header field {key!r} is missing{at(key)}; give one of "
+                       f"{', '.join(allowed)}", trial)
         if val not in allowed:
-            raise _err(path, f"header field {key!r} is {val!r}, not one of "
+            raise _err(path, f"header field {key!r} is {val!r}{at(key)}, not one of "
                        f"{', '.join(allowed)}", trial)
     out = dict(meta)
     out["version"] = VERSION
     return out
 
 
-def _read_csv(path: Path, trial) -> tuple[dict, list[str], list[list[str]], int]:
-    """(header, column names, rows as text, file line of the first data row)."""
+def _read_csv(path: Path, trial) -> tuple[dict, list[str], list[list[str]], int, dict]:
+    """(header, column names, rows as text, file line of the first data row, header
+    key -> its line)."""
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
@@ -95,16 +105,19 @@ def _read_csv(path: Path, trial) -> tuple[dict, list[str], list[list[str]], int]
         first = lines[0][:60] if lines else ""
         raise _err(path, f"line 1 is {first!r}, not '# {FORMAT} v{VERSION}'", trial)
     meta: dict = {"format": FORMAT, "version": VERSION}
+    where = {"format": 1, "version": 1}
     n = 1
     while n < len(lines) and lines[n].startswith("#"):
         key, sep, val = lines[n][1:].partition(":")
         if sep:
             meta[key.strip()] = val.strip()
+            where[key.strip()] = n + 1
         n += 1
+    where[None] = n
     rows = list(csv.reader(io.StringIO("\n".join(lines[n:]))))
     if not rows:
         raise _err(path, "no column header after the '#' lines", trial)
-    return meta, [c.strip() for c in rows[0]], rows[1:], n + 2
+    return meta, [c.strip() for c in rows[0]], rows[1:], n + 2, where
 
 
 def _read_parquet(path: Path, trial) -> tuple[dict, pd.DataFrame]:
@@ -195,7 +208,7 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
     if not p.exists():
         raise _err(p, "no such file", trial)
     if p.suffix == ".csv":
-        meta, names, rows_txt, first_line = _read_csv(p, trial)
+        meta, names, rows_txt, first_line, meta_lines = _read_csv(p, trial)
         for j, r in enumerate(rows_txt):
             if len(r) != len(names):
                 raise _err(p, f"line {first_line + j}: {len(r)} cells, the header has "
@@ -206,6 +219,7 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
             return f"line {first_line + i}"
     elif p.suffix == ".parquet":
         meta, df = _read_parquet(p, trial)
+        meta_lines = None
         names = list(df.columns)
         cols = {n: df[n].tolist() for n in names}
 
@@ -214,7 +228,7 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
     else:
         raise _err(p, f"unknown extension {p.suffix!r}", trial,
                    hint="a track file is *.tracks.csv or *.tracks.parquet")
-    meta = _check_meta(meta, p, trial)
+    meta = _check_meta(meta, p, trial, meta_lines)
     unknown = [n for n in names if n not in COLUMNS]
     if unknown:
         raise _err(p, f"unknown column(s) {', '.join(map(repr, unknown))}", trial,
@@ -262,7 +276,7 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
     dup = df.duplicated(["t_s", key])
     if dup.any():
         i = int(np.flatnonzero(dup.to_numpy())[0])
-        raise _err(p, f"{where(i)}: time stamp {df['t_s'].iloc[i]!r} s has {key} "
+        raise _err(p, f"{where(i)}: time stamp {float(df['t_s'].iloc[i])!r} s has {key} "
                    f"{ids[i]!r} twice", trial)
     if key == "side":
         for s in SIDES:
@@ -275,9 +289,12 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
             i = int(np.flatnonzero((counts < 2).to_numpy())[0])
             other = "R" if ids[i] == "L" else "L"
             raise _err(p, f"{where(i)}: leg {other} is missing at time stamp "
-                       f"{df['t_s'].iloc[i]!r} s (every time stamp has one row per leg; "
+                       f"{float(df['t_s'].iloc[i])!r} s (every time stamp has one row per leg; "
                        "write x, y empty where a leg has no track)", trial)
     df.attrs = {}
+    # where a row is in the file, for later errors (tracks_to_sensor): CSV lines or
+    # Parquet data rows, in the order of the rows returned
+    meta["_row"] = ("line", first_line) if meta_lines is not None else ("row", 1)
     return df, meta
 
 
@@ -368,11 +385,51 @@ def snap_to_scans(t: np.ndarray, scan_t: np.ndarray, tol_s: float = SNAP_S) -> n
     return t
 
 
+def _where(rows: pd.DataFrame, meta: dict, i: int, field: str) -> str:
+    """Row ``i`` of :func:`read_tracks` / :func:`people_to_legs` rows, as the file names
+    it: a CSV line, a Parquet data row, or a bag topic's message (``msg``), with the field."""
+    if "msg" in rows and np.isfinite(rows["msg"].iloc[i]):
+        f = {"t_s": "header.stamp", "x": "position.x", "y": "position.y"}.get(field, field)
+        return f"{meta.get('source', 'topic')}, message {int(rows['msg'].iloc[i])}, field {f}"
+    kind, first = meta.get("_row", ("data row", 1))
+    return f"{kind} {first + i}, column {field!r}"
+
+
+#: a leg farther from the laser than its range by this much is no leg it saw (m)
+RANGE_MARGIN_M = 1.0
+#: every position closer to the laser than this: not in metres (m)
+MIN_DISTANCE_M = 0.05
+
+
+def _check_distances(rows, meta, x, y, max_range_m, path, trial) -> None:
+    """Positions (sensor frame, metres) the laser can have seen: none beyond its range,
+    not all at its origin (wrong ``units``, or ``frame``)."""
+    d = np.hypot(x, y)
+    ok = np.isfinite(d)
+    if not ok.any():
+        return
+    head = f"header units {meta['units']!r}, frame {meta['frame']!r}"
+    far = ok & (d > max_range_m + RANGE_MARGIN_M)
+    if far.any():
+        i = int(np.flatnonzero(far)[0])
+        raise _err(path, f"{_where(rows, meta, i, 'x')}: position "
+                   f"({rows['x_m'].iloc[i]:.6g}, {rows['y_m'].iloc[i]:.6g}) m is "
+                   f"{d[i]:.1f} m from the laser, beyond its range ({max_range_m:g} m) "
+                   f"({head})", trial,
+                   hint="positions in millimetres need 'units: mm'; positions in the "
+                        "mocap field need 'frame: mocap'")
+    if d[ok].max() < MIN_DISTANCE_M:
+        i = int(np.flatnonzero(ok)[0])
+        raise _err(path, f"{_where(rows, meta, i, 'x')}: every position lies within "
+                   f"{MIN_DISTANCE_M * 100:g} cm of the laser (largest {d[ok].max():.3g} m; "
+                   f"{head})", trial, hint="positions in metres need 'units: m'")
+
+
 def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None = None, *,
                      path=None, trial: str | None = None,
                      t_range: tuple[float, float] | None = None,
-                     tolerance_s: float = 0.0, scan_t: np.ndarray | None = None
-                     ) -> pd.DataFrame:
+                     tolerance_s: float = 0.0, scan_t: np.ndarray | None = None,
+                     max_range_m: float | None = None) -> pd.DataFrame:
     """Exchange rows (from :func:`read_tracks`) as gaitval's per-scan leg track.
 
     Parameters
@@ -390,6 +447,12 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
     scan_t : ndarray, optional
         The recording's scan times (sensor clock): a converted time stamp within
         :data:`SNAP_S` of one becomes that scan's time (:func:`snap_to_scans`).
+    max_range_m : float, optional
+        The laser's range: a position (in the sensor frame, after the conversion) farther
+        than this + :data:`RANGE_MARGIN_M`, or every position within
+        :data:`MIN_DISTANCE_M` of the laser, is an error naming the row and the header's
+        ``units`` (and ``frame``): positions in millimetres declared as metres, or the
+        reverse, or in another frame.
 
     Returns
     -------
@@ -403,7 +466,9 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
     """
     if "side" not in rows:
         raise _err(path, "the file gives people (column 'person'), not legs; the leg "
-                   "evaluation needs one row per leg (column 'side')", trial)
+                   "evaluation needs one row per leg (column 'side')", trial,
+                   hint="a bag whose people are legs: set the method's legs: {L: id, R: "
+                        "id}")
     need = [f for f, used in (("frame", meta["frame"] == "mocap"),
                               ("clock", meta["clock"] == "mocap")) if used]
     reg = registration or {}
@@ -426,8 +491,8 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
         out_of = (t < lo) | (t > hi)
         if out_of.any():
             i = int(np.flatnonzero(out_of)[0])
-            line = f"data row {i + 1}"
-            raise _err(path, f"{line}: time stamp {rows['t_s'].iloc[i]!r} s "
+            line = _where(rows, meta, i, "t_s")
+            raise _err(path, f"{line}: time stamp {float(rows['t_s'].iloc[i])!r} s "
                        f"({meta['clock']} clock; {t[i]:.4f} s on the sensor clock) is "
                        f"outside the recording ({t_range[0]:.4f} to {t_range[1]:.4f} s on "
                        "the sensor clock)", trial,
@@ -443,6 +508,8 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
         x, y = c * dx + s * dy, -s * dx + c * dy
         if has_v:
             vx, vy = c * vx + s * vy, -s * vx + c * vy
+    if max_range_m is not None:
+        _check_distances(rows, meta, x, y, float(max_range_m), path, trial)
     df = pd.DataFrame({"t_sensor_s": t, "side": rows["side"].to_numpy(object),
                        "x_m": x, "y_m": y})
     if has_v:
@@ -522,7 +589,8 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
     Returns
     -------
     (DataFrame, dict)
-        Rows ``t_s, person, x, y`` (sorted by time and person, in metres) and the header
+        Rows ``t_s, person, x, y`` (sorted by time and person, in metres; and ``msg``,
+        the message's number on the topic, 1-based, which errors name) and the header
         (``format, version, units: m, frame: sensor, clock: sensor, source``), ready for
         :func:`write_tracks`.
     """
@@ -597,9 +665,9 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
     if dup.any():
         i = int(np.flatnonzero(dup.to_numpy())[0])
         raise _err(p, f"topic {name}, message {df['msg'].iloc[i]}: person "
-                   f"{df['person'].iloc[i]!r} twice at time stamp {df['t_s'].iloc[i]!r} s",
+                   f"{df['person'].iloc[i]!r} twice at time stamp {float(df['t_s'].iloc[i])!r} s",
                    trial)
-    df = df.drop(columns="msg").sort_values(["t_s", "person"], kind="stable")
+    df = df.sort_values(["t_s", "person"], kind="stable")     # msg: where errors point
     meta = {"format": FORMAT, "version": VERSION, "units": "m", "frame": "sensor",
             "clock": "sensor", "source": f"{msgtype} on {name}"}
     return df.reset_index(drop=True), meta
@@ -608,7 +676,8 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
 def people_to_legs(rows: pd.DataFrame, legs: dict, *, path=None, trial: str | None = None,
                    topic: str = "") -> pd.DataFrame:
     """People rows (``t_s, person, x, y`` in metres, :func:`read_bag_tracks`) as leg rows
-    (``t_s, side, x_m, y_m``, :func:`read_tracks`' columns): ``legs`` maps each side to
+    (``t_s, side, x_m, y_m``, :func:`read_tracks`' columns, and ``msg`` when the people
+    rows have it): ``legs`` maps each side to
     the person id that tracked it (``{"L": "1", "R": "2"}``; a PoseArray's index), for a
     tracker that publishes each leg as a person.  Other ids are dropped.  A time stamp
     where one leg's id is absent gets that leg without a position (not observed: the
@@ -633,4 +702,8 @@ def people_to_legs(rows: pd.DataFrame, legs: dict, *, path=None, trial: str | No
     full = pd.MultiIndex.from_product([times, list(SIDES)], names=["t_s", "side"])
     out = (r.set_index(["t_s", "side"])[["x", "y"]].reindex(full).reset_index()
            .rename(columns={"x": "x_m", "y": "y_m"}))
-    return out[["t_s", "side", "x_m", "y_m"]]
+    if "msg" not in rows:
+        return out[["t_s", "side", "x_m", "y_m"]]
+    first = rows.drop_duplicates("t_s").set_index("t_s")["msg"]
+    out["msg"] = out["t_s"].map(first).to_numpy(np.int64)     # the message of each time
+    return out[["t_s", "side", "x_m", "y_m", "msg"]]
