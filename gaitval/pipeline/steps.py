@@ -90,6 +90,10 @@ def study_config(config: dict, sheet: str | Path, out: str | Path,
             study = yaml.safe_load(fh) or {}
         check_study_file(study, cal)
         cfg = deep_merge(cfg, {k: v for k, v in study.items() if k in ANALYSIS_SECTIONS})
+        if study.get("external_methods"):     # the study's own external methods (issue 37)
+            tracking = cfg.setdefault("tracking", {})
+            tracking["external"] = {**(tracking.get("external") or {}),
+                                    **study["external_methods"]}
         cfg["calibration_file"] = str(cal)
     if view is not None:
         cfg = method_view(cfg, view, scope)
@@ -548,6 +552,101 @@ def external_track_path(sheet, entry: dict, trial: str, method: str = "") -> Pat
     return path
 
 
+EXTERNAL_PROTOCOLS = ("tug", "mtst")
+
+
+def study_external(sheet) -> dict:
+    """``external_methods:`` of the ``study.yaml`` beside a trial sheet: the study's own
+    external methods, method name -> entry as in ``tracking.external`` ({} without)."""
+    cal = Path(sheet).parent / "study.yaml"
+    if not cal.is_file():
+        return {}
+    with open(cal, encoding="utf-8") as fh:
+        doc = yaml.safe_load(fh) or {}
+    return dict((doc.get("external_methods") or {}) if isinstance(doc, dict) else {})
+
+
+def external_declarations(config_external: dict | None, sheets: dict, taken) -> dict:
+    """Each study's external methods: ``tracking.external`` of the workflow config (every
+    study of ``run``) and ``external_methods:`` of the study's own ``study.yaml``.
+
+    ``sheets``: study -> its trial sheet's path (the study.yaml beside it need not exist
+    yet: a simulated study before its simulation); ``taken``: the names of gaitval's own
+    methods.  Returns ``{study: {method: entry}}``.
+
+    Raises
+    ------
+    ConfigError
+        Naming the study.yaml and key: a name that is already a method or also declared in
+        the workflow config; a name declared by some studies of ``run`` and not by
+        another, or with other ``protocols`` there (the tables pool the studies of
+        ``run``, one row per method, so every study needs the method's files).
+    """
+    from gaitval.configcheck import display_path
+
+    config_external = dict(config_external or {})
+    own = {s: study_external(sheet) for s, sheet in sheets.items()}
+    where = {s: display_path(Path(sheets[s]).parent / "study.yaml") for s in sheets}
+    for s, entries in own.items():
+        for m in entries:
+            if m in taken:
+                raise ConfigError(f"[file {where[s]}] external_methods.{m}: {m!r} is already "
+                                  "a tracking method; give the external tracker another name")
+            if m in config_external:
+                raise ConfigError(f"[file {where[s]}] external_methods.{m}: {m!r} is also "
+                                  "declared in the workflow config (tracking.external); "
+                                  "declare it in one place")
+    names = sorted({m for entries in own.values() for m in entries})
+    for m in names:
+        have = [s for s in sheets if m in own[s]]
+        lack = [s for s in sheets if m not in own[s]]
+        if lack:
+            raise ConfigError(
+                f"[file {where[have[0]]}] external_methods.{m}: study {lack[0]!r} of run "
+                f"{list(sheets)} does not declare it (its study.yaml: {where[lack[0]]})",
+                hint="the tables pool the studies of run, one row per method: declare it "
+                     "in every study's study.yaml, or run the study alone")
+        prot = {s: sorted(own[s][m].get("protocols") or EXTERNAL_PROTOCOLS) for s in have}
+        if len({tuple(v) for v in prot.values()}) > 1:
+            raise ConfigError(f"[file {where[have[1]]}] external_methods.{m}.protocols: "
+                              f"{prot[have[1]]} here, {prot[have[0]]} in "
+                              f"{where[have[0]]}; one method tracks the same protocols "
+                              "in every study of run")
+    return {s: {**config_external, **own[s]} for s in sheets}
+
+
+def missing_external_files(sheet, entries: dict, source: str = "") -> None:
+    """Check, before any job runs, that every trial of each external method's protocols
+    has its file, inside the sheet's folder (:func:`external_track_path`).  A sheet that
+    cannot be read yet (a simulated study before its simulation; a broken sheet, which its
+    own check reports) is skipped.
+
+    Raises
+    ------
+    ConfigError
+        One message per method naming where it is declared, how many files are missing
+        and the first few of them."""
+    try:
+        df = pd.read_csv(sheet, usecols=["trial", "protocol"], dtype=str,
+                         keep_default_na=False)
+    except (OSError, ValueError):
+        return
+    for m, entry in entries.items():
+        prots = (entry or {}).get("protocols") or EXTERNAL_PROTOCOLS
+        trials = sorted(df.loc[df["protocol"].str.strip().isin(prots), "trial"].str.strip())
+        paths = [external_track_path(sheet, entry, t, m) for t in trials]
+        missing = [p for p in paths if not p.exists()]
+        if missing:
+            shown = ", ".join(str(p) for p in missing[:3])
+            raise ConfigError(
+                f"{source or 'external method'} {m}: {len(missing)} of {len(paths)} "
+                f"trials' track files are missing ({shown}"
+                f"{', ...' if len(missing) > 3 else ''})",
+                hint=f"path {entry['path']!r} is relative to the trial sheet's folder "
+                     f"{Path(sheet).parent}; every trial of {', '.join(prots)} needs its "
+                     "file")
+
+
 def external_entry(config_json, method: str) -> dict:
     """``tracking.external.<method>`` of a config view (empty without one)."""
     if not config_json:
@@ -606,7 +705,7 @@ def import_tracks_step(tracks_file, sensor_parquet, registration_json, trial: st
         period = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
         track = tracks_to_sensor(rows, meta, rec, path=tracks_file, trial=trial,
                                  t_range=(float(t[0]), float(t[-1])), tolerance_s=period,
-                                 scan_t=t)
+                                 scan_t=t, max_range_m=float(scans.range_max))
     track.insert(0, "method", method)
     track.insert(0, "trial", trial)
     write_parquet(track, out_parquet)
