@@ -567,6 +567,52 @@ BAG_PEOPLE_TYPES = ("leg_tracker/msg/PersonArray", "people_msgs/msg/People",
 BAG_LEG_DETECTIONS = "leg_tracker/msg/LegArray"
 
 
+def _bag_topic(reader, topic, known, p, trial):
+    """The connections of the tracker topic to read: ``topic`` (an error listing the
+    tracker topics and all topics when the bag has no such topic), or the bag's only
+    topic of a type in ``known``."""
+    from gaitval.io.rosbag import _norm
+
+    cands = [c for c in reader.connections if c.msgtype in known]
+    if topic is not None and str(topic).strip():
+        conns = [c for c in reader.connections if _norm(c.topic) == _norm(str(topic))]
+        if not conns:
+            raise _err(p, f"topic {topic!r} is not in this bag; tracker topics: "
+                       f"{sorted({c.topic for c in cands}) or 'none'}; all topics: "
+                       f"{sorted({c.topic for c in reader.connections})}", trial)
+        return conns
+    topics = sorted({c.topic for c in cands})
+    if len(topics) != 1:
+        raise _err(p, f"{'no' if not topics else 'several'} tracker topic(s) of type "
+                   f"{', '.join(known)} in this bag"
+                   f"{': ' + str(topics) if topics else ''}", trial, hint="name the topic")
+    return [c for c in cands if c.topic == topics[0]]
+
+
+def _scan_frames(reader) -> set:
+    from gaitval.io.rosbag import LASERSCAN
+
+    scans = [c for c in reader.connections if c.msgtype == LASERSCAN]
+    return {str(reader.deserialize(raw, con.msgtype).header.frame_id)
+            for con, _, raw in reader.messages(connections=scans)}
+
+
+def _check_frames(p, name, frames, scan_frames, trial) -> None:
+    """The topic's header frame must be the laser's (gaitval reads no /tf)."""
+    if not scan_frames:
+        raise _err(p, f"no LaserScan topic in this bag: the frame of {name} "
+                   f"({', '.join(sorted(frames))}) cannot be checked against the laser's",
+                   trial, hint="record the scans with the tracker's output")
+    if frames != scan_frames or len(frames) != 1:
+        raise _err(p, f"topic {name} is in frame(s) {sorted(frames)} but the scans in "
+                   f"{sorted(scan_frames)}; gaitval does not transform between frames",
+                   trial, hint="publish the tracks in the laser frame")
+
+
+def _stamp(m) -> float:
+    return int(m.header.stamp.sec) + int(m.header.stamp.nanosec) * 1e-9
+
+
 def read_bag_tracks(path: str | Path, topic: str | None = None, *,
                     trial: str | None = None) -> tuple[pd.DataFrame, dict]:
     """A tracker's people topic of a ROS bag as exchange-format rows (``person``).
@@ -585,7 +631,8 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
     in a fixed order.
 
     ``leg_tracker/LegArray`` (``/detected_leg_clusters``) holds leg *detections* of one
-    scan without identity or side, not tracks: it is refused with that reason.
+    scan without identity or side, not tracks: it is refused with that reason (they are
+    read by :func:`read_bag_leg_detections`).
 
     Returns
     -------
@@ -596,45 +643,28 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
         :func:`write_tracks`.
     """
     from gaitval.io.annotations_bag import _register_custom_types
-    from gaitval.io.rosbag import LASERSCAN, _norm, _open
+    from gaitval.io.rosbag import _open
 
     p = Path(path)
     reader = _open(p, trial)
     try:
         _register_custom_types(reader)
-        known = BAG_PEOPLE_TYPES + (BAG_LEG_DETECTIONS,)
-        cands = [c for c in reader.connections if c.msgtype in known]
-        if topic is not None and str(topic).strip():
-            conns = [c for c in reader.connections if _norm(c.topic) == _norm(str(topic))]
-            if not conns:
-                raise _err(p, f"topic {topic!r} is not in this bag; tracker topics: "
-                           f"{sorted({c.topic for c in cands}) or 'none'}; all topics: "
-                           f"{sorted({c.topic for c in reader.connections})}", trial)
-        else:
-            topics = sorted({c.topic for c in cands})
-            if len(topics) != 1:
-                raise _err(p, f"{'no' if not topics else 'several'} tracker topic(s) of type "
-                           f"{', '.join(known)} in this bag"
-                           f"{': ' + str(topics) if topics else ''}", trial,
-                           hint="name the topic")
-            conns = [c for c in cands if c.topic == topics[0]]
+        conns = _bag_topic(reader, topic, BAG_PEOPLE_TYPES + (BAG_LEG_DETECTIONS,), p, trial)
         msgtype, name = conns[0].msgtype, conns[0].topic
         if msgtype == BAG_LEG_DETECTIONS:
             raise _err(p, f"topic {name} holds {msgtype}: leg detections of one scan "
                        "without identity or side, not tracks", trial,
                        hint="record the tracker's people topic (leg_tracker/PersonArray, "
-                       "/people_tracked) or write the legs' tracks as a *.tracks.csv")
+                       "/people_tracked) or write the legs' tracks as a *.tracks.csv; "
+                       "detections are scored by 'gaitval leg-detections'")
         if msgtype not in BAG_PEOPLE_TYPES:
             raise _err(p, f"topic {name} holds {msgtype}, not one of "
                        f"{', '.join(BAG_PEOPLE_TYPES)}", trial)
-        scan_frames = set()
-        scans = [c for c in reader.connections if c.msgtype == LASERSCAN]
-        for con, _, raw in reader.messages(connections=scans):
-            scan_frames.add(str(reader.deserialize(raw, con.msgtype).header.frame_id))
+        scan_frames = _scan_frames(reader)
         rows, frames = [], set()
         for n, (con, _, raw) in enumerate(reader.messages(connections=conns)):
             m = reader.deserialize(raw, con.msgtype)
-            t = int(m.header.stamp.sec) + int(m.header.stamp.nanosec) * 1e-9
+            t = _stamp(m)
             frames.add(str(m.header.frame_id))
             if msgtype == BAG_PEOPLE_TYPES[2]:          # PoseArray: the index is the id
                 items = [(str(i), q.position) for i, q in enumerate(m.poses)]
@@ -648,14 +678,7 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
         reader.close()
     if not rows:
         raise _err(p, f"topic {name} holds no person", trial)
-    if not scan_frames:
-        raise _err(p, f"no LaserScan topic in this bag: the frame of {name} "
-                   f"({', '.join(sorted(frames))}) cannot be checked against the laser's",
-                   trial, hint="record the scans with the tracker's output")
-    if frames != scan_frames or len(frames) != 1:
-        raise _err(p, f"topic {name} is in frame(s) {sorted(frames)} but the scans in "
-                   f"{sorted(scan_frames)}; gaitval does not transform between frames",
-                   trial, hint="publish the tracks in the laser frame")
+    _check_frames(p, name, frames, scan_frames, trial)
     df = pd.DataFrame(rows, columns=["t_s", "person", "x", "y", "msg"])
     bad = ~np.isfinite(df[["t_s", "x", "y"]].to_numpy()).all(axis=1)
     if bad.any():
@@ -672,6 +695,66 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
     meta = {"format": FORMAT, "version": VERSION, "units": "m", "frame": "sensor",
             "clock": "sensor", "source": f"{msgtype} on {name}"}
     return df.reset_index(drop=True), meta
+
+
+def read_bag_leg_detections(path: str | Path, topic: str | None = None, *,
+                            trial: str | None = None) -> tuple[pd.DataFrame, dict]:
+    """leg_tracker's leg detections (``leg_tracker/LegArray``, ``/detected_leg_clusters``:
+    ``header``, ``legs[]`` with ``position`` and ``confidence``) of a ROS 1/2 bag.
+
+    A detection has no identity and no side: it is the input of a tracker, not a track.
+    gaitval does not pair detections into left and right tracks (that pairing would be a
+    tracker of gaitval's, not the external system's result); they are scored as
+    detections only (:func:`gaitval.evaluate.leg_detections.detection_statistics`).
+
+    Returns
+    -------
+    (DataFrame, dict)
+        One row per detection: ``t_s`` (``header.stamp``, sensor clock), ``msg`` (the
+        message's number on the topic, 1-based; a message without legs has no row),
+        ``x_m``, ``y_m`` (laser frame, metres), ``confidence``; and
+        ``{"source": "<type> on <topic>", "n_messages": N, "t_messages": [...]}``
+        (every message's stamp, legs or not).
+
+    Raises
+    ------
+    FileFormatError
+        Naming the bag: a topic it does not have or of another type, a topic not in the
+        laser's frame, no LaserScan to check that against, a non-finite position (naming
+        the message).
+    """
+    from gaitval.io.annotations_bag import _register_custom_types
+    from gaitval.io.rosbag import _open
+
+    p = Path(path)
+    reader = _open(p, trial)
+    try:
+        _register_custom_types(reader)
+        conns = _bag_topic(reader, topic, (BAG_LEG_DETECTIONS,), p, trial)
+        msgtype, name = conns[0].msgtype, conns[0].topic
+        if msgtype != BAG_LEG_DETECTIONS:
+            raise _err(p, f"topic {name} holds {msgtype}, not {BAG_LEG_DETECTIONS}", trial)
+        scan_frames = _scan_frames(reader)
+        rows, frames, stamps = [], set(), []
+        for n, (con, _, raw) in enumerate(reader.messages(connections=conns)):
+            m = reader.deserialize(raw, con.msgtype)
+            t = _stamp(m)
+            stamps.append(t)
+            frames.add(str(m.header.frame_id))
+            for leg in m.legs:
+                x, y = float(leg.position.x), float(leg.position.y)
+                if not (math.isfinite(x) and math.isfinite(y)):
+                    raise _err(p, f"topic {name}, message {n + 1}: a leg has a non-finite "
+                               "position", trial)
+                rows.append((t, n + 1, x, y, float(leg.confidence)))
+    finally:
+        reader.close()
+    if not stamps:
+        raise _err(p, f"topic {name} has no message", trial)
+    _check_frames(p, name, frames, scan_frames, trial)
+    df = pd.DataFrame(rows, columns=["t_s", "msg", "x_m", "y_m", "confidence"])
+    return df, {"source": f"{msgtype} on {name}", "n_messages": len(stamps),
+                "t_messages": stamps}
 
 
 def people_to_legs(rows: pd.DataFrame, legs: dict, *, path=None, trial: str | None = None,

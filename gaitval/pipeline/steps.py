@@ -672,6 +672,31 @@ def read_external(tracks_file, entry: dict, trial: str) -> tuple[pd.DataFrame, d
                           topic=meta["source"]), meta
 
 
+def leg_detections_step(bag, groundtruth_parquet, out_dir, *, topic: str | None = None,
+                        trial: str | None = None, gate_m: float = 0.30) -> dict:
+    """leg_tracker's leg detections (``leg_tracker/LegArray``) of one trial's bag scored
+    against the trial's mocap legs (:func:`gaitval.evaluate.leg_detections.
+    detection_statistics`); writes ``per_scan.parquet`` and ``summary.json`` into
+    ``out_dir`` (atomically) and returns the summary.  The bag's stamps must be on the
+    ground truth's sensor clock (the clock of the scans registered)."""
+    from gaitval.evaluate.leg_detections import detection_statistics
+    from gaitval.io.tracks import read_bag_leg_detections
+
+    det, meta = read_bag_leg_detections(bag, topic, trial=trial)
+    truth = read_parquet(groundtruth_parquet)
+    per_scan, summary = detection_statistics(det, meta["t_messages"], truth, gate_m)
+    if not summary["n_scans"]:
+        raise FileFormatError(f"no message of {meta['source']} is at a scan time of the "
+                              "ground truth with both legs known (no scan to score)",
+                              path=bag, trial=trial, hint="the detections' header.stamp "
+                              "must be the scans' stamps, on the registered sensor clock")
+    summary = {"trial": trial, "source": meta["source"], **summary}
+    out = Path(out_dir)
+    write_parquet(per_scan, out / "per_scan.parquet")
+    write_text(out / "summary.json", json.dumps(summary, indent=1, sort_keys=True) + "\n")
+    return summary
+
+
 def import_tracks_step(tracks_file, sensor_parquet, registration_json, trial: str,
                        method: str, out_parquet, config_json=None,
                        moving_sensor: bool = False) -> pd.DataFrame:
