@@ -217,6 +217,12 @@ def analysis_sections_json(view=None, scope=ALL_SCOPE):
     sections = {k: config[k] for k in ANALYSIS_SECTIONS if k in config}
     if view is not None:
         sections = method_view(sections, view, scope)
+        # an external method's entries of each study (study.yaml's external_methods:, read
+        # by the job from the study.yaml): here too, so that changing one (a topic, the
+        # legs) reruns its view and jobs (a params change); study_config ignores the key
+        by_study = {s: e[view] for s, e in _EXTERNAL.items() if view in e}
+        if by_study:
+            sections["external_methods_of_studies"] = by_study
     return json.dumps(sections, sort_keys=True, default=str)
 
 
