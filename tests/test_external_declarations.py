@@ -93,7 +93,8 @@ def test_missing_and_outside_files_are_named_before_any_job(tmp_path):
     ({"mine": {"path": "ext/{trial}.csv", "legs": {"L": "1"}}}, ["legs", "R"]),
     ({"mine": {"path": "ext/{trial}.csv", "protocols": ["ultrasonic"]}},
      ["protocols", "ultrasonic"]),
-    ({"mine": {"path": "ext/{trial}.csv", "topc": "/x"}}, ["topc", "did you mean external_methods.mine.topic"]),
+    ({"mine": {"path": "ext/{trial}.csv", "topc": "/x"}},
+     ["topc", "did you mean external_methods.mine.topic"]),
 ])
 def test_study_yaml_schema_refuses_what_cannot_be_checked(tmp_path, entry, words):
     with pytest.raises(ConfigError) as exc:

@@ -15,8 +15,9 @@ from gaitval.errors import ConfigError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash
 from gaitval.methods import METHODS, get_method, override_problems, set_params
-from gaitval.pipeline.steps import (ALL_SCOPE, EXTERNAL_PROTOCOLS, ANALYSIS_SECTIONS, PROTOCOL_SCOPE, SCOPES, STUDY_VIEW,
-                           method_definition, method_view)
+from gaitval.pipeline.steps import (ALL_SCOPE, ANALYSIS_SECTIONS, EXTERNAL_PROTOCOLS,
+                                    PROTOCOL_SCOPE, SCOPES, STUDY_VIEW,
+                                    method_definition, method_view)
 from gaitval.tables.tug_evidence import method_reading
 
 
