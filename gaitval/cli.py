@@ -31,6 +31,9 @@ def cmd_validate(a) -> int:
     if a.deep and not a.no_file_check:
         from gaitval.io.deepcheck import deep_problems
         problems += deep_problems(df, a.sheet, jobs=a.jobs)
+    if not a.no_file_check:        # the study's external methods (study.yaml, issue 37)
+        from gaitval.pipeline.steps import external_problems
+        problems += external_problems(a.sheet, deep=a.deep)
     if problems:
         for p in problems:
             print(f"gaitval: error: {p}", file=sys.stderr)

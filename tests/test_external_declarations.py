@@ -121,3 +121,25 @@ def test_the_workflow_stops_at_start_naming_the_missing_files(tmp_path):
     for w in ("ConfigError", "study mine", "study.yaml] external_methods my_tracker",
               "2 of 2 trials' track files are missing"):
         assert w in out, (w, out[-2000:])
+
+
+def test_validate_reports_the_studys_external_files(tmp_path):
+    """``gaitval validate`` (the helper it calls) names a study.yaml entry's missing files,
+    and with --deep each file that does not read (here: units in cm)."""
+    from gaitval.pipeline.steps import external_problems
+
+    a = study(tmp_path, "a", {"mine": ENTRY})
+    probs = external_problems(a)
+    assert len(probs) == 1 and "2 of 2 trials' track files are missing" in probs[0]
+    (a.parent / "ext").mkdir()
+    good = ("# gaitval-tracks v1\n# units: m\n# frame: sensor\n# clock: sensor\n"
+            "t_s,side,x,y\n0.0,L,1.0,0.1\n0.0,R,1.0,-0.1\n")
+    (a.parent / "ext" / "tug_a.tracks.csv").write_text(good)
+    (a.parent / "ext" / "tug_b.tracks.csv").write_text(good.replace("units: m", "units: cm"))
+    assert external_problems(a) == []
+    probs = external_problems(a, deep=True)
+    assert len(probs) == 1
+    for w in ("external_methods.mine", "tug_b.tracks.csv", "trial tug_b", "'units' is 'cm'",
+              "(line 2)"):
+        assert w in probs[0], (w, probs[0])
+    assert external_problems(study(tmp_path, "b", None), deep=True) == []

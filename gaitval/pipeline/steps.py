@@ -647,6 +647,45 @@ def missing_external_files(sheet, entries: dict, source: str = "") -> None:
                      "file")
 
 
+def external_problems(sheet, deep: bool = False) -> list[str]:
+    """What ``gaitval validate`` reports of the study's own external methods
+    (``external_methods:`` of the study.yaml beside ``sheet``): the entries against the
+    schema, each trial's file present and inside the folder, and with ``deep`` every file
+    read (:func:`read_external`: header, columns, rows, a bag's topic and legs; the clock
+    and frame conversion needs the registration and is checked when the run imports it).
+    One text per problem."""
+    from gaitval.configcheck import check_study_file
+
+    cal = Path(sheet).parent / "study.yaml"
+    try:
+        entries = study_external(sheet)
+        if not entries:
+            return []
+        check_study_file({"external_methods": entries}, cal)
+    except GaitvalError as exc:
+        return [str(exc)]
+    except (OSError, yaml.YAMLError) as exc:
+        return [f"[file {cal}] cannot be read: {exc}"]
+    out = []
+    for m, entry in entries.items():
+        try:
+            missing_external_files(sheet, {m: entry}, f"[file {cal}] external_methods")
+        except GaitvalError as exc:
+            out.append(str(exc))
+            continue
+        if not deep:
+            continue
+        df = pd.read_csv(sheet, usecols=["trial", "protocol"], dtype=str,
+                         keep_default_na=False)
+        prots = entry.get("protocols") or EXTERNAL_PROTOCOLS
+        for t in sorted(df.loc[df["protocol"].str.strip().isin(prots), "trial"].str.strip()):
+            try:
+                read_external(external_track_path(sheet, entry, t, m), entry, t)
+            except GaitvalError as exc:
+                out.append(f"external_methods.{m}: {exc}")
+    return out
+
+
 def external_entry(config_json, method: str) -> dict:
     """``tracking.external.<method>`` of a config view (empty without one)."""
     if not config_json:
