@@ -221,8 +221,9 @@ def analysis_sections_json(view=None, scope=ALL_SCOPE):
         # an external method's entries of each study (study.yaml's external_methods:, read
         # by the job from the study.yaml): here too, so that changing one (a topic, the
         # legs) reruns its view and jobs (a params change); study_config ignores the key
+        in_config = view in ((config.get("tracking") or {}).get("external") or {})
         by_study = {s: e[view] for s, e in _EXTERNAL.items() if view in e}
-        if by_study:
+        if by_study and not in_config:
             sections["external_methods_of_studies"] = by_study
     return json.dumps(sections, sort_keys=True, default=str)
 
