@@ -31,6 +31,9 @@ def cmd_validate(a) -> int:
     if a.deep and not a.no_file_check:
         from gaitval.io.deepcheck import deep_problems
         problems += deep_problems(df, a.sheet, jobs=a.jobs)
+    if not a.no_file_check:        # the study's external methods (study.yaml, issue 37)
+        from gaitval.pipeline.steps import external_problems
+        problems += external_problems(a.sheet, deep=a.deep)
     if problems:
         for p in problems:
             print(f"gaitval: error: {p}", file=sys.stderr)
@@ -145,6 +148,13 @@ def cmd_export_tracks(a) -> int:
     if a.legs:
         legs = dict(kv.split("=", 1) for kv in a.legs.split(",") if "=" in kv)
     print(f"wrote {export_tracks_step(a.track, a.out, a.units, a.topic, legs)}")
+    return 0
+
+
+def cmd_leg_detections(a) -> int:
+    from gaitval.pipeline.steps import leg_detections_step
+    print(json.dumps(leg_detections_step(a.detections, a.groundtruth, a.out, topic=a.topic,
+                                         trial=a.trial, gate_m=a.gate_m), sort_keys=True))
     return 0
 
 
@@ -334,6 +344,22 @@ def _add_lrs_verbs(sub) -> None:
     s.add_argument("--legs", help="bags whose people are legs: the person ids of the "
                    "left and right leg, e.g. L=1,R=2 (a PoseArray: the poses' indices)")
     s.set_defaults(func=cmd_export_tracks)
+
+    s = sub.add_parser("leg-detections", help="leg_tracker's leg detections "
+                       "(leg_tracker/LegArray, no identity or side) of one trial scored "
+                       "against its mocap legs: detection rate per leg, RMSE, false "
+                       "detections per scan (docs/formats.md, Leg detections)")
+    s.add_argument("--detections", required=True, help="ROS 1 bag or ROS 2 bag folder with "
+                   "the detections and the laser's scans (the same frame)")
+    s.add_argument("--topic", help="the LegArray topic (default: the only one, e.g. "
+                   "/detected_leg_clusters)")
+    s.add_argument("--groundtruth", required=True, help="the trial's groundtruth.parquet "
+                   "(results/<study>/register/<trial>/), on the same sensor clock")
+    s.add_argument("--trial", help="trial id (named in errors)")
+    s.add_argument("--gate-m", type=float, default=0.30, help="a detection farther than "
+                   "this from a leg is not that leg's (default 0.30 m)")
+    s.add_argument("--out", required=True, help="folder: per_scan.parquet, summary.json")
+    s.set_defaults(func=cmd_leg_detections)
 
     s = sub.add_parser("import-tracks", help="an external tracker's *.tracks.csv/parquet of "
                        "one trial as gaitval's track (sensor clock and frame)")

@@ -135,6 +135,8 @@ def _problems_of(error: jsonschema.ValidationError, instance: Any, root: dict
         if isinstance(parent, dict) and error.instance in parent:    # via propertyNames
             key = path + (error.instance,)
             return [Problem(key, f"bad key {dotted(key)}: {s.get('description', '')}")]
+        if s.get("description"):                 # a value: say what it must be
+            return [Problem(path, f"{where}: {error.instance!r} is not {s['description']}")]
     if v in ("anyOf", "oneOf") and s.get("description"):
         return [Problem(path, f"{where}: {s['description']}")]
     return [Problem(path, f"{where}: {error.message}")]

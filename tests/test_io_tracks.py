@@ -120,10 +120,12 @@ GOOD = ["t_s,side,x,y", "0.0,L,1.0,0.1", "0.0,R,1.0,-0.1", "0.025,L,1.0,0.1",
 
 @pytest.mark.parametrize("lines, words", [
     (["# something else"] + HEAD[1:] + GOOD, ["line 1", "gaitval-tracks v1"]),
-    ([HEAD[0], "# units: cm"] + HEAD[2:] + GOOD, ["'units'", "'cm'", "m, mm"]),
-    ([HEAD[0], HEAD[2], HEAD[3]] + GOOD, ["'units'", "missing"]),
-    (HEAD[:2] + ["# frame: world", HEAD[3]] + GOOD, ["'frame'", "'world'", "sensor, mocap"]),
-    (HEAD[:3] + ["# clock: video"] + GOOD, ["'clock'", "'video'"]),
+    ([HEAD[0], "# units: cm"] + HEAD[2:] + GOOD, ["'units'", "'cm'", "(line 2)", "m, mm"]),
+    ([HEAD[0], HEAD[2], HEAD[3]] + GOOD,
+     ["'units'", "missing", "no '# units: ...' line among header lines 1-3"]),
+    (HEAD[:2] + ["# frame: world", HEAD[3]] + GOOD,
+     ["'frame'", "'world'", "(line 3)", "sensor, mocap"]),
+    (HEAD[:3] + ["# clock: video"] + GOOD, ["'clock'", "'video'", "(line 4)"]),
     (HEAD + ["t_s,side,x"] + [r.rsplit(",", 1)[0] for r in GOOD[1:]], ["'y'", "missing"]),
     (HEAD + ["t_s,side,x,y,z"] + [r + ",0" for r in GOOD[1:]], ["unknown column", "'z'"]),
     (HEAD + GOOD[:3] + ["0.025,X,1.0,0.1"], ["'side'", "line 8", "'X'", "L or R"]),
@@ -163,7 +165,8 @@ def test_bad_parquet_errors(tmp_path):
     meta = {"format": "gaitval-tracks", "version": 1, "units": "inch", "frame": "sensor",
             "clock": "sensor"}
     write_parquet(rows, p, metadata={"gaitval:tracks": json.dumps(meta)})
-    with pytest.raises(FileFormatError, match="'units' is 'inch'"):
+    with pytest.raises(FileFormatError, match="'units' is 'inch' .schema metadata "
+                                              "'gaitval:tracks'.,"):
         read_tracks(p)
     meta.update(units="m", version=2)
     write_parquet(rows, p, metadata={"gaitval:tracks": json.dumps(meta)})
@@ -189,7 +192,12 @@ def test_time_outside_recording_and_registration_needed(tmp_path):
     with pytest.raises(FileFormatError) as exc:
         tracks_to_sensor(rows, meta, reg, path=p, trial="T1", t_range=(0.0, 2.0))
     msg = str(exc.value)
-    assert "data row 1" in msg and "outside the recording" in msg and str(p) in msg
+    for w in ("line 6, column 't_s'", "time stamp 0.0 s", "5.0000 s on the sensor clock",
+              "outside the recording", str(p), "trial T1"):
+        assert w in msg, (w, msg)
+    rows2, meta2 = read_tracks(_csv(tmp_path, HEAD + GOOD, "late.tracks.csv"))
+    with pytest.raises(FileFormatError, match=r"line 8, column 't_s': time stamp 0\.025 s"):
+        tracks_to_sensor(rows2, meta2, path=p, t_range=(0.0, 0.01))
     out = tracks_to_sensor(rows, meta, reg, path=p, trial="T1", t_range=(4.9, 6.0))
     np.testing.assert_allclose(out["t_sensor_s"].unique(), [5.0, 5.025])
 
@@ -261,3 +269,28 @@ def test_rollator_tracks_in_the_mocap_frame_are_refused(tmp_path):
                            moving_sensor=True)
     msg = str(exc.value)
     assert str(p) in msg and "trial R1" in msg and "laser moves" in msg
+
+
+@pytest.mark.parametrize("units, scale, words", [
+    ("m", 1000.0, ["line 6, column 'x'", "(1000, 100) m", "beyond its range (30 m)",
+                   "header units 'm'", "units: mm"]),
+    ("mm", 1.0, ["line 6, column 'x'", "every position lies within 5 cm of the laser",
+                 "header units 'mm'", "units: m"]),
+])
+def test_positions_in_the_wrong_units_are_refused(tmp_path, units, scale, words):
+    """Positions in millimetres declared as metres lie beyond the laser's range; positions
+    in metres declared as millimetres all lie at the laser: one error naming the file, the
+    row and the header's units (the laser's range from its scan log)."""
+    lines = [HEAD[0], f"# units: {units}"] + HEAD[2:] + ["t_s,side,x,y"] + [
+        f"{t},{s},{1.0 * scale:g},{(0.1 if s == 'L' else -0.1) * scale:g}"
+        for t in (0.0, 0.025) for s in "LR"]
+    p = _csv(tmp_path, lines)
+    rows, meta = read_tracks(p, trial="T1")
+    with pytest.raises(FileFormatError) as exc:
+        tracks_to_sensor(rows, meta, path=p, trial="T1", max_range_m=30.0)
+    msg = str(exc.value)
+    for w in (str(p), "trial T1", *words):
+        assert w in msg, (w, msg)
+    ok = _csv(tmp_path, HEAD + GOOD, "ok.tracks.csv")
+    r, m = read_tracks(ok)
+    assert len(tracks_to_sensor(r, m, path=ok, max_range_m=30.0)) == 4

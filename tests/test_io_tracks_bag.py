@@ -187,3 +187,22 @@ def test_pose_array_index_is_the_id(tmp_path):
     assert rows["person"].tolist() == ["0", "1", "0", "1"]
     np.testing.assert_allclose(rows["y"], [0.1, -0.1, 0.1, -0.1])
     np.testing.assert_allclose(rows["t_s"], [5.0, 5.0, 5.05, 5.05])
+
+
+def test_bag_time_stamps_outside_the_recording_name_the_message(tmp_path):
+    """A bag's tracks are converted like a file's: a time stamp outside the recording
+    names the topic, the message and its field header.stamp."""
+    from gaitval.io.tracks import people_to_legs, tracks_to_sensor
+
+    bag = make_bag(tmp_path / "t.bag")
+    rows, meta = read_bag_tracks(bag, "/people_tracked", trial="T9")
+    legs = people_to_legs(rows, {"L": "7", "R": "9"}, path=bag, trial="T9")
+    assert legs["msg"].tolist() == [1, 1, 2, 2, 3, 3]
+    out = tracks_to_sensor(legs, meta, path=bag, trial="T9", t_range=(100.0, 100.05))
+    assert len(out) == 6
+    with pytest.raises(FileFormatError) as exc:
+        tracks_to_sensor(legs, meta, path=bag, trial="T9", t_range=(100.01, 100.06))
+    msg = str(exc.value)
+    for w in (str(bag), "trial T9", "leg_tracker/msg/PersonArray on /people_tracked, "
+              "message 1, field header.stamp", "time stamp 100.0 s", "outside the recording"):
+        assert w in msg, (w, msg)

@@ -261,8 +261,9 @@ def test_verdicts_ignore_external_rows(ext_run, paper, names):
 @pytest.mark.slow
 @pytest.mark.parametrize("where", ["config", "study.yaml"])
 def test_external_method_declared_wrongly_stops_at_start(tmp_path, where):
-    """A name that is already a method, or tracking.external in a study.yaml (where the
-    workflow does not see it), stops the run before any job, naming the key."""
+    """A name that is already a method, or tracking.external in a study.yaml (a study
+    declares its own under external_methods:), stops the run before any job, naming the
+    key."""
     sheet = tmp_path / "study" / "trials.csv"
     sheet.parent.mkdir()
     sheet.write_text("study\n")
@@ -276,7 +277,7 @@ def test_external_method_declared_wrongly_stops_at_start(tmp_path, where):
     else:
         (sheet.parent / "study.yaml").write_text(
             "tracking:\n  external:\n    mine: {path: 'x/{trial}.tracks.csv'}\n")
-        words = ["study.yaml", "declared in the workflow config"]
+        words = ["study.yaml", "tracking.external", "external_methods:"]
     cf.write_text(yaml.safe_dump(doc))
     res = subprocess.run([str(SNAKEMAKE), "-n", "--snakefile", str(ROOT / "Snakefile"),
                           "--directory", str(tmp_path), "--cores", "1", "--force-use-threads", "--configfile",

@@ -58,8 +58,17 @@ def _err(path, problem: str, trial=None, hint=None) -> FileFormatError:
     return FileFormatError(problem, path=path, trial=trial, hint=hint)
 
 
-def _check_meta(meta: dict, path, trial) -> dict:
-    """The header, checked: format, version, units, frame, clock (each named when wrong)."""
+def _check_meta(meta: dict, path, trial, lines: dict | None = None) -> dict:
+    """The header, checked: format, version, units, frame, clock (each named when wrong,
+    with its line of a CSV: ``lines``, key -> line number, and ``lines[None]`` the last
+    header line; else the Parquet schema metadata)."""
+    def at(key):
+        if lines is None:
+            return f" (schema metadata {META_KEY.decode()!r})"
+        if key in lines:
+            return f" (line {lines[key]})"
+        return f" (no '# {key}: ...' line among header lines 1-{lines.get(None, 1)})"
+
     if meta.get("format") != FORMAT:
         raise _err(path, f"header field 'format' is {meta.get('format')!r}, not {FORMAT!r}",
                    trial, hint="the first line of a CSV is '# gaitval-tracks v1'")
@@ -69,23 +78,24 @@ def _check_meta(meta: dict, path, trial) -> dict:
     except (TypeError, ValueError):
         ok = False
     if not ok:
-        raise _err(path, f"header field 'version' is {v!r}; this gaitval reads version "
-                   f"{VERSION}", trial)
+        raise _err(path, f"header field 'version' is {v!r}{at('version')}; this gaitval "
+                   f"reads version {VERSION}", trial)
     for key, allowed in (("units", tuple(UNITS)), ("frame", FRAMES), ("clock", CLOCKS)):
         val = meta.get(key)
         if val is None:
-            raise _err(path, f"header field {key!r} is missing (one of "
-                       f"{', '.join(allowed)})", trial)
+            raise _err(path, f"header field {key!r} is missing{at(key)}; give one of "
+                       f"{', '.join(allowed)}", trial)
         if val not in allowed:
-            raise _err(path, f"header field {key!r} is {val!r}, not one of "
+            raise _err(path, f"header field {key!r} is {val!r}{at(key)}, not one of "
                        f"{', '.join(allowed)}", trial)
     out = dict(meta)
     out["version"] = VERSION
     return out
 
 
-def _read_csv(path: Path, trial) -> tuple[dict, list[str], list[list[str]], int]:
-    """(header, column names, rows as text, file line of the first data row)."""
+def _read_csv(path: Path, trial) -> tuple[dict, list[str], list[list[str]], int, dict]:
+    """(header, column names, rows as text, file line of the first data row, header
+    key -> its line)."""
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
@@ -95,16 +105,19 @@ def _read_csv(path: Path, trial) -> tuple[dict, list[str], list[list[str]], int]
         first = lines[0][:60] if lines else ""
         raise _err(path, f"line 1 is {first!r}, not '# {FORMAT} v{VERSION}'", trial)
     meta: dict = {"format": FORMAT, "version": VERSION}
+    where = {"format": 1, "version": 1}
     n = 1
     while n < len(lines) and lines[n].startswith("#"):
         key, sep, val = lines[n][1:].partition(":")
         if sep:
             meta[key.strip()] = val.strip()
+            where[key.strip()] = n + 1
         n += 1
+    where[None] = n
     rows = list(csv.reader(io.StringIO("\n".join(lines[n:]))))
     if not rows:
         raise _err(path, "no column header after the '#' lines", trial)
-    return meta, [c.strip() for c in rows[0]], rows[1:], n + 2
+    return meta, [c.strip() for c in rows[0]], rows[1:], n + 2, where
 
 
 def _read_parquet(path: Path, trial) -> tuple[dict, pd.DataFrame]:
@@ -195,7 +208,7 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
     if not p.exists():
         raise _err(p, "no such file", trial)
     if p.suffix == ".csv":
-        meta, names, rows_txt, first_line = _read_csv(p, trial)
+        meta, names, rows_txt, first_line, meta_lines = _read_csv(p, trial)
         for j, r in enumerate(rows_txt):
             if len(r) != len(names):
                 raise _err(p, f"line {first_line + j}: {len(r)} cells, the header has "
@@ -206,6 +219,7 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
             return f"line {first_line + i}"
     elif p.suffix == ".parquet":
         meta, df = _read_parquet(p, trial)
+        meta_lines = None
         names = list(df.columns)
         cols = {n: df[n].tolist() for n in names}
 
@@ -214,7 +228,7 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
     else:
         raise _err(p, f"unknown extension {p.suffix!r}", trial,
                    hint="a track file is *.tracks.csv or *.tracks.parquet")
-    meta = _check_meta(meta, p, trial)
+    meta = _check_meta(meta, p, trial, meta_lines)
     unknown = [n for n in names if n not in COLUMNS]
     if unknown:
         raise _err(p, f"unknown column(s) {', '.join(map(repr, unknown))}", trial,
@@ -262,7 +276,7 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
     dup = df.duplicated(["t_s", key])
     if dup.any():
         i = int(np.flatnonzero(dup.to_numpy())[0])
-        raise _err(p, f"{where(i)}: time stamp {df['t_s'].iloc[i]!r} s has {key} "
+        raise _err(p, f"{where(i)}: time stamp {float(df['t_s'].iloc[i])!r} s has {key} "
                    f"{ids[i]!r} twice", trial)
     if key == "side":
         for s in SIDES:
@@ -275,9 +289,12 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
             i = int(np.flatnonzero((counts < 2).to_numpy())[0])
             other = "R" if ids[i] == "L" else "L"
             raise _err(p, f"{where(i)}: leg {other} is missing at time stamp "
-                       f"{df['t_s'].iloc[i]!r} s (every time stamp has one row per leg; "
+                       f"{float(df['t_s'].iloc[i])!r} s (every time stamp has one row per leg; "
                        "write x, y empty where a leg has no track)", trial)
     df.attrs = {}
+    # where a row is in the file, for later errors (tracks_to_sensor): CSV lines or
+    # Parquet data rows, in the order of the rows returned
+    meta["_row"] = ("line", first_line) if meta_lines is not None else ("row", 1)
     return df, meta
 
 
@@ -368,11 +385,51 @@ def snap_to_scans(t: np.ndarray, scan_t: np.ndarray, tol_s: float = SNAP_S) -> n
     return t
 
 
+def _where(rows: pd.DataFrame, meta: dict, i: int, field: str) -> str:
+    """Row ``i`` of :func:`read_tracks` / :func:`people_to_legs` rows, as the file names
+    it: a CSV line, a Parquet data row, or a bag topic's message (``msg``), with the field."""
+    if "msg" in rows and np.isfinite(rows["msg"].iloc[i]):
+        f = {"t_s": "header.stamp", "x": "position.x", "y": "position.y"}.get(field, field)
+        return f"{meta.get('source', 'topic')}, message {int(rows['msg'].iloc[i])}, field {f}"
+    kind, first = meta.get("_row", ("data row", 1))
+    return f"{kind} {first + i}, column {field!r}"
+
+
+#: a leg farther from the laser than its range by this much is no leg it saw (m)
+RANGE_MARGIN_M = 1.0
+#: every position closer to the laser than this: not in metres (m)
+MIN_DISTANCE_M = 0.05
+
+
+def _check_distances(rows, meta, x, y, max_range_m, path, trial) -> None:
+    """Positions (sensor frame, metres) the laser can have seen: none beyond its range,
+    not all at its origin (wrong ``units``, or ``frame``)."""
+    d = np.hypot(x, y)
+    ok = np.isfinite(d)
+    if not ok.any():
+        return
+    head = f"header units {meta['units']!r}, frame {meta['frame']!r}"
+    far = ok & (d > max_range_m + RANGE_MARGIN_M)
+    if np.median(d[ok]) > max_range_m + RANGE_MARGIN_M:   # most, not one diverged track
+        i = int(np.flatnonzero(far)[0])
+        raise _err(path, f"{_where(rows, meta, i, 'x')}: position "
+                   f"({rows['x_m'].iloc[i]:.6g}, {rows['y_m'].iloc[i]:.6g}) m is "
+                   f"{d[i]:.1f} m from the laser, beyond its range ({max_range_m:g} m), "
+                   f"as are {far.sum()} of {ok.sum()} positions ({head})", trial,
+                   hint="positions in millimetres need 'units: mm'; positions in the "
+                        "mocap field need 'frame: mocap'")
+    if d[ok].max() < MIN_DISTANCE_M:
+        i = int(np.flatnonzero(ok)[0])
+        raise _err(path, f"{_where(rows, meta, i, 'x')}: every position lies within "
+                   f"{MIN_DISTANCE_M * 100:g} cm of the laser (largest {d[ok].max():.3g} m; "
+                   f"{head})", trial, hint="positions in metres need 'units: m'")
+
+
 def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None = None, *,
                      path=None, trial: str | None = None,
                      t_range: tuple[float, float] | None = None,
-                     tolerance_s: float = 0.0, scan_t: np.ndarray | None = None
-                     ) -> pd.DataFrame:
+                     tolerance_s: float = 0.0, scan_t: np.ndarray | None = None,
+                     max_range_m: float | None = None) -> pd.DataFrame:
     """Exchange rows (from :func:`read_tracks`) as gaitval's per-scan leg track.
 
     Parameters
@@ -390,6 +447,13 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
     scan_t : ndarray, optional
         The recording's scan times (sensor clock): a converted time stamp within
         :data:`SNAP_S` of one becomes that scan's time (:func:`snap_to_scans`).
+    max_range_m : float, optional
+        The laser's range: most positions (their median; in the sensor frame, after the
+        conversion) farther than this + :data:`RANGE_MARGIN_M` (a track that diverged
+        far in a few scans is a tracker's result, kept), or every position within
+        :data:`MIN_DISTANCE_M` of the laser, is an error naming the row and the header's
+        ``units`` (and ``frame``): positions in millimetres declared as metres, or the
+        reverse, or in another frame.
 
     Returns
     -------
@@ -403,7 +467,9 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
     """
     if "side" not in rows:
         raise _err(path, "the file gives people (column 'person'), not legs; the leg "
-                   "evaluation needs one row per leg (column 'side')", trial)
+                   "evaluation needs one row per leg (column 'side')", trial,
+                   hint="a bag whose people are legs: set the method's legs: {L: id, R: "
+                        "id}")
     need = [f for f, used in (("frame", meta["frame"] == "mocap"),
                               ("clock", meta["clock"] == "mocap")) if used]
     reg = registration or {}
@@ -426,8 +492,8 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
         out_of = (t < lo) | (t > hi)
         if out_of.any():
             i = int(np.flatnonzero(out_of)[0])
-            line = f"data row {i + 1}"
-            raise _err(path, f"{line}: time stamp {rows['t_s'].iloc[i]!r} s "
+            line = _where(rows, meta, i, "t_s")
+            raise _err(path, f"{line}: time stamp {float(rows['t_s'].iloc[i])!r} s "
                        f"({meta['clock']} clock; {t[i]:.4f} s on the sensor clock) is "
                        f"outside the recording ({t_range[0]:.4f} to {t_range[1]:.4f} s on "
                        "the sensor clock)", trial,
@@ -443,6 +509,8 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
         x, y = c * dx + s * dy, -s * dx + c * dy
         if has_v:
             vx, vy = c * vx + s * vy, -s * vx + c * vy
+    if max_range_m is not None:
+        _check_distances(rows, meta, x, y, float(max_range_m), path, trial)
     df = pd.DataFrame({"t_sensor_s": t, "side": rows["side"].to_numpy(object),
                        "x_m": x, "y_m": y})
     if has_v:
@@ -499,6 +567,52 @@ BAG_PEOPLE_TYPES = ("leg_tracker/msg/PersonArray", "people_msgs/msg/People",
 BAG_LEG_DETECTIONS = "leg_tracker/msg/LegArray"
 
 
+def _bag_topic(reader, topic, known, p, trial):
+    """The connections of the tracker topic to read: ``topic`` (an error listing the
+    tracker topics and all topics when the bag has no such topic), or the bag's only
+    topic of a type in ``known``."""
+    from gaitval.io.rosbag import _norm
+
+    cands = [c for c in reader.connections if c.msgtype in known]
+    if topic is not None and str(topic).strip():
+        conns = [c for c in reader.connections if _norm(c.topic) == _norm(str(topic))]
+        if not conns:
+            raise _err(p, f"topic {topic!r} is not in this bag; tracker topics: "
+                       f"{sorted({c.topic for c in cands}) or 'none'}; all topics: "
+                       f"{sorted({c.topic for c in reader.connections})}", trial)
+        return conns
+    topics = sorted({c.topic for c in cands})
+    if len(topics) != 1:
+        raise _err(p, f"{'no' if not topics else 'several'} tracker topic(s) of type "
+                   f"{', '.join(known)} in this bag"
+                   f"{': ' + str(topics) if topics else ''}", trial, hint="name the topic")
+    return [c for c in cands if c.topic == topics[0]]
+
+
+def _scan_frames(reader) -> set:
+    from gaitval.io.rosbag import LASERSCAN
+
+    scans = [c for c in reader.connections if c.msgtype == LASERSCAN]
+    return {str(reader.deserialize(raw, con.msgtype).header.frame_id)
+            for con, _, raw in reader.messages(connections=scans)}
+
+
+def _check_frames(p, name, frames, scan_frames, trial) -> None:
+    """The topic's header frame must be the laser's (gaitval reads no /tf)."""
+    if not scan_frames:
+        raise _err(p, f"no LaserScan topic in this bag: the frame of {name} "
+                   f"({', '.join(sorted(frames))}) cannot be checked against the laser's",
+                   trial, hint="record the scans with the tracker's output")
+    if frames != scan_frames or len(frames) != 1:
+        raise _err(p, f"topic {name} is in frame(s) {sorted(frames)} but the scans in "
+                   f"{sorted(scan_frames)}; gaitval does not transform between frames",
+                   trial, hint="publish the tracks in the laser frame")
+
+
+def _stamp(m) -> float:
+    return int(m.header.stamp.sec) + int(m.header.stamp.nanosec) * 1e-9
+
+
 def read_bag_tracks(path: str | Path, topic: str | None = None, *,
                     trial: str | None = None) -> tuple[pd.DataFrame, dict]:
     """A tracker's people topic of a ROS bag as exchange-format rows (``person``).
@@ -517,55 +631,40 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
     in a fixed order.
 
     ``leg_tracker/LegArray`` (``/detected_leg_clusters``) holds leg *detections* of one
-    scan without identity or side, not tracks: it is refused with that reason.
+    scan without identity or side, not tracks: it is refused with that reason (they are
+    read by :func:`read_bag_leg_detections`).
 
     Returns
     -------
     (DataFrame, dict)
-        Rows ``t_s, person, x, y`` (sorted by time and person, in metres) and the header
+        Rows ``t_s, person, x, y`` (sorted by time and person, in metres; and ``msg``,
+        the message's number on the topic, 1-based, which errors name) and the header
         (``format, version, units: m, frame: sensor, clock: sensor, source``), ready for
         :func:`write_tracks`.
     """
     from gaitval.io.annotations_bag import _register_custom_types
-    from gaitval.io.rosbag import LASERSCAN, _norm, _open
+    from gaitval.io.rosbag import _open
 
     p = Path(path)
     reader = _open(p, trial)
     try:
         _register_custom_types(reader)
-        known = BAG_PEOPLE_TYPES + (BAG_LEG_DETECTIONS,)
-        cands = [c for c in reader.connections if c.msgtype in known]
-        if topic is not None and str(topic).strip():
-            conns = [c for c in reader.connections if _norm(c.topic) == _norm(str(topic))]
-            if not conns:
-                raise _err(p, f"topic {topic!r} is not in this bag; tracker topics: "
-                           f"{sorted({c.topic for c in cands}) or 'none'}; all topics: "
-                           f"{sorted({c.topic for c in reader.connections})}", trial)
-        else:
-            topics = sorted({c.topic for c in cands})
-            if len(topics) != 1:
-                raise _err(p, f"{'no' if not topics else 'several'} tracker topic(s) of type "
-                           f"{', '.join(known)} in this bag"
-                           f"{': ' + str(topics) if topics else ''}", trial,
-                           hint="name the topic")
-            conns = [c for c in cands if c.topic == topics[0]]
+        conns = _bag_topic(reader, topic, BAG_PEOPLE_TYPES + (BAG_LEG_DETECTIONS,), p, trial)
         msgtype, name = conns[0].msgtype, conns[0].topic
         if msgtype == BAG_LEG_DETECTIONS:
             raise _err(p, f"topic {name} holds {msgtype}: leg detections of one scan "
                        "without identity or side, not tracks", trial,
                        hint="record the tracker's people topic (leg_tracker/PersonArray, "
-                       "/people_tracked) or write the legs' tracks as a *.tracks.csv")
+                       "/people_tracked) or write the legs' tracks as a *.tracks.csv; "
+                       "detections are scored by 'gaitval leg-detections'")
         if msgtype not in BAG_PEOPLE_TYPES:
             raise _err(p, f"topic {name} holds {msgtype}, not one of "
                        f"{', '.join(BAG_PEOPLE_TYPES)}", trial)
-        scan_frames = set()
-        scans = [c for c in reader.connections if c.msgtype == LASERSCAN]
-        for con, _, raw in reader.messages(connections=scans):
-            scan_frames.add(str(reader.deserialize(raw, con.msgtype).header.frame_id))
+        scan_frames = _scan_frames(reader)
         rows, frames = [], set()
         for n, (con, _, raw) in enumerate(reader.messages(connections=conns)):
             m = reader.deserialize(raw, con.msgtype)
-            t = int(m.header.stamp.sec) + int(m.header.stamp.nanosec) * 1e-9
+            t = _stamp(m)
             frames.add(str(m.header.frame_id))
             if msgtype == BAG_PEOPLE_TYPES[2]:          # PoseArray: the index is the id
                 items = [(str(i), q.position) for i, q in enumerate(m.poses)]
@@ -579,14 +678,7 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
         reader.close()
     if not rows:
         raise _err(p, f"topic {name} holds no person", trial)
-    if not scan_frames:
-        raise _err(p, f"no LaserScan topic in this bag: the frame of {name} "
-                   f"({', '.join(sorted(frames))}) cannot be checked against the laser's",
-                   trial, hint="record the scans with the tracker's output")
-    if frames != scan_frames or len(frames) != 1:
-        raise _err(p, f"topic {name} is in frame(s) {sorted(frames)} but the scans in "
-                   f"{sorted(scan_frames)}; gaitval does not transform between frames",
-                   trial, hint="publish the tracks in the laser frame")
+    _check_frames(p, name, frames, scan_frames, trial)
     df = pd.DataFrame(rows, columns=["t_s", "person", "x", "y", "msg"])
     bad = ~np.isfinite(df[["t_s", "x", "y"]].to_numpy()).all(axis=1)
     if bad.any():
@@ -597,18 +689,79 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
     if dup.any():
         i = int(np.flatnonzero(dup.to_numpy())[0])
         raise _err(p, f"topic {name}, message {df['msg'].iloc[i]}: person "
-                   f"{df['person'].iloc[i]!r} twice at time stamp {df['t_s'].iloc[i]!r} s",
+                   f"{df['person'].iloc[i]!r} twice at time stamp {float(df['t_s'].iloc[i])!r} s",
                    trial)
-    df = df.drop(columns="msg").sort_values(["t_s", "person"], kind="stable")
+    df = df.sort_values(["t_s", "person"], kind="stable")     # msg: where errors point
     meta = {"format": FORMAT, "version": VERSION, "units": "m", "frame": "sensor",
             "clock": "sensor", "source": f"{msgtype} on {name}"}
     return df.reset_index(drop=True), meta
 
 
+def read_bag_leg_detections(path: str | Path, topic: str | None = None, *,
+                            trial: str | None = None) -> tuple[pd.DataFrame, dict]:
+    """leg_tracker's leg detections (``leg_tracker/LegArray``, ``/detected_leg_clusters``:
+    ``header``, ``legs[]`` with ``position`` and ``confidence``) of a ROS 1/2 bag.
+
+    A detection has no identity and no side: it is the input of a tracker, not a track.
+    gaitval does not pair detections into left and right tracks (that pairing would be a
+    tracker of gaitval's, not the external system's result); they are scored as
+    detections only (:func:`gaitval.evaluate.leg_detections.detection_statistics`).
+
+    Returns
+    -------
+    (DataFrame, dict)
+        One row per detection: ``t_s`` (``header.stamp``, sensor clock), ``msg`` (the
+        message's number on the topic, 1-based; a message without legs has no row),
+        ``x_m``, ``y_m`` (laser frame, metres), ``confidence``; and
+        ``{"source": "<type> on <topic>", "n_messages": N, "t_messages": [...]}``
+        (every message's stamp, legs or not).
+
+    Raises
+    ------
+    FileFormatError
+        Naming the bag: a topic it does not have or of another type, a topic not in the
+        laser's frame, no LaserScan to check that against, a non-finite position (naming
+        the message).
+    """
+    from gaitval.io.annotations_bag import _register_custom_types
+    from gaitval.io.rosbag import _open
+
+    p = Path(path)
+    reader = _open(p, trial)
+    try:
+        _register_custom_types(reader)
+        conns = _bag_topic(reader, topic, (BAG_LEG_DETECTIONS,), p, trial)
+        msgtype, name = conns[0].msgtype, conns[0].topic
+        if msgtype != BAG_LEG_DETECTIONS:
+            raise _err(p, f"topic {name} holds {msgtype}, not {BAG_LEG_DETECTIONS}", trial)
+        scan_frames = _scan_frames(reader)
+        rows, frames, stamps = [], set(), []
+        for n, (con, _, raw) in enumerate(reader.messages(connections=conns)):
+            m = reader.deserialize(raw, con.msgtype)
+            t = _stamp(m)
+            stamps.append(t)
+            frames.add(str(m.header.frame_id))
+            for leg in m.legs:
+                x, y = float(leg.position.x), float(leg.position.y)
+                if not (math.isfinite(x) and math.isfinite(y)):
+                    raise _err(p, f"topic {name}, message {n + 1}: a leg has a non-finite "
+                               "position", trial)
+                rows.append((t, n + 1, x, y, float(leg.confidence)))
+    finally:
+        reader.close()
+    if not stamps:
+        raise _err(p, f"topic {name} has no message", trial)
+    _check_frames(p, name, frames, scan_frames, trial)
+    df = pd.DataFrame(rows, columns=["t_s", "msg", "x_m", "y_m", "confidence"])
+    return df, {"source": f"{msgtype} on {name}", "n_messages": len(stamps),
+                "t_messages": stamps}
+
+
 def people_to_legs(rows: pd.DataFrame, legs: dict, *, path=None, trial: str | None = None,
                    topic: str = "") -> pd.DataFrame:
     """People rows (``t_s, person, x, y`` in metres, :func:`read_bag_tracks`) as leg rows
-    (``t_s, side, x_m, y_m``, :func:`read_tracks`' columns): ``legs`` maps each side to
+    (``t_s, side, x_m, y_m``, :func:`read_tracks`' columns, and ``msg`` when the people
+    rows have it): ``legs`` maps each side to
     the person id that tracked it (``{"L": "1", "R": "2"}``; a PoseArray's index), for a
     tracker that publishes each leg as a person.  Other ids are dropped.  A time stamp
     where one leg's id is absent gets that leg without a position (not observed: the
@@ -633,4 +786,8 @@ def people_to_legs(rows: pd.DataFrame, legs: dict, *, path=None, trial: str | No
     full = pd.MultiIndex.from_product([times, list(SIDES)], names=["t_s", "side"])
     out = (r.set_index(["t_s", "side"])[["x", "y"]].reindex(full).reset_index()
            .rename(columns={"x": "x_m", "y": "y_m"}))
-    return out[["t_s", "side", "x_m", "y_m"]]
+    if "msg" not in rows:
+        return out[["t_s", "side", "x_m", "y_m"]]
+    first = rows.drop_duplicates("t_s").set_index("t_s")["msg"]
+    out["msg"] = out["t_s"].map(first).to_numpy(np.int64)     # the message of each time
+    return out[["t_s", "side", "x_m", "y_m", "msg"]]

@@ -84,6 +84,10 @@ def analysis_config(config: dict, sheet: str | Path, *, check: bool = False) -> 
         if check:
             check_study_file(study, cal)
         cfg = deep_merge(cfg, {k: v for k, v in study.items() if k in ANALYSIS_SECTIONS})
+        if study.get("external_methods"):     # the study's own external methods (issue 37)
+            tracking = cfg.setdefault("tracking", {})
+            tracking["external"] = {**(tracking.get("external") or {}),
+                                    **study["external_methods"]}
         cfg["calibration_file"] = str(cal)
     return cfg
 
@@ -588,6 +592,140 @@ def external_track_path(sheet, entry: dict, trial: str, method: str = "") -> Pat
     return path
 
 
+EXTERNAL_PROTOCOLS = ("tug", "mtst")
+
+
+def study_external(sheet) -> dict:
+    """``external_methods:`` of the ``study.yaml`` beside a trial sheet: the study's own
+    external methods, method name -> entry as in ``tracking.external`` ({} without)."""
+    cal = Path(sheet).parent / "study.yaml"
+    if not cal.is_file():
+        return {}
+    with open(cal, encoding="utf-8") as fh:
+        doc = yaml.safe_load(fh) or {}
+    return dict((doc.get("external_methods") or {}) if isinstance(doc, dict) else {})
+
+
+def external_declarations(config_external: dict | None, sheets: dict, taken) -> dict:
+    """Each study's external methods: ``tracking.external`` of the workflow config (every
+    study of ``run``) and ``external_methods:`` of the study's own ``study.yaml``.
+
+    ``sheets``: study -> its trial sheet's path (the study.yaml beside it need not exist
+    yet: a simulated study before its simulation); ``taken``: the names of gaitval's own
+    methods.  Returns ``{study: {method: entry}}``.
+
+    Raises
+    ------
+    ConfigError
+        Naming the study.yaml and key: a name that is already a method or also declared in
+        the workflow config; a name declared by some studies of ``run`` and not by
+        another, or with other ``protocols`` there (the tables pool the studies of
+        ``run``, one row per method, so every study needs the method's files).
+    """
+    from gaitval.configcheck import display_path
+
+    config_external = dict(config_external or {})
+    own = {s: study_external(sheet) for s, sheet in sheets.items()}
+    where = {s: display_path(Path(sheets[s]).parent / "study.yaml") for s in sheets}
+    for s, entries in own.items():
+        for m in entries:
+            if m in taken:
+                raise ConfigError(f"[file {where[s]}] external_methods.{m}: {m!r} is already "
+                                  "a tracking method; give the external tracker another name")
+            if m in config_external:
+                raise ConfigError(f"[file {where[s]}] external_methods.{m}: {m!r} is also "
+                                  "declared in the workflow config (tracking.external); "
+                                  "declare it in one place")
+    names = sorted({m for entries in own.values() for m in entries})
+    for m in names:
+        have = [s for s in sheets if m in own[s]]
+        lack = [s for s in sheets if m not in own[s]]
+        if lack:
+            raise ConfigError(
+                f"[file {where[have[0]]}] external_methods.{m}: study {lack[0]!r} of run "
+                f"{list(sheets)} does not declare it (its study.yaml: {where[lack[0]]})",
+                hint="the tables pool the studies of run, one row per method: declare it "
+                     "in every study's study.yaml, or run the study alone")
+        prot = {s: sorted(own[s][m].get("protocols") or EXTERNAL_PROTOCOLS) for s in have}
+        if len({tuple(v) for v in prot.values()}) > 1:
+            raise ConfigError(f"[file {where[have[1]]}] external_methods.{m}.protocols: "
+                              f"{prot[have[1]]} here, {prot[have[0]]} in "
+                              f"{where[have[0]]}; one method tracks the same protocols "
+                              "in every study of run")
+    return {s: {**config_external, **own[s]} for s in sheets}
+
+
+def missing_external_files(sheet, entries: dict, source: str = "") -> None:
+    """Check, before any job runs, that every trial of each external method's protocols
+    has its file, inside the sheet's folder (:func:`external_track_path`).  A sheet that
+    cannot be read yet (a simulated study before its simulation; a broken sheet, which its
+    own check reports) is skipped.
+
+    Raises
+    ------
+    ConfigError
+        One message per method naming where it is declared, how many files are missing
+        and the first few of them."""
+    try:
+        df = pd.read_csv(sheet, usecols=["trial", "protocol"], dtype=str,
+                         keep_default_na=False)
+    except (OSError, ValueError):
+        return
+    for m, entry in entries.items():
+        prots = (entry or {}).get("protocols") or EXTERNAL_PROTOCOLS
+        trials = sorted(df.loc[df["protocol"].str.strip().isin(prots), "trial"].str.strip())
+        paths = [external_track_path(sheet, entry, t, m) for t in trials]
+        missing = [p for p in paths if not p.exists()]
+        if missing:
+            shown = ", ".join(str(p) for p in missing[:3])
+            raise ConfigError(
+                f"{source or 'external method'} {m}: {len(missing)} of {len(paths)} "
+                f"trials' track files are missing ({shown}"
+                f"{', ...' if len(missing) > 3 else ''})",
+                hint=f"path {entry['path']!r} is relative to the trial sheet's folder "
+                     f"{Path(sheet).parent}; every trial of {', '.join(prots)} needs its "
+                     "file")
+
+
+def external_problems(sheet, deep: bool = False) -> list[str]:
+    """What ``gaitval validate`` reports of the study's own external methods
+    (``external_methods:`` of the study.yaml beside ``sheet``): the entries against the
+    schema, each trial's file present and inside the folder, and with ``deep`` every file
+    read (:func:`read_external`: header, columns, rows, a bag's topic and legs; the clock
+    and frame conversion needs the registration and is checked when the run imports it).
+    One text per problem."""
+    from gaitval.configcheck import check_study_file
+
+    cal = Path(sheet).parent / "study.yaml"
+    try:
+        entries = study_external(sheet)
+        if not entries:
+            return []
+        check_study_file({"external_methods": entries}, cal)
+    except GaitvalError as exc:
+        return [str(exc)]
+    except (OSError, yaml.YAMLError) as exc:
+        return [f"[file {cal}] cannot be read: {exc}"]
+    out = []
+    for m, entry in entries.items():
+        try:
+            missing_external_files(sheet, {m: entry}, f"[file {cal}] external_methods")
+        except GaitvalError as exc:
+            out.append(str(exc))
+            continue
+        if not deep:
+            continue
+        df = pd.read_csv(sheet, usecols=["trial", "protocol"], dtype=str,
+                         keep_default_na=False)
+        prots = entry.get("protocols") or EXTERNAL_PROTOCOLS
+        for t in sorted(df.loc[df["protocol"].str.strip().isin(prots), "trial"].str.strip()):
+            try:
+                read_external(external_track_path(sheet, entry, t, m), entry, t)
+            except GaitvalError as exc:
+                out.append(f"external_methods.{m}: {exc}")
+    return out
+
+
 def external_entry(config_json, method: str) -> dict:
     """``tracking.external.<method>`` of a config view (empty without one)."""
     if not config_json:
@@ -611,6 +749,31 @@ def read_external(tracks_file, entry: dict, trial: str) -> tuple[pd.DataFrame, d
         return rows.rename(columns={"x": "x_m", "y": "y_m"}), meta
     return people_to_legs(rows, legs, path=tracks_file, trial=trial,
                           topic=meta["source"]), meta
+
+
+def leg_detections_step(bag, groundtruth_parquet, out_dir, *, topic: str | None = None,
+                        trial: str | None = None, gate_m: float = 0.30) -> dict:
+    """leg_tracker's leg detections (``leg_tracker/LegArray``) of one trial's bag scored
+    against the trial's mocap legs (:func:`gaitval.evaluate.leg_detections.
+    detection_statistics`); writes ``per_scan.parquet`` and ``summary.json`` into
+    ``out_dir`` (atomically) and returns the summary.  The bag's stamps must be on the
+    ground truth's sensor clock (the clock of the scans registered)."""
+    from gaitval.evaluate.leg_detections import detection_statistics
+    from gaitval.io.tracks import read_bag_leg_detections
+
+    det, meta = read_bag_leg_detections(bag, topic, trial=trial)
+    truth = read_parquet(groundtruth_parquet)
+    per_scan, summary = detection_statistics(det, meta["t_messages"], truth, gate_m)
+    if not summary["n_scans"]:
+        raise FileFormatError(f"no message of {meta['source']} is at a scan time of the "
+                              "ground truth with both legs known (no scan to score)",
+                              path=bag, trial=trial, hint="the detections' header.stamp "
+                              "must be the scans' stamps, on the registered sensor clock")
+    summary = {"trial": trial, "source": meta["source"], **summary}
+    out = Path(out_dir)
+    write_parquet(per_scan, out / "per_scan.parquet")
+    write_text(out / "summary.json", json.dumps(summary, indent=1, sort_keys=True) + "\n")
+    return summary
 
 
 def import_tracks_step(tracks_file, sensor_parquet, registration_json, trial: str,
@@ -646,7 +809,7 @@ def import_tracks_step(tracks_file, sensor_parquet, registration_json, trial: st
         period = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
         track = tracks_to_sensor(rows, meta, rec, path=tracks_file, trial=trial,
                                  t_range=(float(t[0]), float(t[-1])), tolerance_s=period,
-                                 scan_t=t)
+                                 scan_t=t, max_range_m=float(scans.range_max))
     track.insert(0, "method", method)
     track.insert(0, "trial", trial)
     write_parquet(track, out_parquet)

@@ -15,8 +15,9 @@ from gaitval.errors import ConfigError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash
 from gaitval.methods import METHODS, get_method, override_problems, set_params
-from gaitval.pipeline.steps import (ALL_SCOPE, ANALYSIS_SECTIONS, PROTOCOL_SCOPE, SCOPES, STUDY_VIEW,
-                           method_definition, method_view)
+from gaitval.pipeline.steps import (ALL_SCOPE, ANALYSIS_SECTIONS, EXTERNAL_PROTOCOLS,
+                                    PROTOCOL_SCOPE, SCOPES, STUDY_VIEW,
+                                    method_definition, method_view)
 from gaitval.tables.tug_evidence import method_reading
 
 
@@ -68,25 +69,45 @@ def _check_study_files(schema):
                 [(display_path(cal), own)]))
 
 
+def _sheet_of(cfg, study):
+    entry = cfg["studies"].get(study) or {}
+    return Path(entry.get("trial_sheet") or Path(DATA) / study / "trials.csv")
+
+
 def _check_external(cfg):
-    """tracking.external (issue 37): a name that is not already a method, and declared in
-    the workflow config, where the workflow sees it, not in a study.yaml."""
+    """External methods (issue 37): tracking.external of the workflow config (every study
+    of run) and external_methods: of each study's study.yaml (gaitval.pipeline.steps.
+    external_declarations): a name that is not already a method, the same names in every
+    study of run, and every trial's file there, inside the study's folder, before any job
+    runs.  tracking.external in a study.yaml is refused (external_methods: is the key).
+    Returns {study: {method: entry}}."""
+    from gaitval.pipeline.steps import external_declarations, missing_external_files
+
     names = _method_definitions(cfg)
     names.update(dict.fromkeys((cfg.get("tug") or {}).get("methods") or []))
     names.update(dict.fromkeys((cfg.get("mtst") or {}).get("methods") or []))
-    for m in (cfg.get("tracking") or {}).get("external") or {}:
+    config_external = (cfg.get("tracking") or {}).get("external") or {}
+    for m in config_external:
         if m in names:
             raise ConfigError(f"tracking.external.{m}: {m!r} is already a tracking method; "
                               "give the external tracker another name")
-    for study in cfg["run"]:
-        entry = cfg["studies"].get(study) or {}
-        sheet = Path(entry.get("trial_sheet") or Path(DATA) / study / "trials.csv")
+    sheets = {study: _sheet_of(cfg, study) for study in cfg["run"]}
+    for study, sheet in sheets.items():
         cal = sheet.parent / "study.yaml"
         if cal.is_file() and ((load_configfile(str(cal)) or {}).get("tracking") or {}).get(
                 "external"):
-            raise ConfigError(f"[file {display_path(cal)}] tracking.external: external "
-                              "methods are declared in the workflow config (a --configfile), "
-                              "not in a study's study.yaml (docs/formats.md, Leg tracks)")
+            raise ConfigError(f"[file {display_path(cal)}] tracking.external: a study "
+                              "declares its external methods under external_methods: "
+                              "(tracking.external is declared in the workflow config, a "
+                              "--configfile; docs/formats.md, Leg tracks)")
+    per_study = external_declarations(config_external, sheets, names)
+    for study, entries in per_study.items():
+        for m, entry in entries.items():
+            src = ("tracking.external" if m in config_external else
+                   f"[file {display_path(sheets[study].parent / 'study.yaml')}] "
+                   "external_methods")
+            missing_external_files(sheets[study], {m: entry}, f"study {study}: {src}")
+    return per_study
 
 
 DATA = config.get("data_dir", "data")
@@ -104,7 +125,7 @@ try:
         override_problems((config.get("tracking") or {}).get("overrides"),
                           _method_definitions(config)), _config_layers()))
     _check_study_files(_SCHEMA)
-    _check_external(config)
+    _EXTERNAL = _check_external(config)
 except ConfigError as exc:
     sys.exit(f"ConfigError: {exc}")
 
@@ -197,6 +218,13 @@ def analysis_sections_json(view=None, scope=ALL_SCOPE):
     sections = {k: config[k] for k in ANALYSIS_SECTIONS if k in config}
     if view is not None:
         sections = method_view(sections, view, scope)
+        # an external method's entries of each study (study.yaml's external_methods:, read
+        # by the job from the study.yaml): here too, so that changing one (a topic, the
+        # legs) reruns its view and jobs (a params change); study_config ignores the key
+        in_config = view in ((config.get("tracking") or {}).get("external") or {})
+        by_study = {s: e[view] for s, e in _EXTERNAL.items() if view in e}
+        if by_study and not in_config:
+            sections["external_methods_of_studies"] = by_study
     return json.dumps(sections, sort_keys=True, default=str)
 
 
@@ -422,15 +450,17 @@ _READING_VARIANTS = _reading_variants()
 
 
 def external_methods(protocol=None):
-    """The external methods (tracking.external, issue 37): another tracker's tracks of each
-    trial, read from files in the leg-track exchange format (docs/formats.md); those of
-    one protocol (an entry's `protocols`, default tug and mtst) when it is given."""
-    entries = (config.get("tracking") or {}).get("external") or {}
+    """The external methods (issue 37): another tracker's tracks of each trial, read from
+    files in the leg-track exchange format or a ROS bag (docs/formats.md), declared in
+    tracking.external or in the studies' study.yaml (external_methods:, the same names in
+    every study of run: _check_external); those of one protocol (an entry's `protocols`,
+    default tug and mtst) when it is given."""
+    entries = {}
+    for study_entries in _EXTERNAL.values():
+        for m, e in study_entries.items():
+            entries.setdefault(m, e)
     return [m for m, e in entries.items()
             if protocol is None or protocol in ((e or {}).get("protocols") or EXTERNAL_PROTOCOLS)]
-
-
-EXTERNAL_PROTOCOLS = ("tug", "mtst")
 
 
 def external_tracks_file(wildcards):
@@ -438,7 +468,7 @@ def external_tracks_file(wildcards):
     the trial sheet's folder, {trial} replaced)."""
     from gaitval.pipeline.steps import external_track_path
 
-    entry = config["tracking"]["external"][wildcards.method]
+    entry = _EXTERNAL[wildcards.study][wildcards.method]
     return str(external_track_path(sheet_path(wildcards.study), entry, wildcards.trial,
                                    wildcards.method))
 
