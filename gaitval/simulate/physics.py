@@ -25,7 +25,13 @@ shin_stance_speed         mean stance speed / walking speed, same walks; pass: w
 step_length, cadence      straight-walking steps of the twin's footfalls vs the published
                           range of the population (:data:`STEP_RANGES`); pass: mean inside
 tug_phase_duration        forward / turning / return seconds per trial vs seed 000 Table 4
-                          (leg-scans / 25 trials / 2 legs / 40 Hz); pass: within ±25 %
+                          (leg-scans / 25 trials / 2 legs / 40 Hz); pass: within ±25 %.
+                          Phases (issue 34): the rule that labels the reproduced Table 4
+                          (:func:`gaitval.evaluate.tug_truth.tug_phase_bounds`: walking
+                          direction more than 30° off the outbound / return line) applied
+                          to the twin's true legs (the truth ``phase`` column); before, the
+                          twin's step labels (first turning lift-off to first return
+                          contact), given in the note.  Tolerance unchanged
 tug_occlusion             per TUG phase, leg-scans with < 3 returning beams vs seed 000
                           Table 4 (Method 2: 3.5 / 11.3 / 5.1 %); pass: ratio in [2/3, 3/2]
 tug_turn_to_sit           seconds from the last return-line contact to the last contact
@@ -37,6 +43,10 @@ tug_marker_clearance      closest approach of a shank's surface to the marker co
                           during the turn (the legs go around it, not through it); pass: > 0
 tug_turn_radius           mean distance of the turning footholds from the marker; no
                           published value (shown; the clearance row is its check)
+tug_turn_step_time        mean step time of the steps turning around the marker ÷ the
+                          mean straight step time of the same trials; reference 1.0
+                          (curved walking keeps the straight stepping rate); pass: within
+                          ±10 % (:data:`TURN_STEP_TIME_REL`)
 shank_clearance           per protocol: per swing, the closest the two shank centres come
                           (truth legs at sensor height, mocap rate) ÷ the subject's leg
                           width; value: the smallest over all swings (issue 34: a swing
@@ -102,6 +112,14 @@ OCCLUSION_FACTOR = 1.5
 #: Final 180° turn (turn to sit) of the instrumented TUG, healthy controls: mean, SD (s).
 TURN_TO_SIT_S = (1.7, 0.5)
 RETURN_OFFSET_MAX_M = 0.25
+#: Issue 34, the turn at the marker (stated before the sourced turn model was written or
+#: simulated): the mean step time of the turning steps (path label ``turning``) ÷ the mean
+#: step time of the same trials' straight outbound steps.  Reference 1.0: on curved paths
+#: the stepping rate stays that of straight walking and speed changes through the step
+#: length (Grasso, Glasauer, Takei, Berthoz 1996; Madrid et al. 2024, young adults turning
+#: 90 / 180 / 360°: cadence a "pace gait constant").  Pass: within ±10 % (the young
+#: walkers' step-time CV is 2.5 %, four turning steps per trial).
+TURN_STEP_TIME_REL = 0.10
 #: Issue 34 (stated before the contact model was written): the two shank centres at sensor
 #: height never come closer than this many leg widths in any swing (two 10 cm sections
 #: touch at 1.0; 5 % for soft tissue and trouser cloth), and no scan has them closer.
