@@ -287,14 +287,32 @@ def _step_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
     return rows
 
 
+def step_label_bounds(ev: pd.DataFrame) -> tuple[float, float]:
+    """The TUG turn by the twin's step labels (the phase rule before issue 34): lift-off
+    of the first step labelled ``turning`` and the first contact labelled ``return``."""
+    c = ev[ev["event"] == "foot_contact"].sort_values("t_s")
+    lab = c["label"].astype(str)
+    first = c[lab == "turning"].iloc[0]
+    offs = ev[(ev["event"] == "foot_off") & (ev["side"] == first["side"])
+              & (ev["t_s"] < first["t_s"])]["t_s"]
+    return float(offs.max()), float(c[lab == "return"]["t_s"].iloc[0])
+
+
 def _tug_phase_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
     durations = {ph: [] for ph in TUG_PHASE_LEG_SCANS}
     occ = {ph: [0, 0] for ph in TUG_PHASE_LEG_SCANS}
+    by_steps = {ph: [] for ph in TUG_PHASE_LEG_SCANS}
     for t in trials["trial"]:
+        ev = pd.read_csv(study_dir / "truth" / t / "events.csv")
+        a, b = step_label_bounds(ev)
         s = pd.read_parquet(study_dir / "truth" / t / "scans_legs.parquet")
         t_end = float(pd.read_parquet(study_dir / "truth" / t / "legs.parquet")["t_s"].max())
         s = s[(s["t_mocap_s"] >= 0) & (s["t_mocap_s"] <= t_end)]
         dt = float(np.median(np.diff(np.unique(s["t_mocap_s"]))))
+        tm = s.drop_duplicates("scan")["t_mocap_s"].to_numpy(float)
+        for ph, m in (("forward", tm < a), ("turning", (tm >= a) & (tm < b)),
+                      ("return", tm >= b)):
+            by_steps[ph].append(int(m.sum()) * dt)
         for ph in durations:
             e = s[s["phase"] == ph]
             durations[ph].append(e["scan"].nunique() * dt)
@@ -307,7 +325,10 @@ def _tug_phase_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
         rows.append(_row("tug_phase_duration", "tug", float(np.mean(durations[ph])), ref,
                          ref * (1 - TUG_PHASE_REL), ref * (1 + TUG_PHASE_REL), "s/trial",
                          f"±{TUG_PHASE_REL:.0%}", src4 + ": leg-scans / 25 / 2 / 40 Hz",
-                         group="young", phase=ph))
+                         group="young", phase=ph,
+                         note="phases: walking direction > 30° off the line (the rule of the "
+                              "reproduced Table 4, on the true legs); by the twin's step "
+                              f"labels {np.mean(by_steps[ph]):.3f} s"))
         k, m = TUG_OCCLUSION[ph]
         ref = k / m
         rows.append(_row("tug_occlusion", "tug", occ[ph][0] / max(occ[ph][1], 1), ref,
@@ -325,7 +346,7 @@ def _tug_path_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
 
     subj = pd.read_csv(study_dir / "subjects.csv").set_index("subject")
     mk = np.asarray(TUG_MARKER_XY, float)
-    tts, offs, clear, radii = [], [], [], []
+    tts, offs, clear, radii, turn_T, straight_T = [], [], [], [], [], []
     for _, tr in trials.iterrows():
         d = study_dir / "truth" / tr["trial"]
         ev = pd.read_csv(d / "events.csv")
@@ -339,13 +360,16 @@ def _tug_path_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
         turn = np.flatnonzero(lab == "turning")
         if len(turn) >= 2:
             radii.append(float(np.mean(np.hypot(*(p[turn] - mk).T))))
-        ph = ev[ev["event"] == "phase_start"].set_index("label")["t_s"]
+        # the whole trial (since issue 34; before, the turning phase only): the legs come
+        # near the marker only while going around it
         legs = pd.read_parquet(d / "legs.parquet")
-        m = (legs["t_s"] >= ph.get("turning", np.inf)) & (legs["t_s"] < ph.get("return", -np.inf))
-        if m.any():
-            dist = np.hypot(*(legs.loc[m, ["x_m", "y_m"]].to_numpy(float) - mk).T)
-            w = float(subj.loc[tr["subject"], "leg_width_m"])
-            clear.append(float(dist.min()) - MARKER_RADIUS_M - w / 2)
+        dist = np.hypot(*(legs[["x_m", "y_m"]].to_numpy(float) - mk).T)
+        w = float(subj.loc[tr["subject"], "leg_width_m"])
+        clear.append(float(dist.min()) - MARKER_RADIUS_M - w / 2)
+        tc = c["t_s"].to_numpy(float)
+        k = turn[turn >= 1]
+        turn_T.append(tc[k] - tc[k - 1])
+        straight_T.append(_straight_steps(ev, "tug")[1])
     mu, sd = TURN_TO_SIT_S
     src = "Aging Clin Exp Res 2020;33:1853, Table 3 (healthy controls, final 180° turn)"
     rows = [
@@ -364,6 +388,16 @@ def _tug_path_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
              "path)", group="young", note="mean distance of the turning footholds from the "
                                           "marker (inner and outer feet)"),
     ]
+    tT = np.concatenate(turn_T) if turn_T else np.zeros(0)
+    sT = np.concatenate(straight_T) if straight_T else np.zeros(0)
+    if len(tT) and len(sT):
+        rows.append(_row("tug_turn_step_time", "tug", float(np.mean(tT) / np.mean(sT)), 1.0,
+                         1 - TURN_STEP_TIME_REL, 1 + TURN_STEP_TIME_REL, "× straight step time",
+                         f"±{TURN_STEP_TIME_REL:.0%}",
+                         "curved walking keeps the straight stepping rate (Grasso et al.; "
+                         "Madrid et al. 2024, Front Hum Neurosci 18:1269772)", group="young",
+                         note=f"{len(tT)} turning steps {np.mean(tT):.3f} s, {len(sT)} "
+                              f"straight steps {np.mean(sT):.3f} s"))
     return rows
 
 
