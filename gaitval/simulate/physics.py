@@ -116,7 +116,8 @@ RETURN_OFFSET_MAX_M = 0.25
 #: simulated): the mean step time of the turning steps (path label ``turning``) ÷ the mean
 #: step time of the same trials' straight outbound steps.  Reference 1.0: on curved paths
 #: the stepping rate stays that of straight walking and speed changes through the step
-#: length (Grasso, Glasauer, Takei, Berthoz 1996; Madrid et al. 2024, young adults turning
+#: length (Grasso, Glasauer, Takei, Berthoz, doi:10.1201/9780203735701-41; Madrid et al.
+#: 2024, young adults turning
 #: 90 / 180 / 360°: cadence a "pace gait constant").  Pass: within ±10 % (the young
 #: walkers' step-time CV is 2.5 %, four turning steps per trial).
 TURN_STEP_TIME_REL = 0.10

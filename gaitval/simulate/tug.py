@@ -44,7 +44,8 @@ TURN_TO_SIT_STEPS = 3
 END_AFTER_SEATED_S = (0.1, 0.3)
 #: Step time of a turning step ÷ the walker's straight step time (issue 34).  On curved
 #: paths people keep the stepping rate of straight walking and change speed through the
-#: step length: Grasso R, Glasauer S, Takei Y, Berthoz A (walking circular paths: "a high
+#: step length: Grasso R, Glasauer S, Takei Y, Berthoz A, "Gaze anticipation contributes
+#: to steering in locomotion", doi:10.1201/9780203735701-41 (walking circular paths: "a high
 #: correlation was found between linear speed and step-length while the correlation
 #: between linear speed and stepping rate was much lower"; the main locomotion parameters
 #: "fell in the range of those measured during linear walking"); Madrid J et al., Front
@@ -52,6 +53,11 @@ END_AFTER_SEATED_S = (0.1, 0.3)
 #: gait constant").  Before issue 34 the TUG used ``GaitParams.turn_time_factor`` = 1.15,
 #: which had no source.  Applies to the turn at the marker and to the pivot steps of the
 #: turn to sit (turning steps of the same walker; no source gives those a step time).
+#: A third source puts the factor a little above 1: on a figure-of-eight path at
+#: self-selected speed all age groups walked ≈ 16 % slower than on a line and the two
+#: younger groups (20–45, 46–65 years) took ≈ 8 % shorter steps (Front Neurol
+#: 2021;12:698160, abstract), i.e. a cadence ≈ 9 % lower (step time ≈ 1.09 ×).  1.0 was fixed before that source was read and before any simulation; the
+#: ``tug_turn_step_time`` row's tolerance (±10 %) covers both readings.
 TURN_TIME_FACTOR = 1.0
 
 
@@ -60,7 +66,9 @@ def turn_radius(gp, leg_width_m: float) -> float:
     steps allow.
 
     No TUG paper gives the radius, so it follows from the geometry of the steps: in the turn
-    the steps shorten to ``L_t = turn_step_factor · L`` (+ 2 SD of step variability), a
+    the steps shorten to ``L_t = turn_step_factor · L`` (+ 2 SD of step variability; the
+    factor 0.6 has no source: issue 34 looked for published step lengths of young adults
+    in tight 180° turns and found none, docs/simulator.md), a
     step on the path of radius ``r`` turns the body by ``L_t / r``, and the inner foot
     (at ``r − W/2``) swings straight from one foothold to the next, a chord that passes
     ``(r − W/2) cos(L_t / r)`` from the marker's axis.  The radius is the smallest ``r`` at
