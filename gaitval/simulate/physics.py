@@ -40,7 +40,8 @@ tug_turn_to_sit           seconds from the last return-line contact to the last 
 tug_return_to_chair       lateral distance of the return path from the chair's axis where
                           the turn to sit starts (out-and-back, seed 000 §1); pass: ≤ 0.25 m
 tug_marker_clearance      closest approach of a shank's surface to the marker cone's surface
-                          during the turn (the legs go around it, not through it); pass: > 0
+                          over the whole trial (the legs go around it, not through it;
+                          before issue 34's turn model, over the turning phase); pass: > 0
 tug_turn_radius           mean distance of the turning footholds from the marker; no
                           published value (shown; the clearance row is its check)
 tug_turn_step_time        mean step time of the steps turning around the marker ÷ the
