@@ -56,7 +56,8 @@ END_AFTER_SEATED_S = (0.1, 0.3)
 #: A third source puts the factor a little above 1: on a figure-of-eight path at
 #: self-selected speed all age groups walked ≈ 16 % slower than on a line and the two
 #: younger groups (20–45, 46–65 years) took ≈ 8 % shorter steps (Front Neurol
-#: 2021;12:698160, abstract), i.e. a cadence ≈ 9 % lower (step time ≈ 1.09 ×).  1.0 was fixed before that source was read and before any simulation; the
+#: 2021;12:698160, abstract), i.e. a cadence ≈ 9 % lower (step time ≈ 1.09 ×).  1.0 was
+#: fixed before that source was read and before any simulation; the
 #: ``tug_turn_step_time`` row's tolerance (±10 %) covers both readings.
 TURN_TIME_FACTOR = 1.0
 
@@ -176,13 +177,11 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     circles.append((*TUG_MARKER_XY, MARKER_RADIUS_M, ID_MARKER))
     poles = np.array([[1.4, -1.0], [3.9, 1.3]])
     circles += [(x, y, POLE_RADIUS_M, ID_POLE) for x, y in poles]
+    # phases by the rule of the reproduced Table 4 (issue 34; before, the step labels:
+    # lift-off of the first turning step, first contact on the return line, which
+    # physics.step_label_bounds still reads from the events for its note)
     t_turn0, t_turn1 = turn_phase_bounds(walker, t_end, cfg["mocap_rate_hz"],
                                          cfg["sensor_height_m"])
-    # the step labels' bounds (before issue 34 the phases): lift-off of the first turning
-    # step, first contact on the return line; kept for the physics table's note
-    labs = walker.plan.label
-    steps_bounds = (float(walker.plan.t_off[int(np.argmax(labs == "turning"))]),
-                    float(walker.plan.t_contact[int(np.argmax(labs == "return"))]))
 
     def phase(t):
         return np.where(t < t_turn0, "forward", np.where(t <= t_turn1, "turning", "return"))
@@ -192,5 +191,4 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
                     mocap_rate_hz=cfg["mocap_rate_hz"], t_end_s=t_end,
                     circles=np.array(circles, dtype=float), walls=_walls(-2.0, 5.5, -2.5, 2.5),
                     poles=poles, fixed_pose=sensor_pose, phase_fn=phase, repetition=rep,
-                    speed="fast", variant={"t_phase": (t_turn0, t_turn1),
-                                                       "t_phase_steps": steps_bounds})
+                    speed="fast", variant={"t_phase": (t_turn0, t_turn1)})
