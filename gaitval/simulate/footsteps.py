@@ -43,7 +43,10 @@ class GaitParams:
     ankle_height_m: float = 0.08
     hip_height_m: float = 0.90
     turn_step_factor: float = 0.6       # step length in a tight turn / straight step length
-    turn_time_factor: float = 1.15      # step time in a tight turn / straight step time
+    #                                     (no source; docs/simulator.md "Free choices")
+    turn_time_factor: float = 1.15      # step time in a tight turn / straight step time (no
+    #                                     source; the TUG uses tug.TURN_TIME_FACTOR = 1.0,
+    #                                     sourced; the rollator keeps 1.15)
     knee_half_sep_m: float = 0.08       # knee joint centre from the body midline (frontal plane)
     roll_fwd_m: float = 0.14            # ankle advance over the forefoot from heel off to toe off
     roll_up_m: float = 0.09             # ankle rise from heel off to toe off

@@ -25,7 +25,13 @@ shin_stance_speed         mean stance speed / walking speed, same walks; pass: w
 step_length, cadence      straight-walking steps of the twin's footfalls vs the published
                           range of the population (:data:`STEP_RANGES`); pass: mean inside
 tug_phase_duration        forward / turning / return seconds per trial vs seed 000 Table 4
-                          (leg-scans / 25 trials / 2 legs / 40 Hz); pass: within ±25 %
+                          (leg-scans / 25 trials / 2 legs / 40 Hz); pass: within ±25 %.
+                          Phases (issue 34): the rule that labels the reproduced Table 4
+                          (:func:`gaitval.evaluate.tug_truth.tug_phase_bounds`: walking
+                          direction more than 30° off the outbound / return line) applied
+                          to the twin's true legs (the truth ``phase`` column); before, the
+                          twin's step labels (first turning lift-off to first return
+                          contact), given in the note.  Tolerance unchanged
 tug_occlusion             per TUG phase, leg-scans with < 3 returning beams vs seed 000
                           Table 4 (Method 2: 3.5 / 11.3 / 5.1 %); pass: ratio in [2/3, 3/2]
 tug_turn_to_sit           seconds from the last return-line contact to the last contact
@@ -34,9 +40,14 @@ tug_turn_to_sit           seconds from the last return-line contact to the last 
 tug_return_to_chair       lateral distance of the return path from the chair's axis where
                           the turn to sit starts (out-and-back, seed 000 §1); pass: ≤ 0.25 m
 tug_marker_clearance      closest approach of a shank's surface to the marker cone's surface
-                          during the turn (the legs go around it, not through it); pass: > 0
+                          over the whole trial (the legs go around it, not through it;
+                          before issue 34's turn model, over the turning phase); pass: > 0
 tug_turn_radius           mean distance of the turning footholds from the marker; no
                           published value (shown; the clearance row is its check)
+tug_turn_step_time        mean step time of the steps turning around the marker ÷ the
+                          mean straight step time of the same trials; reference 1.0
+                          (curved walking keeps the straight stepping rate); pass: within
+                          ±10 % (:data:`TURN_STEP_TIME_REL`)
 shank_clearance           per protocol: per swing, the closest the two shank centres come
                           (truth legs at sensor height, mocap rate) ÷ the subject's leg
                           width; value: the smallest over all swings (issue 34: a swing
@@ -102,6 +113,15 @@ OCCLUSION_FACTOR = 1.5
 #: Final 180° turn (turn to sit) of the instrumented TUG, healthy controls: mean, SD (s).
 TURN_TO_SIT_S = (1.7, 0.5)
 RETURN_OFFSET_MAX_M = 0.25
+#: Issue 34, the turn at the marker (stated before the sourced turn model was written or
+#: simulated): the mean step time of the turning steps (path label ``turning``) ÷ the mean
+#: step time of the same trials' straight outbound steps.  Reference 1.0: on curved paths
+#: the stepping rate stays that of straight walking and speed changes through the step
+#: length (Grasso, Glasauer, Takei, Berthoz, doi:10.1201/9780203735701-41; Madrid et al.
+#: 2024, young adults turning
+#: 90 / 180 / 360°: cadence a "pace gait constant").  Pass: within ±10 % (the young
+#: walkers' step-time CV is 2.5 %, four turning steps per trial).
+TURN_STEP_TIME_REL = 0.10
 #: Issue 34 (stated before the contact model was written): the two shank centres at sensor
 #: height never come closer than this many leg widths in any swing (two 10 cm sections
 #: touch at 1.0; 5 % for soft tissue and trouser cloth), and no scan has them closer.
@@ -269,14 +289,32 @@ def _step_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
     return rows
 
 
+def step_label_bounds(ev: pd.DataFrame) -> tuple[float, float]:
+    """The TUG turn by the twin's step labels (the phase rule before issue 34): lift-off
+    of the first step labelled ``turning`` and the first contact labelled ``return``."""
+    c = ev[ev["event"] == "foot_contact"].sort_values("t_s")
+    lab = c["label"].astype(str)
+    first = c[lab == "turning"].iloc[0]
+    offs = ev[(ev["event"] == "foot_off") & (ev["side"] == first["side"])
+              & (ev["t_s"] < first["t_s"])]["t_s"]
+    return float(offs.max()), float(c[lab == "return"]["t_s"].iloc[0])
+
+
 def _tug_phase_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
     durations = {ph: [] for ph in TUG_PHASE_LEG_SCANS}
     occ = {ph: [0, 0] for ph in TUG_PHASE_LEG_SCANS}
+    by_steps = {ph: [] for ph in TUG_PHASE_LEG_SCANS}
     for t in trials["trial"]:
+        ev = pd.read_csv(study_dir / "truth" / t / "events.csv")
+        a, b = step_label_bounds(ev)
         s = pd.read_parquet(study_dir / "truth" / t / "scans_legs.parquet")
         t_end = float(pd.read_parquet(study_dir / "truth" / t / "legs.parquet")["t_s"].max())
         s = s[(s["t_mocap_s"] >= 0) & (s["t_mocap_s"] <= t_end)]
         dt = float(np.median(np.diff(np.unique(s["t_mocap_s"]))))
+        tm = s.drop_duplicates("scan")["t_mocap_s"].to_numpy(float)
+        for ph, m in (("forward", tm < a), ("turning", (tm >= a) & (tm < b)),
+                      ("return", tm >= b)):
+            by_steps[ph].append(int(m.sum()) * dt)
         for ph in durations:
             e = s[s["phase"] == ph]
             durations[ph].append(e["scan"].nunique() * dt)
@@ -289,7 +327,10 @@ def _tug_phase_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
         rows.append(_row("tug_phase_duration", "tug", float(np.mean(durations[ph])), ref,
                          ref * (1 - TUG_PHASE_REL), ref * (1 + TUG_PHASE_REL), "s/trial",
                          f"±{TUG_PHASE_REL:.0%}", src4 + ": leg-scans / 25 / 2 / 40 Hz",
-                         group="young", phase=ph))
+                         group="young", phase=ph,
+                         note="phases: walking direction > 30° off the line (the rule of the "
+                              "reproduced Table 4, on the true legs); by the twin's step "
+                              f"labels {np.mean(by_steps[ph]):.3f} s"))
         k, m = TUG_OCCLUSION[ph]
         ref = k / m
         rows.append(_row("tug_occlusion", "tug", occ[ph][0] / max(occ[ph][1], 1), ref,
@@ -307,7 +348,7 @@ def _tug_path_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
 
     subj = pd.read_csv(study_dir / "subjects.csv").set_index("subject")
     mk = np.asarray(TUG_MARKER_XY, float)
-    tts, offs, clear, radii = [], [], [], []
+    tts, offs, clear, radii, turn_T, straight_T = [], [], [], [], [], []
     for _, tr in trials.iterrows():
         d = study_dir / "truth" / tr["trial"]
         ev = pd.read_csv(d / "events.csv")
@@ -321,13 +362,16 @@ def _tug_path_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
         turn = np.flatnonzero(lab == "turning")
         if len(turn) >= 2:
             radii.append(float(np.mean(np.hypot(*(p[turn] - mk).T))))
-        ph = ev[ev["event"] == "phase_start"].set_index("label")["t_s"]
+        # the whole trial (since issue 34; before, the turning phase only): the legs come
+        # near the marker only while going around it
         legs = pd.read_parquet(d / "legs.parquet")
-        m = (legs["t_s"] >= ph.get("turning", np.inf)) & (legs["t_s"] < ph.get("return", -np.inf))
-        if m.any():
-            dist = np.hypot(*(legs.loc[m, ["x_m", "y_m"]].to_numpy(float) - mk).T)
-            w = float(subj.loc[tr["subject"], "leg_width_m"])
-            clear.append(float(dist.min()) - MARKER_RADIUS_M - w / 2)
+        dist = np.hypot(*(legs[["x_m", "y_m"]].to_numpy(float) - mk).T)
+        w = float(subj.loc[tr["subject"], "leg_width_m"])
+        clear.append(float(dist.min()) - MARKER_RADIUS_M - w / 2)
+        tc = c["t_s"].to_numpy(float)
+        k = turn[turn >= 1]
+        turn_T.append(tc[k] - tc[k - 1])
+        straight_T.append(_straight_steps(ev, "tug")[1])
     mu, sd = TURN_TO_SIT_S
     src = "Aging Clin Exp Res 2020;33:1853, Table 3 (healthy controls, final 180° turn)"
     rows = [
@@ -346,6 +390,16 @@ def _tug_path_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
              "path)", group="young", note="mean distance of the turning footholds from the "
                                           "marker (inner and outer feet)"),
     ]
+    tT = np.concatenate(turn_T) if turn_T else np.zeros(0)
+    sT = np.concatenate(straight_T) if straight_T else np.zeros(0)
+    if len(tT) and len(sT):
+        rows.append(_row("tug_turn_step_time", "tug", float(np.mean(tT) / np.mean(sT)), 1.0,
+                         1 - TURN_STEP_TIME_REL, 1 + TURN_STEP_TIME_REL, "× straight step time",
+                         f"±{TURN_STEP_TIME_REL:.0%}",
+                         "curved walking keeps the straight stepping rate (Grasso et al.; "
+                         "Madrid et al. 2024, Front Hum Neurosci 18:1269772)", group="young",
+                         note=f"{len(tT)} turning steps {np.mean(tT):.3f} s, {len(sT)} "
+                              f"straight steps {np.mean(sT):.3f} s"))
     return rows
 
 

@@ -11,8 +11,12 @@ spline-based interpolation during turning motion in walk tests. Sensors 2015;15:
 """
 from __future__ import annotations
 
-import numpy as np
+from dataclasses import replace
 
+import numpy as np
+import pandas as pd
+
+from gaitval.evaluate.tug_truth import tug_phase_bounds
 from gaitval.simulate.kinematics import make_path, plan_steps
 from gaitval.simulate.scene import ID_CHAIR, ID_MARKER, ID_POLE, Walker
 from gaitval.simulate.trialsim import POLE_RADIUS_M, TrialSim, _walls
@@ -38,6 +42,24 @@ TURN_TO_SIT_STEPS = 3
 #: The capture ends this long after the participant is seated (s, uniform): the timed
 #: span of the TUG ends when the participant sits (Podsiadlo & Richardson 1991).
 END_AFTER_SEATED_S = (0.1, 0.3)
+#: Step time of a turning step ÷ the walker's straight step time (issue 34).  On curved
+#: paths people keep the stepping rate of straight walking and change speed through the
+#: step length: Grasso R, Glasauer S, Takei Y, Berthoz A, "Gaze anticipation contributes
+#: to steering in locomotion", doi:10.1201/9780203735701-41 (walking circular paths: "a high
+#: correlation was found between linear speed and step-length while the correlation
+#: between linear speed and stepping rate was much lower"; the main locomotion parameters
+#: "fell in the range of those measured during linear walking"); Madrid J et al., Front
+#: Hum Neurosci 2024;18:1269772 (10 young adults, 90 / 180 / 360° turns: cadence "a pace
+#: gait constant").  Before issue 34 the TUG used ``GaitParams.turn_time_factor`` = 1.15,
+#: which had no source.  Applies to the turn at the marker and to the pivot steps of the
+#: turn to sit (turning steps of the same walker; no source gives those a step time).
+#: A third source puts the factor a little above 1: on a figure-of-eight path at
+#: self-selected speed all age groups walked ≈ 16 % slower than on a line and the two
+#: younger groups (20–45, 46–65 years) took ≈ 8 % shorter steps (Front Neurol
+#: 2021;12:698160, abstract), i.e. a cadence ≈ 9 % lower (step time ≈ 1.09 ×).  1.0 was
+#: fixed before that source was read and before any simulation; the
+#: ``tug_turn_step_time`` row's tolerance (±10 %) covers both readings.
+TURN_TIME_FACTOR = 1.0
 
 
 def turn_radius(gp, leg_width_m: float) -> float:
@@ -45,7 +67,9 @@ def turn_radius(gp, leg_width_m: float) -> float:
     steps allow.
 
     No TUG paper gives the radius, so it follows from the geometry of the steps: in the turn
-    the steps shorten to ``L_t = turn_step_factor · L`` (+ 2 SD of step variability), a
+    the steps shorten to ``L_t = turn_step_factor · L`` (+ 2 SD of step variability; the
+    factor 0.6 has no source: issue 34 looked for published step lengths of young adults
+    in tight 180° turns and found none, docs/simulator.md), a
     step on the path of radius ``r`` turns the body by ``L_t / r``, and the inner foot
     (at ``r − W/2``) swings straight from one foothold to the next, a chord that passes
     ``(r − W/2) cos(L_t / r)`` from the marker's axis.  The radius is the smallest ``r`` at
@@ -82,6 +106,29 @@ def tug_path(r: float):
                                                 ("line", leg - TURN_TO_SIT_FROM_M, "return")])
 
 
+def turn_phase_bounds(walker: Walker, t_end: float, rate_hz: float, height_m: float
+                      ) -> tuple[float, float]:
+    """Start and end (s, mocap clock) of the TUG turning phase of a simulated trial.
+
+    Seed 000 defines its three phases only in its Figure 3a ("three TUG phases (forward,
+    turning and return phases) are defined"); its text places the turning phase where
+    "the moving direction of the leg rapidly changes".  The twin uses the rule that labels
+    the reproduced Table 4 (:func:`gaitval.evaluate.tug_truth.tug_phase_bounds`: the
+    smoothed midpoint of the two legs at sensor height walks more than 30° off the
+    outbound / return line), applied to the true legs at the mocap rate, so the twin's
+    phase durations and truth occlusion (``physics.csv``) and the tracked Table 4 count
+    the same scans.
+    """
+    t = np.arange(0.0, t_end + 0.5 / rate_hz, 1.0 / rate_hz)
+    legs = walker.legs(t)
+    rows = [pd.DataFrame({"t_sensor_s": t, "side": side, "xs_m": p[:, 0], "ys_m": p[:, 1],
+                          "valid": True})
+            for side, p in (("L", legs[0].point_at_height(height_m)),
+                            ("R", legs[1].point_at_height(height_m)))]
+    b = tug_phase_bounds(pd.concat(rows, ignore_index=True))
+    return float(b["t_turn_start_s"]), float(b["t_turn_end_s"])
+
+
 def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     """Timed Up and Go: rise, walk 3 m, turn around a marker, walk back, turn, sit.
 
@@ -98,6 +145,7 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     t_rise = float(rng.uniform(0.5, 0.9))
     rise_dur = float(rng.normal(0.9, 0.08))
     t0 = t_rise + 0.6 * rise_dur                       # gait initiation during the rise
+    gp = replace(gp, turn_time_factor=TURN_TIME_FACTOR)
     path = tug_path(turn_radius(gp, subj["leg_width_m"]))
     plan = plan_steps(path, gp, rng, t0=t0, first_side=int(rng.integers(0, 2)),
                       end_pose=(SEAT_X_M, 0.0, 2 * np.pi, TURN_TO_SIT_STEPS),
@@ -129,15 +177,14 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     circles.append((*TUG_MARKER_XY, MARKER_RADIUS_M, ID_MARKER))
     poles = np.array([[1.4, -1.0], [3.9, 1.3]])
     circles += [(x, y, POLE_RADIUS_M, ID_POLE) for x, y in poles]
-    # phase: forward until the first turning step, turning until the first return step
-    labs = plan.label.copy()
-    first_turn = int(np.argmax(labs == "turning"))
-    first_ret = int(np.argmax(labs == "return"))
-    t_turn0 = plan.t_off[first_turn]                  # lift-off of the first turning step
-    t_turn1 = plan.t_contact[first_ret]                # first contact on the return line
+    # phases by the rule of the reproduced Table 4 (issue 34; before, the step labels:
+    # lift-off of the first turning step, first contact on the return line, which
+    # physics.step_label_bounds still reads from the events for its note)
+    t_turn0, t_turn1 = turn_phase_bounds(walker, t_end, cfg["mocap_rate_hz"],
+                                         cfg["sensor_height_m"])
 
     def phase(t):
-        return np.where(t < t_turn0, "forward", np.where(t < t_turn1, "turning", "return"))
+        return np.where(t < t_turn0, "forward", np.where(t <= t_turn1, "turning", "return"))
 
     return TrialSim(study=study, protocol="tug", subject=subj["subject"], trial=trial,
                     walker=walker, sensor="utm30lx", sensor_height_m=cfg["sensor_height_m"],

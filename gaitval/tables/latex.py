@@ -71,6 +71,9 @@ LANDSCAPE = {"width_pt": 540.0, "height_pt": 345.0, "size_pt": 7.0, "baseline_pt
 #: A text column whose entries average more characters than this is prose (a sentence
 #: per row): it is set as a full-width line under its row, not as a column.
 PROSE_CHARS = 120
+#: Width (pt) the ragged-right paragraph columns leave free for the error of the other
+#: columns' estimated widths.
+FLEX_MARGIN_PT = 2.0
 #: A part taller than this fraction of the page's height is a longtable, not a float.
 FLOAT_FRACTION = 0.8
 
@@ -257,10 +260,15 @@ def _layout(groups, info, page) -> tuple[dict[str, str], bool]:
             specs[c], avail = "l", avail - info[c]["chars"] * cw
             left.pop(0)
             continue
+        # the paragraph columns leave FLEX_MARGIN_PT of the width unused: the widths of
+        # the other columns are estimates (0.6 em a character), and a row of them 0.36 pt
+        # wider than estimated overfilled the line (tiny's tug_failures, issue 34)
+        share = (avail - FLEX_MARGIN_PT) / len(left)
         for c in left:
             w = max(share, info[c]["min"] * cw)
             specs[c] = _p(w)
             avail -= w
+        avail += FLEX_MARGIN_PT
         break
     return specs, avail >= -0.5
 
