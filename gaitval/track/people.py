@@ -199,7 +199,8 @@ class PeopleTracker(TrackerKind):
         """Track every person through precomputed per-scan observations (``xy[k]``: (J, 2)
         array, ``pats[k]``: their patterns).  ``profile``: also return ``scan_seconds`` and
         ``scan_hypotheses`` (per scan: time spent, person hypotheses alive) as attributes of
-        the result (benchmarks/people_tracker.py)."""
+        the result (benchmarks/people_tracker.py), and ``scan_static`` (per scan: for each
+        observation, whether it lay on a static cell of the map; benchmarks/people_misses.py)."""
         from time import perf_counter
         t = np.asarray(scans.t, dtype=float)
         n = len(t)
@@ -226,7 +227,7 @@ class PeopleTracker(TrackerKind):
         inputs = self.motion.inputs
         sep2 = self.max_leg_separation_m ** 2
         dts = dts.tolist()
-        cost, alive = ([], []) if profile else (None, None)
+        cost, alive, on_static = ([], [], []) if profile else (None, None, None)
         for k in range(n):
             if profile:
                 t_start = perf_counter()
@@ -392,6 +393,7 @@ class PeopleTracker(TrackerKind):
             if profile:
                 cost.append(perf_counter() - t_start)
                 alive.append(len(persons))
+                on_static.append(static)
         people = pd.DataFrame.from_records(rows, columns=list(PEOPLE_COLUMNS))
         people = people.astype({"k": np.int64, "person_id": np.int64, "phase": np.int64,
                                 "observed": bool})
@@ -400,6 +402,7 @@ class PeopleTracker(TrackerKind):
         if profile:
             res.scan_seconds = np.asarray(cost)
             res.scan_hypotheses = np.asarray(alive, dtype=np.int64)
+            res.scan_static = on_static
         return res
 
     # -- output ------------------------------------------------------------------------------
