@@ -162,6 +162,7 @@ def main() -> None:
     gt_all = f.set_index("k")[["gt_x_m", "gt_y_m"]]
     f = f[np.isfinite(f["gt_x_m"])]
     classes = collections.Counter()
+    class_of = {}
     n_known = n_still = 0
     for r in f[f["event"] == "MISS"].itertuples():
         g = (r.gt_x_m, r.gt_y_m)
@@ -177,6 +178,7 @@ def main() -> None:
         else:
             c = "no hypothesis"
         classes[c] += 1
+        class_of[int(r.k)] = c
         hs = [h for h in near if h[4] is not None]
         if hs:
             n_known += 1
@@ -243,6 +245,8 @@ def main() -> None:
               f" annotation path speed {speed:.2f} m/s; nearest hypothesis's legs still "
               f"(r spread < w_l over 1.4 s) on {still} of {known} scans with one; every "
               f"observation within 0.5 m on a static cell on {absorbed}")
+        print("    " + "; ".join(f"{c}: {n}" for c, n in collections.Counter(
+            class_of[int(k)] for k in run).most_common()))
 
 
 def getattr_why(h) -> str:
