@@ -33,6 +33,10 @@ holds none of their rules (Stone Soup's initiator/deleter split, docs/STYLE §13
     leg to travel ``dist_travelled_together_to_initiate_leg_pair`` = 0.5 m in the odometry
     frame; gaitval has no odometry, so the same 0.5 m is asked of the vector between the
     legs.
+    ``leg_travel``: leg_tracker's own rule — each leg's filtered path since the pair formed
+    exceeds 0.5 m (steps > 1 cm of leg_tracker's leg filter), both legs seen
+    (:class:`LegTravel`); without leg_tracker's leg classifier it confirms furniture in an
+    empty room, so the ``people`` method does not use it (docs/people.md).
 ``refind`` (:data:`REFINDS`)
     ``remember(pid, t_last_seen, centre)`` when a reported person ends; ``match(tentative
     persons, t_k)`` → [(person, pid)]: tentative hypotheses that are a recently ended person
@@ -354,6 +358,10 @@ class LegTravel(Confirmer):
     std_obs_m, p0, process_std_per_s : float
         leg_tracker's leg filter (0.1 m, 0.5, 0.5 m/s · Δt: its 0.05 at 10 Hz, 0.0667 at
         7.5 Hz, 0.0333 at 15 Hz).
+    percentile, assoc_extra_m : float
+        leg_tracker's leg gate: an observation at Mahalanobis distance ≥ z =
+        Φ⁻¹(1 − (1 − 0.90)/2) = 1.645 with cov = P_xx + (σ_o + 0.4)² is not this leg's; it
+        would start a new leg track, so both legs' paths restart from zero (a new pair).
     """
 
     def __init__(self, min_travel_m: float = 0.5, min_step_m: float = 0.01,
@@ -361,8 +369,8 @@ class LegTravel(Confirmer):
                  percentile: float = 0.90, assoc_extra_m: float = 0.4):
         self.percentile = percentile
         self.assoc_extra_m = assoc_extra_m
-        self.gate2 = 1.645 ** 2
-        self.var_assoc = 0.25
+        self.gate2 = float(norm.ppf(1.0 - (1.0 - percentile) / 2.0)) ** 2     # 1.645²
+        self.var_assoc = (std_obs_m + assoc_extra_m) ** 2
         self.min_travel_m = min_travel_m
         self.min_step_m = min_step_m
         self.std_obs_m = std_obs_m
@@ -375,8 +383,6 @@ class LegTravel(Confirmer):
         out = LegTravel(self.min_travel_m, self.min_step_m, self.std_obs_m, self.p0,
                         self.process_std_per_s, self.percentile, self.assoc_extra_m)
         out.dt = float(dt)
-        out.gate2 = float(norm.ppf(1.0 - (1.0 - self.percentile) / 2.0)) ** 2
-        out.var_assoc = (self.std_obs_m + self.assoc_extra_m) ** 2
         return out
 
     def scan(self, k: int, motion) -> None:
@@ -410,7 +416,7 @@ class LegTravel(Confirmer):
             kf = mem["kf"][f]
             if kf is None:
                 if z is not None:
-                    mem["kf"][f] = ([z[0], z[1], 0.0, 0.0], [self.p0, 0.0, self.p0])
+                    mem["kf"][f] = ([z[0], z[1], 0.0, 0.0], (self.p0, 0.0, self.p0))
                 continue
             st, (pxx, pxv, pvv) = kf
             old = self._carry(st)
