@@ -30,10 +30,12 @@ within 0.75 m of the annotation (the person was still there to be seen); and the
 (``refind`` role): on the annotated person (< 0.75 m) or elsewhere.
 
 Then the runs of consecutive misses, longest first, with the annotation's mean range and
-its path speed in the sensor frame (clicks included), and on how many of its scans the
+its path speed in the sensor frame (clicks included), on how many of its scans the
 hypothesis nearest the annotation has *still* legs: r = p_L − p_R, over the confirmation
 window's scans with both legs, spreads less than one leg width along its principal axis
-(a walker's r swings through ± half a step; a person who stands keeps r).
+(a walker's r swings through ± half a step; a person who stands keeps r), and on how many
+every leg observation within 0.5 m of the annotation lay on a static cell of the tracker's
+map (the map absorbed the person; ``PeopleResult.scan_static``).
 """
 from __future__ import annotations
 
@@ -152,7 +154,7 @@ def main() -> None:
     lc.MOfNMoving.bind = observed_bind
     lc.LegTrackerGate.bind = observed_rbind
     try:
-        kind.run(scans, xy, pats, 0.10)
+        res = kind.run(scans, xy, pats, 0.10, profile=True)
     finally:
         lc.MOfNMoving.bind = bind
         lc.LegTrackerGate.bind = rbind
@@ -160,6 +162,7 @@ def main() -> None:
     gt_all = f.set_index("k")[["gt_x_m", "gt_y_m"]]
     f = f[np.isfinite(f["gt_x_m"])]
     classes = collections.Counter()
+    class_of = {}
     n_known = n_still = 0
     for r in f[f["event"] == "MISS"].itertuples():
         g = (r.gt_x_m, r.gt_y_m)
@@ -175,6 +178,7 @@ def main() -> None:
         else:
             c = "no hypothesis"
         classes[c] += 1
+        class_of[int(r.k)] = c
         hs = [h for h in near if h[4] is not None]
         if hs:
             n_known += 1
@@ -230,9 +234,19 @@ def main() -> None:
             if hs:
                 known += 1
                 still += min(hs, key=lambda h: math.dist(h[1:3], (x, y)))[4] < 0.10
+        # the static map (hypothesis: it absorbs a person who stands): on how many scans do
+        # all observations within 0.5 m of the annotation lie on static cells
+        absorbed = 0
+        for k, x, y in zip(g.index, gx, gy):
+            o = xy[int(k)]
+            near = np.flatnonzero(np.hypot(o[:, 0] - x, o[:, 1] - y) < 0.5) if len(o) else []
+            absorbed += bool(len(near)) and all(res.scan_static[int(k)][j] for j in near)
         print(f"  scans {run[0]}-{run[-1]} ({len(run)}): range {np.hypot(gx, gy).mean():.2f} m,"
               f" annotation path speed {speed:.2f} m/s; nearest hypothesis's legs still "
-              f"(r spread < w_l over 1.4 s) on {still} of {known} scans with one")
+              f"(r spread < w_l over 1.4 s) on {still} of {known} scans with one; every "
+              f"observation within 0.5 m on a static cell on {absorbed}")
+        print("    " + "; ".join(f"{c}: {n}" for c, n in collections.Counter(
+            class_of[int(k)] for k in run).most_common()))
 
 
 def getattr_why(h) -> str:

@@ -456,18 +456,25 @@ METHODS["people"] = {
              "tentative_gate": {"name": "variable_region", "v_sw": 1.1, "v_st": 0.55},
              "birth": {"name": "unexplained_pairs", "max_pair_m": 0.8,
                        "min_leg_widths": 0.7},
+             # M of N scans with a leg pair that walks (docs/people.md; leg_tracker's own
+             # rule, `leg_travel`, confirms furniture in an empty room without its leg
+             # classifier)
              "confirmer": {"name": "m_of_n_moving", "window_s": 1.4, "m_fraction": 0.5,
                            "min_relative_travel_m": 0.5, "pass_leg_widths": 1.0,
                            "min_travel_m": 0.5},
              "deleter": {"name": "unsupported_time", "max_unsupported_s": 3.0,
                          "tentative_unsupported_s": 0.2},
              "area": {"name": "field_of_view", "margin_m": 0.25},
+             # an ended person found again near where it was last seen (leg_tracker's person
+             # gate and deletion bound, lifecycle.LegTrackerGate)
+             "refind": {"name": "leg_tracker_gate", "max_std_m": 0.9, "percentile": 0.90,
+                        "std_obs_m": 0.1, "assoc_extra_m": 0.4},
              # no odometry in the recordings: the sensor's motion from its scans, and a map
              # of what stays put (leg_tracker's local occupancy grid), both online
              "ego_motion": {"name": "scan_matching", "max_pair_m": 0.5, "trim": 0.8,
                             "iterations": 20, "beam_step": 2, "min_pairs": 20},
              "static_map": {"name": "recent_hits", "cell_m": 0.1, "min_static_s": 1.4,
                             "tau_s": 5.0, "neighbourhood": 1},
-             "init": None, "max_leg_separation_m": 0.8, "dt_s": None,
+             "init": None, "max_leg_separation_m": 0.8, "person_points_m": 0.13, "dt_s": None,
              "sides": "walking_direction"},
 }

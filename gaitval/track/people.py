@@ -93,7 +93,7 @@ class Person:
 
     __slots__ = ("pid", "status", "post", "prior", "seen", "pattern", "obs_j", "phase",
                  "windows", "t_last_seen", "confirm_memory", "n_unobs", "k_born", "n_obs",
-                 "world_centre", "seen_centre")
+                 "world_centre", "seen_centre", "z")
 
     def __init__(self, pid, filter, zl, zr, pl, pr, jl, jr, k, t, windows, memory,
                  status=TENTATIVE):
@@ -114,6 +114,7 @@ class Person:
         self.k_born = k
         self.world_centre = (0, 0.0, 0.0)      # (ego-motion segment, x, y)
         self.seen_centre = self.centre()       # the centre on the last scan with a leg seen
+        self.z = [(float(zl[0]), float(zl[1])), (float(zr[0]), float(zr[1]))]  # observations
 
     def pos(self, f: int) -> tuple[float, float]:
         s = self.post[f]
@@ -151,6 +152,10 @@ class PeopleTracker(TrackerKind):
     max_leg_separation_m : float
         An observation further than this from a person's other leg (predicted) is not that
         person's leg (leg_tracker's ``max_leg_pairing_dist``, 0.8 m).
+    person_points_m : float
+        Scan returns within this distance of an observation assigned to a reported person
+        are that person's leg and are not learned by the static map (leg_tracker's cluster
+        distance ``cluster_dist_euclid``, 0.13 m).
     dt_s : float or None
         Scan period (None: the median timestamp difference).
     sides : {"walking_direction", "as_initialised"}
@@ -162,7 +167,7 @@ class PeopleTracker(TrackerKind):
                  confirmer="m_of_n_moving", deleter="unsupported_time",
                  area="field_of_view", ego_motion="none", static_map="none",
                  init=None, tentative_gate=None, refind="leg_tracker_gate",
-                 max_leg_separation_m: float = 0.8,
+                 max_leg_separation_m: float = 0.8, person_points_m: float = 0.13,
                  dt_s: float | None = None, sides: str = "walking_direction"):
         self.detector = DETECTORS.build(detector)
         self.filter = FILTERS.build(filter)
@@ -179,6 +184,7 @@ class PeopleTracker(TrackerKind):
         self.static_map = STATIC_MAPS.build(static_map)
         self.init = INITIALISERS.build(init) if init else None
         self.max_leg_separation_m = max_leg_separation_m
+        self.person_points_m = person_points_m
         self.dt_s = dt_s
         self.sides = sides
 
@@ -198,7 +204,8 @@ class PeopleTracker(TrackerKind):
         """Track every person through precomputed per-scan observations (``xy[k]``: (J, 2)
         array, ``pats[k]``: their patterns).  ``profile``: also return ``scan_seconds`` and
         ``scan_hypotheses`` (per scan: time spent, person hypotheses alive) as attributes of
-        the result (benchmarks/people_tracker.py)."""
+        the result (benchmarks/people_tracker.py), and ``scan_static`` (per scan: for each
+        observation, whether it lay on a static cell of the map; benchmarks/people_misses.py)."""
         from time import perf_counter
         t = np.asarray(scans.t, dtype=float)
         n = len(t)
@@ -225,7 +232,7 @@ class PeopleTracker(TrackerKind):
         inputs = self.motion.inputs
         sep2 = self.max_leg_separation_m ** 2
         dts = dts.tolist()
-        cost, alive = ([], []) if profile else (None, None)
+        cost, alive, on_static = ([], [], []) if profile else (None, None, None)
         for k in range(n):
             if profile:
                 t_start = perf_counter()
@@ -236,7 +243,11 @@ class PeopleTracker(TrackerKind):
             if segment[k] != seg:          # the sensor's motion was lost: a new map
                 seg = int(segment[k])
                 smap = self.static_map.start(scans, poses)
-            smap.update(k, to_world(pose, scan_points(scans, k)))
+                confirmer.scan(k, None)
+            else:
+                confirmer.scan(k, _relative(poses[k - 1], pose))
+            # the map as learned up to the previous scan (leg_tracker's local map is the one
+            # published after the previous scan)
             static = [smap.is_static(*w) for w in
                       to_world(pose, np.asarray(obs).reshape(-1, 2)).tolist()]
             # predict (seed000 eq. (7)-(8); input u of the motion role, eq. (18)-(20))
@@ -297,12 +308,14 @@ class PeopleTracker(TrackerKind):
                     if j is None:
                         p.post[f] = p.prior[f]
                         p.seen[f] = False
+                        p.z[f] = None
                         p.pattern[f] = "UO"
                         p.obs_j[f] = -1
                         p.n_unobs[f] += 1
                     else:
                         p.post[f] = correct(p.prior[f], obs[j][0], obs[j][1])
                         p.seen[f] = True
+                        p.z[f] = obs[j]
                         p.pattern[f] = pats[k][j]
                         p.obs_j[f] = j
                         p.n_unobs[f] = 0
@@ -317,6 +330,16 @@ class PeopleTracker(TrackerKind):
                         s1, s0 = p.post[f], before[f]
                         w.push(math.hypot(s1[2] - s0[2], s1[3] - s0[3]) / dt,
                                _SWING[p.phase][f])
+            # the static map learns this scan, except the returns on reported persons' legs
+            # (leg_tracker maps only clusters not matched to a person: a person who stands
+            # is not learned as background)
+            pts = scan_points(scans, k)
+            on_people = [obs[j] for p in persons if p.reported for j in p.obs_j if j >= 0]
+            if on_people and len(pts):
+                lx = np.array(on_people)
+                d2 = ((pts[:, None, :] - lx[None, :, :]) ** 2).sum(axis=2).min(axis=1)
+                pts = pts[d2 > self.person_points_m ** 2]
+            smap.update(k, to_world(pose, pts))
             # life cycle
             for p in persons:
                 if p.status == TENTATIVE:
@@ -375,6 +398,7 @@ class PeopleTracker(TrackerKind):
             if profile:
                 cost.append(perf_counter() - t_start)
                 alive.append(len(persons))
+                on_static.append(static)
         people = pd.DataFrame.from_records(rows, columns=list(PEOPLE_COLUMNS))
         people = people.astype({"k": np.int64, "person_id": np.int64, "phase": np.int64,
                                 "observed": bool})
@@ -383,6 +407,7 @@ class PeopleTracker(TrackerKind):
         if profile:
             res.scan_seconds = np.asarray(cost)
             res.scan_hypotheses = np.asarray(alive, dtype=np.int64)
+            res.scan_static = on_static
         return res
 
     # -- output ------------------------------------------------------------------------------
@@ -415,8 +440,16 @@ class PeopleTracker(TrackerKind):
         return res
 
 
+def _relative(a, b) -> tuple[float, float, float]:
+    """Pose ``b`` = (x, y, θ) in the frame of pose ``a`` (both in one world frame)."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    dx, dy = float(b[0] - a[0]), float(b[1] - a[1])
+    return c * dx + s * dy, -s * dx + c * dy, float(b[2] - a[2])
+
+
 def _on_static(p: Person, pose, smap) -> bool:
-    """Both legs of ``p`` lie on static cells of the map (not in free space)."""
+    """Either leg of ``p`` lies on a static cell of the map (not in free space; stricter
+    than leg_tracker, which asks one leg in free space — docs/people.md)."""
     w = to_world(pose, np.array([p.pos(0), p.pos(1)]))
     return smap.is_static(*w[0]) or smap.is_static(*w[1])
 
