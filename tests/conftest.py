@@ -47,13 +47,16 @@ def tiny_simulated(tmp_path_factory) -> Path:
 
 
 def tiny_workflow(work: Path, *extra: str, snakemake: Path = SNAKEMAKE, targets=(),
-                  timeout: int = 900) -> subprocess.CompletedProcess:
+                  profile: bool = True, timeout: int = 900) -> subprocess.CompletedProcess:
     """The README's report command on the tiny study in folder ``work`` (its data in
     ``work/data``, the config's default ``data_dir``): ``extra`` goes after the
     ``--config`` items, so it may add more of them, then options (``-n``,
-    ``--configfile ...``); ``targets`` come first."""
+    ``--configfile ...``); ``targets`` come first.  ``profile=False``: without the
+    README's profile, so each `run:` job runs in a Snakemake process of its own (as a
+    cluster job does) under Snakemake's default scheduler."""
     cmd = [str(snakemake), *map(str, targets), "--snakefile", str(ROOT / "Snakefile"),
-           "--profile", str(PROFILE), "--directory", str(work), "--cores", "2",
+           *(["--profile", str(PROFILE)] if profile else []),
+           "--directory", str(work), "--cores", "2",
            "--config", 'run=["tiny"]', f"peer_results={PEER}", *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
 
