@@ -1,6 +1,10 @@
-"""Shared fixtures: where the real data lives, and skipping cleanly when it does not."""
+"""Shared fixtures: where the real data lives, and skipping cleanly when it does not; the
+tiny study's workflow run, built once per session and shared read-only."""
 from __future__ import annotations
 
+import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -8,6 +12,12 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 REALDATA = (ROOT / ".." / "shared" / "realdata").resolve()
 SEEDS = (ROOT / ".." / "shared" / "seeds").resolve()
+#: the peer's published results (tables/peer_agreement): made when ../shared is there
+PEER = REALDATA / "peer-results" / "gailo_results.parquet"
+#: the Snakemake of this venv (the 9.x requirements.lock installs)
+SNAKEMAKE = Path(sys.executable).parent / "snakemake"
+#: the README's report command's profile (threads for the `run:` jobs, the greedy scheduler)
+PROFILE = ROOT / "workflow" / "profiles" / "default"
 
 
 @pytest.fixture(scope="session")
@@ -22,3 +32,62 @@ def realdata() -> Path:
 @pytest.fixture(scope="session")
 def repo_root() -> Path:
     return ROOT
+
+
+@pytest.fixture(scope="session")
+def tiny_simulated(tmp_path_factory) -> Path:
+    """``generate_study(folder, "tiny")`` once per session: the tiny preset's files, read
+    only by the tests (tests/test_simulate.py, test_physics.py, test_registration.py,
+    test_mtst_steps.py); a test that changes files copies them."""
+    from gaitval.simulate import generate_study
+
+    out = tmp_path_factory.mktemp("tiny_simulated")
+    generate_study(out, "tiny")
+    return out
+
+
+def tiny_workflow(work: Path, *extra: str, snakemake: Path = SNAKEMAKE, targets=(),
+                  profile: bool = True, timeout: int = 900) -> subprocess.CompletedProcess:
+    """The README's report command on the tiny study in folder ``work`` (its data in
+    ``work/data``, the config's default ``data_dir``): ``extra`` goes after the
+    ``--config`` items, so it may add more of them, then options (``-n``,
+    ``--configfile ...``); ``targets`` come first.  ``profile=False``: without the
+    README's profile, so each `run:` job runs in a Snakemake process of its own (as a
+    cluster job does) under Snakemake's default scheduler."""
+    cmd = [str(snakemake), *map(str, targets), "--snakefile", str(ROOT / "Snakefile"),
+           *(["--profile", str(PROFILE)] if profile else []),
+           "--directory", str(work), "--cores", "2",
+           "--config", 'run=["tiny"]', f"peer_results={PEER}", *extra]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.fixture(scope="session")
+def tiny_run(tmp_path_factory) -> Path:
+    """The tiny study simulated and reported once per session, with this venv's Snakemake,
+    in a scratch folder that tests only read (dry runs included).  A test that runs the
+    workflow for real builds its own folder, from a copy of this one's ``data``
+    (:func:`copy_run`; a copy of the whole folder is not up to date where it lands: the
+    ingest job's inputs are the raw files' absolute paths)."""
+    work = tmp_path_factory.mktemp("tiny_run")
+    res = tiny_workflow(work)
+    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-4000:]
+    return work
+
+
+@pytest.fixture(scope="session")
+def tiny_run_snakemake8(tmp_path_factory) -> Path:
+    """The same tiny report in another folder, simulated there again with the same seed, on
+    the newest Snakemake 8.x (tests/test_snakemake_releases.py, ``.venv-snakemake8``)."""
+    from test_snakemake_releases import snakemake_8
+
+    work = tmp_path_factory.mktemp("tiny_run_snakemake8")
+    res = tiny_workflow(work, snakemake=snakemake_8())
+    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-4000:]
+    return work
+
+
+def copy_run(run: Path, dst: Path) -> Path:
+    """A copy of a run's folder (e.g. its ``data``: the simulated study), times kept, so
+    that a run reading it finds the simulation up to date and does not simulate again."""
+    shutil.copytree(run, dst, symlinks=True)
+    return dst

@@ -1,7 +1,8 @@
 """Issue 37 scope 3 and 4: ``gaitval init-study FOLDER`` and a study without poles.
 
 Fast tests build small folders (copies of tiny-study files under other names) and check
-what init-study pairs, fills and marks.  The slow tests run the tiny study once, then:
+what init-study pairs, fills and marks.  The slow tests read the session's tiny study run
+(tests/conftest.py; its peer-data table aside, which no study's files change), then:
 
 * copy ``data/tiny`` without its trial sheet and subject table, run ``gaitval init-study``,
   fill in exactly the cells it marked ``FILL_IN`` from the original tables (what a lab does
@@ -32,8 +33,9 @@ import yaml
 from gaitval.errors import GaitvalError
 from gaitval.io.initstudy import FILL_IN, init_study
 
+from conftest import PROFILE, SNAKEMAKE
+
 ROOT = Path(__file__).resolve().parents[1]
-SNAKEMAKE = Path(sys.executable).parent / "snakemake"
 GAITVAL = Path(sys.executable).parent / "gaitval"
 
 
@@ -43,20 +45,16 @@ def snakemake(work: Path, *args) -> subprocess.CompletedProcess:
     args = list(map(str, args))
     files, targets = (args[:args.index("--")], args[args.index("--") + 1:]) if "--" in args \
         else (args, [])
-    cmd = [str(SNAKEMAKE), *targets, "--snakefile", str(ROOT / "Snakefile"), "--directory",
-           str(work), "--cores", "2", "--configfile", *files]
+    cmd = [str(SNAKEMAKE), *targets, "--snakefile", str(ROOT / "Snakefile"), "--profile",
+           str(PROFILE), "--directory", str(work), "--cores", "2", "--configfile", *files]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=1200)
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory) -> Path:
-    """The tiny study, simulated and reported once in a scratch folder."""
-    work = tmp_path_factory.mktemp("orig")
-    base = work / "base.yaml"
-    base.write_text(yaml.safe_dump({"run": ["tiny"], "peer_results": ""}))
-    res = snakemake(work, base)
-    assert res.returncode == 0, res.stderr[-4000:]
-    return work
+def tiny(tiny_run) -> Path:
+    """The tiny study, simulated and reported once per session in a scratch folder (read
+    only here: the tests copy its data)."""
+    return tiny_run
 
 
 def fill_in(new: Path, orig: Path, pose: dict | None = None) -> list[tuple[str, str, str]]:
@@ -87,9 +85,10 @@ def fill_in(new: Path, orig: Path, pose: dict | None = None) -> list[tuple[str, 
 
 
 def tables(work: Path, run: str) -> dict[str, str]:
+    """The run's study tables (not the peer's, which no study's files change) by name."""
     d = work / "reports" / run / "tables"
     return {p.name.replace(f"_{run}.", "."): p.read_text().replace(run, "<study>")
-            for p in sorted(d.glob("*.csv"))}
+            for p in sorted(d.glob("*.csv")) if p.name != "peer_agreement.csv"}
 
 
 def copy_without_sheet(src: Path, dst: Path) -> Path:
@@ -185,15 +184,10 @@ def test_a_tiny_study_without_poles_runs_end_to_end_on_a_measured_pose(tiny, tmp
 
 # -- small folders --------------------------------------------------------------------------
 @pytest.fixture(scope="module")
-def tiny_files(tmp_path_factory) -> Path:
-    """The tiny preset's TUG and MTST trials, simulated without running the workflow."""
-    from gaitval.simulate import generate_study
-
-    out = tmp_path_factory.mktemp("sim")
-    preset = yaml.safe_load((ROOT / "config" / "studies" / "tiny.yaml").read_text())
-    preset = {k: v for k, v in preset.items() if k not in ("rollator", "ultrasonic")}
-    generate_study(out, preset)
-    return out
+def tiny_files(tiny_simulated) -> Path:
+    """The tiny preset's files (its TUG and MTST trials are used here), simulated without
+    running the workflow, once per session (tests/conftest.py); the tests copy them."""
+    return tiny_simulated
 
 
 def test_files_of_other_names_are_paired_by_time_and_reported(tiny_files, tmp_path):

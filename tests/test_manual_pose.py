@@ -80,7 +80,7 @@ def test_a_study_without_poles_runs_on_a_hand_measured_pose(tmp_path):
     sheet = build_study(tmp_path / "data" / STUDY, drop_poles=True)
     res = run(tmp_path, sheet)
     assert res.returncode == 0, res.stderr[-4000:]
-    regs = sorted((tmp_path / "results" / STUDY / "register").glob("*/registration.json"))
+    regs = sorted((tmp_path / "results" / STUDY / "register").glob("*/*/registration.json"))
     assert regs
     truth = pd.read_csv(tmp_path / "data" / "sim" / "truth" / "sensor_pose.csv"
                         ).set_index("trial")
@@ -101,7 +101,9 @@ def test_with_poles_the_hand_measured_pose_is_checked_against_them(tmp_path):
     sheet = build_study(tmp_path / "data" / STUDY, drop_poles=False)
     res = run(tmp_path, sheet, "--until", "registration_summary")
     assert res.returncode == 0, res.stderr[-4000:]
-    for p in sorted((tmp_path / "results" / STUDY / "register").glob("*/registration.json")):
+    regs = sorted((tmp_path / "results" / STUDY / "register").glob("*/*/registration.json"))
+    assert regs
+    for p in regs:
         r = json.loads(p.read_text())
         assert r["pose_source"] == "poles"
         # the pole fit lands within centimetres and a degree of the true pose

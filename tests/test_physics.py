@@ -7,17 +7,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from gaitval.simulate import generate_study
 from gaitval.simulate.kinematics import GaitParams, leg_kinematics, make_path, plan_steps
 from gaitval.simulate.physics import COLUMNS, SWING_BACKWARD_MPS, physics_table, poisson_ci
 from gaitval.simulate.shin import point_profile
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("tiny_physics")
-    generate_study(out, "tiny")
-    return out
+def tiny(tiny_simulated) -> Path:
+    return tiny_simulated
 
 
 @pytest.fixture(scope="module")

@@ -474,11 +474,9 @@ def _read_us_log(path):
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory):
-    sim = pytest.importorskip("gaitval.simulate")
+def tiny(tiny_simulated):
     import yaml
-    out = tmp_path_factory.mktemp("tiny")
-    sim.generate_study(out, "tiny")
+    out = tiny_simulated                      # generate_study(out, "tiny"), read only
     trials = pd.read_csv(out / "trials.csv", dtype=str, keep_default_na=False)
     subjects = pd.read_csv(out / "subjects.csv", dtype=str, keep_default_na=False)
     cfg = yaml.safe_load((out / "study.yaml").read_text()) if (out / "study.yaml").exists() else {}

@@ -3,8 +3,9 @@
 A power cut or a killed cluster job leaves Snakemake's lock in ``.snakemake/locks`` and,
 possibly, job processes that keep writing.  ``python3 run.py report`` must see that no live
 Snakemake holds the lock, clear it, and finish; the tables must be byte-identical to an
-uninterrupted run's.  Runs the TUG branch of the tiny study (simulate, ingest, register,
-track, evaluate, tables) to stay within a few minutes.
+uninterrupted run's.  Runs the TUG branch of the tiny study (ingest, register, track,
+evaluate, tables) to stay within a few minutes, on a copy of the session's simulated tiny
+study (tests/conftest.py: both runs here read one data folder, so neither simulates).
 """
 from __future__ import annotations
 
@@ -18,6 +19,8 @@ from pathlib import Path
 
 import pytest
 
+from conftest import copy_run
+
 ROOT = Path(__file__).resolve().parents[1]
 TARGETS = ["reports/tiny/tables/tug_table4.csv", "reports/tiny/tables/study_ingest_tiny.csv"]
 
@@ -30,8 +33,9 @@ def _report(workdir: Path, data: Path, **popen) -> list[str]:
 
 
 @pytest.mark.slow
-def test_kill_9_at_a_random_point_then_report_resumes_with_identical_tables(tmp_path):
-    data = tmp_path / "data"
+def test_kill_9_at_a_random_point_then_report_resumes_with_identical_tables(tiny_run,
+                                                                             tmp_path):
+    data = copy_run(tiny_run / "data", tmp_path / "data")
     t0 = time.monotonic()
     ref = subprocess.run(_report(tmp_path / "ref", data), capture_output=True, text=True,
                          timeout=1200)

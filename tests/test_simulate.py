@@ -18,10 +18,8 @@ from gaitval.simulate.study import SUBJECT_COLUMNS, TRIAL_COLUMNS, load_preset
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("tiny")
-    generate_study(out, "tiny")
-    return out
+def tiny(tiny_simulated) -> Path:
+    return tiny_simulated
 
 
 @pytest.fixture(scope="module")

@@ -4,7 +4,8 @@ requirements.lock installs into ``.venv``; 8.x goes into ``.venv-snakemake8`` be
 (made here on first use, ~15 s: a venv whose own site-packages hold Snakemake 8 and the
 packages it needs in other versions, and that sees ``.venv``'s packages after them, so
 numpy, pandas and gaitval are the same).  Each runs a dry run and the tiny study; the
-tables of the two runs are byte-identical."""
+tables of the two runs are byte-identical.  The 9.x run is the session's ``tiny_run`` and
+the 8.x run ``tiny_run_snakemake8`` (tests/conftest.py), which other tests read too."""
 from __future__ import annotations
 
 import subprocess
@@ -13,13 +14,12 @@ import sysconfig
 from pathlib import Path
 
 import pytest
+from conftest import SNAKEMAKE, tiny_workflow
 
 ROOT = Path(__file__).resolve().parents[1]
 #: the newest Snakemake 8 on the package index (2026-11)
 SNAKEMAKE_8 = "8.30.0"
 VENV_8 = ROOT / ".venv-snakemake8"
-#: as tests/test_workflow.py: the peer data when ../shared is there, else no such table
-PEER = (ROOT / ".." / "shared" / "realdata" / "peer-results" / "gailo_results.parquet").resolve()
 
 
 def snakemake_8() -> Path:
@@ -46,38 +46,34 @@ def snakemake_8() -> Path:
     return VENV_8 / "bin" / "snakemake"
 
 
-def _run(snakemake: Path, work: Path, *extra: str) -> subprocess.CompletedProcess:
-    cmd = [str(snakemake), "--snakefile", str(ROOT / "Snakefile"),
-           "--profile", str(ROOT / "workflow" / "profiles" / "default"),
-           "--directory", str(work), "--cores", "2", "--force-use-threads",
-           "--config", 'run=["tiny"]', f"data_dir={work / 'data'}", f"peer_results={PEER}", *extra]
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
-
-
 @pytest.fixture(scope="module")
 def releases():
-    return {"9": Path(sys.executable).parent / "snakemake", "8": snakemake_8()}
+    return {"9": SNAKEMAKE, "8": snakemake_8()}
+
+
+def version_of(snakemake: Path) -> str:
+    return subprocess.run([str(snakemake), "--version"], capture_output=True, text=True,
+                          check=True).stdout.strip()
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("release", ["8", "9"])
 def test_dry_run(releases, release, tmp_path):
-    version = subprocess.run([str(releases[release]), "--version"], capture_output=True,
-                             text=True, check=True).stdout.strip()
+    version = version_of(releases[release])
     assert version.split(".")[0] == release, version
-    res = _run(releases[release], tmp_path, "-n")
+    res = tiny_workflow(tmp_path, "-n", snakemake=releases[release])
     assert res.returncode == 0, res.stderr[-3000:]
     assert "simulate" in res.stdout and "report" in res.stdout, res.stdout[-3000:]
 
 
 @pytest.mark.slow
-def test_the_tiny_study_on_both_releases_gives_the_same_tables(releases, tmp_path):
+def test_the_tiny_study_on_both_releases_gives_the_same_tables(releases, tiny_run,
+                                                               tiny_run_snakemake8):
+    assert version_of(releases["9"]).split(".")[0] == "9"
     tables = {}
-    for release in ("8", "9"):
-        work = tmp_path / release
-        res = _run(releases[release], work)
-        assert res.returncode == 0, (release, res.stdout[-3000:] + res.stderr[-3000:])
+    for release, work in (("8", tiny_run_snakemake8), ("9", tiny_run)):
         found = sorted((work / "reports" / "tiny" / "tables").glob("*.csv"))
         assert len(found) >= 10, (release, found)
+        assert (work / "reports" / "tiny" / "index.html").is_file(), release
         tables[release] = {p.name: p.read_bytes() for p in found}
     assert tables["8"] == tables["9"]

@@ -1,4 +1,4 @@
-"""The whole Snakemake DAG on the tiny simulated study, in a scratch working directory.
+"""The whole Snakemake DAG on the tiny simulated study: the session's run (tests/conftest.py).
 
 This is the README's report command on the small study: simulate -> ingest -> register ->
 ... -> report.  It checks that the DAG runs end to end, that every report item carries
@@ -7,30 +7,20 @@ provenance, and that the same config and seed give byte-identical tables.
 from __future__ import annotations
 
 import subprocess
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
+from conftest import SNAKEMAKE, tiny_workflow
+
 ROOT = Path(__file__).resolve().parents[1]
-SNAKEMAKE = Path(sys.executable).parent / "snakemake"
 
 
-def run_workflow(workdir: Path, data_dir: Path, *extra: str) -> subprocess.CompletedProcess:
-    peer = (ROOT / ".." / "shared" / "realdata" / "peer-results" / "gailo_results.parquet").resolve()
-    cmd = [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(workdir),
-           "--cores", "2", "--force-use-threads", "--config", 'run=["tiny"]', f"data_dir={data_dir}",
-           f"peer_results={peer}", *extra]
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
-
-
-@pytest.fixture(scope="module")
-def tiny_run(tmp_path_factory):
-    work = tmp_path_factory.mktemp("wf1")
-    res = run_workflow(work, work / "data")
-    assert res.returncode == 0, res.stderr[-4000:]
-    return work
+def run_workflow(workdir: Path, *extra: str) -> subprocess.CompletedProcess:
+    """The tiny study's report command in ``workdir`` as the session's ``tiny_run``
+    (tests/conftest.py) was made, plus ``extra``."""
+    return tiny_workflow(workdir, *extra)
 
 
 @pytest.mark.slow
@@ -80,13 +70,14 @@ def test_a_track_job_tracks_then_evaluates_every_trial(tiny_run):
 
 
 @pytest.mark.slow
-def test_same_config_and_seed_give_byte_identical_tables(tiny_run, tmp_path):
-    res = run_workflow(tmp_path, tiny_run / "data")
-    assert res.returncode == 0, res.stderr[-4000:]
+def test_same_config_and_seed_give_byte_identical_tables(tiny_run, tiny_run_snakemake8):
+    """A second run of the same config and seed in another folder -- its own simulation,
+    on Snakemake 8.x, the session's run the one tests/test_snakemake_releases.py also
+    compares -- gives the same bytes in every table."""
     first = sorted((tiny_run / "reports" / "tiny" / "tables").glob("*.csv"))
     assert first
     for p in first:
-        q = tmp_path / "reports" / "tiny" / "tables" / p.name
+        q = tiny_run_snakemake8 / "reports" / "tiny" / "tables" / p.name
         assert q.read_bytes() == p.read_bytes(), p.name
 
 
@@ -117,7 +108,7 @@ def test_tables_equal_the_stored_reference_within_the_tolerance(tiny_run):
 def test_switching_run_rebuilds_into_that_runs_folder(tiny_run):
     """After the tiny report, the tiny run is up to date and a default run asks for its
     own reports/default/ (issue 14: it used to say "Nothing to be done" and serve tiny)."""
-    same = run_workflow(tiny_run, tiny_run / "data", "-n")
+    same = run_workflow(tiny_run, "-n")
     assert same.returncode == 0 and "Nothing to be done" in same.stdout + same.stderr
     other = subprocess.run(
         [str(SNAKEMAKE), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(tiny_run),
@@ -147,7 +138,7 @@ def test_one_methods_parameter_reruns_only_that_methods_trials(tiny_run):
     inherits the override), the TUG tables and the report -- no registration, no
     other method's track, no ultrasonic noise identification or track, no other study
     section's tables or summaries."""
-    res = run_workflow(tiny_run, tiny_run / "data",   # a --config item, then the dry run
+    res = run_workflow(tiny_run,                   # a --config item, then the dry run
                        'tracking={"overrides": {"tug_m1": {"gate__g": 9.21}}}', "-n")
     assert res.returncode == 0, res.stderr[-3000:]
     planned = _planned(res)
@@ -173,7 +164,7 @@ def test_a_detector_parameter_detects_once_more_for_its_methods_only(tiny_run):
     (workflow/rules/detect.smk); a new detector parameter of tug_m1 plans one detection
     with the new spec (tug_m1 and its reading variant share it) and those two tracks, no
     other method's track and no other detection."""
-    res = run_workflow(tiny_run, tiny_run / "data",
+    res = run_workflow(tiny_run,
                        'tracking={"overrides": {"tug_m1": {"detector__max_occluder_m": 0.2}}}',
                        "-n")
     assert res.returncode == 0, res.stderr[-3000:]
@@ -189,25 +180,22 @@ def test_a_detector_parameter_detects_once_more_for_its_methods_only(tiny_run):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="issue 38 regression, not fixed yet: registration is "
-                   "one job per study and reads every family's study view (the rollator "
-                   "trials' registration reads rollator.sensor_mount), so a rollator: change "
-                   "reruns the study's registration and every method's tracks after it")
 def test_a_rollator_setting_reruns_only_the_rollator_trials(tiny_run, tmp_path):
-    """Issue 13: a new rollator.pf_seed (a section of one protocol family) plans the
-    rollator jobs and tables only (and the study's registration, whose job reads every
-    family's view, issue 38): the TUG, MTST and ultrasonic jobs read views without the
-    rollator: section (config_views/<scope>/)."""
+    """Issues 13 and 38: a new rollator.pf_seed (a section of one protocol family) plans
+    the rollator trials' registration (one job per study and family, reading the rollator
+    view), the rollator jobs and tables only: the TUG, MTST and ultrasonic jobs, their
+    registrations included, read views without the rollator: section
+    (config_views/<scope>/)."""
     import pandas as pd
 
     overlay = tmp_path / "seed.yaml"
     overlay.write_text("rollator:\n  pf_seed: 2018\n")
-    res = run_workflow(tiny_run, tiny_run / "data", "--configfile",
+    res = run_workflow(tiny_run, "--configfile",
                        str(ROOT / "config" / "config.yaml"), str(overlay), "-n")
     assert res.returncode == 0, res.stderr[-3000:]
     planned = _planned(res)
     # the same on the command line: the nested 2018 is a number there too
-    cli = run_workflow(tiny_run, tiny_run / "data", 'rollator={"pf_seed": 2018}', "-n")
+    cli = run_workflow(tiny_run, 'rollator={"pf_seed": 2018}', "-n")
     assert cli.returncode == 0, cli.stderr[-3000:]
     assert _planned(cli) == planned
     sheet = pd.read_csv(tiny_run / "data" / "tiny" / "trials.csv")
@@ -215,7 +203,11 @@ def test_a_rollator_setting_reruns_only_the_rollator_trials(tiny_run, tmp_path):
     assert n_rollator > 0
     assert planned["rollator_track"] == 2          # KF and PF: one job each for the study
     assert planned["rollator_tables"] == 1
-    assert planned.get("register", 0) <= 1         # the study's job reads the rollator view
+    assert planned["register"] == 1                # the rollator family's job only
+    import re
+    blocks = re.findall(r"^rule register:\n((?:[ \t]+\S.*\n)+)", res.stdout + res.stderr, re.M)
+    outputs = [re.search(r"output: (\S+)", b).group(1) for b in blocks]
+    assert [o.rstrip(",").split("/")[-2:] for o in outputs] == [["register", "rollator"]], blocks
     for rule in ("track", "mtst_track", "ultrasonic_noise",
                  "ultrasonic_track", "tug_tables", "mtst_tables",
                  "ultrasonic_tables", "ingest"):

@@ -2,7 +2,8 @@
 external methods (``tracking.external``), give the same TUG Tables 3-5 and MTST Table 3
 rows as the method they came from.
 
-The tiny study's TUG and MTST parts are run once (Snakemake in a temporary folder); then
+The tiny study's TUG, MTST and rollator parts are run once (Snakemake in a temporary
+folder, on a copy of the session's simulated tiny study, tests/conftest.py); then
 tug_m1's tracks (TUG trials) and mtst_m1's (MTST trials) are exported with
 ``gaitval export-tracks`` as CSV on the sensor clock in the sensor frame (``ext_m1``: exact
 equality), and tug_m2's as Parquet in millimetres, in the mocap field frame and on the
@@ -25,8 +26,9 @@ import yaml
 
 from gaitval.io.tracks import track_to_exchange, write_tracks
 
+from conftest import SNAKEMAKE, copy_run, tiny_workflow
+
 ROOT = Path(__file__).resolve().parents[1]
-SNAKEMAKE = Path(sys.executable).parent / "snakemake"
 TARGETS = ["reports/tiny/tables/tug_table4.csv", "reports/tiny/tables/mtst_table3.csv",
            "reports/tiny/tables/rollator_table1.csv"]
 PERSON_DEFS = {"leg_tracker/msg/Person": "geometry_msgs/Pose pose\nuint32 id\n",
@@ -95,12 +97,6 @@ def positions_only(track: pd.DataFrame) -> pd.DataFrame:
     return rows[has.to_numpy(bool)].reset_index(drop=True)
 
 
-def snakemake(work: Path, *configfiles: Path) -> subprocess.CompletedProcess:
-    cmd = [str(SNAKEMAKE), *TARGETS, "--snakefile", str(ROOT / "Snakefile"), "--directory",
-           str(work), "--cores", "2", "--force-use-threads", "--configfile", *map(str, configfiles)]
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
-
-
 def to_mocap(track: pd.DataFrame, reg: dict) -> pd.DataFrame:
     """Exchange rows of a sensor-frame track in the mocap frame (mm) and clock."""
     rows = track_to_exchange(track)
@@ -114,11 +110,14 @@ def to_mocap(track: pd.DataFrame, reg: dict) -> pd.DataFrame:
 
 
 @pytest.fixture(scope="module")
-def ext_run(tmp_path_factory):
+def ext_run(tiny_run, tmp_path_factory):
+    """The tables TARGETS in a folder of their own (this module writes into its data
+    folder and runs it again with external methods declared), on a copy of the session's
+    tiny data.  (Not a copy of the whole run: the ingest job's inputs are the raw files'
+    absolute paths, so a copied run is out of date where it lands.)"""
     work = tmp_path_factory.mktemp("ext")
-    base = work / "base.yaml"
-    base.write_text(yaml.safe_dump({"run": ["tiny"], "peer_results": ""}))
-    res = snakemake(work, base)
+    copy_run(tiny_run / "data", work / "data")
+    res = tiny_workflow(work, targets=TARGETS)
     assert res.returncode == 0, res.stderr[-4000:]
     study = work / "data" / "tiny"
     results = work / "results" / "tiny"
@@ -134,7 +133,7 @@ def ext_run(tmp_path_factory):
                            capture_output=True, text=True)
         assert r.returncode == 0, r.stderr
     for t in trials:
-        reg = json.loads((results / "register" / t / "registration.json").read_text())
+        reg = json.loads((results / "register" / "tug" / t / "registration.json").read_text())
         track = pd.read_parquet(results / "track" / "tug_m2" / f"{t}.parquet")
         write_tracks(to_mocap(track, reg), study / "ext2" / f"{t}.tracks.parquet",
                      units="mm", frame="mocap", clock="mocap")
@@ -160,7 +159,9 @@ def ext_run(tmp_path_factory):
                     "topic": "/people_tracked", "legs": {"L": "1", "R": "2"}},
         "ext_pos": {"path": "pos/{trial}.tracks.csv", "protocols": ["tug"]},
         "ext_kf": {"path": "extr/{trial}.tracks.csv", "protocols": ["rollator"]}}}}))
-    res = snakemake(work, base, ext)
+    # without the profile: the external methods' jobs and the tables each in a Snakemake
+    # process of their own, the way a cluster runs them (the suite's one real run so)
+    res = tiny_workflow(work, "--configfile", str(ext), targets=TARGETS, profile=False)
     assert res.returncode == 0, res.stderr[-4000:]
     return work, res.stdout + res.stderr
 

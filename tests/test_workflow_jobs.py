@@ -27,11 +27,10 @@ BAD = "tug_Y01_t2"
 
 
 @pytest.fixture(scope="module")
-def tiny_data(tmp_path_factory):
-    data = tmp_path_factory.mktemp("jobs") / "data"
-    subprocess.run([sys.executable, "-m", "gaitval", "simulate", "--preset",
-                    str(ROOT / "config" / "studies" / "tiny.yaml"), "--seed", "0",
-                    "--out", str(data / "tiny")], check=True, capture_output=True, timeout=300)
+def tiny_data(tiny_run):
+    """The session's simulated tiny study (tests/conftest.py), read only: each test here
+    copies it."""
+    data = tiny_run / "data"
     sheet = pd.read_csv(data / "tiny" / "trials.csv")
     return data, sheet
 

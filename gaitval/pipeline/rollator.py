@@ -31,8 +31,8 @@ from gaitval.errors import GaitvalError
 from gaitval.io.atomic import write_parquet, write_text
 from gaitval.pipeline.memo import FileMemo, file_identity
 from gaitval.io.parquet import read_parquet
-from gaitval.pipeline.steps import (load_json, method_definition, method_display_names,
-                           trial_and_subject)
+from gaitval.pipeline.steps import (PROTOCOL_SCOPE, load_json, method_definition,
+                                    method_display_names, trial_and_subject)
 
 #: defaults of the ``rollator:`` keys read here
 DEFAULTS = {"kf_method": "rollator_kf", "pf_method": "rollator_pf", "pf_seed": 2017,
@@ -64,9 +64,10 @@ def rollator_train_step(results_dir, sheet, subjects, subject: str, config_json,
     """Learn the PF model for held-out ``subject`` from the other subjects' trials.
 
     Reads ``<results_dir>/ingest/<trial>/sensor.parquet``,
-    ``<results_dir>/register/<trial>/{registration.json,groundtruth.parquet}`` of every
-    rollator trial of another subject; refused registrations are left out (and listed in
-    the model under ``skipped``).
+    ``<results_dir>/register/rollator/<trial>/{registration.json,groundtruth.parquet}``
+    (the rollator family's registration folder) of every rollator trial of another
+    subject; refused registrations are left out (and listed in the model under
+    ``skipped``).
     """
     from gaitval.io.scanlog import read_scanlog
     from gaitval.io.trialsheet import load_subjects, load_trial_sheet
@@ -80,14 +81,15 @@ def rollator_train_step(results_dir, sheet, subjects, subject: str, config_json,
         raise GaitvalError(f"subject {subject!r} has no trial in the trial sheet", path=sheet)
     train = df[(df["protocol"] == "rollator") & (df["subject"] != subject)].sort_index()
     rd = Path(results_dir)
+    registered = rd / "register" / PROTOCOL_SCOPE["rollator"]   # register.smk: per family
     samples, used, skipped = [], [], []
     for trial, row in train.iterrows():
-        reg = load_json(rd / "register" / trial / "registration.json")
+        reg = load_json(registered / trial / "registration.json")
         if reg.get("status") != "ok":
             skipped.append(trial)
             continue
         sensor = rd / "ingest" / trial / "sensor.parquet"
-        gt_path = rd / "register" / trial / "groundtruth.parquet"
+        gt_path = registered / trial / "groundtruth.parquet"
         w = _leg_width(subj.loc[row["subject"]].to_dict(), cfg)
         got = _SAMPLES.fetch(
             _SAMPLES.key(sensor, file_identity(gt_path), w),

@@ -12,7 +12,7 @@ rule rollator_track_external:
         tracks=lambda w: [external_tracks_file(trial_wildcards(w.study, t, w.method))
                           for t in trial_ids(w.study, ["rollator"])],
         ingest=f"{RESULTS}/{{study}}/ingest",
-        register=f"{RESULTS}/{{study}}/register",
+        register=f"{RESULTS}/{{study}}/register/rollator",
         config=f"{RESULTS}/{{study}}/config_views/rollator/{{method}}.json",
         sheet=lambda w: sheet_path(w.study),
     output:

@@ -22,7 +22,7 @@ def mtst_registration(wildcards):
     """registration.json and groundtruth.parquet when the trial has mocap."""
     if not has_mocap(wildcards.study, wildcards.trial):
         return {}
-    reg = f"{RESULTS}/{wildcards.study}/register/{wildcards.trial}"
+    reg = registration_dir(wildcards.study, wildcards.trial)
     return {
         "reg": f"{reg}/registration.json",
         "gt": f"{reg}/groundtruth.parquet",
@@ -84,7 +84,7 @@ def mtst_batch_inputs(wildcards):
     }
     if any(has_mocap(study, t) for t in trials):
         files["ingest"] = f"{RESULTS}/{study}/ingest"
-        files["register"] = f"{RESULTS}/{study}/register"
+        files["register"] = register_dir(study, "mtst")
     # the trials' observations, when another method shares this one's detector (detect.smk)
     files["detections"] = detections_dir("mtst")(wildcards)
     return files

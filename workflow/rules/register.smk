@@ -1,5 +1,5 @@
 # Per-study analysis config, then registration + ground truth of every trial with mocap
-# (one job per study), then the registration table reviewers read first.
+# (one job per study and protocol family), then the registration table reviewers read first.
 
 
 rule study_config:
@@ -47,29 +47,62 @@ rule config_view:
         )
 
 
+# REGISTRATION PER PROTOCOL FAMILY.  One job per (study, family): the trials with mocap of
+# one protocol family (gaitval.pipeline.steps.PROTOCOL_SCOPE: tug, mtst, rollator,
+# ultrasonic, or "all" for another protocol), each reading its family's study view
+# (config_views/<family>/study.json), into results/<study>/register/<family>/<trial>/.  A
+# change of one family's section (e.g. rollator.sensor_mount) thus reruns that family's
+# registration and what reads it, not the other families' tracks (issue 38; with one job
+# per study every family's view was its input).
+def trial_family(study, trial):
+    """The protocol family (config view scope) of a trial: its register folder's name."""
+    return PROTOCOL_SCOPE.get(trial_row(study, trial)["protocol"], ALL_SCOPE)
+
+
+def family_mocap_trials(study, family):
+    """The trials with mocap of one protocol family: what its register job takes."""
+    return [t for t in mocap_trial_ids(study) if trial_family(study, t) == family]
+
+
+def register_dir(study, family):
+    """results/<study>/register/<family>: the output of one register job."""
+    return f"{RESULTS}/{study}/register/{family}"
+
+
+def registration_dir(study, trial):
+    """results/<study>/register/<family>/<trial>: one trial's registration.json and
+    groundtruth.parquet."""
+    return f"{register_dir(study, trial_family(study, trial))}/{trial}"
+
+
+def register_dirs(study):
+    """The register folders of every family with a trial with mocap (registration_summary)."""
+    return sorted({register_dir(study, trial_family(study, t)) for t in mocap_trial_ids(study)})
+
+
 rule register:
-    # one job per study: every trial with mocap (HOW JOBS RUN in common.smk); each trial
-    # reads the study view of its protocol family's scope (config_view_file)
+    # one job per (study, family): every trial with mocap of the family (HOW JOBS RUN in
+    # common.smk), each reading the family's study view
     input:
         ingest=f"{RESULTS}/{{study}}/ingest",
-        configs=lambda w: sorted({config_view_file(trial_wildcards(w.study, t))
-                                  for t in mocap_trial_ids(w.study)}),
+        config=f"{RESULTS}/{{study}}/config_views/{{family}}/{STUDY_VIEW}.json",
         sheet=lambda w: sheet_path(w.study),
     output:
-        directory(f"{RESULTS}/{{study}}/register"),
+        directory(f"{RESULTS}/{{study}}/register/{{family}}"),
+    wildcard_constraints:
+        family="|".join((*SCOPES, ALL_SCOPE)),
     threads: BATCH_THREADS
     priority: 20  # everything after ingest reads it
     params:
         subjects=lambda w: subjects_path(w.study),
-        trials=lambda w: mocap_trial_ids(w.study),
+        trials=lambda w: family_mocap_trials(w.study, w.family),
     log:
-        "logs/register/{study}.log",
+        "logs/register/{study}/{family}.log",
     run:
         run_trials(
             [(t, [verb("register", "--ingest", f"{input.ingest}/{t}", "--sheet", input.sheet,
                        "--subjects", params.subjects, "--trial", t,
-                       "--config", config_view_file(trial_wildcards(wildcards.study, t)),
-                       "--out", f"{output[0]}/{t}")])
+                       "--config", input.config, "--out", f"{output[0]}/{t}")])
              for t in params.trials],
             threads, log[0], outdirs=output,
             sizes=[trial_bytes(wildcards.study, t) for t in params.trials],
@@ -78,7 +111,7 @@ rule register:
 
 rule registration_summary:
     input:
-        f"{RESULTS}/{{study}}/register",
+        lambda w: register_dirs(w.study),
         sheet=lambda w: sheet_path(w.study),  # the params list its trials
     output:
         csv=f"{RESULTS}/{{study}}/registration.csv",
@@ -90,7 +123,8 @@ rule registration_summary:
         md=f"{REPORTS}/tables/study_registration_{{study}}.md",
         tex=f"{REPORTS}/tables/study_registration_{{study}}.tex",
     params:
-        trials=lambda w: mocap_trial_ids(w.study),
+        registrations=lambda w: [f"{registration_dir(w.study, t)}/registration.json"
+                                 for t in mocap_trial_ids(w.study)],
         stem=lambda w, output: output.table[: -len(".csv")],
         reports=parent_of("table", up=1),
         chash=config_hash_when_run,
@@ -99,7 +133,7 @@ rule registration_summary:
     run:
         run_verb_job(
             verb("registration-summary",
-                 [f"{input[0]}/{t}/registration.json" for t in params.trials],
+                 params.registrations,
                  "--study", wildcards.study, "--out-csv", output.csv,
                  "--out-stem", params.stem, "--reports-dir", params.reports,
                  "--config-hash", params.chash),

@@ -13,7 +13,7 @@ rule rollator_train:
     # trials (leave-one-subject-out; HOW JOBS RUN in common.smk)
     input:
         ingest=f"{RESULTS}/{{study}}/ingest",
-        register=f"{RESULTS}/{{study}}/register",
+        register=f"{RESULTS}/{{study}}/register/rollator",
         config=f"{RESULTS}/{{study}}/config_views/rollator/{STUDY_VIEW}.json",
         sheet=lambda w: sheet_path(w.study),
     output:
@@ -43,7 +43,7 @@ rule rollator_track:
     # held-out subject's model), then evaluated (two verbs of one task)
     input:
         ingest=f"{RESULTS}/{{study}}/ingest",
-        register=f"{RESULTS}/{{study}}/register",
+        register=f"{RESULTS}/{{study}}/register/rollator",
         config=f"{RESULTS}/{{study}}/config_views/rollator/{{method}}.json",
         sheet=lambda w: sheet_path(w.study),
         models=rollator_models,

@@ -8,7 +8,7 @@ rule track:
     # registered ground truth (two verbs of one task; HOW JOBS RUN in common.smk)
     input:
         ingest=f"{RESULTS}/{{study}}/ingest",
-        register=f"{RESULTS}/{{study}}/register",
+        register=f"{RESULTS}/{{study}}/register/tug",
         config=f"{RESULTS}/{{study}}/config_views/tug/{{method}}.json",
         sheet=lambda w: sheet_path(w.study),
         # the trials' observations, when another method shares this one's detector
@@ -50,7 +50,7 @@ rule track_external:
         tracks=lambda w: [external_tracks_file(trial_wildcards(w.study, t, w.method))
                           for t in trial_ids(w.study, ["tug"])],
         ingest=f"{RESULTS}/{{study}}/ingest",
-        register=f"{RESULTS}/{{study}}/register",
+        register=f"{RESULTS}/{{study}}/register/tug",
         config=f"{RESULTS}/{{study}}/config_views/tug/{{method}}.json",
         sheet=lambda w: sheet_path(w.study),  # the params list its trials
     output:
