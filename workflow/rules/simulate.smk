@@ -1,8 +1,26 @@
-# The embedded default study: generated once, unless its files are already there.
+# The embedded default study: generated once, unless its files are already there -- or
+# the twin that made them has changed: `twin` is a digest of the simulator's source
+# (gaitval/simulate/), so a new twin regenerates the study on the next run instead of
+# leaving a report of the old twin's data under the new code (Snakemake reruns a job whose
+# params changed; a study folder copied without .snakemake/ metadata is taken as it is).
 # No conda: directive (snakemake --lint asks for one): Snakemake 8.30 runs `conda info` for
 # it even without --use-conda, which fails where conda is absent, and the batch rules'
 # run: blocks cannot use conda at all; the software is pinned by requirements.lock,
 # which run.py installs into .venv/ (README, docs/speed.md).
+
+
+def twin_digest():
+    """sha256 of the simulator's source files (names and bytes), first 16 hex digits."""
+    import hashlib
+
+    h = hashlib.sha256()
+    src = Path(workflow.basedir) / "gaitval" / "simulate"
+    for f in sorted(src.rglob("*.py")):
+        h.update(f.relative_to(src).as_posix().encode() + b"\0" + f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+TWIN = twin_digest()
 
 
 checkpoint simulate:
@@ -15,6 +33,7 @@ checkpoint simulate:
     params:
         gv=GV,
         seed=lambda w: study_cfg(w.study)["simulate"].get("seed", 0),
+        twin=TWIN,
         out=parent_of("sheet"),
     log:
         "logs/simulate/{study}.log",
