@@ -49,7 +49,10 @@ def cmd_validate(a) -> int:
 
 def cmd_init_study(a) -> int:
     from gaitval.io.initstudy import init_study
+    from gaitval.pipeline.steps import external_problems
     res = init_study(a.folder, study=a.study, force=a.force, max_time_gap_s=a.max_time_gap_s)
+    # the study.yaml's external_methods: as `gaitval validate` checks them (issue 37)
+    res.problems += external_problems(Path(a.folder) / "trials.csv")
     print(res.text())
     return 1 if res.problems else 0
 
