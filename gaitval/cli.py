@@ -240,7 +240,8 @@ def _add_input_verbs(sub) -> None:
     s = sub.add_parser("init-study", help="trial sheet, subject table, study.yaml and a "
                        "config snippet from a folder of recordings; then validate")
     s.add_argument("folder", help="the study's folder: C3D files, scan logs or bags, "
-                   "ultrasonic logs, annotations, target layouts (sub-folders too)")
+                   "ultrasonic logs, annotations, target layouts, external trackers' "
+                   "<trial>.tracks.csv (declared in the study.yaml; sub-folders too)")
     s.add_argument("--study", help="study id (default: the folder's name)")
     s.add_argument("--force", action="store_true",
                    help="replace an existing trials.csv and subjects.csv")
