@@ -378,6 +378,7 @@ def test_a_kept_study_yaml_is_not_rewritten_its_missing_methods_are_listed(tiny_
     assert (lab / "study.yaml").read_text() == "registration: {pole_diameter_m: 0.06}\n"
     assert any(t.startswith("study.yaml (kept): add under external_methods: ext_tracks: ")
                and "tracks/{trial}.tracks.csv" in t for t in res.todo), res.todo
+    assert not any("external_methods" in n for n in res.notes), res.notes
 
 
 def test_an_unreadable_file_is_reported_not_fatal(tiny_files, tmp_path):

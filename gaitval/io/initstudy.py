@@ -409,6 +409,8 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
     bag_lines = _bag_tracker_lines(trials, bag_trackers, res)
     if yaml_path.exists():
         res.kept.append(yaml_path)
+        # not written there: the entries to add are in the todo list instead
+        res.notes = [n for n in res.notes if not n.startswith("study.yaml external_methods.")]
         _external_todo(yaml_path, external, bag_lines, res)
     else:
         write_text(yaml_path, _study_yaml(trials, files, res, external, bag_lines))
