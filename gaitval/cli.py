@@ -49,7 +49,10 @@ def cmd_validate(a) -> int:
 
 def cmd_init_study(a) -> int:
     from gaitval.io.initstudy import init_study
+    from gaitval.pipeline.steps import external_problems
     res = init_study(a.folder, study=a.study, force=a.force, max_time_gap_s=a.max_time_gap_s)
+    # the study.yaml's external_methods: as `gaitval validate` checks them (issue 37)
+    res.problems += external_problems(Path(a.folder) / "trials.csv")
     print(res.text())
     return 1 if res.problems else 0
 
@@ -237,7 +240,8 @@ def _add_input_verbs(sub) -> None:
     s = sub.add_parser("init-study", help="trial sheet, subject table, study.yaml and a "
                        "config snippet from a folder of recordings; then validate")
     s.add_argument("folder", help="the study's folder: C3D files, scan logs or bags, "
-                   "ultrasonic logs, annotations, target layouts (sub-folders too)")
+                   "ultrasonic logs, annotations, target layouts, external trackers' "
+                   "<trial>.tracks.csv (declared in the study.yaml; sub-folders too)")
     s.add_argument("--study", help="study id (default: the folder's name)")
     s.add_argument("--force", action="store_true",
                    help="replace an existing trials.csv and subjects.csv")

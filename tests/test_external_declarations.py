@@ -2,13 +2,15 @@
 (``external_methods:``), validated like the rest of it before any job runs: the schema
 (name, path with {trial}, protocols, topic, legs), a name not already a method nor also in
 the workflow config, the same names in every study of run, and every trial's file there,
-inside the study's folder."""
+inside the study's folder; and an edited entry (``legs``, ``topic``) reruns that
+method's jobs and only those (dry runs on a copy of the session's tiny run)."""
 from __future__ import annotations
 
 import subprocess
 import sys
 from pathlib import Path
 
+import pandas as pd
 import pytest
 import yaml
 
@@ -143,3 +145,85 @@ def test_validate_reports_the_studys_external_files(tmp_path):
               "(line 2)"):
         assert w in probs[0], (w, probs[0])
     assert external_problems(study(tmp_path, "b", None), deep=True) == []
+
+
+# -- an edited study.yaml entry reruns that method's jobs, and only those ------------------
+EXT_TARGETS = ["results/tiny/evaluate/ext_bag", "results/tiny/evaluate/ext_csv",
+               "results/tiny/evaluate/tug_m1"]
+
+
+def dry_run_jobs(work: Path) -> dict[str, set[str]]:
+    """The jobs a dry run of EXT_TARGETS would run: rule -> the ``method``/``view``
+    wildcard of each of its jobs (the study's own jobs by rule name alone)."""
+    from conftest import tiny_workflow
+
+    res = tiny_workflow(work, "-n", targets=EXT_TARGETS)
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out[-3000:]
+    jobs: dict[str, set[str]] = {}
+    for block in ("\n" + out).split("\nrule ")[1:] + ("\n" + out).split("\nlocalrule ")[1:]:
+        rule = block.split(":", 1)[0].strip()
+        wc = next((ln for ln in block.splitlines() if ln.strip().startswith("wildcards:")),
+                  "")
+        ws = dict(kv.strip().split("=", 1) for kv in wc.split(":", 1)[-1].split(",")
+                  if "=" in kv)
+        jobs.setdefault(rule, set()).add(ws.get("method") or ws.get("view") or "")
+    return jobs
+
+
+@pytest.fixture(scope="module")
+def study_ext_run(tiny_run, tmp_path_factory):
+    """A copy of the session's tiny data (tiny_run itself is only read) with two external
+    methods in its study.yaml, made from tiny_run's own TUG tracks: ``ext_bag`` (tug_m2's
+    legs as leg_tracker's /people_tracked in a ROS 1 bag per trial, each leg a person) and
+    ``ext_csv`` (tug_m1's track as an exchange CSV); then the EXT_TARGETS run for real once
+    (the ingest, the TUG registration, tug_m1 and the two external methods)."""
+    from conftest import copy_run, tiny_workflow
+    from gaitval.io.tracks import track_to_exchange, write_tracks
+    from test_workflow_external import people_bag
+
+    work = tmp_path_factory.mktemp("study_ext")
+    copy_run(tiny_run / "data", work / "data")
+    study, done = work / "data" / "tiny", tiny_run / "results" / "tiny"
+    trials = sorted(p.stem for p in (done / "track" / "tug_m2").glob("*.parquet"))
+    assert trials
+    for t in trials:
+        people_bag(study / "bags" / f"{t}.bag", done / "ingest" / t / "sensor.parquet",
+                   pd.read_parquet(done / "track" / "tug_m2" / f"{t}.parquet"))
+        write_tracks(track_to_exchange(pd.read_parquet(done / "track" / "tug_m1" /
+                                                       f"{t}.parquet")),
+                     study / "ext" / f"{t}.tracks.csv")
+    cal = study / "study.yaml"
+    doc = yaml.safe_load(cal.read_text()) or {}
+    doc["external_methods"] = {
+        "ext_bag": {"path": "bags/{trial}.bag", "topic": "/people_tracked",
+                    "legs": {"L": "1", "R": "2"}, "protocols": ["tug"]},
+        "ext_csv": {"path": "ext/{trial}.tracks.csv", "protocols": ["tug"]}}
+    cal.write_text(yaml.safe_dump(doc))
+    res = tiny_workflow(work, targets=EXT_TARGETS)
+    assert res.returncode == 0, res.stderr[-4000:]
+    assert dry_run_jobs(work) == {}, "not up to date after its own run"
+    return work
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("key, value", [("legs", {"L": "2", "R": "1"}),
+                                        ("topic", "/people_tracked_2")])
+def test_editing_a_study_yaml_entry_reruns_that_methods_jobs_only(study_ext_run, key,
+                                                                   value):
+    """A changed ``legs`` or ``topic`` of ext_bag (read by its jobs from the study.yaml)
+    reruns ext_bag's config view and its import-and-evaluate job -- not ext_csv's, not
+    tug_m1's, not the study's ingest or registration -- and the original entry back is
+    up to date again (dry runs: Snakemake's params trigger, common.smk
+    analysis_sections_json)."""
+    cal = study_ext_run / "data" / "tiny" / "study.yaml"
+    text = cal.read_text()
+    doc = yaml.safe_load(text)
+    doc["external_methods"]["ext_bag"][key] = value
+    try:
+        cal.write_text(yaml.safe_dump(doc))
+        jobs = dry_run_jobs(study_ext_run)
+    finally:
+        cal.write_text(text)
+    assert jobs == {"config_view": {"ext_bag"}, "track_external": {"ext_bag"}}, jobs
+    assert dry_run_jobs(study_ext_run) == {}

@@ -313,11 +313,72 @@ def test_external_tracks_named_by_trial_become_an_external_method(tiny_files, tm
     rows = pd.DataFrame({"t_s": [0.0, 0.0], "side": ["L", "R"], "x": [1.0, 1.0],
                          "y": [0.1, -0.1]})
     write_tracks(rows, lab / "mytracker" / "tug_Y01_t1.tracks.csv")
-    res = init_study(lab)
-    cfg = yaml.safe_load((lab / "gaitval.config.yaml").read_text())
-    assert cfg["tracking"]["external"] == {"ext_mytracker": {
+    res = run_cli("init-study", str(lab))
+    # declared in the study's own study.yaml, not in the workflow config snippet
+    cal = yaml.safe_load((lab / "study.yaml").read_text())
+    assert cal["external_methods"] == {"ext_mytracker": {
         "path": "mytracker/{trial}.tracks.csv", "protocols": ["tug"]}}
-    assert any("tug_Y01_t2" in t and "ext_mytracker" in t for t in res.todo)
+    assert "tracking" not in yaml.safe_load((lab / "gaitval.config.yaml").read_text())
+    # tug_Y01_t2 has no file: said as a cell to fill, and refused as validate refuses it
+    assert "external_methods.ext_mytracker: no file for trial(s) tug_Y01_t2" in res.stdout
+    assert "1 of 2 trials' track files are missing" in res.stdout, res.stdout
+    assert res.returncode == 1
+
+
+def test_init_study_external_methods_pass_validate(tiny_files, tmp_path):
+    """Every trial with its track file: the study.yaml init-study writes declares the
+    tracker, and `gaitval validate --deep` (schema, files, every file read) accepts it once
+    the one cell the files cannot give (the leg width) is filled in; the workflow's own
+    start-up check (gaitval.pipeline.steps.external_declarations) returns the entry."""
+    from gaitval.io.tracks import write_tracks
+    from gaitval.pipeline.steps import external_declarations
+
+    lab = tmp_path / "lab"
+    (lab / "tracks").mkdir(parents=True)
+    rows = pd.DataFrame({"t_s": [0.0, 0.0, 0.1, 0.1], "side": ["L", "R", "L", "R"],
+                         "x": [1.0, 1.0, 1.02, 1.0], "y": [0.1, -0.1, 0.1, -0.1]})
+    for t in ("tug_Y01_t1", "tug_Y01_t2"):
+        shutil.copy(tiny_files / "lrs" / f"{t}.scan.parquet", lab / f"{t}.scan.parquet")
+        shutil.copy(tiny_files / "mocap" / f"{t}.c3d", lab / f"{t}.c3d")
+        write_tracks(rows, lab / "tracks" / f"{t}.tracks.csv")
+    res = run_cli("init-study", str(lab))
+    assert "study.yaml external_methods.ext_tracks: tracks/{trial}.tracks.csv" in res.stdout
+    assert "external_methods" not in res.stdout.split("gaitval validate:")[1], res.stdout
+    subj = pd.read_csv(lab / "subjects.csv", dtype=str, keep_default_na=False)
+    assert list(subj["leg_width_m"]) == [FILL_IN]
+    subj["leg_width_m"] = "0.11"
+    subj.to_csv(lab / "subjects.csv", index=False)
+    val = run_cli("validate", "--deep", str(lab / "trials.csv"))
+    assert val.returncode == 0, val.stderr
+    got = external_declarations({}, {"lab": lab / "trials.csv"}, {"tug_m1"})
+    assert got == {"lab": {"ext_tracks": {"path": "tracks/{trial}.tracks.csv",
+                                          "protocols": ["tug"]}}}
+    # the same validation as a hand-written entry: a file that does not read is named
+    (lab / "tracks" / "tug_Y01_t2.tracks.csv").write_text(
+        (lab / "tracks" / "tug_Y01_t2.tracks.csv").read_text().replace("units: m",
+                                                                       "units: cm"))
+    val = run_cli("validate", "--deep", str(lab / "trials.csv"))
+    assert val.returncode == 1
+    for w in ("external_methods.ext_tracks", "tug_Y01_t2.tracks.csv", "'units' is 'cm'"):
+        assert w in val.stderr, (w, val.stderr)
+
+
+def test_a_kept_study_yaml_is_not_rewritten_its_missing_methods_are_listed(tiny_files,
+                                                                          tmp_path):
+    from gaitval.io.tracks import write_tracks
+
+    lab = tmp_path / "lab"
+    (lab / "tracks").mkdir(parents=True)
+    shutil.copy(tiny_files / "lrs" / "tug_Y01_t1.scan.parquet", lab / "tug_Y01_t1.scan.parquet")
+    shutil.copy(tiny_files / "mocap" / "tug_Y01_t1.c3d", lab / "tug_Y01_t1.c3d")
+    write_tracks(pd.DataFrame({"t_s": [0.0], "side": ["L"], "x": [1.0], "y": [0.1]}),
+                 lab / "tracks" / "tug_Y01_t1.tracks.csv")
+    (lab / "study.yaml").write_text("registration: {pole_diameter_m: 0.06}\n")
+    res = init_study(lab)
+    assert (lab / "study.yaml").read_text() == "registration: {pole_diameter_m: 0.06}\n"
+    assert any(t.startswith("study.yaml (kept): add under external_methods: ext_tracks: ")
+               and "tracks/{trial}.tracks.csv" in t for t in res.todo), res.todo
+    assert not any("external_methods" in n for n in res.notes), res.notes
 
 
 def test_an_unreadable_file_is_reported_not_fatal(tiny_files, tmp_path):
@@ -341,8 +402,16 @@ def test_a_tracker_recorded_in_the_sensor_bags_is_offered_commented(tiny_files, 
     row = pd.read_csv(lab / "trials.csv", dtype=str, keep_default_na=False).iloc[0]
     assert (row["sensor_file"], row["sensor_topic"], row["sensor_height_m"]) == (
         "bags/tug_Y01_t1.bag", "/scan", FILL_IN)        # a bag: no height in its metadata
-    text = (lab / "gaitval.config.yaml").read_text()
-    assert "tracking" not in yaml.safe_load(text)       # commented: the legs are the user's
-    assert ('#     ext_people_tracked: {path: "bags/{trial}.bag", topic: "/people_tracked", '
-            "protocols: ['tug'], legs: {L: FILL_IN, R: FILL_IN}}") in text
+    text = (lab / "study.yaml").read_text()
+    assert "external_methods" not in (yaml.safe_load(text) or {})   # commented: the legs
+    assert "\n# external_methods:\n#   ext_" in text
+    assert ('\n#   ext_people_tracked: {path: "bags/{trial}.bag", topic: "/people_tracked", '
+            "protocols: ['tug'], legs: {L: FILL_IN, R: FILL_IN}}\n") in text
     assert any("/people_tracked" in t and "uncomment" in t for t in res.todo)
+    assert "tracking" not in yaml.safe_load((lab / "gaitval.config.yaml").read_text())
+    # filled in and uncommented, the entry is what the workflow's start-up check accepts
+    entry = text.split("#   ext_people_tracked: ")[1].splitlines()[0].replace(
+        "L: FILL_IN, R: FILL_IN", "L: '1', R: '2'")
+    (lab / "study.yaml").write_text(text + f"external_methods:\n  ext_people_tracked: {entry}\n")
+    from gaitval.configcheck import check_study_file
+    check_study_file(yaml.safe_load((lab / "study.yaml").read_text()), lab / "study.yaml")

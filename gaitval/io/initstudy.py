@@ -20,6 +20,11 @@ files say about each trial:
   Plug-in-Gait ``PROCESSING`` parameters (``Height``, ``Bodymass``, ``L/RKneeWidth``, ...);
 * whether the laser can be registered with poles: a C3D without ``POLE<n>`` markers gets
   the manual-pose columns ``sensor_x_m``, ``sensor_y_m``, ``sensor_yaw_deg`` to fill in.
+* external trackers' track files named by trial id (``<folder>/<trial>.tracks.csv``):
+  an entry of the ``study.yaml``'s ``external_methods:``, checked like a hand-written one;
+  a tracker topic recorded in the sensor bags: a commented entry (its legs are the
+  user's to name).  The config snippet holds only what a study.yaml cannot: where the
+  sheet and subject table are, and ``run``.
 
 What the files cannot say and a table needs is written as :data:`FILL_IN` — the shank
 width at the sensor's height (``leg_width_m``), a subject's height for the MTST foot model,
@@ -400,18 +405,21 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
 
     subjects = _subject_rows(trials, facts, res)
     yaml_path = folder / "study.yaml"
+    external = _external_methods(trials, files, res, yaml_path)
+    bag_lines = _bag_tracker_lines(trials, bag_trackers, res)
     if yaml_path.exists():
         res.kept.append(yaml_path)
+        # not written there: the entries to add are in the todo list instead
+        res.notes = [n for n in res.notes if not n.startswith("study.yaml external_methods.")]
+        _external_todo(yaml_path, external, bag_lines, res)
     else:
-        write_text(yaml_path, _study_yaml(trials, files, res))
+        write_text(yaml_path, _study_yaml(trials, files, res, external, bag_lines))
         res.written.append(yaml_path)
     write_text(sheet, _csv(trials, TRIAL_COLUMNS))
     write_text(subjects_csv, _csv(subjects, SUBJECT_COLUMNS))
     res.written += [sheet, subjects_csv]
     snippet = folder / "gaitval.config.yaml"
-    write_text(snippet, _config_snippet(study, folder, files,
-                                        _external_methods(trials, files, res),
-                                        _bag_tracker_lines(trials, bag_trackers, res)))
+    write_text(snippet, _config_snippet(study, folder))
     res.written.append(snippet)
     res.notes.append(f"{len(trials)} trials, {len(subjects)} subjects; run with "
                      f"`python3 run.py report --configfile {snippet}`")
@@ -477,9 +485,12 @@ def _subject_rows(trials: list[dict], facts: dict, res: InitResult) -> list[dict
     return rows
 
 
-def _study_yaml(trials: list[dict], files: list[Found], res: InitResult) -> str:
+def _study_yaml(trials: list[dict], files: list[Found], res: InitResult,
+                external: dict | None = None, bag_lines: list[str] = ()) -> str:
     """study.yaml: the MTST target layouts when every MTST trial has one in one folder;
-    the rollator's sensor mount as a key to fill in."""
+    the rollator's sensor mount as a key to fill in; the external trackers' track files as
+    ``external_methods:`` (:func:`_external_methods`), a tracker recorded in the sensor
+    bags as commented entries (:func:`_bag_tracker_lines`)."""
     doc: dict = {}
     lines = ["# Study calibration (docs/formats.md, 'Study calibration'), written by "
              "gaitval init-study."]
@@ -504,14 +515,51 @@ def _study_yaml(trials: list[dict], files: list[Found], res: InitResult) -> str:
            and r.get("sensor_x_m") != FILL_IN for r in trials):
         lines.append("# registration.pole_diameter_m: the calibration poles' diameter "
                      "(default 0.05 m)")
+    if external:
+        doc["external_methods"] = external
     body = yaml.safe_dump(doc, sort_keys=True) if doc else ""
-    return "\n".join(lines) + "\n" + body
+    tail = []
+    if bag_lines:
+        tail += ["# A tracker recorded in the sensor bags (docs/formats.md, 'External "
+                 "methods'):", "# to validate it, fill in each leg's person id and "
+                 "uncomment its entry"]
+        tail += ["# external_methods:"] * (not external) + list(bag_lines)
+    tracks = sorted({f.rel for f in files if f.kind == "tracks"})
+    if tracks and not external:
+        tail += ["# External trackers' tracks were found, not named by trial ids "
+                 "(docs/formats.md, 'External methods'); declare each as a method, e.g.",
+                 "# external_methods:",
+                 f"#   my_tracker: {{path: \"{tracks[0]}\"}}   # {{trial}} for the trial id"]
+    return "\n".join(lines) + "\n" + body + "".join(f"{t}\n" for t in tail)
 
 
-def _external_methods(trials: list[dict], files: list[Found], res: InitResult) -> dict:
+def _external_todo(yaml_path: Path, external: dict, bag_lines: list[str],
+                   res: InitResult) -> None:
+    """A study.yaml init-study keeps (the user's): the external methods it found and the
+    file does not declare, as entries for the user to add (the file is not rewritten)."""
+    try:
+        doc = yaml.safe_load(yaml_path.read_text(encoding="utf-8")) or {}
+    except (OSError, yaml.YAMLError):
+        doc = {}
+    have = (doc.get("external_methods") or {}) if isinstance(doc, dict) else {}
+    for name, entry in external.items():
+        if name not in have:
+            res.todo.append(f"study.yaml (kept): add under external_methods: {name}: "
+                            f"{yaml.safe_dump(entry, default_flow_style=True).strip()}")
+    for line in bag_lines:
+        res.todo.append(f"study.yaml (kept): a tracker in the sensor bags, to add under "
+                        f"external_methods: with its legs filled in: {line.lstrip('# ')}")
+
+
+def _external_methods(trials: list[dict], files: list[Found], res: InitResult,
+                      yaml_path: Path) -> dict:
     """External trackers' files (``<folder>/<trial>.tracks.csv`` or ``.parquet``): one
     method per folder and suffix whose files are named by trial ids, named after the
-    folder; its protocols those of its trials (docs/formats.md, *External methods*)."""
+    folder; its protocols those of its trials (docs/formats.md, *External methods*): the
+    study.yaml's ``external_methods:``, each entry checked against the schema a
+    hand-written one is (:func:`gaitval.configcheck.check_study_file`)."""
+    from gaitval.configcheck import check_study_file
+
     proto = {r["trial"]: r.get("protocol") for r in trials}
     groups: dict[tuple[str, str], list[str]] = {}
     for f in files:
@@ -535,11 +583,17 @@ def _external_methods(trials: list[dict], files: list[Found], res: InitResult) -
         missing = sorted(set(want) - set(known))
         if not protos:
             continue
-        out[name] = {"path": path, "protocols": protos}
-        res.notes.append(f"gaitval.config.yaml tracking.external.{name}: {path} "
+        entry = {"path": path, "protocols": protos}
+        try:
+            check_study_file({"external_methods": {name: entry}}, yaml_path)
+        except GaitvalError as exc:
+            res.unpaired.append(f"{parent}/*{suffix}: not declared ({exc})")
+            continue
+        out[name] = entry
+        res.notes.append(f"study.yaml external_methods.{name}: {path} "
                          f"({', '.join(protos)} trials)")
         if missing:
-            res.todo.append(f"tracking.external.{name}: no file for trial(s) "
+            res.todo.append(f"study.yaml external_methods.{name}: no file for trial(s) "
                             f"{', '.join(missing[:5])}{' ...' if len(missing) > 5 else ''} "
                             "(every trial of its protocols needs one; narrow protocols or "
                             "add the files)")
@@ -548,7 +602,7 @@ def _external_methods(trials: list[dict], files: list[Found], res: InitResult) -
 
 def _bag_tracker_lines(trials: list[dict], bag_trackers: dict[str, list[str]],
                        res: InitResult) -> list[str]:
-    """Commented config lines for a tracker topic recorded in the sensor bags: which
+    """Commented study.yaml lines (entries of ``external_methods:``) for a tracker topic recorded in the sensor bags: which
     person id is which leg only the user knows, so the entry is left for them to enable."""
     lines = []
     by_file = {r["sensor_file"]: r["trial"] for r in trials}
@@ -564,35 +618,25 @@ def _bag_tracker_lines(trials: list[dict], bag_trackers: dict[str, list[str]],
         if not protos:
             continue
         name = "ext_" + (_ID_BAD.sub("_", topic.strip("/")) or "bag")
-        lines += [f"#     {name}: {{path: \"{path}\", topic: \"{topic}\", "
+        lines += [f"#   {name}: {{path: \"{path}\", topic: \"{topic}\", "
                   f"protocols: {protos}, legs: {{L: FILL_IN, R: FILL_IN}}}}"]
-        res.todo.append(f"gaitval.config.yaml: the sensor bags hold tracker topic {topic}; "
+        res.todo.append(f"study.yaml: the sensor bags hold tracker topic {topic}; "
                         f"to validate that tracker, give the person id of each leg and "
-                        f"uncomment tracking.external.{name}")
-    if lines:
-        lines = ["# A tracker recorded in the sensor bags (docs/formats.md, 'Leg tracks'):",
-                 "# tracking:", "#   external:"] + lines
+                        f"uncomment external_methods.{name}")
     return lines
 
 
-def _config_snippet(study: str, folder: Path, files: list[Found],
-                    external: dict | None = None, extra: list[str] = ()) -> str:
+def _config_snippet(study: str, folder: Path) -> str:
+    """What only the workflow config holds: where the study's sheet and subject table are,
+    and ``run`` (the study's own settings, its external methods included, are in its
+    study.yaml)."""
     sheet = (folder / "trials.csv").resolve()
     subjects = (folder / "subjects.csv").resolve()
     doc = {"studies": {study: {"trial_sheet": str(sheet), "subjects": str(subjects)}},
            "run": [study]}
-    if external:
-        doc["tracking"] = {"external": external}
-    text = ("# Workflow config of this study, written by gaitval init-study: pass it with\n"
+    return ("# Workflow config of this study, written by gaitval init-study: pass it with\n"
             "#   python3 run.py report --configfile " + str((folder /
-                                                            "gaitval.config.yaml").resolve())
+                                                           "gaitval.config.yaml").resolve())
             + "\n# (or snakemake --configfile ...); config/config.yaml stays as it is.\n"
-            + yaml.safe_dump(doc, sort_keys=False))
-    if extra and not external:
-        text += "\n".join(extra) + "\n"
-    tracks = sorted({f.rel for f in files if f.kind == "tracks"})
-    if tracks and not external:
-        text += ("# External trackers' tracks were found (docs/formats.md, 'Leg tracks'); "
-                 "declare each as a method, e.g.\n# tracking:\n#   external:\n"
-                 "#     my_tracker: {path: " + tracks[0] + "}   # {trial} for the trial id\n")
-    return text
+            "# The study's own settings (external methods, calibration) are in its "
+            "study.yaml.\n" + yaml.safe_dump(doc, sort_keys=False))
