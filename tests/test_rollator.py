@@ -315,3 +315,54 @@ def test_published_values_are_in_the_seed_text():
     for row in P.TABLE_II.values():
         for v in row[:4]:
             assert f"{v}" in text, row
+
+
+# -- the people tracker on the rollator (issue 36) --------------------------------------------
+def _people_on_rollator():
+    from gaitval.pipeline.rollator import rollator_people_overrides
+    return build_method("people", rollator_people_overrides())
+
+
+def test_people_on_the_rollator_follows_the_user_from_the_first_scan():
+    """With the rollator's setup (the KF's window detector, facing_pair initialiser and
+    births in the window) the people tracker reports the walking user from scan 0, on the
+    user's legs; its default setup, whose motion test was written for a sensor standing in
+    the room, confirms nobody inside the window."""
+    scans, truth = walk(200, seed=5)
+    with threadpool_limits(1):
+        res = _people_on_rollator().track(scans, W)
+    assert res.n_confirmed == 1 and np.isfinite(res.x).all()
+    assert max(rmse_per_leg(res, truth)) < 0.05
+    window = build_method("people", {"kind__area": {"name": "rectangle", "x_m": [0.10, 1.00],
+                                                    "y_m": [-0.40, 0.40]}})
+    with threadpool_limits(1):
+        assert window.track(scans, W).n_confirmed == 0
+
+
+def test_people_on_the_rollator_reports_nobody_without_a_walking_user():
+    """Legs standing still in the window and two objects sweeping across it (the scenes of
+    the facing_pair test above): no person."""
+    scans_still, _ = walk(150, seed=6, amp=0.0)
+    n = 60
+    y = np.linspace(0.45, -0.45, n)
+    posts = [(np.column_stack([np.linspace(0.55, 0.80, n), y]), W / 2),
+             (np.column_stack([np.linspace(0.80, 0.55, n), y - 0.15]), W / 2)]
+    for scans in (scans_still, scan_series(cast(posts, n, seed=7))):
+        with threadpool_limits(1):
+            res = _people_on_rollator().track(scans, W)
+        assert res.n_confirmed == 0 and not np.isfinite(res.x).any()
+
+
+def test_table2_notes_gaitvals_own_extra_method_apart_from_external_ones():
+    from gaitval.tables.rollator import rollator_table2
+    rows = [{"trial": f"t_{m}", "tracker": m, "status": "ok", "subject": "P01",
+             "scenario": "straight", "n_evaluated": 100, "n_error": 10, "n_swapped": 0,
+             "tracking_time_s": 2.0, "restarts": 0, "n_pose_unknown": 0, "n_no_truth": 0}
+            for m in ("rollator_kf", "rollator_pf", "people", "ext")]
+    t2 = rollator_table2(pd.DataFrame(rows), "rollator_kf", "rollator_pf",
+                         ["people", "ext"], own=["people"])
+    note = t2.set_index("tracker")["published_note"]
+    assert note["people"] == "gaitval method, no published values"
+    assert note["ext"] == "external method"
+    assert pd.isna(t2.set_index("tracker").loc["people", "error_frames_published"])
+    assert t2.set_index("tracker").loc["people", "error_frames"] == 10

@@ -21,6 +21,7 @@ methods (``kf_method``, ``pf_method``), the PF's seed (``pf_seed``), the mixture
 """
 from __future__ import annotations
 
+import copy
 import json
 from pathlib import Path
 
@@ -35,7 +36,8 @@ from gaitval.pipeline.steps import (PROTOCOL_SCOPE, load_json, method_definition
                                     method_display_names, trial_and_subject)
 
 #: defaults of the ``rollator:`` keys read here
-DEFAULTS = {"kf_method": "rollator_kf", "pf_method": "rollator_pf", "pf_seed": 2017,
+DEFAULTS = {"kf_method": "rollator_kf", "pf_method": "rollator_pf", "methods": ["people"],
+            "pf_seed": 2017,
             "train_seed": 0, "error_m": 0.10, "figure_trial": None}
 
 
@@ -43,6 +45,36 @@ def rollator_cfg(cfg: dict) -> dict:
     """The ``rollator:`` section of a study config with defaults filled in."""
     return {**DEFAULTS, **{k: v for k, v in (cfg.get("rollator") or {}).items()
                            if k in DEFAULTS}}
+
+
+def rollator_people_overrides() -> dict:
+    """The people tracker's setup on the rollator (issue 36; docs/people.md, "In the
+    protocol tables"): the sensor is carried by the walker, so the user's place is known
+    by construction — seed 002 §II's user window (x 0.10–1.00 m, y ±0.40 m behind the
+    laser) — and the papers' KF starts on the leg pair it finds there at once.  The people
+    tracker gets the same three things, all the built-in ``rollator_kf``'s (seed 002 §II):
+    its detector (the window's K-means grouping, run on every scan without a prediction),
+    its initialiser (``facing_pair``: the pair found there is the user, confirmed from its
+    scan on, the people tracker's ``init`` role) and births limited to the window
+    (``area``).  Its motion-based confirmation (``m_of_n_moving``) is left to hypotheses
+    born later: it was written for a sensor that stands in the room and never confirms a
+    rollator user (the legs stay side by side in the laser's frame, docs/people.md).
+    Applied by :func:`rollator_track_step` to every method of kind ``people``, under the
+    method's own ``tracking.overrides``; the TUG, MTST and legbench steps do not use it."""
+    from gaitval.methods import METHODS
+
+    kf = METHODS["rollator_kf"]
+    det = kf["detector"]
+    return {"kind__detector": copy.deepcopy(det), "kind__init": copy.deepcopy(kf["init"]),
+            "kind__area": {"name": "rectangle", "x_m": list(det["window_x_m"]),
+                           "y_m": list(det["window_y_m"])}}
+
+
+def _kind_name(definition) -> str:
+    from gaitval.methods import get_method
+
+    kind = get_method(definition).get("kind")
+    return (kind.get("name") if isinstance(kind, dict) else kind) or ""
 
 
 def _leg_width(subj: dict, cfg: dict) -> float:
@@ -116,7 +148,9 @@ def rollator_train_step(results_dir, sheet, subjects, subject: str, config_json,
 # -- track ----------------------------------------------------------------------------------
 def rollator_track_step(sensor_parquet, sheet, subjects, trial: str, method: str,
                         config_json, out_parquet, model_json=None) -> pd.DataFrame:
-    """Track one rollator trial with one method (KF or PF); write the per-scan track.
+    """Track one rollator trial with one method (KF, PF, or an extra method of
+    ``rollator.methods``); write the per-scan track.  A ``people`` method runs with the
+    rollator's setup (:func:`rollator_people_overrides`).
 
     A raw-scan (particle-filter) method gets the held-out subject's model
     (``model_json``) and ``rollator.pf_seed`` as ``kind__model`` / ``kind__seed``;
@@ -137,7 +171,10 @@ def rollator_track_step(sensor_parquet, sheet, subjects, trial: str, method: str
         overrides = {"kind__model": load_json(model_json),
                      "kind__seed": int(rc["pf_seed"]), **overrides}
     try:
-        kind = build_method(method_definition(cfg, method), overrides)
+        definition = method_definition(cfg, method)
+        if _kind_name(definition) == "people":        # the user's window (issue 36)
+            overrides = {**rollator_people_overrides(), **overrides}
+        kind = build_method(definition, overrides)
         with threadpool_limits(1):
             res = kind.track(scans, _leg_width(subj, cfg))
     except GaitvalError as exc:
@@ -228,11 +265,15 @@ def rollator_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, r
     sources = sorted({load_json(m).get("source", "") for m in models})
     shown = (method_display_names(Path(config_json).parent, [kf_method, pf_method])
              if config_json else {})
-    # the other trackers evaluated are external methods (tracking.external, issue 37)
-    external = sorted(set(summary["tracker"].astype(str)) - {kf_method, pf_method})
+    # the other trackers evaluated: gaitval's own extra methods (rollator.methods, issue
+    # 36) in the config's order, then external methods (tracking.external, issue 37)
+    present = set(summary["tracker"].astype(str)) - {kf_method, pf_method}
+    own = [m for m in rc["methods"] if m in present]
+    external = own + sorted(present - set(own))
     paths = write_rollator_tables(frames_df, summary, tables_dir, kf=kf_method,
                                   pf=pf_method, error_m=float(rc["error_m"]),
-                                  model_sources=sources, shown=shown, external=external)
+                                  model_sources=sources, shown=shown, external=external,
+                                  own=own)
     stamp("rollator_tables", paths, reports_dir, config_hash_=config_hash)
     figs = write_rollator_figure(frames_df, figures_dir, kf=kf_method, pf=pf_method,
                                  trial=rc["figure_trial"],

@@ -111,7 +111,7 @@ def rollator_table1(frames: pd.DataFrame, summary: pd.DataFrame, kf: str, pf: st
 
 
 def rollator_table2(summary: pd.DataFrame, kf: str, pf: str,
-                    external: list[str] = ()) -> pd.DataFrame:
+                    external: list[str] = (), own: list[str] = ()) -> pd.DataFrame:
     """Table II.
 
     Returns
@@ -120,6 +120,8 @@ def rollator_table2(summary: pd.DataFrame, kf: str, pf: str,
     external method by its name, without published values or re-initialisations): ``trials,
     evaluated_frames, tracking_time_s, error_frames, error_pct, swapped_frames,
     reinitialisations, pose_unknown_frames, no_truth_frames`` and ``*_published``.
+    ``own``: those of the extra methods that are gaitval's own (rollator.methods, issue
+    36), noted "gaitval method" instead of "external method".
     """
     sub_no, scen_no = _numbers(summary)
     s = summary[summary["status"] == "ok"]
@@ -146,7 +148,8 @@ def rollator_table2(summary: pd.DataFrame, kf: str, pf: str,
             "pose_unknown_frames": int(g["n_pose_unknown"].sum()),
             "no_truth_frames": int(g["n_no_truth"].sum()),
             "published_note": (PUB.TABLE_II_FLAGS.get(key, "") if pub else
-                               "external method" if tag not in ("KF", "PF") else
+                               ("gaitval method, no published values" if tag in own
+                                else "external method") if tag not in ("KF", "PF") else
                                "no published row")})
     order = {"KF": 0, "PF": 1, **{m: 2 + i for i, m in enumerate(external)}}
     df = pd.DataFrame(rows)
@@ -191,23 +194,34 @@ def improvement(t1: pd.DataFrame) -> pd.DataFrame:
 def write_rollator_tables(frames: pd.DataFrame, summary: pd.DataFrame, tables_dir, *,
                           kf: str, pf: str, error_m: float = 0.10,
                           model_sources=(), shown: dict[str, str] | None = None,
-                          external: list[str] = ()) -> list[Path]:
+                          external: list[str] = (), own: list[str] = ()) -> list[Path]:
     """Write ``rollator_table1``, ``rollator_table2`` and ``rollator_improvement``.
     ``shown``: method -> its name with the overrides it ran with
     (:func:`gaitval.methods.display_name`); a modified KF or PF is named in a note of
-    every table (the columns keep their ``_kf``/``_pf`` suffixes)."""
+    every table (the columns keep their ``_kf``/``_pf`` suffixes).  ``external``: every
+    extra row's method (KF and PF first, then these); ``own``: those of them that are
+    gaitval's own methods (rollator.methods, issue 36), the others being another tracker's
+    tracks (tracking.external, issue 37) — each kind gets its own note."""
     from gaitval.tables.rollator_notes import table1_notes, table2_notes
 
     td = Path(tables_dir)
     t1 = rollator_table1(frames, summary, kf, pf, external)
-    t2 = rollator_table2(summary, kf, pf, external)
+    t2 = rollator_table2(summary, kf, pf, external, own)
     imp = improvement(t1)
-    if external:                  # another tracker's tracks (tracking.external, issue 37)
-        changed = [f"External method{'s' * (len(external) > 1)} {', '.join(external)}: "
-                   "another tracker's tracks (tracking.external), evaluated like the KF and "
-                   "PF; no published values and no re-initialisation count"]
-    else:
-        changed = []
+    changed = []
+    mine = [m for m in external if m in own]
+    theirs = [m for m in external if m not in own]
+    if mine:                      # gaitval's own extra methods (rollator.methods, issue 36)
+        changed.append(
+            f"Extra method{'s' * (len(mine) > 1)} {', '.join(mine)}: gaitval's own "
+            "(rollator.methods), not the paper's, evaluated like the KF and PF; no published "
+            "values, no re-initialisation count and no verdict; the people tracker runs with "
+            "the KF's user window, detector and initialiser (docs/people.md)")
+    if theirs:                    # another tracker's tracks (tracking.external, issue 37)
+        changed.append(
+            f"External method{'s' * (len(theirs) > 1)} {', '.join(theirs)}: "
+            "another tracker's tracks (tracking.external), evaluated like the KF and "
+            "PF; no published values and no re-initialisation count")
     changed += [f"{tag} ran as {(shown or {})[m]}: parameters changed by "
                "tracking.overrides; the published values beside are the paper's method's"
                for tag, m in (("KF", kf), ("PF", pf)) if (shown or {}).get(m, m) != m]

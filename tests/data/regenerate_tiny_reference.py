@@ -28,7 +28,7 @@ OUT = HERE / "tiny_reference"
 def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
-        res = run_workflow(work, work / "data")
+        res = run_workflow(work)
         if res.returncode != 0:
             print(res.stderr[-4000:], file=sys.stderr)
             return 1

@@ -11,8 +11,10 @@ def rollator_cfg():
 
 
 def rollator_methods():
+    """The KF and the PF, then gaitval's own extra methods (rollator.methods, issue 36)."""
     rc = rollator_cfg()
-    return [rc["kf_method"], rc["pf_method"]]
+    return [rc["kf_method"], rc["pf_method"]] + [
+        m for m in rc["methods"] if m not in (rc["kf_method"], rc["pf_method"])]
 
 
 def rollator_subjects(study):
