@@ -1,5 +1,6 @@
 # Per-study analysis config, then registration + ground truth of every trial with mocap
 # (one job per study and protocol family), then the registration table reviewers read first.
+include: "register_common.smk"
 
 
 rule study_config:
@@ -54,32 +55,6 @@ rule config_view:
 # change of one family's section (e.g. rollator.sensor_mount) thus reruns that family's
 # registration and what reads it, not the other families' tracks (issue 38; with one job
 # per study every family's view was its input).
-def trial_family(study, trial):
-    """The protocol family (config view scope) of a trial: its register folder's name."""
-    return PROTOCOL_SCOPE.get(trial_row(study, trial)["protocol"], ALL_SCOPE)
-
-
-def family_mocap_trials(study, family):
-    """The trials with mocap of one protocol family: what its register job takes."""
-    return [t for t in mocap_trial_ids(study) if trial_family(study, t) == family]
-
-
-def register_dir(study, family):
-    """results/<study>/register/<family>: the output of one register job."""
-    return f"{RESULTS}/{study}/register/{family}"
-
-
-def registration_dir(study, trial):
-    """results/<study>/register/<family>/<trial>: one trial's registration.json and
-    groundtruth.parquet."""
-    return f"{register_dir(study, trial_family(study, trial))}/{trial}"
-
-
-def register_dirs(study):
-    """The register folders of every family with a trial with mocap (registration_summary)."""
-    return sorted({register_dir(study, trial_family(study, t)) for t in mocap_trial_ids(study)})
-
-
 rule register:
     # one job per (study, family): every trial with mocap of the family (HOW JOBS RUN in
     # common.smk), each reading the family's study view

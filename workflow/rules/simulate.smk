@@ -9,20 +9,6 @@
 # which run.py installs into .venv/ (README, docs/speed.md).
 
 
-def twin_digest():
-    """sha256 of the simulator's source files (names and bytes), first 16 hex digits."""
-    import hashlib
-
-    h = hashlib.sha256()
-    src = Path(workflow.basedir) / "gaitval" / "simulate"
-    for f in sorted(src.rglob("*.py")):
-        h.update(f.relative_to(src).as_posix().encode() + b"\0" + f.read_bytes())
-    return h.hexdigest()[:16]
-
-
-TWIN = twin_digest()
-
-
 checkpoint simulate:
     input:
         preset=lambda w: PRESETS / f"{study_cfg(w.study)['simulate']['preset']}.yaml",
