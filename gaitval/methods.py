@@ -321,7 +321,7 @@ def display_name(name: str, definition: Any = None, base: str | None = None) -> 
     return f"{name} ({', '.join(parts)})"
 
 
-def _kind_name(method: dict[str, Any]) -> str:
+def kind_name(method: dict[str, Any]) -> str:
     kind = method.get("kind", DEFAULT_KIND)
     return kind if isinstance(kind, str) else kind.get("name", DEFAULT_KIND)
 
@@ -334,7 +334,7 @@ def get_method(method: str | dict[str, Any]) -> dict[str, Any]:
         except KeyError:
             raise ConfigError(f"unknown tracking method {method!r}",
                               hint=f"choose one of: {', '.join(sorted(METHODS))}") from None
-    if _kind_name(method) != DEFAULT_KIND:
+    if kind_name(method) != DEFAULT_KIND:
         return copy.deepcopy(method)          # a raw-scan tracker: its parameters are its own
     missing = [r for r in ROLES if r not in method]
     if missing:
@@ -356,9 +356,9 @@ def build_tracker(method: str | dict[str, Any], overrides: dict[str, Any] | None
         ``{"role__param": value}`` applied on top.
     """
     m = set_params(get_method(method), overrides)
-    if _kind_name(m) != DEFAULT_KIND:
+    if kind_name(m) != DEFAULT_KIND:
         raise ConfigError(f"method {method if isinstance(method, str) else ''!r} is a "
-                          f"{_kind_name(m)!r} tracker, not detect-then-track",
+                          f"{kind_name(m)!r} tracker, not detect-then-track",
                           hint="use build_method() for it")
     detector = DETECTORS.build(m["detector"])
     tracker = Tracker(**{r: m[r] for r in ROLES if r != "detector"}, **m.get("tracker", {}))
@@ -374,7 +374,7 @@ def build_method(method: str | dict[str, Any], overrides: dict[str, Any] | None 
     (``{"name": ..., **params}``) through :data:`~gaitval.track.kinds.TRACKER_KINDS`.
     """
     m = set_params(get_method(method), overrides)
-    if _kind_name(m) == DEFAULT_KIND:
+    if kind_name(m) == DEFAULT_KIND:
         return DetectThenTrack(*build_tracker(m), detector_spec=m["detector"])
     return TRACKER_KINDS.build(m["kind"])
 
@@ -387,7 +387,7 @@ def trial_detector(method: str | dict[str, Any], overrides: dict[str, Any] | Non
     the same observation table of a trial, so a workflow detects once for both and hands
     the table to each (``observations`` of :func:`track_trial`; docs/speed.md)."""
     m = set_params(get_method(method), overrides)
-    if _kind_name(m) == DEFAULT_KIND:
+    if kind_name(m) == DEFAULT_KIND:
         spec = m["detector"]
     else:
         kind = m["kind"] if isinstance(m["kind"], dict) else {"name": m["kind"]}

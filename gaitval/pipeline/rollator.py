@@ -70,13 +70,6 @@ def rollator_people_overrides() -> dict:
                            "y_m": list(det["window_y_m"])}}
 
 
-def _kind_name(definition) -> str:
-    from gaitval.methods import get_method
-
-    kind = get_method(definition).get("kind")
-    return (kind.get("name") if isinstance(kind, dict) else kind) or ""
-
-
 def _leg_width(subj: dict, cfg: dict) -> float:
     w = subj.get("leg_width_m")
     if w is None or not np.isfinite(w):
@@ -160,7 +153,7 @@ def rollator_track_step(sensor_parquet, sheet, subjects, trial: str, method: str
     from threadpoolctl import threadpool_limits
 
     from gaitval.io.scanlog import read_scanlog
-    from gaitval.methods import build_method
+    from gaitval.methods import build_method, get_method, kind_name
 
     cfg = load_json(config_json)
     rc = rollator_cfg(cfg)
@@ -172,7 +165,7 @@ def rollator_track_step(sensor_parquet, sheet, subjects, trial: str, method: str
                      "kind__seed": int(rc["pf_seed"]), **overrides}
     try:
         definition = method_definition(cfg, method)
-        if _kind_name(definition) == "people":        # the user's window (issue 36)
+        if kind_name(get_method(definition)) == "people":        # the user's window (issue 36)
             overrides = {**rollator_people_overrides(), **overrides}
         kind = build_method(definition, overrides)
         with threadpool_limits(1):
