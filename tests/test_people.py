@@ -433,3 +433,26 @@ def test_leg_travel_confirms_furniture_in_the_empty_room(realdata):
     res = build_method("people", {"kind__confirmer": "leg_travel"}).track(
         read_rosbag_scans(bag, "/left_scan"), 0.10)
     assert res.n_confirmed > 0
+
+
+def test_leg_tracker_person_gate_equals_the_four_state_filter():
+    """The gate's per-axis scalar recursion is leg_tracker's 4-state constant-velocity
+    filter (F, Q = (0.5·Δt)² I, H = [I 0], R = 0.1² I, P₀ = 0.5 I) written out: the same
+    gates as the 4 × 4 matrix form, iterated the same way, to 1e-12 m."""
+    for dt in (0.025, 0.1, 1 / 7.5):
+        F = np.array([[1.0, 0, dt, 0], [0, 1.0, 0, dt], [0, 0, 1.0, 0], [0, 0, 0, 1.0]])
+        Q, H, R = (0.5 * dt) ** 2 * np.eye(4), np.eye(2, 4), 0.01 * np.eye(2)
+        P = 0.5 * np.eye(4)
+        for _ in range(1000):
+            P = F @ P @ F.T + Q
+            K = P @ H.T @ np.linalg.inv(H @ P @ H.T + R)
+            P = (np.eye(4) - K @ H) @ P
+        want = [1.6448536269514722 * np.sqrt(P[0, 0] + 0.25)]
+        while True:
+            P = F @ P @ F.T + Q
+            if P[0, 0] + 0.25 > 0.81:
+                break
+            want.append(1.6448536269514722 * np.sqrt(P[0, 0] + 0.25))
+        got = leg_tracker_person_gate(dt)
+        assert len(got) == len(want)
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)

@@ -39,6 +39,10 @@ from scipy.spatial import cKDTree
 
 from gaitval.registry import Registry
 
+#: a grid cell (i, j) is kept as the one integer i * _SHIFT + j (|j| < 2**31 cells, i.e.
+#: 2e8 m at 0.1 m cells), which orders cells as the pairs would
+_SHIFT = 1 << 32
+
 EGO_MOTIONS = Registry("ego motion")
 STATIC_MAPS = Registry("static map")
 
@@ -211,7 +215,7 @@ class RecentHits(StaticMap):
         n = max(1, int(round(self.min_static_s / dt)))
         out._threshold = (1.0 - a ** n) / (1.0 - a) - 1e-9
         out._t = np.asarray(scans.t, dtype=float)
-        out._cells: dict = {}          # cell -> [score, time of last hit]
+        out._cells: dict = {}          # cell key (_SHIFT) -> [score, time of last hit]
         out._now = 0.0
         return out
 
@@ -219,9 +223,11 @@ class RecentHits(StaticMap):
         now = self._now = float(self._t[k])
         if not len(pts_world):
             return
-        cells = np.unique(np.floor(pts_world / self.cell_m).astype(np.int64), axis=0)
+        ij = np.floor(pts_world / self.cell_m).astype(np.int64)
+        # one int per cell (_key): a 1-D unique is ~10x faster than unique(axis=0) on pairs
+        cells = np.unique(ij[:, 0] * _SHIFT + ij[:, 1])
         tab, tau, exp = self._cells, self.tau_s, math.exp
-        for c in map(tuple, cells.tolist()):
+        for c in cells.tolist():
             e = tab.get(c)
             if e is None:
                 tab[c] = [1.0, now]
@@ -235,7 +241,7 @@ class RecentHits(StaticMap):
         tab, now, thr = self._cells, self._now, self._threshold
         for i in range(cx - n, cx + n + 1):
             for j in range(cy - n, cy + n + 1):
-                e = tab.get((i, j))
+                e = tab.get(i * _SHIFT + j)
                 if e is not None and e[0] * math.exp(-(now - e[1]) / self.tau_s) >= thr:
                     return True
         return False
