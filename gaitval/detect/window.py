@@ -159,6 +159,7 @@ class RollatorWindowDetector(WindowedDetector):
         self.random_state = int(random_state)
         self._cache: dict = {}
         self._rng: tuple | None = None
+        self._openmp = None                  # threadpoolctl's handle on OpenMP (_kmeans)
 
     def _xy(self, scans):
         """Cartesian points of every scan (polar → Cartesian, seed002 §II), cached per
@@ -205,7 +206,16 @@ class RollatorWindowDetector(WindowedDetector):
         # parameters and of the input cost ~17 % of the call: the parameters are fixed here
         # and P is finite (window_points keeps only points inside a finite box, no NaN).
         # Same labels (checked on the default study's rollator KF tracks).
-        with warnings.catch_warnings(), sklearn.config_context(
+        # One thread: scikit-learn's OpenMP threads (one per core) cost more than the
+        # ~50-point fit itself -- 4.4 against 1.0 ms a call, and a rollator trial's
+        # tracking 6.6 against 2.8 s wall (docs/speed.md) -- and a batch job already
+        # runs a trial per core.  With one chunk of points the labels do not depend on
+        # the thread count (checked: the default study's rollator tracks, byte-identical).
+        if self._openmp is None:
+            from threadpoolctl import ThreadpoolController
+
+            self._openmp = ThreadpoolController().select(user_api="openmp")
+        with warnings.catch_warnings(), self._openmp.limit(limits=1), sklearn.config_context(
                 assume_finite=True, skip_parameter_validation=True):
             warnings.simplefilter("ignore")                       # duplicate points
             km = KMeans(n_clusters=2, n_init=self.n_init, random_state=self._seeded())
