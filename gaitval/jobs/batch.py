@@ -60,6 +60,18 @@ def _context():
     return ctx
 
 
+def warm() -> None:
+    """Start the pool's forkserver now, without waiting for it: it imports :data:`PRELOAD`
+    (~2 CPU-s) in its own process while this one goes on, so the first batch does not
+    wait for the imports with one core busy and the others idle.  The workflow calls it
+    when Snakemake starts running jobs (``onstart``, workflow/rules/common.smk), where the
+    simulation's start-up leaves a core free.  The forkserver ends with this process."""
+    from multiprocessing import forkserver
+
+    _context()
+    forkserver.ensure_running()
+
+
 def _call(func, kwargs) -> tuple[bool, str, str, float]:
     """Run one task in a worker: (ok, its printed output and log messages, the error, its
     CPU seconds)."""

@@ -162,6 +162,19 @@ def batch_threads():
 BATCH_THREADS = batch_threads()
 
 
+# The batch jobs' pool: its forkserver imports numpy, pandas, scipy and gaitval (~2 CPU-s)
+# once per run.  Started when Snakemake begins to run jobs (not on a dry run, nor when
+# nothing is to be done), it imports beside the first jobs (the simulation's own start-up
+# leaves a core free) instead of inside the first batch job with one core idle
+# (docs/speed.md).  Only where the jobs run in this process: on a cluster each job is a
+# process of its own (Snakemake's `local_exec`, False for a cluster executor).
+onstart:
+    if getattr(workflow, "local_exec", True):
+        from gaitval.jobs.batch import warm
+
+        warm()
+
+
 def verb(*words):
     """One gaitval verb's command line, as a list of words (nested lists flattened, so an
     optional ``[flag, value]`` param goes in as is)."""
