@@ -222,10 +222,12 @@ def test_tug_occlusion_notes_name_the_screens_and_the_return_split(tiny, physics
     marker on the line of sight (the walker goes around the cone on its far side, seen
     from the chair end) and those screened by the other leg only; on the straight walks
     only the legs hide each other.  The return row's note splits the phase into the walk
-    back, the turn to sit and the sitting down, which add up to the phase."""
+    back, the turn to sit and the sitting down, which add up to the phase; the phases
+    span the TUG, from the start of the rise to seated, and the capture's still-seated
+    spans around it are labelled "seated"."""
     import re
 
-    from gaitval.simulate.physics import occluders, tug_timeline
+    from gaitval.simulate.physics import occluders, tug_span, tug_timeline
     from gaitval.simulate.tug import scene_circles
 
     occ = physics[physics["check"] == "tug_occlusion"].set_index("phase")
@@ -254,14 +256,26 @@ def test_tug_occlusion_notes_name_the_screens_and_the_return_split(tiny, physics
         o = occluders(s, poses.loc[tr["trial"], ["x_m", "y_m", "yaw_rad"]].to_numpy(float),
                       float(subj.loc[tr["subject"], "leg_width_m"]), scene_circles())
         n_turn += int((o["phase"] == "turning").sum())
-        tl = tug_timeline(pd.read_csv(d / "events.csv"), s, t_end)
+        ev = pd.read_csv(d / "events.csv")
+        tl = tug_timeline(ev, s, t_end)
         assert all(v > 0 for v in tl.values()), tl
+        t_rise, t_seated = tug_span(ev, t_end)
         ret = s.loc[s["phase"] == "return", "t_mocap_s"]
-        span = t_end - float(s.loc[s["phase"] == "turning", "t_mocap_s"].max())
-        assert tl["walk_back"] + tl["turn_to_sit"] + tl["sit_down_end"] == \
+        span = t_seated - float(s.loc[s["phase"] == "turning", "t_mocap_s"].max())
+        assert tl["walk_back"] + tl["turn_to_sit"] + tl["sitting_down"] == \
             pytest.approx(span, abs=1e-9)
         # the scans' span of the return phase, within a scan period at either end
         assert span == pytest.approx(ret.max() - ret.min(), abs=0.05)
+        # the TUG phases start with the rise and end seated; before and after, the
+        # capture's still-seated spans ("seated", no TUG phase) where no leg moves
+        fwd = s.loc[s["phase"] == "forward", "t_mocap_s"]
+        assert fwd.min() >= t_rise and fwd.min() - t_rise < 0.03
+        assert ret.max() <= t_seated and t_seated - ret.max() < 0.03
+        still = s[s["phase"] == "seated"]
+        assert len(still) and still["t_mocap_s"].between(t_rise, t_seated).sum() == 0
+        for span in (still[still["t_mocap_s"] < t_rise], still[still["t_mocap_s"] > t_seated]):
+            moved = span.groupby("side")[["x_m", "y_m"]].agg(lambda v: v.max() - v.min())
+            assert len(span) and float(moved.to_numpy().max()) < 1e-3, moved
     assert n_turn == counts["turning"][0]
 
 

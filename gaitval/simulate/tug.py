@@ -122,8 +122,10 @@ def turn_phase_bounds(walker: Walker, t_end: float, rate_hz: float, height_m: fl
     the reproduced Table 4 (:func:`gaitval.evaluate.tug_truth.tug_phase_bounds`: the
     smoothed midpoint of the two legs at sensor height walks more than 30° off the
     outbound / return line), applied to the true legs at the mocap rate, so the twin's
-    phase durations and truth occlusion (``physics.csv``) and the tracked Table 4 count
-    the same scans.
+    turning phase (``physics.csv``) and the tracked Table 4's count the same scans.  (The
+    forward and return phases of the truth start with the rise and end seated, the TUG's
+    span; the reproduced Table 4 counts from the first to the last truth sample, the
+    still-seated spans of the capture included: docs/simulator.md.)
     """
     t = np.arange(0.0, t_end + 0.5 / rate_hz, 1.0 / rate_hz)
     legs = walker.legs(t)
@@ -194,12 +196,20 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     t_turn0, t_turn1 = turn_phase_bounds(walker, t_end, cfg["mocap_rate_hz"],
                                          cfg["sensor_height_m"])
 
+    # the three phases partition the TUG itself, from the start of the rise to seated
+    # (seed 000 §2.1 "three TUG phases"; §1 the TUG: "rises from a chair, ... walks back
+    # to the chair and sits down"); the capture's still-seated spans before the rise and
+    # after sitting are no TUG phase: "seated" (issue 34 follow-up, docs/simulator.md)
+    t_seated = t_sit + sit_dur
+
     def phase(t):
-        return np.where(t < t_turn0, "forward", np.where(t <= t_turn1, "turning", "return"))
+        ph = np.where(t < t_turn0, "forward", np.where(t <= t_turn1, "turning", "return"))
+        return np.where((t < t_rise) | (t > t_seated), "seated", ph).astype(object)
 
     return TrialSim(study=study, protocol="tug", subject=subj["subject"], trial=trial,
                     walker=walker, sensor="utm30lx", sensor_height_m=cfg["sensor_height_m"],
                     mocap_rate_hz=cfg["mocap_rate_hz"], t_end_s=t_end,
                     circles=scene_circles(), walls=_walls(-2.0, 5.5, -2.5, 2.5),
                     poles=poles, fixed_pose=sensor_pose, phase_fn=phase, repetition=rep,
-                    speed="fast", variant={"t_phase": (t_turn0, t_turn1)})
+                    speed="fast", variant={"t_phase": (t_turn0, t_turn1),
+                                           "t_tug": (t_rise, t_seated)})
