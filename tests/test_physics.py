@@ -182,3 +182,125 @@ def test_default_twin_gait_passes_the_step_and_cross_step_rows():
         r = rows[key]
         assert r["passed"] is True, (key, r["value"], r["lower"], r["upper"])
         assert r["lower"] <= r["value"] <= r["upper"], key
+
+
+def test_occluders_name_what_stands_on_the_line_of_sight():
+    """physics.occluders: a leg straight behind the turn marker (as seen from the sensor)
+    is screened by the marker; a leg behind the other leg by that leg; a leg with the
+    other leg behind it and nothing in front by neither (hand-made geometry, sensor turned
+    and shifted in the field as the TUG sensor is)."""
+    from gaitval.simulate.physics import occluders
+    from gaitval.simulate.scene import ID_MARKER, ID_POLE
+
+    pose = (-0.7, -1.0, 0.3)
+    circles = np.array([[3.0, 0.0, 0.06, ID_MARKER], [1.4, -1.0, 0.025, ID_POLE]])
+    c, s = np.cos(pose[2]), np.sin(pose[2])
+    mx, my = c * (3.0 + 0.7) + s * 1.0, -s * (3.0 + 0.7) + c * 1.0   # marker, sensor frame
+    k = 1.12                                     # 12 % farther along the marker's ray
+    scans = pd.DataFrame({
+        "scan": [0, 0, 1, 1, 2, 2], "side": ["L", "R"] * 3,
+        # scan 0: L behind the marker, R well to the side; scan 1: L behind R (same
+        # bearing, R 0.2 m nearer); scan 2: R behind L (same bearing, L 0.3 m nearer)
+        "x_m": [k * mx, mx, 3.0, 2.8, 2.0, 2.3],
+        "y_m": [k * my, my + 0.8, 0.5, 0.5 * 2.8 / 3.0, -1.0, -1.0 * 2.3 / 2.0],
+        "occluded": [True, False, True, False, False, True],
+        "phase": ["turning", "turning", "forward", "forward", "return", "return"]})
+    out = occluders(scans, pose, 0.10, circles).set_index("scan")
+    assert list(out.index) == [0, 1, 2]
+    assert out.loc[0, "by_turn_marker"] and not out.loc[0, "by_leg"]
+    assert out.loc[1, "by_leg"] and not out.loc[1, "by_turn_marker"]
+    assert out.loc[2, "by_leg"] and out.loc[2, "side"] == "R"
+    assert not out[["by_pole"]].to_numpy().any()
+    # a leg with nothing in front of it (the other leg behind it) is screened by nothing
+    far = scans.assign(occluded=[False, False, False, True, False, False])
+    one = occluders(far, pose, 0.10, circles)
+    assert len(one) == 1 and not one.iloc[0]["by_leg"] and not one.iloc[0]["by_turn_marker"]
+
+
+def test_tug_occlusion_notes_name_the_screens_and_the_return_split(tiny, physics):
+    """The tug_occlusion notes count, per phase, the occluded leg-scans with the turn
+    marker on the line of sight (the walker goes around the cone on its far side, seen
+    from the chair end) and those screened by the other leg only; on the straight walks
+    only the legs hide each other.  The return row's note splits the phase into the walk
+    back, the turn to sit and the sitting down, which add up to the phase; the phases
+    span the TUG, from the start of the rise to seated, and the capture's still-seated
+    spans around it are labelled "seated"."""
+    import re
+
+    from gaitval.simulate.physics import occluders, tug_span, tug_timeline
+    from gaitval.simulate.tug import scene_circles
+
+    occ = physics[physics["check"] == "tug_occlusion"].set_index("phase")
+    counts = {}
+    for ph in ("forward", "turning", "return"):
+        m = re.search(r"the (\d+) occluded leg-scans: the turn marker (\d+), the other leg "
+                      r"only (\d+), neither (\d+)", occ.loc[ph, "note"])
+        assert m, occ.loc[ph, "note"]
+        n, mk, leg, none = map(int, m.groups())
+        assert mk + leg + none == n
+        counts[ph] = (n, mk, leg)
+    for ph in ("forward", "return"):
+        assert counts[ph][1] == 0 and counts[ph][2] == counts[ph][0], (ph, counts[ph])
+    assert counts["turning"][1] > 0
+    # the same from the function, trial by trial, and the return split
+    trials = pd.read_csv(tiny / "trials.csv")
+    subj = pd.read_csv(tiny / "subjects.csv").set_index("subject")
+    poses = pd.read_csv(tiny / "truth" / "sensor_pose.csv").set_index("trial")
+    n_turn = 0
+    for _, tr in trials[trials["protocol"] == "tug"].iterrows():
+        d = tiny / "truth" / tr["trial"]
+        legs = pd.read_parquet(d / "legs.parquet")
+        s = pd.read_parquet(d / "scans_legs.parquet")
+        t_end = float(legs["t_s"].max())
+        s = s[(s["t_mocap_s"] >= 0) & (s["t_mocap_s"] <= t_end)]
+        o = occluders(s, poses.loc[tr["trial"], ["x_m", "y_m", "yaw_rad"]].to_numpy(float),
+                      float(subj.loc[tr["subject"], "leg_width_m"]), scene_circles())
+        n_turn += int((o["phase"] == "turning").sum())
+        ev = pd.read_csv(d / "events.csv")
+        tl = tug_timeline(ev, s, t_end)
+        assert all(v > 0 for v in tl.values()), tl
+        t_rise, t_seated = tug_span(ev, t_end)
+        ret = s.loc[s["phase"] == "return", "t_mocap_s"]
+        span = t_seated - float(s.loc[s["phase"] == "turning", "t_mocap_s"].max())
+        assert tl["walk_back"] + tl["turn_to_sit"] + tl["sitting_down"] == \
+            pytest.approx(span, abs=1e-9)
+        # the scans' span of the return phase, within a scan period at either end
+        assert span == pytest.approx(ret.max() - ret.min(), abs=0.05)
+        # the TUG phases start with the rise and end seated; before and after, the
+        # capture's still-seated spans ("seated", no TUG phase) where no leg moves
+        fwd = s.loc[s["phase"] == "forward", "t_mocap_s"]
+        assert fwd.min() >= t_rise and fwd.min() - t_rise < 0.03
+        assert ret.max() <= t_seated and t_seated - ret.max() < 0.03
+        still = s[s["phase"] == "seated"]
+        assert len(still) and still["t_mocap_s"].between(t_rise, t_seated).sum() == 0
+        for span in (still[still["t_mocap_s"] < t_rise], still[still["t_mocap_s"] > t_seated]):
+            moved = span.groupby("side")[["x_m", "y_m"]].agg(lambda v: v.max() - v.min())
+            assert len(span) and float(moved.to_numpy().max()) < 1e-3, moved
+    assert n_turn == counts["turning"][0]
+
+
+def test_tug_variant_reproduces_the_study_and_the_marker_screens_only_the_turn(physics):
+    """tug_variants.tug_occlusion_variant re-renders the preset's TUG trials in memory:
+    with the twin's own choices it gives the written study's phase durations and truth
+    occlusion (the physics rows); with the turn marker out of the scan plane only the
+    turning phase changes (the marker stands at the turn), and its occlusion falls to at
+    least the leg-on-leg count of the turning row's note."""
+    import re
+
+    from gaitval.simulate.tug_variants import tug_occlusion_variant
+
+    same = tug_occlusion_variant("tiny")
+    rows = physics.set_index(["check", "phase"])
+    for ph in ("forward", "turning", "return"):
+        assert same.loc[ph, "occlusion"] == pytest.approx(
+            rows.loc[("tug_occlusion", ph), "value"], rel=1e-5)
+        assert same.loc[ph, "seconds"] == pytest.approx(
+            rows.loc[("tug_phase_duration", ph), "value"], rel=1e-5)
+    low = tug_occlusion_variant("tiny", marker_in_scan_plane=False)
+    for ph in ("forward", "return"):
+        assert low.loc[ph].equals(same.loc[ph]), ph
+    assert low.loc["turning", "leg_scans"] == same.loc["turning", "leg_scans"]
+    assert low.loc["turning", "occluded"] < same.loc["turning", "occluded"]
+    leg_only = int(re.search(r"the other leg only (\d+)",
+                             rows.loc[("tug_occlusion", "turning"), "note"]).group(1))
+    assert low.loc["turning", "occluded"] >= leg_only

@@ -251,9 +251,13 @@ def gait_events(sim: TrialSim) -> pd.DataFrame:
                              float(p.xy[i, 1])))
     if sim.protocol == "tug":
         t0, t1 = sim.variant["t_phase"]
-        rows += [(0.0, "phase_start", "", "forward", np.nan, np.nan),
+        ta, tb = sim.variant.get("t_tug", (0.0, np.inf))
+        rows += [(0.0, "phase_start", "", "seated", np.nan, np.nan)] if ta > 0 else []
+        rows += [(float(ta), "phase_start", "", "forward", np.nan, np.nan),
                  (float(t0), "phase_start", "", "turning", np.nan, np.nan),
                  (float(t1), "phase_start", "", "return", np.nan, np.nan)]
+        rows += [(float(tb), "phase_start", "", "seated", np.nan, np.nan)] \
+            if tb <= sim.t_end_s else []
     ev = pd.DataFrame(rows, columns=["t_s", "event", "side", "label", "x_m", "y_m"])
     return ev.sort_values(["t_s", "event", "side"], ignore_index=True)
 

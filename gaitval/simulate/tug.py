@@ -29,6 +29,12 @@ TUG_MARKER_XY = (3.0, 0.0)
 #: a shank's surface when the inner foot swings past it.
 MARKER_RADIUS_M = 0.06
 MARKER_CLEARANCE_M = 0.05
+#: The chair's four legs (field frame, m; the front edge at x = 0) and their radius at
+#: shin height (m), and the two calibration poles (seed 000 §2.2: "aligns the field and the
+#: LRS using two poles"; positions not given, a free choice).
+CHAIR_LEGS_XY = ((-0.02, 0.22), (-0.02, -0.22), (-0.42, 0.22), (-0.42, -0.22))
+CHAIR_LEG_RADIUS_M = 0.015
+TUG_POLES_XY = ((1.4, -1.0), (3.9, 1.3))
 #: Where the turn to sit begins: the body is this far in front of its seated place.
 TURN_TO_SIT_FROM_M = 0.45
 #: Feet under the chair's front edge when seated (x), on the course axis (y = 0).
@@ -116,8 +122,10 @@ def turn_phase_bounds(walker: Walker, t_end: float, rate_hz: float, height_m: fl
     the reproduced Table 4 (:func:`gaitval.evaluate.tug_truth.tug_phase_bounds`: the
     smoothed midpoint of the two legs at sensor height walks more than 30° off the
     outbound / return line), applied to the true legs at the mocap rate, so the twin's
-    phase durations and truth occlusion (``physics.csv``) and the tracked Table 4 count
-    the same scans.
+    turning phase (``physics.csv``) and the tracked Table 4's count the same scans.  (The
+    forward and return phases of the truth start with the rise and end seated, the TUG's
+    span; the reproduced Table 4 counts from the first to the last truth sample, the
+    still-seated spans of the capture included: docs/simulator.md.)
     """
     t = np.arange(0.0, t_end + 0.5 / rate_hz, 1.0 / rate_hz)
     legs = walker.legs(t)
@@ -127,6 +135,15 @@ def turn_phase_bounds(walker: Walker, t_end: float, rate_hz: float, height_m: fl
                             ("R", legs[1].point_at_height(height_m)))]
     b = tug_phase_bounds(pd.concat(rows, ignore_index=True))
     return float(b["t_turn_start_s"]), float(b["t_turn_end_s"])
+
+
+def scene_circles() -> np.ndarray:
+    """The TUG scene's static circles at shin height, ``(k, 4)``: ``x, y, radius, id``
+    (field frame): the chair's legs, the turn marker and the calibration poles."""
+    circles = [(x, y, CHAIR_LEG_RADIUS_M, ID_CHAIR) for x, y in CHAIR_LEGS_XY]
+    circles.append((*TUG_MARKER_XY, MARKER_RADIUS_M, ID_MARKER))
+    circles += [(x, y, POLE_RADIUS_M, ID_POLE) for x, y in TUG_POLES_XY]
+    return np.array(circles, dtype=float)
 
 
 def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
@@ -172,23 +189,27 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     walker = Walker(plan=plan, gp=gp, leg_width_m=subj["leg_width_m"], sit=sit,
                     sensor_height_m=cfg["sensor_height_m"],
                     posture_tilt=ptilt)
-    chair = [(-0.02, 0.22), (-0.02, -0.22), (-0.42, 0.22), (-0.42, -0.22)]
-    circles = [(x, y, 0.015, ID_CHAIR) for x, y in chair]
-    circles.append((*TUG_MARKER_XY, MARKER_RADIUS_M, ID_MARKER))
-    poles = np.array([[1.4, -1.0], [3.9, 1.3]])
-    circles += [(x, y, POLE_RADIUS_M, ID_POLE) for x, y in poles]
+    poles = np.array(TUG_POLES_XY, dtype=float)
     # phases by the rule of the reproduced Table 4 (issue 34; before, the step labels:
     # lift-off of the first turning step, first contact on the return line, which
     # physics.step_label_bounds still reads from the events for its note)
     t_turn0, t_turn1 = turn_phase_bounds(walker, t_end, cfg["mocap_rate_hz"],
                                          cfg["sensor_height_m"])
 
+    # the three phases partition the TUG itself, from the start of the rise to seated
+    # (seed 000 §2.1 "three TUG phases"; §1 the TUG: "rises from a chair, ... walks back
+    # to the chair and sits down"); the capture's still-seated spans before the rise and
+    # after sitting are no TUG phase: "seated" (issue 34 follow-up, docs/simulator.md)
+    t_seated = t_sit + sit_dur
+
     def phase(t):
-        return np.where(t < t_turn0, "forward", np.where(t <= t_turn1, "turning", "return"))
+        ph = np.where(t < t_turn0, "forward", np.where(t <= t_turn1, "turning", "return"))
+        return np.where((t < t_rise) | (t > t_seated), "seated", ph).astype(object)
 
     return TrialSim(study=study, protocol="tug", subject=subj["subject"], trial=trial,
                     walker=walker, sensor="utm30lx", sensor_height_m=cfg["sensor_height_m"],
                     mocap_rate_hz=cfg["mocap_rate_hz"], t_end_s=t_end,
-                    circles=np.array(circles, dtype=float), walls=_walls(-2.0, 5.5, -2.5, 2.5),
+                    circles=scene_circles(), walls=_walls(-2.0, 5.5, -2.5, 2.5),
                     poles=poles, fixed_pose=sensor_pose, phase_fn=phase, repetition=rep,
-                    speed="fast", variant={"t_phase": (t_turn0, t_turn1)})
+                    speed="fast", variant={"t_phase": (t_turn0, t_turn1),
+                                           "t_tug": (t_rise, t_seated)})
