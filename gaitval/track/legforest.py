@@ -17,8 +17,8 @@ leg_tracker's recipe, on what is available (:func:`train`):
   0``) because it has five negative bags; with the one available that leaves 788
   negatives against 1,851 positives, and a forest trained so (the first version) called
   25–30 % of the empty room's clusters legs (P ≥ 0.5, each laser scored by the forest
-  that did not see it) and let the people tracker confirm 6–14 persons per laser there
-  (docs/people.md).  So every negative cluster is used (factor 1: ≈ 40,000);
+  that did not see it) and let the people tracker with ``leg_travel`` confirm 6–14 persons
+  per laser there (docs/people.md).  So every negative cluster is used (factor 1: ≈ 40,000);
 * the forest: 100 trees, depth ≤ 20, a node of fewer than 2 samples is a leaf, 2 features
   tried per split (``setActiveVarCount(2)``), bootstrap samples, equal class priors —
   :class:`sklearn.ensemble.RandomForestClassifier` with those values (OpenCV's Gini
