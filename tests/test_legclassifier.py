@@ -209,3 +209,9 @@ def test_leg_forest_confidence_rule():
     assert q.look["person"] == pytest.approx(0.5)
     none = APPEARANCES.build("none")
     assert none.keeps(q) and none.admits(0.0, 0.0)
+
+
+def test_an_unknown_forest_is_one_clear_error(tmp_path):
+    from gaitval.errors import FileFormatError
+    with pytest.raises(FileFormatError, match="leg classifier .* not found"):
+        load_forest(str(tmp_path / "absent.npz"))
