@@ -53,6 +53,7 @@ from scipy.optimize import linear_sum_assignment
 
 from gaitval.detect import DETECTORS
 from gaitval.detect.base import split_observations
+from gaitval.track.appearance import APPEARANCES
 from gaitval.track.gate import GATES, GateContext
 from gaitval.track.init import INITIALISERS
 from gaitval.track.kalman import FILTERS
@@ -93,10 +94,10 @@ class Person:
 
     __slots__ = ("pid", "status", "post", "prior", "seen", "pattern", "obs_j", "phase",
                  "windows", "t_last_seen", "confirm_memory", "n_unobs", "k_born", "n_obs",
-                 "world_centre", "seen_centre", "z")
+                 "world_centre", "seen_centre", "z", "zp", "look")
 
     def __init__(self, pid, filter, zl, zr, pl, pr, jl, jr, k, t, windows, memory,
-                 status=TENTATIVE):
+                 status=TENTATIVE, scores=(1.0, 1.0), look=None):
         self.pid = pid
         self.status = status
         self.post = [filter.init(float(zl[0]), float(zl[1])),
@@ -115,6 +116,8 @@ class Person:
         self.world_centre = (0, 0.0, 0.0)      # (ego-motion segment, x, y)
         self.seen_centre = self.centre()       # the centre on the last scan with a leg seen
         self.z = [(float(zl[0]), float(zl[1])), (float(zr[0]), float(zr[1]))]  # observations
+        self.zp = [float(scores[0]), float(scores[1])]  # their appearance scores (None: unseen)
+        self.look = look                       # the appearance role's memory
 
     def pos(self, f: int) -> tuple[float, float]:
         s = self.post[f]
@@ -143,6 +146,11 @@ class PeopleTracker(TrackerKind):
         The life-cycle roles (:mod:`gaitval.track.lifecycle`); ``refind`` (default
         ``leg_tracker_gate``; ``none``: an ended person stays ended) gives a recently ended
         person back when a tentative hypothesis appears where it was last seen.
+    appearance : spec
+        Does an observation look like a leg (:mod:`gaitval.track.appearance`; ``none``:
+        everything does; ``leg_forest``: leg_tracker's classifier and confidence rule — a
+        pair scoring below its threshold is not born, a tentative pair or a confirmed person
+        whose running confidence falls below it ends).
     ego_motion, static_map : spec
         The sensor's motion and the map of what never moves (:mod:`gaitval.track.staticmap`):
         an observation on a static cell starts no person, and a tentative person with
@@ -167,6 +175,7 @@ class PeopleTracker(TrackerKind):
                  confirmer="m_of_n_moving", deleter="unsupported_time",
                  area="field_of_view", ego_motion="none", static_map="none",
                  init=None, tentative_gate=None, refind="leg_tracker_gate",
+                 appearance="none",
                  max_leg_separation_m: float = 0.8, person_points_m: float = 0.13,
                  dt_s: float | None = None, sides: str = "walking_direction"):
         self.detector = DETECTORS.build(detector)
@@ -180,6 +189,7 @@ class PeopleTracker(TrackerKind):
         self.deleter = DELETERS.build(deleter)
         self.area = AREAS.build(area)
         self.refind = REFINDS.build(refind)
+        self.appearance = APPEARANCES.build(appearance)
         self.ego_motion = EGO_MOTIONS.build(ego_motion)
         self.static_map = STATIC_MAPS.build(static_map)
         self.init = INITIALISERS.build(init) if init else None
@@ -220,6 +230,8 @@ class PeopleTracker(TrackerKind):
         refind = self.refind.bind(dt0)
         area = self.area.bind(scans)
         poses, segment = self.ego_motion.poses(scans)
+        look = self.appearance
+        score = look.scores(scans, xy)          # per scan, P(leg) of each observation
         smap, seg = None, None
         seeded = None
         if self.init is not None:
@@ -309,6 +321,7 @@ class PeopleTracker(TrackerKind):
                         p.post[f] = p.prior[f]
                         p.seen[f] = False
                         p.z[f] = None
+                        p.zp[f] = None
                         p.pattern[f] = "UO"
                         p.obs_j[f] = -1
                         p.n_unobs[f] += 1
@@ -316,10 +329,12 @@ class PeopleTracker(TrackerKind):
                         p.post[f] = correct(p.prior[f], obs[j][0], obs[j][1])
                         p.seen[f] = True
                         p.z[f] = obs[j]
+                        p.zp[f] = float(score[k][j])
                         p.pattern[f] = pats[k][j]
                         p.obs_j[f] = j
                         p.n_unobs[f] = 0
                         p.n_obs[f] += 1
+                look.update(p)
                 if p.seen[0] or p.seen[1]:
                     p.t_last_seen = tk
                     p.seen_centre = p.centre()
@@ -343,14 +358,21 @@ class PeopleTracker(TrackerKind):
             # life cycle
             for p in persons:
                 if p.status == TENTATIVE:
+                    if not look.keeps(p):               # no longer looks like two legs
+                        p.status = ENDED
+                        continue
                     p.world_centre = (seg, *to_world(pose, np.array([p.centre()]))[0].tolist())
                     if confirmer.step(p, k) and not _on_static(p, pose, smap):
                         p.status = CONFIRMED
+                        look.confirmed(p)
                         n_conf += 1
                     elif confirmer.failed(p):
                         p.status = ENDED
                         continue
                 if p.status == ENDED:
+                    continue
+                if not look.keeps(p):                   # a confirmed person that looks
+                    p.status = ENDED                    # like no legs: not re-found
                     continue
                 why = self.deleter.ended(p, k, tk, area)
                 if why:
@@ -368,14 +390,20 @@ class PeopleTracker(TrackerKind):
                 pairs = [(il, ir)] + [(a, b) for a, b in pairs
                                       if a not in (il, ir) and b not in (il, ir)]
             for a, b in pairs:
+                start = CONFIRMED if (seeded is not None and k == seeded[0]
+                                      and (a, b) == (seeded[1], seeded[2])) else TENTATIVE
+                if start == TENTATIVE and not look.admits(score[k][a], score[k][b]):
+                    continue
                 if not area.contains(0.5 * (obs[a][0] + obs[b][0]),
                                      0.5 * (obs[a][1] + obs[b][1])):
                     continue
-                start = CONFIRMED if (seeded is not None and k == seeded[0]
-                                      and (a, b) == (seeded[1], seeded[2])) else TENTATIVE
                 p = Person(next_id, F, obs[a], obs[b], pats[k][a], pats[k][b], a, b, k, tk,
                            [self.motion.new_window(), self.motion.new_window()],
-                           confirmer.new_memory(), status=start)
+                           confirmer.new_memory(), status=start,
+                           scores=(score[k][a], score[k][b]),
+                           look=look.start(score[k][a], score[k][b]))
+                if start == CONFIRMED:
+                    look.confirmed(p)
                 next_id += 1
                 n_born += 1
                 n_conf += start == CONFIRMED
@@ -386,6 +414,7 @@ class PeopleTracker(TrackerKind):
             # a recently ended person found again keeps its confirmation and its id
             for p, pid in refind.match([p for p in persons if p.status == TENTATIVE], tk):
                 p.status = CONFIRMED
+                look.confirmed(p)
                 p.pid = pid
                 n_refound += 1
             # record the reported persons
