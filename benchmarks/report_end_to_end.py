@@ -65,11 +65,13 @@ def _cpu_children() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def _run_snakemake(root: Path, work: Path, study: str, cores: int) -> tuple[float, float, str]:
+def _run_snakemake(root: Path, work: Path, study: str, cores: int,
+                   config: tuple[str, ...] = ()) -> tuple[float, float, str]:
     # the profile `python3 run.py report` uses (workflow/profiles/default), cores overridden
     cmd = [sys.executable, "-c", _SNAKEMAKE_SELF, "-s", str(root / "Snakefile"),
            "--profile", str(root / "workflow" / "profiles" / "default"),
-           "--directory", str(work), "--cores", str(cores), "--config", f'run=["{study}"]']
+           "--directory", str(work), "--cores", str(cores), "--config", f'run=["{study}"]',
+           *config]
     c0, t0 = _cpu_children(), time.perf_counter()
     p = subprocess.run(cmd, cwd=work, capture_output=True, text=True)
     wall, cpu = time.perf_counter() - t0, _cpu_children() - c0
@@ -115,6 +117,9 @@ def main() -> None:
     ap.add_argument("--cores", type=int, default=2)
     ap.add_argument("--workdir", type=Path, default=None,
                     help="run in this new folder and keep it (run0/, run1/, ...)")
+    ap.add_argument("--config", nargs="*", default=(), metavar="KEY=VALUE",
+                    help="more Snakemake --config items, e.g. 'rollator={methods: []}' to "
+                         "leave out a row that an older checkout does not have")
     args = ap.parse_args()
     walls, cpus, jobs = [], [], 0
     if args.workdir is not None:
@@ -124,7 +129,8 @@ def main() -> None:
         for r in range(args.repeat):
             work = base / f"run{r}"
             work.mkdir()
-            wall, cpu, log = _run_snakemake(ROOT, work, args.study, args.cores)
+            wall, cpu, log = _run_snakemake(ROOT, work, args.study, args.cores,
+                                             tuple(args.config))
             jobs = sum(_job_stats(log).values())
             m = re.search(r"snakemake itself: cpu ([\d.]+) s; forkserver: cpu ([\d.]+) s", log)
             own, pool = (float(m[1]), float(m[2])) if m else (float("nan"), 0.0)
