@@ -278,3 +278,20 @@ def test_a_bag_without_the_topic_is_named_at_start(tmp_path):
     for w in ("ConfigError", "external.yaml] external_detections d.topic", "'/legs' is not in",
               "tug_a.bag", "/detected_leg_clusters"):
         assert w in out, (w, out[-3000:])
+
+
+@pytest.mark.slow
+def test_the_report_shows_the_detection_table_and_lists_the_files(det_run):
+    from conftest import tiny_workflow
+
+    work, _ = det_run
+    res = tiny_workflow(work)
+    assert res.returncode == 0, res.stderr[-4000:]
+    html = (work / "reports" / "tiny" / "index.html").read_text()
+    assert "External leg detectors (no identity)" in html and "detections_table" in html
+    inputs = (work / "reports" / "tiny" / "provenance" / "inputs.txt").read_text()
+    assert "data/tiny/external.yaml" in inputs
+    listed = inputs.splitlines()
+    for t in (p.stem for p in (work / "data" / "tiny" / "det").glob("*.bag")):
+        assert f"data/tiny/det/{t}.bag" in listed and \
+            f"data/tiny/det/{t}.detections.csv" in listed, t

@@ -536,6 +536,22 @@ def detection_file(study, detector, trial):
                                    detector, field=f"external_detections.{detector}.path"))
 
 
+def external_input_files(study):
+    """The external trackers' and detectors' files of a study's trials (the report's
+    provenance lists them with the study's other raw inputs); a ROS 2 bag folder by its
+    files."""
+    from gaitval.pipeline.steps import EXTERNAL_PROTOCOLS, external_track_path
+
+    out = []
+    for m, e in _EXTERNAL.get(study, {}).items():
+        for t in trial_ids(study, list(e.get("protocols") or EXTERNAL_PROTOCOLS)):
+            out.append(external_track_path(sheet_path(study), e, t, m))
+    out += [Path(detection_file(study, d, t)) for d in _DETECTIONS.get(study, {})
+            for t, _ in detection_trials(study, d)]
+    return [str(f) for p in out for f in (sorted(x for x in p.rglob("*") if x.is_file())
+                                          if p.is_dir() else [p])]
+
+
 def tug_runs():
     """The TUG methods (tug.methods), their reading variants (tug.phase_readings) and the
     external methods (tracking.external)."""
