@@ -88,3 +88,26 @@ def test_a_simulated_study_declares_an_external_method_before_its_first_run(
     out = res.stdout + res.stderr
     assert res.returncode == 0, out[-3000:]
     assert "rule track_external:" in out and "method=ext_csv" in out
+
+
+def test_validate_reports_the_side_files_detectors(tmp_path):
+    """``gaitval validate`` (external_problems) names an external.yaml detector's missing
+    files, and with --deep each detections file that does not read."""
+    from gaitval.pipeline.steps import external_problems
+
+    sheet = study(tmp_path, None, {"external_detections": {
+        "d": {"path": "det/{trial}.detections.csv", "protocols": ["tug"]}}})
+    probs = external_problems(sheet)
+    assert len(probs) == 1
+    for w in ("external.yaml] external_detections d", "1 of 1 trials' detection files"):
+        assert w in probs[0], (w, probs[0])
+    (sheet.parent / "det").mkdir()
+    (sheet.parent / "det" / "tug_a.detections.csv").write_text(
+        "# gaitval-detections v1\n# units: inch\n# frame: sensor\n# clock: sensor\n"
+        "t_s,x,y\n0.0,1.0,0.1\n")
+    assert external_problems(sheet) == []
+    probs = external_problems(sheet, deep=True)
+    assert len(probs) == 1
+    for w in ("external_detections.d", "tug_a.detections.csv", "trial tug_a",
+              "'units' is 'inch'", "(line 2)"):
+        assert w in probs[0], (w, probs[0])
