@@ -712,28 +712,45 @@ def external_declarations(config_external: dict | None, sheets: dict, taken,
     return {s: {**config_external, **own[s]} for s in sheets}
 
 
+def _entry_trials(df: pd.DataFrame, prots, mocap_only: bool) -> list[str]:
+    """The trials of a sheet (``trial, protocol[, mocap_path]`` as text) of ``prots``;
+    with ``mocap_only`` those with a mocap file (a detector is scored against it)."""
+    keep = df["protocol"].str.strip().isin(prots)
+    if mocap_only and "mocap_path" in df:
+        keep &= df["mocap_path"].str.strip() != ""
+    return sorted(df.loc[keep, "trial"].str.strip())
+
+
+def _sheet_trials(sheet) -> pd.DataFrame | None:
+    try:
+        return pd.read_csv(sheet, usecols=lambda c: c in ("trial", "protocol", "mocap_path"),
+                           dtype=str, keep_default_na=False)
+    except (OSError, ValueError):
+        return None
+
+
 def missing_external_files(sheet, entries: dict, source: str = "", *,
                            protocols: tuple = EXTERNAL_PROTOCOLS,
-                           what: str = "track files", key: str | None = None) -> None:
+                           what: str = "track files", key: str | None = None,
+                           mocap_only: bool = False) -> None:
     """Check, before any job runs, that every trial of each external method's protocols
     has its file, inside the sheet's folder (:func:`external_track_path`).  A sheet that
     cannot be read yet (a simulated study before its simulation; a broken sheet, which its
     own check reports) is skipped.  ``protocols``: an entry's default; ``what``: the files'
-    name in the message; ``key``: the declaration key, named when a path leads outside.
+    name in the message; ``key``: the declaration key, named when a path leads outside;
+    ``mocap_only``: only the trials with a mocap file (an external detector's).
 
     Raises
     ------
     ConfigError
         One message per method naming where it is declared, how many files are missing
         and the first few of them."""
-    try:
-        df = pd.read_csv(sheet, usecols=["trial", "protocol"], dtype=str,
-                         keep_default_na=False)
-    except (OSError, ValueError):
+    df = _sheet_trials(sheet)
+    if df is None or not {"trial", "protocol"} <= set(df.columns):
         return
     for m, entry in entries.items():
         prots = (entry or {}).get("protocols") or protocols
-        trials = sorted(df.loc[df["protocol"].str.strip().isin(prots), "trial"].str.strip())
+        trials = _entry_trials(df, prots, mocap_only)
         paths = [external_track_path(sheet, entry, t, m,
                                      field=f"{key}.{m}.path" if key else None)
                  for t in trials]
@@ -750,7 +767,8 @@ def missing_external_files(sheet, entries: dict, source: str = "", *,
 
 
 def detection_topic_problems(sheet, entries: dict, source: str = "") -> None:
-    """Each external detector's bags (the trials of its protocols) opened before any job
+    """Each external detector's bags (the trials with mocap of its protocols) opened
+    before any job
     runs: its ``topic`` (or, without one, exactly one ``leg_tracker/LegArray`` topic) must
     be in every bag and be a ``LegArray``.  Files that are no bag are read by the job
     (their header and rows; ``gaitval validate --deep`` reads them first).  Skipped, like
@@ -763,15 +781,13 @@ def detection_topic_problems(sheet, entries: dict, source: str = "") -> None:
     from gaitval.io.rosbag import _norm, is_rosbag
     from gaitval.io.tracks import BAG_LEG_DETECTIONS
 
-    try:
-        df = pd.read_csv(sheet, usecols=["trial", "protocol"], dtype=str,
-                         keep_default_na=False)
-    except (OSError, ValueError):
+    df = _sheet_trials(sheet)
+    if df is None or not {"trial", "protocol"} <= set(df.columns):
         return
     for m, entry in entries.items():
         prots = (entry or {}).get("protocols") or DETECTION_PROTOCOLS
         topic = (entry or {}).get("topic")
-        for t in sorted(df.loc[df["protocol"].str.strip().isin(prots), "trial"].str.strip()):
+        for t in _entry_trials(df, prots, mocap_only=True):
             path = external_track_path(sheet, entry, t, m,
                                        field=f"external_detections.{m}.path")
             if not is_rosbag(path):
@@ -831,7 +847,8 @@ def external_problems(sheet, deep: bool = False) -> list[str]:
                 missing_external_files(sheet, {m: entry}, f"[file {f}] {key}",
                                        protocols=default, key=key,
                                        what="track files" if key == "external_methods"
-                                       else "detection files")
+                                       else "detection files",
+                                       mocap_only=key == "external_detections")
                 if key == "external_detections":
                     detection_topic_problems(sheet, {m: entry}, f"[file {f}] {key}")
             except GaitvalError as exc:
@@ -839,11 +856,9 @@ def external_problems(sheet, deep: bool = False) -> list[str]:
                 continue
             if not deep:
                 continue
-            df = pd.read_csv(sheet, usecols=["trial", "protocol"], dtype=str,
-                             keep_default_na=False)
+            df = _sheet_trials(sheet)
             prots = entry.get("protocols") or default
-            for t in sorted(df.loc[df["protocol"].str.strip().isin(prots),
-                                   "trial"].str.strip()):
+            for t in _entry_trials(df, prots, key == "external_detections"):
                 try:
                     path = external_track_path(sheet, entry, t, m)
                     if key == "external_methods":

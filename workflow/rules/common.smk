@@ -137,7 +137,7 @@ def _check_detections(cfg, per_study_methods):
             src = f"study {study}: [file {where[m]}] external_detections"
             missing_external_files(sheets[study], {m: entry}, src,
                                    protocols=DETECTION_PROTOCOLS, what="detection files",
-                                   key="external_detections")
+                                   key="external_detections", mocap_only=True)
             detection_topic_problems(sheets[study], {m: entry}, src)
     return per_study
 
@@ -520,11 +520,12 @@ def external_detectors():
 
 
 def detection_trials(study, detector):
-    """(trial, protocol) of every trial of the detector's protocols in the study."""
+    """(trial, protocol) of every trial with mocap of the detector's protocols in the
+    study (a trial without mocap has no legs to score against)."""
     from gaitval.pipeline.steps import DETECTION_PROTOCOLS
 
     prots = _DETECTIONS[study][detector].get("protocols") or DETECTION_PROTOCOLS
-    return [(t, p) for p in prots for t in trial_ids(study, [p])]
+    return [(t, p) for p in prots for t in trial_ids(study, [p]) if has_mocap(study, t)]
 
 
 def detection_file(study, detector, trial):
