@@ -157,7 +157,19 @@ def cmd_export_tracks(a) -> int:
 def cmd_leg_detections(a) -> int:
     from gaitval.pipeline.steps import leg_detections_step
     print(json.dumps(leg_detections_step(a.detections, a.groundtruth, a.out, topic=a.topic,
-                                         trial=a.trial, gate_m=a.gate_m), sort_keys=True))
+                                         trial=a.trial, gate_m=a.gate_m,
+                                         registration_json=a.registration,
+                                         sensor_parquet=a.sensor, method=a.method,
+                                         protocol=a.protocol),
+                     sort_keys=True))
+    return 0
+
+
+def cmd_leg_detections_table(a) -> int:
+    from gaitval.report.provenance import stamp
+    from gaitval.tables.detections import write_detections_table
+    paths = write_detections_table(a.dirs, a.out_stem)
+    stamp("detections_table", paths, a.reports_dir, config_hash_=a.config_hash)
     return 0
 
 
@@ -272,11 +284,16 @@ def _add_input_verbs(sub) -> None:
     s.add_argument("--config-hash", default="")
     s.set_defaults(func=cmd_ingest_summary)
 
-    s = sub.add_parser("peer", help="agreement statistics of a peer's paired results")
+    s = sub.add_parser("peer", help="agreement statistics (Bland-Altman, ICC, RMSE, "
+                       "t-test) of any system's paired results against a reference: one "
+                       "row per walk or stride, us_<name> / gt_<name> column pairs (e.g. "
+                       "an external system's stride parameters against the mocap's)")
     s.add_argument("parquet", help="Parquet file with us_<name> / gt_<name> column pairs")
-    s.add_argument("--out-stem", required=True)
-    s.add_argument("--reports-dir", default="reports")
-    s.add_argument("--config-hash", default="")
+    s.add_argument("--out-stem", required=True, help="e.g. reports/<run>/tables/"
+                   "peer_agreement (writes .csv, .md, .tex)")
+    s.add_argument("--reports-dir", default="reports", help="the report folder "
+                   "(provenance/)")
+    s.add_argument("--config-hash", default="", help="provenance stamp")
     s.set_defaults(func=cmd_peer)
 
 
@@ -326,14 +343,25 @@ def _add_lrs_verbs(sub) -> None:
     s.add_argument("--out", required=True)
     s.set_defaults(func=cmd_detect)
 
-    s = sub.add_parser("evaluate-tug", help="evaluate one tracked TUG trial")
-    s.add_argument("--track", required=True)
-    s.add_argument("--groundtruth", required=True)
-    s.add_argument("--registration", required=True)
-    s.add_argument("--trial", required=True)
-    s.add_argument("--method", required=True)
-    s.add_argument("--config", required=True)
-    s.add_argument("--out", required=True)
+    s = sub.add_parser("evaluate-tug", help="evaluate one tracked TUG trial against its "
+                       "mocap legs: per-frame errors, false tracking (swaps, lost legs), "
+                       "stance identification (seed 000 Tables 3-5)")
+    s.add_argument("--track", required=True, help="the trial's per-scan track "
+                   "(results/<study>/track/<method>/<trial>.parquet: gaitval's own, or an "
+                   "external method's from 'gaitval import-tracks'; sensor frame and clock)")
+    s.add_argument("--groundtruth", required=True, help="the trial's groundtruth.parquet "
+                   "(results/<study>/register/tug/<trial>/): mocap legs at the laser's "
+                   "height, on the sensor clock")
+    s.add_argument("--registration", required=True, help="the trial's registration.json "
+                   "(a refused registration: the trial is counted as not registered)")
+    s.add_argument("--trial", required=True, help="trial id (named in errors and outputs)")
+    s.add_argument("--method", required=True, help="the method's name (its label in the "
+                   "tables)")
+    s.add_argument("--config", required=True, help="the method's config view "
+                   "(results/<study>/config_views/tug/<method>.json): its evaluation.tug "
+                   "thresholds and tug: section")
+    s.add_argument("--out", required=True, help="folder: frames.parquet, events.parquet, "
+                   "stance.parquet, summary.parquet")
     s.set_defaults(func=cmd_evaluate_tug)
 
     # external tracks (issue 37): docs/formats.md, "Leg tracks"
@@ -342,28 +370,47 @@ def _add_lrs_verbs(sub) -> None:
     s.add_argument("track", help="results/<study>/track/<method>/<trial>.parquet, or a ROS "
                    "bag with a tracker's people topic")
     s.add_argument("out", help="*.tracks.csv or *.tracks.parquet")
-    s.add_argument("--units", choices=("m", "mm"), default="m")
+    s.add_argument("--units", choices=("m", "mm"), default="m", help="the file's position "
+                   "unit (header units:; default m)")
     s.add_argument("--topic", help="bags: the leg_tracker/PersonArray or people_msgs/People "
                    "topic (default: the only one)")
     s.add_argument("--legs", help="bags whose people are legs: the person ids of the "
                    "left and right leg, e.g. L=1,R=2 (a PoseArray: the poses' indices)")
     s.set_defaults(func=cmd_export_tracks)
 
-    s = sub.add_parser("leg-detections", help="leg_tracker's leg detections "
-                       "(leg_tracker/LegArray, no identity or side) of one trial scored "
-                       "against its mocap legs: detection rate per leg, RMSE, false "
+    s = sub.add_parser("leg-detections", help="a detector's leg detections (leg_tracker/"
+                       "LegArray or a *.detections.csv; no identity or side) of one trial "
+                       "scored against its mocap legs: detection rate per leg, RMSE, false "
                        "detections per scan (docs/formats.md, Leg detections)")
-    s.add_argument("--detections", required=True, help="ROS 1 bag or ROS 2 bag folder with "
-                   "the detections and the laser's scans (the same frame)")
-    s.add_argument("--topic", help="the LegArray topic (default: the only one, e.g. "
+    s.add_argument("--detections", required=True, help="a ROS 1 bag or ROS 2 bag folder with "
+                   "the detections and the laser's scans (the same frame), or a "
+                   "*.detections.csv / *.detections.parquet")
+    s.add_argument("--topic", help="a bag's LegArray topic (default: the only one, e.g. "
                    "/detected_leg_clusters)")
     s.add_argument("--groundtruth", required=True, help="the trial's groundtruth.parquet "
-                   "(results/<study>/register/<trial>/), on the same sensor clock")
+                   "(results/<study>/register/<family>/<trial>/), on the sensor clock")
+    s.add_argument("--registration", help="the trial's registration.json: converts a file "
+                   "on the mocap clock or in the mocap frame")
+    s.add_argument("--sensor", help="the trial's ingested sensor.parquet: time stamps "
+                   "outside the recording and positions in the wrong units are refused")
     s.add_argument("--trial", help="trial id (named in errors)")
+    s.add_argument("--method", help="the detector's name (written into summary.json)")
+    s.add_argument("--protocol", help="the trial's protocol (written into summary.json)")
     s.add_argument("--gate-m", type=float, default=0.30, help="a detection farther than "
                    "this from a leg is not that leg's (default 0.30 m)")
     s.add_argument("--out", required=True, help="folder: per_scan.parquet, summary.json")
     s.set_defaults(func=cmd_leg_detections)
+
+    s = sub.add_parser("leg-detections-table", help="the detection table of external leg "
+                       "detectors: per method and protocol, detection rate, RMSE, false "
+                       "detections per scan, pooled over the trials' leg-detections folders")
+    s.add_argument("dirs", nargs="+", help="leg-detections output folders (one per trial: "
+                   "summary.json, per_scan.parquet)")
+    s.add_argument("--out-stem", required=True, help="e.g. reports/<run>/tables/"
+                   "detections_table (writes .csv, .md, .tex)")
+    s.add_argument("--reports-dir", required=True, help="the report folder (provenance/)")
+    s.add_argument("--config-hash", default="", help="provenance stamp")
+    s.set_defaults(func=cmd_leg_detections_table)
 
     s = sub.add_parser("import-tracks", help="an external tracker's *.tracks.csv/parquet of "
                        "one trial as gaitval's track (sensor clock and frame)")
@@ -373,13 +420,14 @@ def _add_lrs_verbs(sub) -> None:
     s.add_argument("--registration", help="the trial's registration.json (pose and clock "
                    "offset, for a file in the mocap frame or clock; none: a trial without "
                    "mocap, the file must be on the sensor clock in the sensor frame)")
-    s.add_argument("--trial", required=True)
+    s.add_argument("--trial", required=True, help="trial id (named in errors)")
     s.add_argument("--method", required=True, help="the external method's name")
     s.add_argument("--config", help="the method's config view: tracking.external.<method> "
                    "gives a bag's topic and legs")
     s.add_argument("--moving-sensor", action="store_true",
                    help="the laser moves (rollator): refuse tracks in the mocap frame")
-    s.add_argument("--out", required=True)
+    s.add_argument("--out", required=True, help="the per-scan track (Parquet; "
+                   "results/<study>/track/<method>/<trial>.parquet in the workflow)")
     s.set_defaults(func=cmd_import_tracks)
 
     s = sub.add_parser("tug-tables", help="seed 000 Tables 2-5 and figures")

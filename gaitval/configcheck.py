@@ -274,12 +274,14 @@ def with_sources(problems: list[Problem], layers: Sequence[tuple[str, Any]]
             for p in problems]
 
 
-def check_study_file(study: Any, path: str | Path, *, schema: dict | None = None) -> None:
-    """Check a study's ``study.yaml`` (already loaded) against ``$defs/study_file``."""
+def check_study_file(study: Any, path: str | Path, *, schema: dict | None = None,
+                     definition: str = "study_file") -> None:
+    """Check a study's ``study.yaml`` (already loaded) against ``$defs/study_file`` (or
+    another definition: ``external_file``, the study's ``external.yaml``)."""
     schema = schema or load_schema()
     src = display_path(path)
     if not isinstance(study, Mapping):
-        raise ConfigError(f"study.yaml must be a mapping of sections, got {_describe(study)}",
-                          path=src)
-    probs = find_problems(dict(study), schema["$defs"]["study_file"], root=schema)
+        raise ConfigError(f"{Path(path).name} must be a mapping of sections, got "
+                          f"{_describe(study)}", path=src)
+    probs = find_problems(dict(study), schema["$defs"][definition], root=schema)
     raise_problems([Problem(p.path, p.message, src) for p in probs])

@@ -408,6 +408,10 @@ def test_a_tracker_recorded_in_the_sensor_bags_is_offered_commented(tiny_files, 
     assert ('\n#   ext_people_tracked: {path: "bags/{trial}.bag", topic: "/people_tracked", '
             "protocols: ['tug'], legs: {L: FILL_IN, R: FILL_IN}}\n") in text
     assert any("/people_tracked" in t and "uncomment" in t for t in res.todo)
+    # the bag's leg detections (LegArray): an active external_detections: entry (no legs
+    # to map), on the sensor bags themselves
+    assert yaml.safe_load(text)["external_detections"] == {"det_detected_leg_clusters": {
+        "path": "bags/{trial}.bag", "topic": "/detected_leg_clusters", "protocols": ["tug"]}}
     assert "tracking" not in yaml.safe_load((lab / "gaitval.config.yaml").read_text())
     # filled in and uncommented, the entry is what the workflow's start-up check accepts
     entry = text.split("#   ext_people_tracked: ")[1].splitlines()[0].replace(

@@ -118,3 +118,113 @@ def test_leg_array_is_no_track_and_other_frames_are_refused(tmp_path):
     odom = detection_bag(tmp_path / "o.bag", frame="odom")
     with pytest.raises(FileFormatError, match=r"frame\(s\) \['odom'\]"):
         read_bag_leg_detections(odom)
+
+
+# -- the detections file (*.detections.csv / .parquet) and the detection table -----------
+def detections_csv(path: Path, body: str, units: str = "m", frame: str = "sensor",
+                   clock: str = "sensor") -> Path:
+    path.write_text(f"# gaitval-detections v1\n# units: {units}\n# frame: {frame}\n"
+                    f"# clock: {clock}\n{body}")
+    return path
+
+
+#: SCANS as a file: t = 100 s + k 25 ms; the empty scan one row without x, y
+CSV_BODY = ("t_s,x,y\n100.0,1.01,0.1\n100.0,1.0,-0.12\n100.025,1.0,0.1\n"
+            "100.05,1.0,0.1\n100.05,1.0,-0.1\n100.05,3.0,0.0\n100.075,,\n")
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_a_detections_file_scores_as_the_bag_does(tmp_path, suffix):
+    from gaitval.io.tracks import read_detections, write_detections
+
+    f = detections_csv(tmp_path / "d.detections.csv", CSV_BODY)
+    if suffix == ".parquet":
+        rows, _ = read_detections(f)
+        f = write_detections(pd.DataFrame({"t_s": [100.0, 100.0, 100.025, 100.05, 100.05,
+                                                   100.05, 100.075],
+                                           "x": [1.01, 1.0, 1.0, 1.0, 1.0, 3.0, np.nan],
+                                           "y": [0.1, -0.12, 0.1, 0.1, -0.1, 0.0, np.nan]}),
+                             tmp_path / "d.detections.parquet")
+    det, meta = read_detections(f)
+    assert meta["n_messages"] == 4 and len(det) == 6
+    _, from_file = detection_statistics(det, meta["t_messages"], truth())
+    bag = detection_bag(tmp_path / "d.bag")
+    det_b, meta_b = read_bag_leg_detections(bag)
+    _, from_bag = detection_statistics(det_b, meta_b["t_messages"], truth())
+    assert from_file == pytest.approx(from_bag)
+
+
+@pytest.mark.parametrize("head, body, words", [
+    ({"units": "cm"}, CSV_BODY, ["'units' is 'cm'", "(line 2)"]),
+    ({}, "t_s,side,x,y\n100.0,L,1.0,0.1\n", ["unknown column(s) 'side'", "track file"]),
+    ({}, "t_s,x,y\n100.0,1.0,\n", ["line 6", "one of 'x', 'y' is empty"]),
+    ({}, "t_s,x,y\n100.0,1.0,abc\n", ["column 'y', line 6", "'abc' is not a number"]),
+    ({}, "t_s,x\n100.0,1.0\n", ["column 'y' is missing"]),
+])
+def test_a_bad_detections_file_names_the_file_field_and_line(tmp_path, head, body, words):
+    from gaitval.io.tracks import read_detections
+
+    f = detections_csv(tmp_path / "d.detections.csv", body, **head)
+    with pytest.raises(FileFormatError) as exc:
+        read_detections(f, trial="T1")
+    msg = str(exc.value)
+    for w in [str(f), "trial T1"] + words:
+        assert w in msg, (w, msg)
+
+
+def test_detections_in_mm_or_outside_the_recording_are_refused(tmp_path):
+    from gaitval.io.tracks import detections_to_sensor, read_detections
+
+    scan_t = 100.0 + 0.025 * np.arange(4)
+    det, meta = read_detections(detections_csv(tmp_path / "a.detections.csv",
+                                               CSV_BODY.replace("1.0,", "1000.0,")))
+    with pytest.raises(FileFormatError, match=r"line 7: detection \(1000, -0.12\) m .* beyond "
+                                              r"its range \(30 m\).*units 'm'"):
+        detections_to_sensor(det, meta, scan_t=scan_t, max_range_m=30.0)
+    det, meta = read_detections(detections_csv(tmp_path / "b.detections.csv", CSV_BODY))
+    with pytest.raises(FileFormatError, match="outside the recording"):
+        detections_to_sensor(det, meta, scan_t=scan_t + 10.0, tolerance_s=0.025)
+    det, meta = read_detections(detections_csv(tmp_path / "c.detections.csv", CSV_BODY,
+                                               clock="mocap"))
+    with pytest.raises(FileFormatError, match="needs the trial's registration"):
+        detections_to_sensor(det, meta, {"status": "refused"})
+    conv, tm = detections_to_sensor(det, meta, {"clock_offset_s": -50.0}, scan_t=scan_t - 50.0)
+    assert tm == pytest.approx(list(scan_t - 50.0)) and len(conv) == 6
+
+
+def test_the_detection_table_and_its_report_section(tmp_path):
+    from gaitval.cli import main
+    from gaitval.report.index import collect
+    from gaitval.tables.detections import detections_table
+
+    gt = tmp_path / "groundtruth.parquet"
+    truth().to_parquet(gt)
+    f = detections_csv(tmp_path / "d.detections.csv", CSV_BODY)
+    dirs = []
+    for t in ("T1", "T2"):
+        out = tmp_path / "det" / t
+        assert main(["leg-detections", "--detections", str(f), "--groundtruth", str(gt),
+                     "--trial", t, "--method", "mine", "--protocol", "tug",
+                     "--out", str(out)]) == 0
+        dirs.append(str(out))
+    reg = tmp_path / "registration.json"
+    reg.write_text(json.dumps({"status": "refused"}))
+    out = tmp_path / "det" / "T3"
+    assert main(["leg-detections", "--detections", str(f), "--groundtruth", str(gt),
+                 "--registration", str(reg), "--trial", "T3", "--method", "mine",
+                 "--protocol", "tug", "--out", str(out)]) == 0
+    tab = detections_table(dirs + [str(out)])
+    row = tab.iloc[0]
+    assert (row["method"], row["n_trials"], row["n_not_registered"], row["n_scans"]) == (
+        "mine", 3, 1, 8)
+    assert row["left_detection_rate"] == pytest.approx(0.75)
+    assert row["detection_rate"] == pytest.approx(5 / 8)
+    assert row["false_per_scan"] == pytest.approx(0.25)
+    rd = tmp_path / "reports"
+    assert main(["leg-detections-table", *dirs, str(out), "--out-stem",
+                 str(rd / "tables" / "detections_table"), "--reports-dir", str(rd)]) == 0
+    sec = {s["key"]: s for s in collect(rd)["sections"]}
+    item = sec["detections"]["items"][0]
+    assert item["stem"] == "detections_table" and "no row in the tracking tables" in \
+        " ".join(item["notes"])
+    assert "left_detection_pct" in [h for h, _ in item["header"]]

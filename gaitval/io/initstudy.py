@@ -23,7 +23,8 @@ files say about each trial:
 * external trackers' track files named by trial id (``<folder>/<trial>.tracks.csv``):
   an entry of the ``study.yaml``'s ``external_methods:``, checked like a hand-written one;
   a tracker topic recorded in the sensor bags: a commented entry (its legs are the
-  user's to name).  The config snippet holds only what a study.yaml cannot: where the
+  user's to name); leg_tracker's leg detections (``LegArray``) recorded in them: an
+  ``external_detections:`` entry.  The config snippet holds only what a study.yaml cannot: where the
   sheet and subject table are, and ``run``.
 
 What the files cannot say and a table needs is written as :data:`FILL_IN` — the shank
@@ -193,20 +194,23 @@ def _c3d_facts(path: Path) -> dict:
     return out
 
 
-def _bag_topics(path: Path) -> tuple[str | None, list[str]]:
-    """The bag's LaserScan topic (None unless exactly one) and its tracker topics
-    (:data:`gaitval.io.tracks.BAG_PEOPLE_TYPES`: a tracker recorded with the scans)."""
+def _bag_topics(path: Path) -> tuple[str | None, list[str], list[str]]:
+    """The bag's LaserScan topic (None unless exactly one), its tracker topics
+    (:data:`gaitval.io.tracks.BAG_PEOPLE_TYPES`: a tracker recorded with the scans) and its
+    leg-detection topics (:data:`gaitval.io.tracks.BAG_LEG_DETECTIONS`)."""
     from gaitval.io.rosbag import LASERSCAN, _open
-    from gaitval.io.tracks import BAG_PEOPLE_TYPES
+    from gaitval.io.tracks import BAG_LEG_DETECTIONS, BAG_PEOPLE_TYPES
 
     reader = _open(path, None)
     try:
         scans = sorted({c.topic for c in reader.connections if c.msgtype == LASERSCAN})
         trackers = sorted({c.topic for c in reader.connections
                            if c.msgtype in BAG_PEOPLE_TYPES})
+        detectors = sorted({c.topic for c in reader.connections
+                            if c.msgtype == BAG_LEG_DETECTIONS})
     finally:
         reader.close()
-    return (scans[0] if len(scans) == 1 else None), trackers
+    return (scans[0] if len(scans) == 1 else None), trackers, detectors
 
 
 def _scanlog_height(path: Path) -> float | None:
@@ -334,6 +338,7 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
 
     facts: dict[str, dict] = {}
     bag_trackers: dict[str, list[str]] = {}       # tracker topic -> sensor bags with it
+    bag_detectors: dict[str, list[str]] = {}      # LegArray topic -> sensor bags with it
     trials: list[dict] = []
     ids: set[str] = set()
     for s in sensors:
@@ -362,12 +367,14 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
             row["annotation_file"] = ann.rel
         if s.kind == "bag":
             try:
-                topic, trackers = _bag_topics(folder / s.rel)
+                topic, trackers, detectors = _bag_topics(folder / s.rel)
             except GaitvalError as exc:
                 res.unpaired.append(f"{s.rel}: {exc}")
-                topic, trackers = None, []
+                topic, trackers, detectors = None, [], []
             for tt in trackers:
                 bag_trackers.setdefault(tt, []).append(s.rel)
+            for tt in detectors:
+                bag_detectors.setdefault(tt, []).append(s.rel)
             row["sensor_topic"] = topic or FILL_IN
             if topic is None:
                 res.todo.append(f"trials.csv {trial}: sensor_topic (the bag has none or "
@@ -407,13 +414,16 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
     yaml_path = folder / "study.yaml"
     external = _external_methods(trials, files, res, yaml_path)
     bag_lines = _bag_tracker_lines(trials, bag_trackers, res)
+    detections = _bag_detections(trials, bag_detectors, res, yaml_path)
     if yaml_path.exists():
         res.kept.append(yaml_path)
         # not written there: the entries to add are in the todo list instead
-        res.notes = [n for n in res.notes if not n.startswith("study.yaml external_methods.")]
-        _external_todo(yaml_path, external, bag_lines, res)
+        res.notes = [n for n in res.notes if not n.startswith(
+            ("study.yaml external_methods.", "study.yaml external_detections."))]
+        _external_todo(yaml_path, external, bag_lines, res, detections)
     else:
-        write_text(yaml_path, _study_yaml(trials, files, res, external, bag_lines))
+        write_text(yaml_path, _study_yaml(trials, files, res, external, bag_lines,
+                                          detections))
         res.written.append(yaml_path)
     write_text(sheet, _csv(trials, TRIAL_COLUMNS))
     write_text(subjects_csv, _csv(subjects, SUBJECT_COLUMNS))
@@ -486,7 +496,8 @@ def _subject_rows(trials: list[dict], facts: dict, res: InitResult) -> list[dict
 
 
 def _study_yaml(trials: list[dict], files: list[Found], res: InitResult,
-                external: dict | None = None, bag_lines: list[str] = ()) -> str:
+                external: dict | None = None, bag_lines: list[str] = (),
+                detections: dict | None = None) -> str:
     """study.yaml: the MTST target layouts when every MTST trial has one in one folder;
     the rollator's sensor mount as a key to fill in; the external trackers' track files as
     ``external_methods:`` (:func:`_external_methods`), a tracker recorded in the sensor
@@ -517,6 +528,8 @@ def _study_yaml(trials: list[dict], files: list[Found], res: InitResult,
                      "(default 0.05 m)")
     if external:
         doc["external_methods"] = external
+    if detections:
+        doc["external_detections"] = detections
     body = yaml.safe_dump(doc, sort_keys=True) if doc else ""
     tail = []
     if bag_lines:
@@ -534,7 +547,7 @@ def _study_yaml(trials: list[dict], files: list[Found], res: InitResult,
 
 
 def _external_todo(yaml_path: Path, external: dict, bag_lines: list[str],
-                   res: InitResult) -> None:
+                   res: InitResult, detections: dict | None = None) -> None:
     """A study.yaml init-study keeps (the user's): the external methods it found and the
     file does not declare, as entries for the user to add (the file is not rewritten)."""
     try:
@@ -549,6 +562,44 @@ def _external_todo(yaml_path: Path, external: dict, bag_lines: list[str],
     for line in bag_lines:
         res.todo.append(f"study.yaml (kept): a tracker in the sensor bags, to add under "
                         f"external_methods: with its legs filled in: {line.lstrip('# ')}")
+    have = (doc.get("external_detections") or {}) if isinstance(doc, dict) else {}
+    for name, entry in (detections or {}).items():
+        if name not in have:
+            res.todo.append(f"study.yaml (kept): add under external_detections: {name}: "
+                            f"{yaml.safe_dump(entry, default_flow_style=True).strip()}")
+
+
+def _bag_detections(trials: list[dict], bag_detectors: dict[str, list[str]],
+                    res: InitResult, yaml_path: Path) -> dict:
+    """leg_tracker's leg detections (``LegArray``) recorded in the sensor bags: one
+    ``external_detections:`` entry per topic whose bags are the trials' sensor bags, named
+    by trial id in one folder (the TUG and MTST trials'; nothing for the user to fill in:
+    detections have no legs to map), each checked against the schema."""
+    from gaitval.configcheck import check_study_file
+
+    out = {}
+    by_file = {r["sensor_file"]: r["trial"] for r in trials}
+    for topic, bags in sorted(bag_detectors.items()):
+        dirs = {str(Path(b).parent) for b in bags}
+        if len(dirs) != 1 or not all(Path(b).stem == by_file.get(b) for b in bags):
+            continue
+        d = dirs.pop()
+        protos = sorted({r.get("protocol") for r in trials if r["sensor_file"] in bags}
+                        & {"tug", "mtst"})
+        if not protos:
+            continue
+        name = "det_" + (_ID_BAD.sub("_", topic.strip("/")) or "bag")
+        entry = {"path": f"{d}/{{trial}}.bag" if d != "." else "{trial}.bag",
+                 "topic": topic, "protocols": protos}
+        try:
+            check_study_file({"external_detections": {name: entry}}, yaml_path)
+        except GaitvalError as exc:
+            res.todo.append(f"study.yaml external_detections.{name}: {exc}")
+            continue
+        out[name] = entry
+        res.notes.append(f"study.yaml external_detections.{name}: leg detections "
+                         f"{topic} of the sensor bags, scored in the detection table")
+    return out
 
 
 def _external_methods(trials: list[dict], files: list[Found], res: InitResult,

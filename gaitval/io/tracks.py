@@ -58,20 +58,21 @@ def _err(path, problem: str, trial=None, hint=None) -> FileFormatError:
     return FileFormatError(problem, path=path, trial=trial, hint=hint)
 
 
-def _check_meta(meta: dict, path, trial, lines: dict | None = None) -> dict:
+def _check_meta(meta: dict, path, trial, lines: dict | None = None, *, fmt: str = FORMAT,
+                meta_key: bytes = META_KEY) -> dict:
     """The header, checked: format, version, units, frame, clock (each named when wrong,
     with its line of a CSV: ``lines``, key -> line number, and ``lines[None]`` the last
     header line; else the Parquet schema metadata)."""
     def at(key):
         if lines is None:
-            return f" (schema metadata {META_KEY.decode()!r})"
+            return f" (schema metadata {meta_key.decode()!r})"
         if key in lines:
             return f" (line {lines[key]})"
         return f" (no '# {key}: ...' line among header lines 1-{lines.get(None, 1)})"
 
-    if meta.get("format") != FORMAT:
-        raise _err(path, f"header field 'format' is {meta.get('format')!r}, not {FORMAT!r}",
-                   trial, hint="the first line of a CSV is '# gaitval-tracks v1'")
+    if meta.get("format") != fmt:
+        raise _err(path, f"header field 'format' is {meta.get('format')!r}, not {fmt!r}",
+                   trial, hint=f"the first line of a CSV is '# {fmt} v{VERSION}'")
     v = meta.get("version")
     try:
         ok = float(v) == VERSION
@@ -93,7 +94,8 @@ def _check_meta(meta: dict, path, trial, lines: dict | None = None) -> dict:
     return out
 
 
-def _read_csv(path: Path, trial) -> tuple[dict, list[str], list[list[str]], int, dict]:
+def _read_csv(path: Path, trial, fmt: str = FORMAT
+              ) -> tuple[dict, list[str], list[list[str]], int, dict]:
     """(header, column names, rows as text, file line of the first data row, header
     key -> its line)."""
     try:
@@ -101,10 +103,10 @@ def _read_csv(path: Path, trial) -> tuple[dict, list[str], list[list[str]], int,
     except UnicodeDecodeError as exc:
         raise _err(path, f"not UTF-8 text ({exc.reason} at byte {exc.start})", trial) from None
     lines = text.splitlines()
-    if not lines or lines[0].strip().lower() != f"# {FORMAT} v{VERSION}":
+    if not lines or lines[0].strip().lower() != f"# {fmt} v{VERSION}":
         first = lines[0][:60] if lines else ""
-        raise _err(path, f"line 1 is {first!r}, not '# {FORMAT} v{VERSION}'", trial)
-    meta: dict = {"format": FORMAT, "version": VERSION}
+        raise _err(path, f"line 1 is {first!r}, not '# {fmt} v{VERSION}'", trial)
+    meta: dict = {"format": fmt, "version": VERSION}
     where = {"format": 1, "version": 1}
     n = 1
     while n < len(lines) and lines[n].startswith("#"):
@@ -120,22 +122,23 @@ def _read_csv(path: Path, trial) -> tuple[dict, list[str], list[list[str]], int,
     return meta, [c.strip() for c in rows[0]], rows[1:], n + 2, where
 
 
-def _read_parquet(path: Path, trial) -> tuple[dict, pd.DataFrame]:
+def _read_parquet(path: Path, trial, fmt: str = FORMAT, meta_key: bytes = META_KEY
+                  ) -> tuple[dict, pd.DataFrame]:
     import pyarrow.parquet as pq
     try:
         tab = pq.read_table(path)
     except Exception as exc:                        # noqa: BLE001 - any unreadable file
         raise _err(path, f"not a readable Parquet file ({exc})", trial) from None
-    raw = (tab.schema.metadata or {}).get(META_KEY)
+    raw = (tab.schema.metadata or {}).get(meta_key)
     if raw is None:
-        raise _err(path, f"no schema metadata key {META_KEY.decode()!r}: not a "
-                   f"{FORMAT} file", trial)
+        raise _err(path, f"no schema metadata key {meta_key.decode()!r}: not a "
+                   f"{fmt} file", trial)
     try:
         meta = json.loads(raw)
     except ValueError:
-        raise _err(path, f"schema metadata {META_KEY.decode()!r} is not JSON", trial) from None
+        raise _err(path, f"schema metadata {meta_key.decode()!r} is not JSON", trial) from None
     if not isinstance(meta, dict):
-        raise _err(path, f"schema metadata {META_KEY.decode()!r} is not a JSON object", trial)
+        raise _err(path, f"schema metadata {meta_key.decode()!r} is not a JSON object", trial)
     return meta, tab.to_pandas()
 
 
@@ -791,3 +794,202 @@ def people_to_legs(rows: pd.DataFrame, legs: dict, *, path=None, trial: str | No
     first = rows.drop_duplicates("t_s").set_index("t_s")["msg"]
     out["msg"] = out["t_s"].map(first).to_numpy(np.int64)     # the message of each time
     return out[["t_s", "side", "x_m", "y_m", "msg"]]
+
+
+# -- leg detections without identity (issue 37; docs/formats.md, "Leg detections") ------
+DET_FORMAT = "gaitval-detections"
+DET_META_KEY = b"gaitval:detections"
+#: the columns of a detections file (required: t_s, x, y)
+DET_COLUMNS = ("t_s", "x", "y", "confidence")
+
+
+def read_detections(path: str | Path, *, trial: str | None = None
+                    ) -> tuple[pd.DataFrame, dict]:
+    """Read a ``*.detections.csv`` or ``*.detections.parquet`` file: per scan, the legs a
+    detector found, without identity or side (leg_tracker's ``LegArray`` as a file).
+
+    One row per detection; a scan in which the detector ran and found no leg is one row
+    with ``x``, ``y`` empty (it is scored as a scan with both legs missed).  The header is
+    that of the track format (``units``, ``frame``, ``clock``), with the first line
+    ``# gaitval-detections v1`` (Parquet: schema metadata key ``gaitval:detections``).
+
+    Returns
+    -------
+    (DataFrame, dict)
+        Rows ``t_s, msg, x_m, y_m`` (and ``confidence`` when given): one per detection,
+        in metres, on the header's clock and frame; ``msg`` numbers the file's distinct
+        time stamps (1-based); and the header with ``source`` (default: the file name),
+        ``n_messages`` and ``t_messages`` (every time stamp, detections or not) — the shape
+        of :func:`read_bag_leg_detections`'s result.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file, the field or column and the line (CSV) or data row (Parquet): a
+        wrong first line, version, units, frame or clock, a missing or unknown column, a
+        non-number, one of ``x``, ``y`` empty without the other, no rows.
+    """
+    p = Path(path)
+    if not p.exists():
+        raise _err(p, "no such file", trial)
+    if p.suffix == ".csv":
+        meta, names, rows_txt, first_line, meta_lines = _read_csv(p, trial, DET_FORMAT)
+        for j, r in enumerate(rows_txt):
+            if len(r) != len(names):
+                raise _err(p, f"line {first_line + j}: {len(r)} cells, the header has "
+                           f"{len(names)}", trial)
+        cols = {n: [r[i] for r in rows_txt] for i, n in enumerate(names)}
+
+        def where(i):
+            return f"line {first_line + i}"
+    elif p.suffix == ".parquet":
+        meta, df = _read_parquet(p, trial, DET_FORMAT, DET_META_KEY)
+        meta_lines, first_line = None, 1
+        names = list(df.columns)
+        cols = {n: df[n].tolist() for n in names}
+
+        def where(i):
+            return f"row {i + 1}"
+    else:
+        raise _err(p, f"unknown extension {p.suffix!r}", trial,
+                   hint="a detections file is *.detections.csv or *.detections.parquet")
+    meta = _check_meta(meta, p, trial, meta_lines, fmt=DET_FORMAT, meta_key=DET_META_KEY)
+    unknown = [n for n in names if n not in DET_COLUMNS]
+    if unknown:
+        raise _err(p, f"unknown column(s) {', '.join(map(repr, unknown))}", trial,
+                   hint=f"the columns are {', '.join(DET_COLUMNS)} (detections have no "
+                        "side or person: a file with legs' identities is a track file)")
+    for c in ("t_s", "x", "y"):
+        if c not in names:
+            raise _err(p, f"column {c!r} is missing", trial)
+    if not cols["t_s"]:
+        raise _err(p, "no rows", trial)
+    scale = UNITS[meta["units"]]
+    t = _floats(p, "t_s", cols["t_s"], where, trial, finite=True)
+    x = _floats(p, "x", cols["x"], where, trial, finite=False) * scale
+    y = _floats(p, "y", cols["y"], where, trial, finite=False) * scale
+    half = np.isnan(x) != np.isnan(y)
+    if half.any():
+        i = int(np.flatnonzero(half)[0])
+        raise _err(p, f"{where(i)}: one of 'x', 'y' is empty and the other not (both "
+                   "empty: a scan without a detection)", trial)
+    inf = np.isinf(x) | np.isinf(y)
+    if inf.any():
+        i = int(np.flatnonzero(inf)[0])
+        raise _err(p, f"{where(i)}: a non-finite position", trial)
+    stamps = np.unique(t)
+    out = pd.DataFrame({"t_s": t, "msg": np.searchsorted(stamps, t) + 1, "x_m": x, "y_m": y})
+    if "confidence" in names:
+        out["confidence"] = _floats(p, "confidence", cols["confidence"], where, trial,
+                                    finite=False)
+    out["_row"] = np.arange(len(out)) + first_line
+    out = out[np.isfinite(out["x_m"].to_numpy())].reset_index(drop=True)
+    meta = {**meta, "source": str(meta.get("source") or p.name),
+            "n_messages": int(len(stamps)), "t_messages": [float(v) for v in stamps],
+            "_row": ("line" if meta_lines is not None else "row", first_line)}
+    return out, meta
+
+
+def write_detections(rows: pd.DataFrame, path: str | Path, *, units: str = "m",
+                     frame: str = "sensor", clock: str = "sensor", **extra) -> Path:
+    """Write detection rows (``t_s, x, y[, confidence]``, positions in ``units``; a scan
+    without a detection a row with ``x``, ``y`` NaN) as ``*.detections.csv`` or
+    ``*.detections.parquet``, atomically (CSV floats as their shortest exact text)."""
+    p = Path(path)
+    meta = _check_meta({"format": DET_FORMAT, "version": VERSION, "units": units,
+                        "frame": frame, "clock": clock}, p, None, fmt=DET_FORMAT,
+                       meta_key=DET_META_KEY)
+    meta.update({k: str(v) for k, v in extra.items()})
+    rows = rows[[c for c in DET_COLUMNS if c in rows.columns]].reset_index(drop=True)
+    if p.suffix == ".parquet":
+        write_parquet(rows, p, metadata={DET_META_KEY.decode(): json.dumps(meta,
+                                                                           sort_keys=True)})
+        return p
+    if p.suffix != ".csv":
+        raise _err(p, f"unknown extension {p.suffix!r}", hint="*.detections.csv or "
+                   "*.detections.parquet")
+    head = [f"# {DET_FORMAT} v{VERSION}"] + [f"# {k}: {v}" for k, v in meta.items()
+                                              if k not in ("format", "version")]
+    body = rows.copy()
+    for c in body.columns:
+        body[c] = ["" if math.isnan(v) else repr(float(v)) for v in body[c].to_numpy(float)]
+    write_bytes(p, ("\n".join(head) + "\n" + body.to_csv(index=False, lineterminator="\n")
+                    ).encode("utf-8"))
+    return p
+
+
+def detections_to_sensor(det: pd.DataFrame, meta: dict, registration: dict | None = None,
+                         *, path=None, trial: str | None = None,
+                         scan_t: np.ndarray | None = None, tolerance_s: float = 0.0,
+                         max_range_m: float | None = None) -> tuple[pd.DataFrame, list]:
+    """Detections (:func:`read_detections` or :func:`read_bag_leg_detections`) on the
+    sensor clock in the laser frame, as :func:`tracks_to_sensor` converts tracks: with
+    ``clock: mocap`` ``t_sensor = clock_offset_s + (1 + clock_drift_ppm 1e-6) t``, with
+    ``frame: mocap`` ``p_s = R(-yaw) (p - [x, y])`` (the trial's ``registration``); a
+    time within 1 µs of a scan's (``scan_t``) becomes that scan's.  With ``scan_t`` a time
+    stamp outside the recording (± ``tolerance_s``) is an error naming its row; with
+    ``max_range_m`` so are positions beyond the laser's range or all at its origin (wrong
+    units or frame).  Returns the rows (``t_s`` now on the sensor clock) and every message's
+    time on the sensor clock."""
+    frame, clock = meta.get("frame", "sensor"), meta.get("clock", "sensor")
+    reg = registration or {}
+    need = [f for f, v in (("frame", frame), ("clock", clock)) if v == "mocap"]
+    if need:
+        keys = (["x_m", "y_m", "yaw_rad"] if "frame" in need else []) + \
+            (["clock_offset_s"] if "clock" in need else [])
+        bad = [k for k in keys if reg.get(k) is None or not math.isfinite(float(reg[k]))]
+        if bad:
+            raise _err(path, f"header {' and '.join(need)} 'mocap' needs the trial's "
+                       f"registration ({', '.join(bad)} unknown)", trial)
+    det = det.copy()
+    t, tm = det["t_s"].to_numpy(float), np.asarray(meta["t_messages"], float)
+    if clock == "mocap":
+        drift = 1.0 + float(reg.get("clock_drift_ppm") or 0.0) * 1e-6
+        t, tm = float(reg["clock_offset_s"]) + drift * t, float(reg["clock_offset_s"]) + drift * tm
+    if scan_t is not None and len(scan_t):
+        t, tm = snap_to_scans(t, scan_t), snap_to_scans(tm, scan_t)
+        lo, hi = float(np.min(scan_t)) - tolerance_s, float(np.max(scan_t)) + tolerance_s
+        out_of = (tm < lo) | (tm > hi)
+        if out_of.any():
+            i = int(np.flatnonzero(out_of)[0])
+            raise _err(path, f"time stamp {float(meta['t_messages'][i])!r} s ({clock} clock; "
+                       f"{tm[i]:.4f} s on the sensor clock) is outside the recording "
+                       f"({lo + tolerance_s:.4f} to {hi - tolerance_s:.4f} s on the sensor "
+                       f"clock), as are {int(out_of.sum())} of {len(tm)} time stamps", trial,
+                       hint="check the header's clock and the trial's clock offset")
+    x, y = det["x_m"].to_numpy(float), det["y_m"].to_numpy(float)
+    if frame == "mocap":
+        c, s = math.cos(float(reg["yaw_rad"])), math.sin(float(reg["yaw_rad"]))
+        dx, dy = x - float(reg["x_m"]), y - float(reg["y_m"])
+        x, y = c * dx + s * dy, -s * dx + c * dy
+    det["t_s"], det["x_m"], det["y_m"] = t, x, y
+    if max_range_m is not None and len(det):
+        _check_detection_distances(det, meta, x, y, float(max_range_m), path, trial)
+    return det.drop(columns=["_row"], errors="ignore"), [float(v) for v in tm]
+
+
+def _check_detection_distances(det, meta, x, y, max_range_m, path, trial) -> None:
+    """As :func:`_check_distances` for tracks: most detections beyond the laser's range
+    (+ :data:`RANGE_MARGIN_M`), or all within :data:`MIN_DISTANCE_M` of it, are wrong
+    units or frame; the error names the first such detection's line (file) or message
+    (bag)."""
+    d = np.hypot(x, y)
+    head = f"header units {meta.get('units', 'm')!r}, frame {meta.get('frame', 'sensor')!r}"
+
+    def at(i):
+        if "_row" in det:
+            return f"{meta.get('_row', ('line', 0))[0]} {int(det['_row'].iloc[i])}"
+        return f"{meta.get('source', 'topic')}, message {int(det['msg'].iloc[i])}"
+
+    far = d > max_range_m + RANGE_MARGIN_M
+    if np.median(d) > max_range_m + RANGE_MARGIN_M:
+        i = int(np.flatnonzero(far)[0])
+        raise _err(path, f"{at(i)}: detection ({x[i]:.6g}, {y[i]:.6g}) m (laser frame) is "
+                   f"{d[i]:.1f} m from the laser, beyond its range ({max_range_m:g} m), as "
+                   f"are {int(far.sum())} of {len(d)} detections ({head})", trial,
+                   hint="positions in millimetres need 'units: mm'; positions in the "
+                        "mocap field need 'frame: mocap'")
+    if d.max() < MIN_DISTANCE_M:
+        raise _err(path, f"{at(0)}: every detection lies within {MIN_DISTANCE_M * 100:g} cm "
+                   f"of the laser (largest {d.max():.3g} m; {head})", trial,
+                   hint="positions in metres need 'units: m'")

@@ -84,11 +84,11 @@ def analysis_config(config: dict, sheet: str | Path, *, check: bool = False) -> 
         if check:
             check_study_file(study, cal)
         cfg = deep_merge(cfg, {k: v for k, v in study.items() if k in ANALYSIS_SECTIONS})
-        if study.get("external_methods"):     # the study's own external methods (issue 37)
-            tracking = cfg.setdefault("tracking", {})
-            tracking["external"] = {**(tracking.get("external") or {}),
-                                    **study["external_methods"]}
         cfg["calibration_file"] = str(cal)
+    own = study_external(sheet)     # the study's own external methods (issue 37): its
+    if own:                         # study.yaml's and external.yaml's
+        tracking = cfg.setdefault("tracking", {})
+        tracking["external"] = {**(tracking.get("external") or {}), **own}
     return cfg
 
 
@@ -575,49 +575,97 @@ def export_tracks_step(track_parquet, out, units: str = "m", topic: str | None =
     return write_tracks(rows, out, units=units, **src)
 
 
-def external_track_path(sheet, entry: dict, trial: str, method: str = "") -> Path:
+def external_track_path(sheet, entry: dict, trial: str, method: str = "",
+                        field: str | None = None) -> Path:
     """The external track file of one trial: ``entry["path"]`` relative to the trial
     sheet's folder, ``{trial}`` replaced by the trial id.  Like the sheet's own paths it
     must stay inside that folder unless the study.yaml beside the sheet sets
-    ``allow_outside_paths: true``."""
+    ``allow_outside_paths: true``.  ``field`` names the entry in the error (default
+    ``tracking.external.<method>.path``)."""
     from gaitval.io.trialsheet import _allows_outside
 
     base = Path(sheet).parent
     path = base / str(entry["path"]).replace("{trial}", trial)
     if not path.resolve().is_relative_to(base.resolve()) and not _allows_outside(Path(sheet)):
-        raise ConfigError(f"tracking.external.{method}.path: {str(path)!r} (trial {trial}) "
-                          f"leads outside the trial sheet's folder {base}",
-                          hint="put the track files beside the sheet, or set "
+        raise ConfigError(f"{field or f'tracking.external.{method}.path'}: {str(path)!r} "
+                          f"(trial {trial}) leads outside the trial sheet's folder {base}",
+                          hint="put the files beside the sheet, or set "
                                "allow_outside_paths: true in the study.yaml beside it")
     return path
 
 
 EXTERNAL_PROTOCOLS = ("tug", "mtst")
+#: the protocols an external detector's entry covers by default (a fixed laser; the
+#: ground truth of these families is in the laser's frame on its clock)
+DETECTION_PROTOCOLS = ("tug", "mtst")
+#: a study's own declarations beside its trial sheet: study.yaml (written by the
+#: simulator for a simulated study) and this side file, which gaitval never writes
+#: (a simulated study's external methods and detectors, declared before its first run)
+STUDY_SIDE_FILE = "external.yaml"
+#: the keys a study declares external trackers and detectors under
+DECLARATION_KEYS = ("external_methods", "external_detections")
 
 
-def study_external(sheet) -> dict:
-    """``external_methods:`` of the ``study.yaml`` beside a trial sheet: the study's own
-    external methods, method name -> entry as in ``tracking.external`` ({} without)."""
-    cal = Path(sheet).parent / "study.yaml"
-    if not cal.is_file():
-        return {}
-    with open(cal, encoding="utf-8") as fh:
-        doc = yaml.safe_load(fh) or {}
-    return dict((doc.get("external_methods") or {}) if isinstance(doc, dict) else {})
+def _declared(sheet, key: str) -> dict:
+    """``key`` (:data:`DECLARATION_KEYS`) of the ``study.yaml`` and the
+    :data:`STUDY_SIDE_FILE` beside a trial sheet: name -> (entry, the file declaring it).
+    A name declared in both files is an error naming both."""
+    from gaitval.configcheck import display_path
+
+    out: dict = {}
+    for f in (Path(sheet).parent / "study.yaml", Path(sheet).parent / STUDY_SIDE_FILE):
+        if not f.is_file():
+            continue
+        with open(f, encoding="utf-8") as fh:
+            doc = yaml.safe_load(fh) or {}
+        entries = (doc.get(key) or {}) if isinstance(doc, dict) else {}
+        for m, e in (entries.items() if isinstance(entries, dict) else ()):
+            if m in out:
+                raise ConfigError(f"[file {display_path(f)}] {key}.{m}: {m!r} is also "
+                                  f"declared in {display_path(out[m][1])}; declare it in "
+                                  "one place")
+            out[m] = (e, f)
+    return out
 
 
-def external_declarations(config_external: dict | None, sheets: dict, taken) -> dict:
+def study_external(sheet, key: str = "external_methods") -> dict:
+    """``external_methods:`` (or another of :data:`DECLARATION_KEYS`) of the study's
+    ``study.yaml`` and its :data:`STUDY_SIDE_FILE` beside a trial sheet: the study's own
+    entries, name -> entry as in ``tracking.external`` ({} without)."""
+    return {m: e for m, (e, _) in _declared(sheet, key).items()}
+
+
+def study_side_problems(sheet, schema: dict | None = None) -> None:
+    """The :data:`STUDY_SIDE_FILE` beside a trial sheet, when there, against the config
+    schema's ``$defs/external_file`` (only :data:`DECLARATION_KEYS`), raising one
+    ConfigError naming the file and key."""
+    from gaitval.configcheck import check_study_file
+
+    f = Path(sheet).parent / STUDY_SIDE_FILE
+    if f.is_file():
+        with open(f, encoding="utf-8") as fh:
+            doc = yaml.safe_load(fh)
+        check_study_file({} if doc is None else doc, f, schema=schema,
+                         definition="external_file")
+
+
+def external_declarations(config_external: dict | None, sheets: dict, taken,
+                          key: str = "external_methods",
+                          protocols: tuple = EXTERNAL_PROTOCOLS) -> dict:
     """Each study's external methods: ``tracking.external`` of the workflow config (every
-    study of ``run``) and ``external_methods:`` of the study's own ``study.yaml``.
+    study of ``run``) and ``external_methods:`` of the study's own ``study.yaml`` or
+    :data:`STUDY_SIDE_FILE`; with ``key="external_detections"`` (and no config entries)
+    its external leg detectors alike.
 
     ``sheets``: study -> its trial sheet's path (the study.yaml beside it need not exist
     yet: a simulated study before its simulation); ``taken``: the names of gaitval's own
-    methods.  Returns ``{study: {method: entry}}``.
+    methods (and, for detectors, of the external methods).  Returns
+    ``{study: {method: entry}}``.
 
     Raises
     ------
     ConfigError
-        Naming the study.yaml and key: a name that is already a method or also declared in
+        Naming the file and key: a name that is already a method or also declared in
         the workflow config; a name declared by some studies of ``run`` and not by
         another, or with other ``protocols`` there (the tables pool the studies of
         ``run``, one row per method, so every study needs the method's files).
@@ -625,15 +673,23 @@ def external_declarations(config_external: dict | None, sheets: dict, taken) -> 
     from gaitval.configcheck import display_path
 
     config_external = dict(config_external or {})
-    own = {s: study_external(sheet) for s, sheet in sheets.items()}
-    where = {s: display_path(Path(sheets[s]).parent / "study.yaml") for s in sheets}
+    decl = {s: _declared(sheet, key) for s, sheet in sheets.items()}
+    own = {s: {m: e for m, (e, _) in d.items()} for s, d in decl.items()}
+    cal = {s: display_path(Path(sheets[s]).parent / "study.yaml") for s in sheets}
+
+    def where(s, m):
+        return display_path(decl[s][m][1]) if m in decl[s] else cal[s]
+
     for s, entries in own.items():
         for m in entries:
             if m in taken:
-                raise ConfigError(f"[file {where[s]}] external_methods.{m}: {m!r} is already "
-                                  "a tracking method; give the external tracker another name")
+                what = ("a tracking method; give the external tracker" if
+                        key == "external_methods" else
+                        "a method name; give the external detector")
+                raise ConfigError(f"[file {where(s, m)}] {key}.{m}: {m!r} is already "
+                                  f"{what} another name")
             if m in config_external:
-                raise ConfigError(f"[file {where[s]}] external_methods.{m}: {m!r} is also "
+                raise ConfigError(f"[file {where(s, m)}] {key}.{m}: {m!r} is also "
                                   "declared in the workflow config (tracking.external); "
                                   "declare it in one place")
     names = sorted({m for entries in own.values() for m in entries})
@@ -642,87 +698,175 @@ def external_declarations(config_external: dict | None, sheets: dict, taken) -> 
         lack = [s for s in sheets if m not in own[s]]
         if lack:
             raise ConfigError(
-                f"[file {where[have[0]]}] external_methods.{m}: study {lack[0]!r} of run "
-                f"{list(sheets)} does not declare it (its study.yaml: {where[lack[0]]})",
+                f"[file {where(have[0], m)}] {key}.{m}: study {lack[0]!r} of run "
+                f"{list(sheets)} does not declare it (its study.yaml: {cal[lack[0]]})",
                 hint="the tables pool the studies of run, one row per method: declare it "
-                     "in every study's study.yaml, or run the study alone")
-        prot = {s: sorted(own[s][m].get("protocols") or EXTERNAL_PROTOCOLS) for s in have}
+                     f"in every study's study.yaml or {STUDY_SIDE_FILE}, or run the study "
+                     "alone")
+        prot = {s: sorted(own[s][m].get("protocols") or protocols) for s in have}
         if len({tuple(v) for v in prot.values()}) > 1:
-            raise ConfigError(f"[file {where[have[1]]}] external_methods.{m}.protocols: "
+            raise ConfigError(f"[file {where(have[1], m)}] {key}.{m}.protocols: "
                               f"{prot[have[1]]} here, {prot[have[0]]} in "
-                              f"{where[have[0]]}; one method tracks the same protocols "
+                              f"{where(have[0], m)}; one method covers the same protocols "
                               "in every study of run")
     return {s: {**config_external, **own[s]} for s in sheets}
 
 
-def missing_external_files(sheet, entries: dict, source: str = "") -> None:
+def _entry_trials(df: pd.DataFrame, prots, mocap_only: bool) -> list[str]:
+    """The trials of a sheet (``trial, protocol[, mocap_path]`` as text) of ``prots``;
+    with ``mocap_only`` those with a mocap file (a detector is scored against it)."""
+    keep = df["protocol"].str.strip().isin(prots)
+    if mocap_only and "mocap_path" in df:
+        keep &= df["mocap_path"].str.strip() != ""
+    return sorted(df.loc[keep, "trial"].str.strip())
+
+
+def _sheet_trials(sheet) -> pd.DataFrame | None:
+    try:
+        return pd.read_csv(sheet, usecols=lambda c: c in ("trial", "protocol", "mocap_path"),
+                           dtype=str, keep_default_na=False)
+    except (OSError, ValueError):
+        return None
+
+
+def missing_external_files(sheet, entries: dict, source: str = "", *,
+                           protocols: tuple = EXTERNAL_PROTOCOLS,
+                           what: str = "track files", key: str | None = None,
+                           mocap_only: bool = False) -> None:
     """Check, before any job runs, that every trial of each external method's protocols
     has its file, inside the sheet's folder (:func:`external_track_path`).  A sheet that
     cannot be read yet (a simulated study before its simulation; a broken sheet, which its
-    own check reports) is skipped.
+    own check reports) is skipped.  ``protocols``: an entry's default; ``what``: the files'
+    name in the message; ``key``: the declaration key, named when a path leads outside;
+    ``mocap_only``: only the trials with a mocap file (an external detector's).
 
     Raises
     ------
     ConfigError
         One message per method naming where it is declared, how many files are missing
         and the first few of them."""
-    try:
-        df = pd.read_csv(sheet, usecols=["trial", "protocol"], dtype=str,
-                         keep_default_na=False)
-    except (OSError, ValueError):
+    df = _sheet_trials(sheet)
+    if df is None or not {"trial", "protocol"} <= set(df.columns):
         return
     for m, entry in entries.items():
-        prots = (entry or {}).get("protocols") or EXTERNAL_PROTOCOLS
-        trials = sorted(df.loc[df["protocol"].str.strip().isin(prots), "trial"].str.strip())
-        paths = [external_track_path(sheet, entry, t, m) for t in trials]
+        prots = (entry or {}).get("protocols") or protocols
+        trials = _entry_trials(df, prots, mocap_only)
+        paths = [external_track_path(sheet, entry, t, m,
+                                     field=f"{key}.{m}.path" if key else None)
+                 for t in trials]
         missing = [p for p in paths if not p.exists()]
         if missing:
             shown = ", ".join(str(p) for p in missing[:3])
             raise ConfigError(
                 f"{source or 'external method'} {m}: {len(missing)} of {len(paths)} "
-                f"trials' track files are missing ({shown}"
+                f"trials' {what} are missing ({shown}"
                 f"{', ...' if len(missing) > 3 else ''})",
                 hint=f"path {entry['path']!r} is relative to the trial sheet's folder "
                      f"{Path(sheet).parent}; every trial of {', '.join(prots)} needs its "
                      "file")
 
 
+def detection_topic_problems(sheet, entries: dict, source: str = "") -> None:
+    """Each external detector's bags (the trials with mocap of its protocols) opened
+    before any job
+    runs: its ``topic`` (or, without one, exactly one ``leg_tracker/LegArray`` topic) must
+    be in every bag and be a ``LegArray``.  Files that are no bag are read by the job
+    (their header and rows; ``gaitval validate --deep`` reads them first).  Skipped, like
+    :func:`missing_external_files`, while the sheet cannot be read.
+
+    Raises
+    ------
+    ConfigError
+        Naming where the detector is declared, the bag, and the topics it has."""
+    from gaitval.io.rosbag import _norm, is_rosbag
+    from gaitval.io.tracks import BAG_LEG_DETECTIONS
+
+    df = _sheet_trials(sheet)
+    if df is None or not {"trial", "protocol"} <= set(df.columns):
+        return
+    for m, entry in entries.items():
+        prots = (entry or {}).get("protocols") or DETECTION_PROTOCOLS
+        topic = (entry or {}).get("topic")
+        for t in _entry_trials(df, prots, mocap_only=True):
+            path = external_track_path(sheet, entry, t, m,
+                                       field=f"external_detections.{m}.path")
+            if not is_rosbag(path):
+                continue
+            from rosbags.highlevel import AnyReader
+            try:
+                with AnyReader([path]) as r:
+                    have = {c.topic: c.msgtype for c in r.connections}
+            except Exception as exc:          # noqa: BLE001 - any unreadable bag
+                raise ConfigError(f"{source} {m}: trial {t}: {path} is not a readable ROS "
+                                  f"bag ({type(exc).__name__}: {exc})") from None
+            if topic:
+                got = {k: v for k, v in have.items() if _norm(k) == _norm(str(topic))}
+                if not got:
+                    raise ConfigError(f"{source} {m}.topic: {topic!r} is not in {path} "
+                                      f"(trial {t}); its topics: {sorted(have)}")
+                bad = [v for v in got.values() if v != BAG_LEG_DETECTIONS]
+                if bad:
+                    raise ConfigError(f"{source} {m}.topic: {topic!r} in {path} (trial "
+                                      f"{t}) holds {bad[0]}, not {BAG_LEG_DETECTIONS}")
+            elif sum(v == BAG_LEG_DETECTIONS for v in have.values()) != 1:
+                raise ConfigError(f"{source} {m}: {path} (trial {t}) has "
+                                  f"{sum(v == BAG_LEG_DETECTIONS for v in have.values())} "
+                                  f"topics of type {BAG_LEG_DETECTIONS}; its topics: "
+                                  f"{sorted(have)}", hint="name the topic (topic: ...)")
+
+
 def external_problems(sheet, deep: bool = False) -> list[str]:
-    """What ``gaitval validate`` reports of the study's own external methods
-    (``external_methods:`` of the study.yaml beside ``sheet``): the entries against the
-    schema, each trial's file present and inside the folder, and with ``deep`` every file
-    read (:func:`read_external`: header, columns, rows, a bag's topic and legs; the clock
-    and frame conversion needs the registration and is checked when the run imports it).
-    One text per problem."""
+    """What ``gaitval validate`` reports of the study's own external methods and leg
+    detectors (``external_methods:``, ``external_detections:`` of the study.yaml or
+    :data:`STUDY_SIDE_FILE` beside ``sheet``): the entries against the schema, each
+    trial's file present and inside the folder (a detector's bags: its topic), and with
+    ``deep`` every file read (:func:`read_external`, :func:`read_external_detections`:
+    header, columns, rows, a bag's topic and legs; the clock and frame conversion needs the
+    registration and is checked when the run imports it).  One text per problem."""
     from gaitval.configcheck import check_study_file
 
-    cal = Path(sheet).parent / "study.yaml"
-    try:
-        entries = study_external(sheet)
-        if not entries:
-            return []
-        check_study_file({"external_methods": entries}, cal)
-    except GaitvalError as exc:
-        return [str(exc)]
-    except (OSError, yaml.YAMLError) as exc:
-        return [f"[file {cal}] cannot be read: {exc}"]
     out = []
-    for m, entry in entries.items():
+    for key, check, default in (("external_methods", "external_method", EXTERNAL_PROTOCOLS),
+                                ("external_detections", "external_detection",
+                                 DETECTION_PROTOCOLS)):
         try:
-            missing_external_files(sheet, {m: entry}, f"[file {cal}] external_methods")
+            decl = _declared(sheet, key)
+            if not decl:
+                continue
+            study_side_problems(sheet)
+            for m, (entry, f) in decl.items():
+                check_study_file({key: {m: entry}}, f)
         except GaitvalError as exc:
             out.append(str(exc))
             continue
-        if not deep:
+        except (OSError, yaml.YAMLError) as exc:
+            out.append(f"[file {Path(sheet).parent}] {key} cannot be read: {exc}")
             continue
-        df = pd.read_csv(sheet, usecols=["trial", "protocol"], dtype=str,
-                         keep_default_na=False)
-        prots = entry.get("protocols") or EXTERNAL_PROTOCOLS
-        for t in sorted(df.loc[df["protocol"].str.strip().isin(prots), "trial"].str.strip()):
+        for m, (entry, f) in decl.items():
             try:
-                read_external(external_track_path(sheet, entry, t, m), entry, t)
+                missing_external_files(sheet, {m: entry}, f"[file {f}] {key}",
+                                       protocols=default, key=key,
+                                       what="track files" if key == "external_methods"
+                                       else "detection files",
+                                       mocap_only=key == "external_detections")
+                if key == "external_detections":
+                    detection_topic_problems(sheet, {m: entry}, f"[file {f}] {key}")
             except GaitvalError as exc:
-                out.append(f"external_methods.{m}: {exc}")
+                out.append(str(exc))
+                continue
+            if not deep:
+                continue
+            df = _sheet_trials(sheet)
+            prots = entry.get("protocols") or default
+            for t in _entry_trials(df, prots, key == "external_detections"):
+                try:
+                    path = external_track_path(sheet, entry, t, m)
+                    if key == "external_methods":
+                        read_external(path, entry, t)
+                    else:
+                        read_external_detections(path, entry.get("topic"), t)
+                except GaitvalError as exc:
+                    out.append(f"{key}.{m}: {exc}")
     return out
 
 
@@ -751,26 +895,75 @@ def read_external(tracks_file, entry: dict, trial: str) -> tuple[pd.DataFrame, d
                           topic=meta["source"]), meta
 
 
-def leg_detections_step(bag, groundtruth_parquet, out_dir, *, topic: str | None = None,
-                        trial: str | None = None, gate_m: float = 0.30) -> dict:
-    """leg_tracker's leg detections (``leg_tracker/LegArray``) of one trial's bag scored
-    against the trial's mocap legs (:func:`gaitval.evaluate.leg_detections.
-    detection_statistics`); writes ``per_scan.parquet`` and ``summary.json`` into
-    ``out_dir`` (atomically) and returns the summary.  The bag's stamps must be on the
-    ground truth's sensor clock (the clock of the scans registered)."""
-    from gaitval.evaluate.leg_detections import detection_statistics
-    from gaitval.io.tracks import read_bag_leg_detections
+def read_external_detections(path, topic: str | None = None, trial: str | None = None
+                             ) -> tuple[pd.DataFrame, dict]:
+    """A detector's leg detections of one trial: a ROS bag's ``leg_tracker/LegArray``
+    topic (:func:`gaitval.io.tracks.read_bag_leg_detections`) or a
+    ``*.detections.csv``/``.parquet`` (:func:`gaitval.io.tracks.read_detections`)."""
+    from gaitval.io.rosbag import is_rosbag
+    from gaitval.io.tracks import read_bag_leg_detections, read_detections
 
-    det, meta = read_bag_leg_detections(bag, topic, trial=trial)
-    truth = read_parquet(groundtruth_parquet)
-    per_scan, summary = detection_statistics(det, meta["t_messages"], truth, gate_m)
-    if not summary["n_scans"]:
-        raise FileFormatError(f"no message of {meta['source']} is at a scan time of the "
-                              "ground truth with both legs known (no scan to score)",
-                              path=bag, trial=trial, hint="the detections' header.stamp "
-                              "must be the scans' stamps, on the registered sensor clock")
-    summary = {"trial": trial, "source": meta["source"], **summary}
+    if is_rosbag(path):
+        return read_bag_leg_detections(path, topic, trial=trial)
+    return read_detections(path, trial=trial)
+
+
+def leg_detections_step(detections, groundtruth_parquet, out_dir, *, topic: str | None = None,
+                        trial: str | None = None, gate_m: float = 0.30,
+                        registration_json=None, sensor_parquet=None,
+                        method: str | None = None, protocol: str | None = None) -> dict:
+    """A detector's leg detections of one trial (leg_tracker's ``leg_tracker/LegArray``
+    in a bag, or a ``*.detections.csv``/``.parquet``; no identity, no side) scored against
+    the trial's mocap legs (:func:`gaitval.evaluate.leg_detections.detection_statistics`);
+    writes ``per_scan.parquet`` and ``summary.json`` into ``out_dir`` (atomically) and
+    returns the summary.  A file on the mocap clock or in the mocap frame is converted with
+    the trial's registration (``registration_json``); with the trial's scan log
+    (``sensor_parquet``) time stamps outside the recording and positions in the wrong
+    units are refused naming the row (:func:`gaitval.io.tracks.detections_to_sensor`).
+    Stamps on the sensor clock must be the scans' (the ground truth's ``t_sensor_s``)."""
+    from gaitval.evaluate.leg_detections import detection_statistics
+    from gaitval.io.tracks import detections_to_sensor
+
+    det, meta = read_external_detections(detections, topic, trial)
+    rec = load_json(registration_json) if registration_json else None
     out = Path(out_dir)
+    if rec is not None and rec.get("status") != "ok":
+        # no mocap legs in the laser's frame: nothing to score (the tracking tables count
+        # such a trial as not registered too)
+        summary = {"trial": trial, "source": meta["source"], "status": "not_registered",
+                   "n_messages": int(meta["n_messages"]), "n_scans": 0, "gate_m": gate_m}
+        summary.update({k: v for k, v in (("method", method), ("protocol", protocol))
+                        if v is not None})
+        write_parquet(pd.DataFrame({"t_sensor_s": pd.Series(dtype=float),
+                                    "side": pd.Series(dtype=object),
+                                    "detected": pd.Series(dtype=bool),
+                                    "dx_m": pd.Series(dtype=float),
+                                    "dy_m": pd.Series(dtype=float),
+                                    "n_false": pd.Series(dtype=np.int64)}),
+                      out / "per_scan.parquet")
+        write_text(out / "summary.json", json.dumps(summary, indent=1, sort_keys=True) + "\n")
+        return summary
+    scan_t, period, rng = None, 0.0, None
+    if sensor_parquet:
+        from gaitval.io.scanlog import read_scanlog
+        scans = read_scanlog(sensor_parquet, trial=trial)
+        scan_t = np.asarray(scans.t, float)
+        period = float(np.median(np.diff(scan_t))) if len(scan_t) > 1 else 0.0
+        rng = float(scans.range_max)
+    det, t_messages = detections_to_sensor(det, meta, rec, path=detections, trial=trial,
+                                           scan_t=scan_t, tolerance_s=period,
+                                           max_range_m=rng)
+    truth = read_parquet(groundtruth_parquet)
+    per_scan, summary = detection_statistics(det, t_messages, truth, gate_m)
+    if not summary["n_scans"]:
+        raise FileFormatError(f"no time stamp of {meta['source']} is a scan time of the "
+                              "ground truth with both legs known (no scan to score)",
+                              path=detections, trial=trial, hint="the detections' time "
+                              "stamps must be the scans' stamps, on the registered sensor "
+                              "clock (or 'clock: mocap' in a detections file's header)")
+    summary = {"trial": trial, "source": meta["source"], "status": "ok", **summary}
+    summary.update({k: v for k, v in (("method", method), ("protocol", protocol))
+                    if v is not None})
     write_parquet(per_scan, out / "per_scan.parquet")
     write_text(out / "summary.json", json.dumps(summary, indent=1, sort_keys=True) + "\n")
     return summary

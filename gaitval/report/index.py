@@ -46,6 +46,8 @@ SECTION_TITLES = {
     "rollator": "Robotic rollator, KF vs PF (Chalvatzaki et al., 2017, seed 002)",
     "ultrasonic": "Ultrasonic foot tracking (Qi et al., Sensors 2014, seed 003)",
     "legbench": "Annotated recordings without mocap: CLEAR-MOT (Leigh et al., ICRA 2015)",
+    "detections": "External leg detectors (no identity): detection rate, RMSE and false "
+                  "detections against the mocap legs",
     "peer": "Worked example: agreement statistics on a peer's published data",
     "sensitivity": "Sensitivity: the verdicts under the twin's alternative free choices "
                    "(python3 run.py sensitivity)",

@@ -310,12 +310,13 @@ def _umask() -> int:
 
 # -- what the workflow hands over -------------------------------------------------------
 def study_input_files(sheet: str | Path, subjects: str | Path, trials) -> list[str]:
-    """The raw files of one study: trial sheet, subject table, ``study.yaml`` beside the
-    sheet, and each trial's mocap, sensor and annotation file (``trials``: the validated
+    """The raw files of one study: trial sheet, subject table, ``study.yaml`` and
+    ``external.yaml`` beside the sheet, and each trial's mocap, sensor and annotation file (``trials``: the validated
     trial sheet, :func:`gaitval.io.trialsheet.load_trial_sheet`)."""
     files = [str(sheet), str(subjects)]
-    if (Path(sheet).parent / "study.yaml").is_file():
-        files.append(str(Path(sheet).parent / "study.yaml"))
+    for name in ("study.yaml", "external.yaml"):   # external.yaml: external trackers and
+        if (Path(sheet).parent / name).is_file():  # detectors (issue 37)
+            files.append(str(Path(sheet).parent / name))
     for col in ("mocap_path", "sensor_path", "annotation_path"):
         if col in trials:
             files += [str(v) for v in trials[col] if isinstance(v, (str, Path)) and str(v)]

@@ -58,6 +58,9 @@ def _check_study_files(schema):
         entry = config["studies"].get(study) or {}
         sheet = Path(entry.get("trial_sheet") or Path(DATA) / study / "trials.csv")
         cal = sheet.parent / "study.yaml"
+        # external.yaml beside it (external methods and detectors; never written by gaitval)
+        from gaitval.pipeline.steps import study_side_problems
+        study_side_problems(sheet, schema=schema)
         if cal.is_file():
             own = load_configfile(str(cal))
             check_study_file(own, cal, schema=schema)
@@ -102,12 +105,48 @@ def _check_external(cfg):
                               "--configfile; docs/formats.md, Leg tracks)")
     per_study = external_declarations(config_external, sheets, names)
     for study, entries in per_study.items():
+        where = declared_in(sheets[study], "external_methods")
         for m, entry in entries.items():
             src = ("tracking.external" if m in config_external else
-                   f"[file {display_path(sheets[study].parent / 'study.yaml')}] "
-                   "external_methods")
-            missing_external_files(sheets[study], {m: entry}, f"study {study}: {src}")
+                   f"[file {where[m]}] external_methods")
+            missing_external_files(sheets[study], {m: entry}, f"study {study}: {src}",
+                                   key=None if m in config_external else "external_methods")
     return per_study
+
+
+def _check_detections(cfg, per_study_methods):
+    """External leg detectors (issue 37): external_detections: of each study's study.yaml
+    or external.yaml, checked as _check_external checks the external methods (a name that
+    is no method nor external method, the same names in every study of run, every trial's
+    file there and inside the study's folder) and each bag's LegArray topic, before any
+    job runs.  Returns {study: {detector: entry}}."""
+    from gaitval.pipeline.steps import (DETECTION_PROTOCOLS, detection_topic_problems,
+                                        external_declarations, missing_external_files)
+
+    names = _method_definitions(cfg)
+    names.update(dict.fromkeys((cfg.get("tug") or {}).get("methods") or []))
+    names.update(dict.fromkeys((cfg.get("mtst") or {}).get("methods") or []))
+    for entries in per_study_methods.values():
+        names.update(dict.fromkeys(entries))
+    sheets = {study: _sheet_of(cfg, study) for study in cfg["run"]}
+    per_study = external_declarations({}, sheets, names, key="external_detections",
+                                      protocols=DETECTION_PROTOCOLS)
+    for study, entries in per_study.items():
+        where = declared_in(sheets[study], "external_detections")
+        for m, entry in entries.items():
+            src = f"study {study}: [file {where[m]}] external_detections"
+            missing_external_files(sheets[study], {m: entry}, src,
+                                   protocols=DETECTION_PROTOCOLS, what="detection files",
+                                   key="external_detections", mocap_only=True)
+            detection_topic_problems(sheets[study], {m: entry}, src)
+    return per_study
+
+
+def declared_in(sheet, key):
+    """name -> the file (study.yaml or external.yaml beside the sheet) declaring it."""
+    from gaitval.pipeline.steps import _declared
+
+    return {m: display_path(f) for m, (_, f) in _declared(sheet, key).items()}
 
 
 DATA = config.get("data_dir", "data")
@@ -126,6 +165,7 @@ try:
                           _method_definitions(config)), _config_layers()))
     _check_study_files(_SCHEMA)
     _EXTERNAL = _check_external(config)
+    _DETECTIONS = _check_detections(config, _EXTERNAL)
 except ConfigError as exc:
     sys.exit(f"ConfigError: {exc}")
 
@@ -484,6 +524,46 @@ def external_tracks_file(wildcards):
     entry = _EXTERNAL[wildcards.study][wildcards.method]
     return str(external_track_path(sheet_path(wildcards.study), entry, wildcards.trial,
                                    wildcards.method))
+
+
+def external_detectors():
+    """The external leg detectors (issue 37): external_detections: of the studies'
+    study.yaml / external.yaml (the same names in every study of run: _check_detections)."""
+    return sorted({m for entries in _DETECTIONS.values() for m in entries})
+
+
+def detection_trials(study, detector):
+    """(trial, protocol) of every trial with mocap of the detector's protocols in the
+    study (a trial without mocap has no legs to score against)."""
+    from gaitval.pipeline.steps import DETECTION_PROTOCOLS
+
+    prots = _DETECTIONS[study][detector].get("protocols") or DETECTION_PROTOCOLS
+    return [(t, p) for p in prots for t in trial_ids(study, [p]) if has_mocap(study, t)]
+
+
+def detection_file(study, detector, trial):
+    """The detector's file of one trial (its path relative to the trial sheet's folder,
+    {trial} replaced)."""
+    from gaitval.pipeline.steps import external_track_path
+
+    return str(external_track_path(sheet_path(study), _DETECTIONS[study][detector], trial,
+                                   detector, field=f"external_detections.{detector}.path"))
+
+
+def external_input_files(study):
+    """The external trackers' and detectors' files of a study's trials (the report's
+    provenance lists them with the study's other raw inputs); a ROS 2 bag folder by its
+    files."""
+    from gaitval.pipeline.steps import EXTERNAL_PROTOCOLS, external_track_path
+
+    out = []
+    for m, e in _EXTERNAL.get(study, {}).items():
+        for t in trial_ids(study, list(e.get("protocols") or EXTERNAL_PROTOCOLS)):
+            out.append(external_track_path(sheet_path(study), e, t, m))
+    out += [Path(detection_file(study, d, t)) for d in _DETECTIONS.get(study, {})
+            for t, _ in detection_trials(study, d)]
+    return [str(f) for p in out for f in (sorted(x for x in p.rglob("*") if x.is_file())
+                                          if p.is_dir() else [p])]
 
 
 def tug_runs():

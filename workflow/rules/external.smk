@@ -43,3 +43,79 @@ rule rollator_track_external:
              for t, tracks in zip(params.trials, input.tracks)],
             threads, log[0], outdirs=output,
         )
+
+
+# External leg detectors (external_detections: of a study's study.yaml or external.yaml,
+# issue 37): per scan, legs without identity or side (leg_tracker/LegArray in a bag, or a
+# *.detections.csv), scored per trial against the registered mocap legs (`gaitval
+# leg-detections`, gaitval.evaluate.leg_detections); one job per (study, detector), its
+# trials in a process pool.  No track, so no row in the tracking tables: the detection
+# table (detections_table) is theirs.  The entry is a param, so a changed entry (path,
+# topic, protocols) reruns its own job and the table, not another detector's.
+rule leg_detections:
+    input:
+        files=lambda w: [detection_file(w.study, w.detector, t)
+                         for t, _ in detection_trials(w.study, w.detector)],
+        ingest=f"{RESULTS}/{{study}}/ingest",
+        register=lambda w: sorted({f"{RESULTS}/{w.study}/register/{p}"
+                                   for _, p in detection_trials(w.study, w.detector)}),
+        sheet=lambda w: sheet_path(w.study),  # the params list its trials
+    output:
+        directory(f"{RESULTS}/{{study}}/leg_detections/{{detector}}"),
+    wildcard_constraints:
+        study="[^/]+",
+        detector="|".join(re.escape(m) for m in external_detectors()) or "(?!x)x",
+    threads: BATCH_THREADS
+    params:
+        trials=lambda w: detection_trials(w.study, w.detector),
+        entry=lambda w: json.dumps(_DETECTIONS[w.study][w.detector], sort_keys=True),
+        topic=lambda w: _DETECTIONS[w.study][w.detector].get("topic") or "",
+    log:
+        "logs/leg_detections/{study}/{detector}.log",
+    run:
+        reg = f"{RESULTS}/{wildcards.study}/register"
+        run_trials(
+            [(t, [verb("leg-detections", "--detections", f,
+                       *(["--topic", params.topic] if params.topic else []),
+                       "--groundtruth", f"{reg}/{p}/{t}/groundtruth.parquet",
+                       "--registration", f"{reg}/{p}/{t}/registration.json",
+                       "--sensor", f"{input.ingest}/{t}/sensor.parquet",
+                       "--trial", t, "--method", wildcards.detector, "--protocol", p,
+                       "--out", f"{output[0]}/{t}")])
+             for (t, p), f in zip(params.trials, input.files)],
+            threads, log[0], outdirs=output,
+        )
+
+
+rule detections_table:
+    input:
+        dets=lambda w: [f"{RESULTS}/{s}/leg_detections/{d}" for s in config["run"]
+                        for d in external_detectors()],
+        # the trial sheets: the params list their trials (a checkpoint's output for a
+        # simulated study, which a cluster job's Snakemake must see as an input)
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
+    output:
+        csv=report(f"{REPORTS}/tables/detections_table.csv", category="External detectors"),
+        md=f"{REPORTS}/tables/detections_table.md",
+        tex=f"{REPORTS}/tables/detections_table.tex",
+    params:
+        dirs=lambda w: [f"{RESULTS}/{s}/leg_detections/{d}/{t}" for s in config["run"]
+                        for d in external_detectors()
+                        for t, _ in detection_trials(s, d)],
+        stem=lambda w, output: output.csv[: -len(".csv")],
+        reports=parent_of("csv", up=1),
+        chash=config_hash_when_run,
+    priority: -10  # after the jobs it pools, beside the other tables (PRIORITIES in common.smk)
+    log:
+        "logs/detections_table.log",
+    run:
+        run_verb_job(
+            verb("leg-detections-table", params.dirs, "--out-stem", params.stem,
+                 "--reports-dir", params.reports, "--config-hash", params.chash),
+            log[0],
+        )
+
+
+REPORT_ITEM_FUNCS.append(
+    lambda study: [f"{REPORTS}/tables/detections_table.csv"] if external_detectors() else []
+)

@@ -15,6 +15,7 @@ rule report_config:
         lambda w: sorted(
             {f for s in config["run"]
              for f in study_input_files(sheet_path(s), subjects_path(s), trials(s))}
+            | {str(Path(f).resolve()) for s in config["run"] for f in external_input_files(s)}
             | {str(Path(f).resolve()) for f in workflow.configfiles if Path(f).is_file()}
             | {str(PRESETS / f"{study_cfg(s)['simulate']['preset']}.yaml")
                for s in config["run"] if is_simulated(s)}
