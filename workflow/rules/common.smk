@@ -345,10 +345,13 @@ def config_view_in(scope):
 # in a default run, benchmarks/batch_tails.py and the run's Snakemake log); at -10 they
 # wait until no batch job is left and then run two at a time, ultrasonic_tables (-5, the
 # longest) beside the three others in turn: 5.8 against 5.8 CPU-s.
-# Order only: same jobs, same files.  (Tried
-# and left out: config_view 200, so the views -- milliseconds each -- run before the
-# ingests; it made every registration ready at once, and the greedy scheduler's rounds over
-# the larger ready set cost Snakemake ~5 CPU-s more (10.3 vs 15.2 s) for no gain in wall.)
+# config_view 200: the views take milliseconds each, but at priority 0 they ran only when
+# a core was free of batch jobs, so the jobs that read them waited -- the ultrasonic chain
+# (noise 100, tracks 50) started only after every MTST track, and its table then ran alone
+# with a core idle (benchmarks/report_end_to_end.py, the run's Snakemake log).  (With the
+# per-trial jobs of before issue 38 the same priority made every registration ready at
+# once and cost Snakemake ~5 CPU-s of scheduling rounds; with ~50 jobs it costs nothing.)
+# Order only: same jobs, same files.
 
 # Rule files add functions study -> [report items] here; rule `report` collects them.
 REPORT_ITEM_FUNCS = []

@@ -39,6 +39,7 @@ rule config_view:
         sections=lambda w: analysis_sections_json(w.view, w.scope),
     log:
         "logs/config_view/{study}/{scope}/{view}.log",
+    priority: 200  # milliseconds each, and every job waits for its view (PRIORITIES in common.smk)
     run:
         from gaitval.pipeline.steps import study_config
 
