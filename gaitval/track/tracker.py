@@ -143,6 +143,7 @@ class Tracker:
         Lpat, Rpat, Lidx, Ridx = L.pattern, R.pattern, L.obs_index, R.obs_index
         Lacc, Racc = L.acc, R.acc
         phase, dts, hypot, swing_of = run.phase, run.dts, math.hypot, _SWING
+        w_l = run.leg_width_m
         c0, c1 = hyp.cache
         pcache = hyp.pcache
         pre = source.precomputed() if isinstance(source, DetectionSeries) else None
@@ -164,8 +165,12 @@ class Tracker:
             else:                                                 # detect
                 obs, pats = at(k, prior)
             if context:                                           # seed000 eq. (11)–(13)
-                cl = candidates(F, pl, obs, run.gate_context(0, k))
-                cr = candidates(F, pr, obs, run.gate_context(1, k))
+                # TrackingRun.gate_context written out
+                sw = swing_of[ph]
+                cl = candidates(F, pl, obs, GateContext(w_l, dt, hypot(sl[2], sl[3]), sw[0],
+                                                        L.n_unobserved))
+                cr = candidates(F, pr, obs, GateContext(w_l, dt, hypot(sr[2], sr[3]), sw[1],
+                                                        R.n_unobserved))
             else:
                 cl, cr = candidates(F, pl, obs, None), candidates(F, pr, obs, None)
             # TrackingRun.commit written out: seed000 eq. (14)–(16) (corrected states) and
