@@ -122,6 +122,36 @@ def _read_csv(path: Path, trial, fmt: str = FORMAT
     return meta, [c.strip() for c in rows[0]], rows[1:], n + 2, where
 
 
+def _columns_of(p: Path, trial, kind: str, fmt: str = FORMAT, meta_key: bytes = META_KEY):
+    """A track or detections file (``kind``: ``tracks``/``detections``) as
+    ``(meta, column names, {name: values}, where(i) -> "line N"/"row N", meta_lines,
+    first data line)``: CSV cells checked against the header, Parquet rows 1-based."""
+    if not p.exists():
+        raise _err(p, "no such file", trial)
+    if p.suffix == ".csv":
+        meta, names, rows_txt, first_line, meta_lines = _read_csv(p, trial, fmt)
+        for j, r in enumerate(rows_txt):
+            if len(r) != len(names):
+                raise _err(p, f"line {first_line + j}: {len(r)} cells, the header has "
+                           f"{len(names)}", trial)
+        cols = {n: [r[i] for r in rows_txt] for i, n in enumerate(names)}
+
+        def where(i):
+            return f"line {first_line + i}"
+    elif p.suffix == ".parquet":
+        meta, df = _read_parquet(p, trial, fmt, meta_key)
+        meta_lines, first_line = None, 1
+        names = list(df.columns)
+        cols = {n: df[n].tolist() for n in names}
+
+        def where(i):
+            return f"row {i + 1}"
+    else:
+        raise _err(p, f"unknown extension {p.suffix!r}", trial,
+                   hint=f"a {kind} file is *.{kind}.csv or *.{kind}.parquet")
+    return meta, names, cols, where, meta_lines, first_line
+
+
 def _read_parquet(path: Path, trial, fmt: str = FORMAT, meta_key: bytes = META_KEY
                   ) -> tuple[dict, pd.DataFrame]:
     import pyarrow.parquet as pq
@@ -208,29 +238,7 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
         other than L/R, a leg missing at a time stamp, a time stamp given twice.
     """
     p = Path(path)
-    if not p.exists():
-        raise _err(p, "no such file", trial)
-    if p.suffix == ".csv":
-        meta, names, rows_txt, first_line, meta_lines = _read_csv(p, trial)
-        for j, r in enumerate(rows_txt):
-            if len(r) != len(names):
-                raise _err(p, f"line {first_line + j}: {len(r)} cells, the header has "
-                           f"{len(names)}", trial)
-        cols = {n: [r[i] for r in rows_txt] for i, n in enumerate(names)}
-
-        def where(i):
-            return f"line {first_line + i}"
-    elif p.suffix == ".parquet":
-        meta, df = _read_parquet(p, trial)
-        meta_lines = None
-        names = list(df.columns)
-        cols = {n: df[n].tolist() for n in names}
-
-        def where(i):
-            return f"row {i + 1}"
-    else:
-        raise _err(p, f"unknown extension {p.suffix!r}", trial,
-                   hint="a track file is *.tracks.csv or *.tracks.parquet")
+    meta, names, cols, where, meta_lines, first_line = _columns_of(p, trial, "tracks")
     meta = _check_meta(meta, p, trial, meta_lines)
     unknown = [n for n in names if n not in COLUMNS]
     if unknown:
@@ -830,29 +838,8 @@ def read_detections(path: str | Path, *, trial: str | None = None
         non-number, one of ``x``, ``y`` empty without the other, no rows.
     """
     p = Path(path)
-    if not p.exists():
-        raise _err(p, "no such file", trial)
-    if p.suffix == ".csv":
-        meta, names, rows_txt, first_line, meta_lines = _read_csv(p, trial, DET_FORMAT)
-        for j, r in enumerate(rows_txt):
-            if len(r) != len(names):
-                raise _err(p, f"line {first_line + j}: {len(r)} cells, the header has "
-                           f"{len(names)}", trial)
-        cols = {n: [r[i] for r in rows_txt] for i, n in enumerate(names)}
-
-        def where(i):
-            return f"line {first_line + i}"
-    elif p.suffix == ".parquet":
-        meta, df = _read_parquet(p, trial, DET_FORMAT, DET_META_KEY)
-        meta_lines, first_line = None, 1
-        names = list(df.columns)
-        cols = {n: df[n].tolist() for n in names}
-
-        def where(i):
-            return f"row {i + 1}"
-    else:
-        raise _err(p, f"unknown extension {p.suffix!r}", trial,
-                   hint="a detections file is *.detections.csv or *.detections.parquet")
+    meta, names, cols, where, meta_lines, first_line = _columns_of(
+        p, trial, "detections", DET_FORMAT, DET_META_KEY)
     meta = _check_meta(meta, p, trial, meta_lines, fmt=DET_FORMAT, meta_key=DET_META_KEY)
     unknown = [n for n in names if n not in DET_COLUMNS]
     if unknown:
