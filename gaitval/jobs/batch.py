@@ -7,8 +7,9 @@ of the rule's ``threads`` processes and writes every trial's output files as bef
 file, or folder, per trial).  Why, and what it costs: docs/speed.md.
 
 The pool's processes start from the standard library's *forkserver*
-(:mod:`multiprocessing`, ``forkserver`` start method): one clean process, started the
-first time a batch runs in this Python process, that has already imported the modules in
+(:mod:`multiprocessing`, ``forkserver`` start method): one clean process, started by
+:func:`warm` when the workflow begins to run jobs (else the first time a batch runs in
+this Python process), that has already imported the modules in
 :data:`PRELOAD` (numpy, pandas, scipy, the trackers' compiled kernels: ~1 CPU-s) and forks
 each worker from there.  So a batch's workers pay no import, and the Snakemake process
 that waits on them imports none of the analysis.  Each batch has its own workers; they
