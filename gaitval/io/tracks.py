@@ -339,20 +339,29 @@ def write_tracks(rows: pd.DataFrame, path: str | Path, *, units: str = "m",
                         "frame": frame, "clock": clock}, p, None)
     meta.update({k: str(v) for k, v in extra.items()})
     rows = rows[[c for c in COLUMNS if c in rows.columns]].reset_index(drop=True)
+    return _write_rows(p, rows, meta, FORMAT, META_KEY, "tracks", bool_columns=BOOL_COLUMNS)
+
+
+def _write_rows(p: Path, rows: pd.DataFrame, meta: dict, fmt: str, meta_key: bytes,
+                kind: str, bool_columns=(), all_float: bool = False) -> Path:
+    """A tracks or detections file (``kind``): Parquet with ``meta`` as JSON under
+    ``meta_key``, or CSV after a ``# fmt vVERSION`` line and ``# key: value`` lines, booleans
+    as ``true``/``false``, floats (every column with ``all_float``) as the shortest text
+    that reads back to the same float, NaN as an empty cell."""
     if p.suffix == ".parquet":
-        write_parquet(rows, p, metadata={META_KEY.decode(): json.dumps(meta, sort_keys=True)})
+        write_parquet(rows, p, metadata={meta_key.decode(): json.dumps(meta, sort_keys=True)})
         return p
     if p.suffix != ".csv":
-        raise _err(p, f"unknown extension {p.suffix!r}", hint="*.tracks.csv or "
-                   "*.tracks.parquet")
-    head = [f"# {FORMAT} v{VERSION}"] + [f"# {k}: {v}" for k, v in meta.items()
-                                          if k not in ("format", "version")]
+        raise _err(p, f"unknown extension {p.suffix!r}", hint=f"*.{kind}.csv or "
+                   f"*.{kind}.parquet")
+    head = [f"# {fmt} v{VERSION}"] + [f"# {k}: {v}" for k, v in meta.items()
+                                       if k not in ("format", "version")]
     body = rows.copy()
-    for c in BOOL_COLUMNS:
+    for c in bool_columns:
         if c in body:
             body[c] = np.where(body[c].to_numpy(bool), "true", "false")
     for c in body.columns:
-        if body[c].dtype.kind == "f":
+        if all_float or body[c].dtype.kind == "f":
             body[c] = ["" if math.isnan(v) else repr(float(v))
                        for v in body[c].to_numpy(float)]
     text = "\n".join(head) + "\n" + body.to_csv(index=False, lineterminator="\n")
@@ -888,21 +897,7 @@ def write_detections(rows: pd.DataFrame, path: str | Path, *, units: str = "m",
                        meta_key=DET_META_KEY)
     meta.update({k: str(v) for k, v in extra.items()})
     rows = rows[[c for c in DET_COLUMNS if c in rows.columns]].reset_index(drop=True)
-    if p.suffix == ".parquet":
-        write_parquet(rows, p, metadata={DET_META_KEY.decode(): json.dumps(meta,
-                                                                           sort_keys=True)})
-        return p
-    if p.suffix != ".csv":
-        raise _err(p, f"unknown extension {p.suffix!r}", hint="*.detections.csv or "
-                   "*.detections.parquet")
-    head = [f"# {DET_FORMAT} v{VERSION}"] + [f"# {k}: {v}" for k, v in meta.items()
-                                              if k not in ("format", "version")]
-    body = rows.copy()
-    for c in body.columns:
-        body[c] = ["" if math.isnan(v) else repr(float(v)) for v in body[c].to_numpy(float)]
-    write_bytes(p, ("\n".join(head) + "\n" + body.to_csv(index=False, lineterminator="\n")
-                    ).encode("utf-8"))
-    return p
+    return _write_rows(p, rows, meta, DET_FORMAT, DET_META_KEY, "detections", all_float=True)
 
 
 def detections_to_sensor(det: pd.DataFrame, meta: dict, registration: dict | None = None,
