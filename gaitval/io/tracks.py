@@ -342,6 +342,19 @@ def write_tracks(rows: pd.DataFrame, path: str | Path, *, units: str = "m",
     return _write_rows(p, rows, meta, FORMAT, META_KEY, "tracks", bool_columns=BOOL_COLUMNS)
 
 
+def _check_registration(path, trial, frame: str, clock: str, reg: dict) -> None:
+    """A file in the mocap frame or on the mocap clock needs the trial's registration's
+    pose or clock offset: an error naming the file, the header field and what is unknown."""
+    need = [f for f, v in (("frame", frame), ("clock", clock)) if v == "mocap"]
+    if need:
+        keys = (["x_m", "y_m", "yaw_rad"] if "frame" in need else []) + \
+            (["clock_offset_s"] if "clock" in need else [])
+        bad = [k for k in keys if reg.get(k) is None or not math.isfinite(float(reg[k]))]
+        if bad:
+            raise _err(path, f"header {' and '.join(need)} 'mocap' needs the trial's "
+                       f"registration ({', '.join(bad)} unknown)", trial)
+
+
 def _write_rows(p: Path, rows: pd.DataFrame, meta: dict, fmt: str, meta_key: bytes,
                 kind: str, bool_columns=(), all_float: bool = False) -> Path:
     """A tracks or detections file (``kind``): Parquet with ``meta`` as JSON under
@@ -490,16 +503,8 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
                    "evaluation needs one row per leg (column 'side')", trial,
                    hint="a bag whose people are legs: set the method's legs: {L: id, R: "
                         "id}")
-    need = [f for f, used in (("frame", meta["frame"] == "mocap"),
-                              ("clock", meta["clock"] == "mocap")) if used]
     reg = registration or {}
-    if need:
-        keys = (["x_m", "y_m", "yaw_rad"] if "frame" in need else []) + \
-            (["clock_offset_s"] if "clock" in need else [])
-        bad = [k for k in keys if reg.get(k) is None or not math.isfinite(float(reg[k]))]
-        if bad:
-            raise _err(path, f"header {' and '.join(need)} 'mocap' needs the trial's "
-                       f"registration ({', '.join(bad)} unknown)", trial)
+    _check_registration(path, trial, meta["frame"], meta["clock"], reg)
     t = rows["t_s"].to_numpy(float)
     if meta["clock"] == "mocap":
         # docs/formats.md, Clock: t_sensor = offset + (1 + drift ppm 1e-6) t_mocap
@@ -915,14 +920,7 @@ def detections_to_sensor(det: pd.DataFrame, meta: dict, registration: dict | Non
     time on the sensor clock."""
     frame, clock = meta.get("frame", "sensor"), meta.get("clock", "sensor")
     reg = registration or {}
-    need = [f for f, v in (("frame", frame), ("clock", clock)) if v == "mocap"]
-    if need:
-        keys = (["x_m", "y_m", "yaw_rad"] if "frame" in need else []) + \
-            (["clock_offset_s"] if "clock" in need else [])
-        bad = [k for k in keys if reg.get(k) is None or not math.isfinite(float(reg[k]))]
-        if bad:
-            raise _err(path, f"header {' and '.join(need)} 'mocap' needs the trial's "
-                       f"registration ({', '.join(bad)} unknown)", trial)
+    _check_registration(path, trial, frame, clock, reg)
     det = det.copy()
     t, tm = det["t_s"].to_numpy(float), np.asarray(meta["t_messages"], float)
     if clock == "mocap":
