@@ -91,3 +91,20 @@ def copy_run(run: Path, dst: Path) -> Path:
     that a run reading it finds the simulation up to date and does not simulate again."""
     shutil.copytree(run, dst, symlinks=True)
     return dst
+
+
+def planned_jobs(work, targets, wildcards=("method", "view")) -> dict[str, set[str]]:
+    """The jobs a dry run of ``targets`` in the tiny workflow at ``work`` would run: rule ->
+    the first of ``wildcards`` each job has ("" for a job with none of them)."""
+    res = tiny_workflow(work, "-n", targets=targets)
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out[-3000:]
+    jobs: dict[str, set[str]] = {}
+    for block in ("\n" + out).split("\nrule ")[1:] + ("\n" + out).split("\nlocalrule ")[1:]:
+        rule = block.split(":", 1)[0].strip()
+        wc = next((ln for ln in block.splitlines() if ln.strip().startswith("wildcards:")),
+                  "")
+        ws = dict(kv.strip().split("=", 1) for kv in wc.split(":", 1)[-1].split(",")
+                  if "=" in kv)
+        jobs.setdefault(rule, set()).add(next((ws[w] for w in wildcards if ws.get(w)), ""))
+    return jobs

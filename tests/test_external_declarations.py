@@ -155,20 +155,9 @@ EXT_TARGETS = ["results/tiny/evaluate/ext_bag", "results/tiny/evaluate/ext_csv",
 def dry_run_jobs(work: Path) -> dict[str, set[str]]:
     """The jobs a dry run of EXT_TARGETS would run: rule -> the ``method``/``view``
     wildcard of each of its jobs (the study's own jobs by rule name alone)."""
-    from conftest import tiny_workflow
+    from conftest import planned_jobs
 
-    res = tiny_workflow(work, "-n", targets=EXT_TARGETS)
-    out = res.stdout + res.stderr
-    assert res.returncode == 0, out[-3000:]
-    jobs: dict[str, set[str]] = {}
-    for block in ("\n" + out).split("\nrule ")[1:] + ("\n" + out).split("\nlocalrule ")[1:]:
-        rule = block.split(":", 1)[0].strip()
-        wc = next((ln for ln in block.splitlines() if ln.strip().startswith("wildcards:")),
-                  "")
-        ws = dict(kv.strip().split("=", 1) for kv in wc.split(":", 1)[-1].split(",")
-                  if "=" in kv)
-        jobs.setdefault(rule, set()).add(ws.get("method") or ws.get("view") or "")
-    return jobs
+    return planned_jobs(work, EXT_TARGETS, ("method", "view"))
 
 
 @pytest.fixture(scope="module")

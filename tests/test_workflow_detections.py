@@ -112,20 +112,9 @@ def to_mocap(rows: pd.DataFrame, reg: dict) -> pd.DataFrame:
 
 def dry_run(work: Path) -> dict[str, set[str]]:
     """rule -> the detector wildcard of each job a dry run of TABLE would run."""
-    from conftest import tiny_workflow
+    from conftest import planned_jobs
 
-    res = tiny_workflow(work, "-n", targets=[TABLE])
-    out = res.stdout + res.stderr
-    assert res.returncode == 0, out[-3000:]
-    jobs: dict[str, set[str]] = {}
-    for block in ("\n" + out).split("\nrule ")[1:] + ("\n" + out).split("\nlocalrule ")[1:]:
-        rule = block.split(":", 1)[0].strip()
-        wc = next((ln for ln in block.splitlines() if ln.strip().startswith("wildcards:")),
-                  "")
-        ws = dict(kv.strip().split("=", 1) for kv in wc.split(":", 1)[-1].split(",")
-                  if "=" in kv)
-        jobs.setdefault(rule, set()).add(ws.get("detector", ""))
-    return jobs
+    return planned_jobs(work, [TABLE], ("detector",))
 
 
 @pytest.fixture(scope="module")
