@@ -207,10 +207,10 @@ class RollatorWindowDetector(WindowedDetector):
         # and P is finite (window_points keeps only points inside a finite box, no NaN).
         # Same labels (checked on the default study's rollator KF tracks).
         # One thread: scikit-learn's OpenMP threads (one per core) cost more than the
-        # ~50-point fit itself -- 4.4 against 1.0 ms a call, and a rollator trial's
-        # tracking 6.6 against 2.8 s wall (docs/speed.md) -- and a batch job already
-        # runs a trial per core.  With one chunk of points the labels do not depend on
-        # the thread count (checked: the default study's rollator tracks, byte-identical).
+        # ~50-point fit itself when run by hand -- 4.4 against 1.0 ms a call, a rollator
+        # trial's tracking 6.6 against 2.4 s wall (docs/speed.md; in the batch jobs'
+        # workers no difference was measurable).  With one chunk of points the labels do
+        # not depend on the thread count (the default study's rollator tracks: identical).
         if self._openmp is None:
             from threadpoolctl import ThreadpoolController
 

@@ -606,7 +606,7 @@ STUDY_SIDE_FILE = "external.yaml"
 DECLARATION_KEYS = ("external_methods", "external_detections")
 
 
-def _declared(sheet, key: str) -> dict:
+def declared_entries(sheet, key: str) -> dict:
     """``key`` (:data:`DECLARATION_KEYS`) of the ``study.yaml`` and the
     :data:`STUDY_SIDE_FILE` beside a trial sheet: name -> (entry, the file declaring it).
     A name declared in both files is an error naming both."""
@@ -632,7 +632,7 @@ def study_external(sheet, key: str = "external_methods") -> dict:
     """``external_methods:`` (or another of :data:`DECLARATION_KEYS`) of the study's
     ``study.yaml`` and its :data:`STUDY_SIDE_FILE` beside a trial sheet: the study's own
     entries, name -> entry as in ``tracking.external`` ({} without)."""
-    return {m: e for m, (e, _) in _declared(sheet, key).items()}
+    return {m: e for m, (e, _) in declared_entries(sheet, key).items()}
 
 
 def study_side_problems(sheet, schema: dict | None = None) -> None:
@@ -673,7 +673,7 @@ def external_declarations(config_external: dict | None, sheets: dict, taken,
     from gaitval.configcheck import display_path
 
     config_external = dict(config_external or {})
-    decl = {s: _declared(sheet, key) for s, sheet in sheets.items()}
+    decl = {s: declared_entries(sheet, key) for s, sheet in sheets.items()}
     own = {s: {m: e for m, (e, _) in d.items()} for s, d in decl.items()}
     cal = {s: display_path(Path(sheets[s]).parent / "study.yaml") for s in sheets}
 
@@ -830,7 +830,7 @@ def external_problems(sheet, deep: bool = False) -> list[str]:
                                 ("external_detections", "external_detection",
                                  DETECTION_PROTOCOLS)):
         try:
-            decl = _declared(sheet, key)
+            decl = declared_entries(sheet, key)
             if not decl:
                 continue
             study_side_problems(sheet)

@@ -144,9 +144,9 @@ def _check_detections(cfg, per_study_methods):
 
 def declared_in(sheet, key):
     """name -> the file (study.yaml or external.yaml beside the sheet) declaring it."""
-    from gaitval.pipeline.steps import _declared
+    from gaitval.pipeline.steps import declared_entries
 
-    return {m: display_path(f) for m, (_, f) in _declared(sheet, key).items()}
+    return {m: display_path(f) for m, (_, f) in declared_entries(sheet, key).items()}
 
 
 DATA = config.get("data_dir", "data")
