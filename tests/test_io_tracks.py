@@ -294,3 +294,31 @@ def test_positions_in_the_wrong_units_are_refused(tmp_path, units, scale, words)
     ok = _csv(tmp_path, HEAD + GOOD, "ok.tracks.csv")
     r, m = read_tracks(ok)
     assert len(tracks_to_sensor(r, m, path=ok, max_range_m=30.0)) == 4
+
+
+@pytest.mark.parametrize("ext", ["csv", "parquet"])
+def test_third_clock_offset_in_the_header(tmp_path, ext):
+    """A tracker on its own computer's clock: the header's clock_offset_s, stated by the
+    user, moves every t_s onto the header's clock; the import is then the same track."""
+    track = own_track()
+    rows = track_to_exchange(track)
+    rows["t_s"] = rows["t_s"] + 1.7e9                     # e.g. Unix time on the tracker PC
+    p = write_tracks(rows, tmp_path / f"a.tracks.{ext}", clock_offset_s=-1.7e9)
+    back_rows, meta = read_tracks(p)
+    assert meta["clock_offset_s"] == -1.7e9
+    back = tracks_to_sensor(back_rows, meta)
+    np.testing.assert_allclose(back["t_sensor_s"], track["t_sensor_s"], rtol=0, atol=1e-6)
+    np.testing.assert_array_equal(back["x_m"], track["x_m"])
+    # without the offset the same stamps are outside the recording, named with the row
+    p2 = write_tracks(rows, tmp_path / f"b.tracks.{ext}")
+    r2, m2 = read_tracks(p2)
+    with pytest.raises(FileFormatError, match="outside the recording"):
+        tracks_to_sensor(r2, m2, t_range=(12.0, 14.0))
+
+
+def test_third_clock_offset_that_is_no_number(tmp_path):
+    p = _csv(tmp_path, ["# gaitval-tracks v1", "# units: m", "# frame: sensor",
+                        "# clock: sensor", "# clock_offset_s: soon", "t_s,side,x,y",
+                        "0.0,L,1.0,0.1", "0.0,R,1.0,-0.1"])
+    with pytest.raises(FileFormatError, match=r"clock_offset_s.*'soon' \(line 5\)"):
+        read_tracks(p)

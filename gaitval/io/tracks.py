@@ -91,7 +91,27 @@ def _check_meta(meta: dict, path, trial, lines: dict | None = None, *, fmt: str 
                        f"{', '.join(allowed)}", trial)
     out = dict(meta)
     out["version"] = VERSION
+    if meta.get("clock_offset_s") not in (None, ""):
+        # a tracker stamped on a third clock (its own computer's): the user states the
+        # offset to the header's clock, t = t_s + clock_offset_s (docs/formats.md, Clock)
+        raw = meta["clock_offset_s"]
+        try:
+            off = float(raw) if not isinstance(raw, bool) else float("nan")
+        except (TypeError, ValueError):
+            off = float("nan")
+        if not math.isfinite(off):
+            raise _err(path, f"header field 'clock_offset_s' is {raw!r}{at('clock_offset_s')}"
+                       ", not a finite number of seconds", trial,
+                       hint="seconds added to every t_s to put it on the header's clock")
+        out["clock_offset_s"] = off
     return out
+
+
+def _on_header_clock(t: np.ndarray, meta: dict) -> np.ndarray:
+    """Time stamps as stored, moved onto the header's ``clock`` by its optional
+    ``clock_offset_s`` (a third clock's offset, stated by the user)."""
+    off = float(meta.get("clock_offset_s") or 0.0)
+    return t + off if off else t
 
 
 def _read_csv(path: Path, trial, fmt: str = FORMAT
@@ -227,7 +247,8 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
         (``L``/``R``) or ``person``, ``x_m``, ``y_m`` and whichever of ``k``, ``vx_mps``,
         ``vy_mps``, ``observed``, ``pattern``, ``phase``, ``swing``, ``interpolated`` the
         file has; and the header (``format, version, units, frame, clock``, and any other
-        key, e.g. ``source``).  Times are as stored, on the header's clock.
+        key, e.g. ``source``).  Times are on the header's clock: as stored, plus the
+        header's ``clock_offset_s`` when it gives one (a tracker on a third clock).
 
     Raises
     ------
@@ -254,7 +275,8 @@ def read_tracks(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataF
     if n == 0:
         raise _err(p, "no rows", trial)
     scale = UNITS[meta["units"]]
-    out = {"t_s": _floats(p, "t_s", cols["t_s"], where, trial, finite=True)}
+    out = {"t_s": _on_header_clock(_floats(p, "t_s", cols["t_s"], where, trial,
+                                           finite=True), meta)}
     if "k" in names:
         out["k"] = _ints(p, "k", cols["k"], where, trial, 0, 2 ** 62)
     key = "side" if "side" in names else "person"
@@ -518,8 +540,10 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
         if out_of.any():
             i = int(np.flatnonzero(out_of)[0])
             line = _where(rows, meta, i, "t_s")
-            raise _err(path, f"{line}: time stamp {float(rows['t_s'].iloc[i])!r} s "
-                       f"({meta['clock']} clock; {t[i]:.4f} s on the sensor clock) is "
+            c0 = float(meta.get("clock_offset_s") or 0.0)
+            off = f" after the header's clock_offset_s {c0!r} s" if c0 else ""
+            raise _err(path, f"{line}: time stamp {float(rows['t_s'].iloc[i]) - c0!r} s "
+                       f"({meta['clock']} clock{off}; {t[i]:.4f} s on the sensor clock) is "
                        f"outside the recording ({t_range[0]:.4f} to {t_range[1]:.4f} s on "
                        "the sensor clock)", trial,
                        hint="check the header's clock and the trial's clock offset")
@@ -839,7 +863,8 @@ def read_detections(path: str | Path, *, trial: str | None = None
     -------
     (DataFrame, dict)
         Rows ``t_s, msg, x_m, y_m`` (and ``confidence`` when given): one per detection,
-        in metres, on the header's clock and frame; ``msg`` numbers the file's distinct
+        in metres, on the header's clock (plus its ``clock_offset_s``, when given) and
+        frame; ``msg`` numbers the file's distinct
         time stamps (1-based); and the header with ``source`` (default: the file name),
         ``n_messages`` and ``t_messages`` (every time stamp, detections or not) — the shape
         of :func:`read_bag_leg_detections`'s result.
@@ -866,7 +891,7 @@ def read_detections(path: str | Path, *, trial: str | None = None
     if not cols["t_s"]:
         raise _err(p, "no rows", trial)
     scale = UNITS[meta["units"]]
-    t = _floats(p, "t_s", cols["t_s"], where, trial, finite=True)
+    t = _on_header_clock(_floats(p, "t_s", cols["t_s"], where, trial, finite=True), meta)
     x = _floats(p, "x", cols["x"], where, trial, finite=False) * scale
     y = _floats(p, "y", cols["y"], where, trial, finite=False) * scale
     half = np.isnan(x) != np.isnan(y)
@@ -932,8 +957,11 @@ def detections_to_sensor(det: pd.DataFrame, meta: dict, registration: dict | Non
         out_of = (tm < lo) | (tm > hi)
         if out_of.any():
             i = int(np.flatnonzero(out_of)[0])
-            raise _err(path, f"time stamp {float(meta['t_messages'][i])!r} s ({clock} clock; "
-                       f"{tm[i]:.4f} s on the sensor clock) is outside the recording "
+            c0 = float(meta.get("clock_offset_s") or 0.0)
+            off = f" after the header's clock_offset_s {c0!r} s" if c0 else ""
+            raise _err(path, f"time stamp {float(meta['t_messages'][i]) - c0!r} s ({clock} "
+                       f"clock{off}; {tm[i]:.4f} s on the sensor clock) is outside the "
+                       "recording "
                        f"({lo + tolerance_s:.4f} to {hi - tolerance_s:.4f} s on the sensor "
                        f"clock), as are {int(out_of.sum())} of {len(tm)} time stamps", trial,
                        hint="check the header's clock and the trial's clock offset")
