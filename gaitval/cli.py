@@ -485,6 +485,57 @@ def _add_ultrasonic_verbs(sub) -> None:
     s.set_defaults(func=cmd_ultrasonic_tables)
 
 
+def _add_external_foot_verbs(sub) -> None:
+    """Another system's heel trajectory on the treadmill trials (issue 37): its gait
+    parameters and the agreement table of every system."""
+    def run(a) -> int:
+        from gaitval.pipeline import steps as S
+        if a.verb == "external-gait-parameters":
+            gp = S.external_gait_parameters_step(a.foot, a.ingest, a.sheet, a.subjects,
+                                                 a.trial, a.method, a.config, a.out)
+            print(f"{a.trial}: {gp['stride'].nunique()} strides matched")
+        else:
+            S.method_agreement_step(a.gait, a.out_stem, a.reports_dir, a.config_hash,
+                                    a.config)
+        return 0
+
+    s = sub.add_parser("external-gait-parameters", help="per-stride gait parameters of "
+                       "another system's heel trajectory (*.foot.csv/parquet) on one "
+                       "treadmill trial, against the camera reference (docs/formats.md, "
+                       "Foot trajectories)")
+    s.add_argument("--foot", required=True, help="the system's *.foot.csv or "
+                   "*.foot.parquet of this trial (t_s, x, y, z; header units, frame, clock)")
+    s.add_argument("--ingest", required=True, help="the trial's ingest folder "
+                   "(results/<study>/ingest/<trial>/: sensor.parquet with the anchors, "
+                   "mocap.parquet)")
+    s.add_argument("--sheet", required=True, help="the study's trials.csv")
+    s.add_argument("--subjects", required=True, help="the study's subjects.csv")
+    s.add_argument("--trial", required=True, help="trial id (a treadmill trial)")
+    s.add_argument("--method", required=True, help="the system's name (the rows' method)")
+    s.add_argument("--config", required=True, help="the study's config view "
+                   "(results/<study>/config_views/ultrasonic/study.json): its ultrasonic "
+                   "section (markers, resampling, low-pass, strides)")
+    s.add_argument("--out", required=True, help="the gait parameter table (Parquet; "
+                   "results/<study>/ultrasonic_external/<method>/<trial>.parquet)")
+    s.set_defaults(func=run)
+
+    s = sub.add_parser("method-agreement", help="agreement (Bland-Altman, ICC, repeated "
+                       "measures) of each foot-tracking system with the camera reference on "
+                       "the treadmill trials, one block of rows per system")
+    s.add_argument("--gait", nargs="+", action="append", required=True,
+                   metavar="METHOD_OR_FILE", help="a system's name followed by its gait "
+                   "parameter files (gait-parameters / external-gait-parameters output); "
+                   "once per system")
+    s.add_argument("--out-stem", required=True, help="e.g. reports/<run>/tables/"
+                   "ultrasonic_agreement_methods (writes .csv, .md, .tex)")
+    s.add_argument("--config", help="a config view JSON: ultrasonic.tables chooses the "
+                   "strides (default: 10 per subject and speed, seed 2014)")
+    s.add_argument("--reports-dir", default="reports", help="the report folder "
+                   "(provenance/)")
+    s.add_argument("--config-hash", default="", help="provenance stamp")
+    s.set_defaults(func=run)
+
+
 def _add_mtst_verbs(sub) -> None:
     """The MTST study (seed 001): tracking, walking parameters and evaluation, Tables 1/3/4."""
     def run(a) -> int:
@@ -588,6 +639,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_input_verbs(sub)
     _add_lrs_verbs(sub)
     _add_ultrasonic_verbs(sub)
+    _add_external_foot_verbs(sub)
     _add_mtst_verbs(sub)
     _add_rollator_verbs(sub)
     from gaitval.pipeline.legbench import add_legbench_verbs

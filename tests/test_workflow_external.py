@@ -30,7 +30,8 @@ from conftest import SNAKEMAKE, copy_run, tiny_workflow
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGETS = ["reports/tiny/tables/tug_table4.csv", "reports/tiny/tables/mtst_table3.csv",
-           "reports/tiny/tables/rollator_table1.csv"]
+           "reports/tiny/tables/rollator_table1.csv", "results/tiny/ultrasonic"]
+AGREEMENT = "reports/tiny/tables/ultrasonic_agreement_methods.csv"
 PERSON_DEFS = {"leg_tracker/msg/Person": "geometry_msgs/Pose pose\nuint32 id\n",
                "leg_tracker/msg/PersonArray": "Header header\nleg_tracker/Person[] people\n"}
 
@@ -109,6 +110,44 @@ def to_mocap(track: pd.DataFrame, reg: dict) -> pd.DataFrame:
                        t_s=(rows["t_s"] - reg["clock_offset_s"]) / drift)
 
 
+def feet_from_the_ukf(work: Path, study: Path, results: Path) -> None:
+    """gaitval's UKF heel trajectory of each treadmill trial as an external system's: as
+    CSV in the ultrasonic frame on its clock (``feet``: exact equality expected), and as
+    Parquet in millimetres in the mocap field frame on the mocap clock, with a third
+    clock's offset in the header (``feet_mocap``: the receiver-marker fit and the clock
+    offset the alignment found, both inverted here)."""
+    from gaitval.evaluate.alignment import align_track_to_reference
+    from gaitval.evaluate.ultrasonic_config import reference_kwargs, resolve_cfg
+    from gaitval.groundtruth.reference import reference_trajectory
+    from gaitval.io.foot import ukf_track_to_foot, write_foot
+    from gaitval.io.ingest import read_mocap_parquet
+    from gaitval.io.ultrasonic import read_ultrasonic
+    from gaitval.registration.anchors import fit_anchor_frame
+
+    view = json.loads(next((results / "config_views" / "ultrasonic").glob("*.json"))
+                      .read_text())
+    c = resolve_cfg(view.get("ultrasonic") or {})
+    tracks = sorted((results / "ultrasonic" / "track").glob("*.parquet"))
+    assert tracks
+    for p in tracks:
+        track = pd.read_parquet(p)
+        rows = ukf_track_to_foot(track)
+        write_foot(rows, study / "feet" / f"{p.stem}.foot.csv", source="gaitval ukf")
+        ing = results / "ingest" / p.stem
+        log = read_ultrasonic(ing / "sensor.parquet")
+        mocap = read_mocap_parquet(ing / "mocap.parquet")
+        ref = reference_trajectory(mocap, log.anchors, **reference_kwargs(c))
+        off = align_track_to_reference(track, ref, c)["clock_offset_s"]   # t_us - t_mocap
+        fit = fit_anchor_frame(mocap, log.anchors, c["anchor_markers"], centre="mean",
+                               max_residual_m=0.02)
+        xyz = rows[["x", "y", "z"]].to_numpy(float) @ fit.R.T + fit.t   # p_f = R p_us + t
+        pc = 1234.5                                 # the third clock: t_pc = t_mocap + pc
+        m = pd.DataFrame({"t_s": rows["t_s"] - off + pc, "x": xyz[:, 0] * 1000,
+                          "y": xyz[:, 1] * 1000, "z": xyz[:, 2] * 1000})
+        write_foot(m, study / "feetm" / f"{p.stem}.foot.parquet", units="mm",
+                   frame="mocap", clock="mocap", clock_offset_s=-pc)
+
+
 @pytest.fixture(scope="module")
 def ext_run(tiny_run, tmp_path_factory):
     """The tables TARGETS in a folder of their own (this module writes into its data
@@ -151,8 +190,11 @@ def ext_run(tiny_run, tmp_path_factory):
                             str(study / "extr" / f"{t}.tracks.csv")],
                            capture_output=True, text=True)
         assert r.returncode == 0, r.stderr
+    feet_from_the_ukf(work, study, results)
     ext = work / "ext.yaml"
     ext.write_text(yaml.safe_dump({"tracking": {"external": {
+        "feet": {"path": "feet/{trial}.foot.csv", "protocols": ["treadmill"]},
+        "feet_mocap": {"path": "feetm/{trial}.foot.parquet", "protocols": ["treadmill"]},
         "ext_m1": {"path": "ext/{trial}.tracks.csv"},
         "ext_m2": {"path": "ext2/{trial}.tracks.parquet", "protocols": ["tug"]},
         "ext_bag": {"path": "bags/{trial}.bag", "protocols": ["tug"],
@@ -161,7 +203,8 @@ def ext_run(tiny_run, tmp_path_factory):
         "ext_kf": {"path": "extr/{trial}.tracks.csv", "protocols": ["rollator"]}}}}))
     # without the profile: the external methods' jobs and the tables each in a Snakemake
     # process of their own, the way a cluster runs them (the suite's one real run so)
-    res = tiny_workflow(work, "--configfile", str(ext), targets=TARGETS, profile=False)
+    res = tiny_workflow(work, "--configfile", str(ext), targets=[*TARGETS, AGREEMENT],
+                        profile=False)
     assert res.returncode == 0, res.stderr[-4000:]
     return work, res.stdout + res.stderr
 
@@ -351,3 +394,39 @@ def test_rollator_tables_get_the_external_method(ext_run):
     assert ext["tracking_time_s_published"].isna().all()
     md = (tables / "rollator_table1.md").read_text()
     assert "ext_kf" in md and "External method" in md
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("ext, exact", [("feet", True), ("feet_mocap", False)])
+def test_external_heel_trajectories_get_the_ukfs_agreement_rows(ext_run, ext, exact):
+    """The UKF's heel trajectories as external systems: their rows of the agreement table
+    equal the UKF's (CSV: exactly; mm, mocap frame, mocap clock, third-clock offset: counts
+    exactly, per-stride values to 1e-9 relative, the table's 6-digit statistics to 1e-5,
+    the iterative proportional-bias fit to 1e-3)."""
+    work, log = ext_run
+    assert "rule ultrasonic_external:" in log and "rule method_agreement:" in log
+    assert "rule ultrasonic_track:" not in log          # the UKF's own job did not rerun
+    t = pd.read_csv(work / AGREEMENT)
+    assert set(t["method"]) == {"ultrasonic_ukf", "feet", "feet_mocap"}
+    a, b = _rows(t, "ultrasonic_ukf"), _rows(t, ext)
+    assert len(a) >= 9 and len(a) == len(b)
+    keys = ["parameter", "speed", "n_strides", "n_subjects"]
+    pd.testing.assert_frame_equal(a[keys], b[keys], check_exact=True)
+    stats = [c for c in _results(t) if c not in keys]
+    assert {"bias", "loa_low", "loa_high", "icc_a1", "bias_rm", "icc_agreement_rm"} <= set(stats)
+    # the CSV has 6 significant digits: a last-digit flip is a relative 1e-5 at most.  The
+    # proportional-bias model is fitted by REML with an iterative optimiser: per-stride
+    # inputs that differ by 1e-13 moved its slope by 1.5e-6 and its p-value by 5e-4
+    # (relative; h_symmetry at fast speed, 4 windows), hence 1e-3 for those two columns.
+    reml = ["prop_bias_slope", "prop_bias_p"]
+    rest = [c for c in stats if c not in reml]
+    pd.testing.assert_frame_equal(a[rest], b[rest], check_exact=exact, rtol=1e-5,
+                                  atol=1e-12)
+    pd.testing.assert_frame_equal(a[reml], b[reml], check_exact=exact, rtol=1e-3,
+                                  atol=1e-12)
+    gait = work / "results" / "tiny" / "ultrasonic_external" / ext
+    for p in sorted((work / "results" / "tiny" / "ultrasonic" / "gait").glob("*.parquet")):
+        own, other = pd.read_parquet(p), pd.read_parquet(gait / p.name)
+        assert (other["method"] == ext).all()
+        pd.testing.assert_frame_equal(own, other.drop(columns="method"),
+                                      check_exact=exact, rtol=1e-9, atol=1e-12)

@@ -543,6 +543,75 @@ def ultrasonic_tables_step(inputs: list[str | Path], tables_dir, figures_dir, re
     return paths + figs
 
 
+def external_gait_parameters_step(foot_file, ingest_dir, sheet, subjects, trial: str,
+                                  method: str, config_json, out_parquet) -> pd.DataFrame:
+    """Gait parameters per stride of another system's heel trajectory on one treadmill
+    trial (a ``*.foot.csv``/``.parquet``, :mod:`gaitval.io.foot`), reference vs that
+    system, exactly as :func:`gait_parameters_step` does for gaitval's UKF track (seed 003
+    eq. 16-22; issue 37).
+
+    Frame: ``sensor`` is the ultrasonic receivers' frame (the trial's anchor table);
+    ``mocap`` positions are brought into it by the receiver markers' rigid fit, as the
+    reference is (:func:`gaitval.registration.anchors.fit_anchor_frame`).  Clock: a file
+    on the mocap clock is aligned with offset 0; on the sensor clock, with the trial
+    sheet's ``clock_offset_s`` when given, else by the cross-correlation that aligns
+    gaitval's own track (§4.2).  The rows get a ``method`` column."""
+    from gaitval.evaluate.ultrasonic import gait_parameters
+    from gaitval.evaluate.ultrasonic_config import reference_kwargs, resolve_cfg
+    from gaitval.groundtruth.reference import MAX_ANCHOR_RESIDUAL_M
+    from gaitval.io.foot import read_foot
+    from gaitval.io.ingest import read_mocap_parquet
+    from gaitval.io.ultrasonic import read_ultrasonic
+    from gaitval.registration.anchors import fit_anchor_frame
+
+    cfg = load_json(config_json).get("ultrasonic") or {}
+    row, subj = trial_and_subject(sheet, subjects, trial)
+    d = Path(ingest_dir)
+    log = read_ultrasonic(d / "sensor.parquet", trial=trial)
+    mocap = read_mocap_parquet(d / "mocap.parquet", source=row.get("mocap_path") or None,
+                               trial=trial)
+    foot, meta = read_foot(foot_file, trial=trial)
+    if meta["frame"] == "mocap":
+        fit = fit_anchor_frame(mocap, log.anchors, reference_kwargs(resolve_cfg(cfg))
+                               ["anchor_markers"], centre="mean",
+                               max_residual_m=MAX_ANCHOR_RESIDUAL_M, trial=trial)
+        foot[["x_m", "y_m", "z_m"]] = fit.to_ultrasonic(
+            foot[["x_m", "y_m", "z_m"]].to_numpy(float))        # p_us = R^T (p_f - t)
+    if meta["clock"] == "mocap":
+        row = {**row, "clock_offset_s": 0.0}      # t_system = t_mocap: no offset to find
+    try:
+        gp = gait_parameters(foot, mocap, row, subj, cfg, anchors=log.anchors)
+    except GaitvalError as exc:           # the reference's file, or no stride in both
+        raise GaitvalError(f"external method {method}, {foot_file}: {exc.problem}",
+                           path=exc.path, trial=trial, hint=exc.hint) from None
+    gp = gp.reset_index(drop=True)
+    gp.insert(0, "method", method)
+    write_parquet(gp, out_parquet)
+    return gp
+
+
+def method_agreement_step(groups: list[list[str]], out_stem, reports_dir,
+                          config_hash: str = "", config_json=None) -> list[Path]:
+    """The agreement table of several systems on the treadmill trials (issue 37): for
+    each ``[method, gait file, ...]`` group, the pooled and repeated-measures agreement
+    (:func:`gaitval.tables.ultrasonic_agreement.agreement_table`) of every parameter at
+    every speed, on the strides ``ultrasonic.tables`` of ``config_json`` selects (the
+    strides of seed 003's Tables 2-6)."""
+    from gaitval.report.provenance import stamp
+    from gaitval.tables.method_agreement import write_method_agreement
+
+    gps = {}
+    for g in groups:
+        if len(g) < 2:
+            raise ConfigError(f"--gait {' '.join(g)}: give a method name and its gait "
+                              "parameter files")
+        gps[g[0]] = pd.concat([read_parquet(f) for f in g[1:]], ignore_index=True)
+    cfg = (load_json(config_json).get("ultrasonic") or {}) if config_json else {}
+    paths = write_method_agreement(gps, out_stem, cfg)
+    stamp(Path(out_stem).name, paths, reports_dir, config_hash_=config_hash)
+    return paths
+
+
 # -- external tracks (issue 37; gaitval/io/tracks.py, docs/formats.md "Leg tracks") ------
 def export_tracks_step(track_parquet, out, units: str = "m", topic: str | None = None,
                        legs: dict | None = None) -> Path:
@@ -604,6 +673,29 @@ DETECTION_PROTOCOLS = ("tug", "mtst")
 STUDY_SIDE_FILE = "external.yaml"
 #: the keys a study declares external trackers and detectors under
 DECLARATION_KEYS = ("external_methods", "external_detections")
+
+
+#: the protocol whose external files are heel trajectories (*.foot.csv, gaitval.io.foot),
+#: not leg tracks: an entry covering it covers no other protocol
+FOOT_PROTOCOL = "treadmill"
+
+
+def foot_entry_problem(method: str, entry: dict, where: str = "external_methods") -> None:
+    """An external method whose ``protocols`` name the treadmill and another protocol:
+    one file template cannot be heel trajectories there and leg tracks elsewhere
+    (ConfigError naming the key)."""
+    prots = list((entry or {}).get("protocols") or EXTERNAL_PROTOCOLS)
+    if FOOT_PROTOCOL in prots and len(prots) > 1:
+        raise ConfigError(f"{where}.{method}.protocols: {prots}: a treadmill method's files "
+                          "are heel trajectories (*.foot.csv), the other protocols' are leg "
+                          "tracks; declare two methods",
+                          hint="e.g. my_feet: {path: ..., protocols: [treadmill]} beside "
+                               "my_legs: {path: ..., protocols: [tug, mtst]}")
+
+
+def is_foot_entry(entry: dict) -> bool:
+    """The entry covers the treadmill trials (heel trajectories, :mod:`gaitval.io.foot`)."""
+    return FOOT_PROTOCOL in ((entry or {}).get("protocols") or ())
 
 
 def declared_entries(sheet, key: str) -> dict:
@@ -680,6 +772,12 @@ def external_declarations(config_external: dict | None, sheets: dict, taken,
     def where(s, m):
         return display_path(decl[s][m][1]) if m in decl[s] else cal[s]
 
+    if key == "external_methods":
+        for m, e in config_external.items():
+            foot_entry_problem(m, e, "tracking.external")
+        for s, entries in own.items():
+            for m, e in entries.items():
+                foot_entry_problem(m, e, f"[file {where(s, m)}] {key}")
     for s, entries in own.items():
         for m in entries:
             if m in taken:
@@ -836,6 +934,8 @@ def external_problems(sheet, deep: bool = False) -> list[str]:
             study_side_problems(sheet)
             for m, (entry, f) in decl.items():
                 check_study_file({key: {m: entry}}, f)
+                if key == "external_methods":
+                    foot_entry_problem(m, entry, f"[file {f}] {key}")
         except GaitvalError as exc:
             out.append(str(exc))
             continue
@@ -846,8 +946,9 @@ def external_problems(sheet, deep: bool = False) -> list[str]:
             try:
                 missing_external_files(sheet, {m: entry}, f"[file {f}] {key}",
                                        protocols=default, key=key,
-                                       what="track files" if key == "external_methods"
-                                       else "detection files",
+                                       what=("detection files" if key != "external_methods"
+                                             else "heel trajectories" if is_foot_entry(entry)
+                                             else "track files"),
                                        mocap_only=key == "external_detections")
                 if key == "external_detections":
                     detection_topic_problems(sheet, {m: entry}, f"[file {f}] {key}")
@@ -861,7 +962,10 @@ def external_problems(sheet, deep: bool = False) -> list[str]:
             for t in _entry_trials(df, prots, key == "external_detections"):
                 try:
                     path = external_track_path(sheet, entry, t, m)
-                    if key == "external_methods":
+                    if key == "external_methods" and is_foot_entry(entry):
+                        from gaitval.io.foot import read_foot
+                        read_foot(path, trial=t)
+                    elif key == "external_methods":
                         read_external(path, entry, t)
                     else:
                         read_external_detections(path, entry.get("topic"), t)

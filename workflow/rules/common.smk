@@ -77,6 +77,10 @@ def _sheet_of(cfg, study):
     return Path(entry.get("trial_sheet") or Path(DATA) / study / "trials.csv")
 
 
+#: gaitval's ultrasonic UKF as a system of the treadmill agreement table (external.smk)
+UKF_SYSTEM = "ultrasonic_ukf"
+
+
 def _check_external(cfg):
     """External methods (issue 37): tracking.external of the workflow config (every study
     of run) and external_methods: of each study's study.yaml (gaitval.pipeline.steps.
@@ -89,6 +93,7 @@ def _check_external(cfg):
     names = _method_definitions(cfg)
     names.update(dict.fromkeys((cfg.get("tug") or {}).get("methods") or []))
     names.update(dict.fromkeys((cfg.get("mtst") or {}).get("methods") or []))
+    names[UKF_SYSTEM] = None          # gaitval's own row of the treadmill agreement table
     config_external = (cfg.get("tracking") or {}).get("external") or {}
     for m in config_external:
         if m in names:

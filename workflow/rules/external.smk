@@ -119,3 +119,83 @@ rule detections_table:
 REPORT_ITEM_FUNCS.append(
     lambda study: [f"{REPORTS}/tables/detections_table.csv"] if external_detectors() else []
 )
+
+
+# External foot-tracking systems on the treadmill trials (external_methods: with
+# protocols: [treadmill], issue 37): each trial's heel trajectory (*.foot.csv, gaitval.io.
+# foot) goes through seed 003's stride extraction against the camera reference, exactly
+# as gaitval's UKF track does (`gaitval external-gait-parameters`); one job per (study,
+# method), its trials in a process pool.  The agreement table (method_agreement) puts the
+# systems' rows beside gaitval's UKF; seed 003's Tables 2-8 stay the UKF's alone.
+rule ultrasonic_external:
+    input:
+        feet=lambda w: [external_tracks_file(trial_wildcards(w.study, t, w.method))
+                        for t in trial_ids(w.study, ["treadmill"])],
+        ingest=f"{RESULTS}/{{study}}/ingest",
+        config=f"{RESULTS}/{{study}}/config_views/ultrasonic/{STUDY_VIEW}.json",
+        sheet=lambda w: sheet_path(w.study),
+    output:
+        directory(f"{RESULTS}/{{study}}/ultrasonic_external/{{method}}"),
+    wildcard_constraints:
+        study="[^/]+",
+        method="|".join(re.escape(m) for m in external_methods("treadmill")) or "(?!x)x",
+    threads: BATCH_THREADS
+    params:
+        subjects=lambda w: subjects_path(w.study),
+        trials=lambda w: trial_ids(w.study, ["treadmill"]),
+    log:
+        "logs/ultrasonic_external/{study}/{method}.log",
+    run:
+        run_trials(
+            [(t, [verb("external-gait-parameters", "--foot", foot,
+                       "--ingest", f"{input.ingest}/{t}", "--sheet", input.sheet,
+                       "--subjects", params.subjects, "--trial", t,
+                       "--method", wildcards.method, "--config", input.config,
+                       "--out", f"{output[0]}/{t}.parquet")])
+             for t, foot in zip(params.trials, input.feet)],
+            threads, log[0], outdirs=output,
+        )
+
+
+rule method_agreement:
+    input:
+        ukf=lambda w: sorted({f"{RESULTS}/{s}/ultrasonic" for s, _ in treadmill_trials()}),
+        ext=lambda w: sorted({f"{RESULTS}/{s}/ultrasonic_external/{m}"
+                              for s, _ in treadmill_trials()
+                              for m in external_methods("treadmill")}),
+        config=lambda w: f"{RESULTS}/{config['run'][0]}/config_views/ultrasonic/{STUDY_VIEW}.json",
+        sheets=lambda w: [sheet_path(s) for s in config["run"]],
+    output:
+        csv=report(f"{REPORTS}/tables/ultrasonic_agreement_methods.csv",
+                   category="External systems"),
+        md=f"{REPORTS}/tables/ultrasonic_agreement_methods.md",
+        tex=f"{REPORTS}/tables/ultrasonic_agreement_methods.tex",
+    params:
+        gait=lambda w: [
+            x
+            for m, d in [(UKF_SYSTEM, "ultrasonic/gait"),
+                         *((m, f"ultrasonic_external/{m}")
+                           for m in external_methods("treadmill"))]
+            for x in ["--gait", m, *(f"{RESULTS}/{s}/{d}/{t}.parquet"
+                                     for s, t in treadmill_trials())]
+        ],
+        stem=lambda w, output: output.csv[: -len(".csv")],
+        reports=parent_of("csv", up=1),
+        chash=config_hash_when_run,
+    priority: -10  # after the jobs it pools, beside the other tables (PRIORITIES in common.smk)
+    log:
+        "logs/method_agreement.log",
+    run:
+        run_verb_job(
+            verb("method-agreement", params.gait, "--out-stem", params.stem,
+                 "--config", input.config, "--reports-dir", params.reports,
+                 "--config-hash", params.chash),
+            log[0],
+        )
+
+
+REPORT_ITEM_FUNCS.append(
+    lambda study: [f"{REPORTS}/tables/ultrasonic_agreement_methods.csv"]
+    if external_methods("treadmill") and trial_ids(study, ["treadmill"])
+    else []
+)
