@@ -227,18 +227,34 @@ def cmd_report(a) -> int:
 
 
 # -- parser -------------------------------------------------------------------------------
+# Help texts several verbs share; the paths are those the workflow passes (workflow/rules/).
+_SHEET = ("the study's trial sheet, trials.csv (data/<study>/trials.csv for a simulated "
+          "study; docs/formats.md, Trial sheet)")
+_SUBJECTS = "the study's subject table, subjects.csv (leg width, height; docs/formats.md)"
+_TRIAL = "trial id: a row of the trial sheet (named in errors and outputs)"
+_REPORTS = ("the report folder (reports/<run> in the workflow): the step's provenance record "
+            "goes to its provenance/ (default: reports)")
+_HASH = "the run's config hash, written into the provenance record (default: empty)"
+_TABLES = "folder the tables go to, each as .csv, .md, .tex (reports/<run>/tables)"
+_FIGURES = "folder the figures go to, PNG (reports/<run>/figures)"
+
+
 def _add_input_verbs(sub) -> None:
     """Getting data in: inspect a file, validate a sheet, simulate, ingest, a peer's results."""
     s = sub.add_parser("inspect", help="show what gaitval's loaders see in a file")
-    s.add_argument("file")
-    s.add_argument("--json", action="store_true", help="machine-readable output")
+    s.add_argument("file", help="a *.c3d, a ROS 1 *.bag or ROS 2 bag folder, a *.scan.parquet, "
+                   "a *.us.parquet or a *.annotations.csv (docs/formats.md)")
+    s.add_argument("--json", action="store_true",
+                   help="print the description as JSON instead of text")
     s.add_argument("--topic", help="LaserScan topic (ROS bags with several)")
     s.set_defaults(func=cmd_inspect)
 
     s = sub.add_parser("validate", help="validate a trial sheet and its subject table")
-    s.add_argument("sheet")
+    s.add_argument("sheet", help=_SHEET)
     s.add_argument("--subjects", help="subject table (default: subjects.csv beside the sheet)")
-    s.add_argument("--no-file-check", action="store_true")
+    s.add_argument("--no-file-check", action="store_true",
+                   help="check the sheet's columns and values only, not the files it names "
+                   "(skips --deep and the study's external methods' files)")
     s.add_argument("--allow-outside-paths", action="store_true",
                    help="accept paths outside the sheet's folder (default: as study.yaml says)")
     s.add_argument("--deep", action="store_true",
@@ -264,24 +280,34 @@ def _add_input_verbs(sub) -> None:
 
     s = sub.add_parser("simulate", help="generate a simulated study (raw files + truth/)")
     s.add_argument("--preset", default="default",
-                   help="preset name in config/studies/ or a YAML file")
-    s.add_argument("--seed", type=int, default=None)
-    s.add_argument("--out", required=True)
+                   help="preset name in config/studies/ (default, tiny, replay, ...) or a "
+                   "YAML file (the workflow passes config/studies/<preset>.yaml; "
+                   "default: default)")
+    s.add_argument("--seed", type=int, default=None,
+                   help="random seed, overrides the preset's seed (default: the preset's)")
+    s.add_argument("--out", required=True, metavar="DIR",
+                   help="the study folder to write (data/<study>): trials.csv, subjects.csv, "
+                   "study.yaml, mocap/, lrs/, annotations/, ..., truth/")
     s.set_defaults(func=cmd_simulate)
 
     s = sub.add_parser("ingest", help="raw files of one trial -> tidy per-trial files")
-    s.add_argument("--sheet", required=True)
-    s.add_argument("--subjects")
-    s.add_argument("--trial", required=True)
-    s.add_argument("--out", required=True)
+    s.add_argument("--sheet", required=True, help=_SHEET)
+    s.add_argument("--subjects", help="subject table (default: subjects.csv beside the sheet)")
+    s.add_argument("--trial", required=True, help=_TRIAL)
+    s.add_argument("--out", required=True, metavar="DIR",
+                   help="the trial's ingest folder (results/<study>/ingest/<trial>): "
+                   "mocap.parquet (metres, mocap clock), events.csv, sensor.parquet, "
+                   "annotations.csv, ingest.json")
     s.set_defaults(func=cmd_ingest)
 
     s = sub.add_parser("ingest-summary", help="table of what was ingested")
-    s.add_argument("inputs", nargs="+", help="ingest.json files")
-    s.add_argument("--study", required=True)
-    s.add_argument("--out-stem", required=True)
-    s.add_argument("--reports-dir", default="reports")
-    s.add_argument("--config-hash", default="")
+    s.add_argument("inputs", nargs="+", metavar="INGEST_JSON",
+                   help="ingest.json files (results/<study>/ingest/<trial>/ingest.json)")
+    s.add_argument("--study", required=True, help="study id (named in the caption)")
+    s.add_argument("--out-stem", required=True, help="the table's path without suffix "
+                   "(reports/<run>/tables/study_ingest_<study>; writes .csv, .md, .tex)")
+    s.add_argument("--reports-dir", default="reports", help=_REPORTS)
+    s.add_argument("--config-hash", default="", help=_HASH)
     s.set_defaults(func=cmd_ingest_summary)
 
     s = sub.add_parser("peer", help="agreement statistics (Bland-Altman, ICC, RMSE, "
@@ -300,47 +326,69 @@ def _add_input_verbs(sub) -> None:
 def _add_lrs_verbs(sub) -> None:
     """Laser range sensor studies: registration and ground truth, tracking, TUG evaluation."""
     s = sub.add_parser("register", help="register one trial and build its ground truth")
-    s.add_argument("--ingest", required=True, help="the trial's ingest folder")
-    s.add_argument("--sheet", required=True)
-    s.add_argument("--subjects", required=True)
-    s.add_argument("--trial", required=True)
-    s.add_argument("--config", required=True, help="results/<study>/config.json")
-    s.add_argument("--out", required=True)
+    s.add_argument("--ingest", required=True, metavar="DIR", help="the trial's ingest "
+                   "folder (results/<study>/ingest/<trial>: mocap.parquet, sensor.parquet)")
+    s.add_argument("--sheet", required=True, help=_SHEET)
+    s.add_argument("--subjects", required=True, help=_SUBJECTS)
+    s.add_argument("--trial", required=True, help=_TRIAL)
+    s.add_argument("--config", required=True, metavar="JSON", help="the study view of the "
+                   "trial's protocol family (results/<study>/config_views/<family>/"
+                   "study.json) or results/<study>/config.json: registration: and "
+                   "groundtruth: sections")
+    s.add_argument("--out", required=True, metavar="DIR", help="the trial's register folder "
+                   "(results/<study>/register/<family>/<trial>): registration.json (pose, "
+                   "clock offset, status ok/refused and reason), groundtruth.parquet (leg "
+                   "points at the sensor's height, metres, sensor clock)")
     s.set_defaults(func=cmd_register)
 
     s = sub.add_parser("registration-summary", help="registration.csv + report table")
-    s.add_argument("inputs", nargs="+", help="registration.json files")
-    s.add_argument("--study", required=True)
-    s.add_argument("--out-csv", required=True)
-    s.add_argument("--out-stem", required=True)
-    s.add_argument("--reports-dir", default="reports")
-    s.add_argument("--config-hash", default="")
+    s.add_argument("inputs", nargs="+", metavar="REGISTRATION_JSON",
+                   help="registration.json files (results/<study>/register/<family>/"
+                   "<trial>/registration.json)")
+    s.add_argument("--study", required=True, help="study id (named in the caption)")
+    s.add_argument("--out-csv", required=True, help="one row per trial "
+                   "(results/<study>/registration.csv)")
+    s.add_argument("--out-stem", required=True, help="the report table's path without "
+                   "suffix (reports/<run>/tables/study_registration_<study>; writes .csv, "
+                   ".md, .tex)")
+    s.add_argument("--reports-dir", default="reports", help=_REPORTS)
+    s.add_argument("--config-hash", default="", help=_HASH)
     s.set_defaults(func=cmd_registration_summary)
 
     s = sub.add_parser("track", help="run one tracker method on one LRS trial")
-    s.add_argument("--sensor", required=True, help="ingested sensor.parquet")
-    s.add_argument("--sheet", required=True)
-    s.add_argument("--subjects", required=True)
-    s.add_argument("--trial", required=True)
-    s.add_argument("--method", required=True, help="e.g. tug_m1, tug_m2, tug_m3")
-    s.add_argument("--config", required=True, help="results/<study>/config.json")
+    s.add_argument("--sensor", required=True, help="the trial's ingested scan log "
+                   "(results/<study>/ingest/<trial>/sensor.parquet)")
+    s.add_argument("--sheet", required=True, help=_SHEET)
+    s.add_argument("--subjects", required=True, help=_SUBJECTS)
+    s.add_argument("--trial", required=True, help=_TRIAL)
+    s.add_argument("--method", required=True, help="the method's name: a built-in (e.g. "
+                   "tug_m1, tug_m2, tug_m3, people) or one of tracking.methods")
+    s.add_argument("--config", required=True, metavar="JSON", help="the method's config "
+                   "view (results/<study>/config_views/tug/<method>.json) or "
+                   "results/<study>/config.json: tracking.methods and tracking.overrides; "
+                   "registration.default_leg_width_m for a subject without leg_width_m")
     s.add_argument("--detections", default=None,
                    help="the trial's observations by this method's detector (gaitval "
-                        "detect), used instead of detecting again")
-    s.add_argument("--out", required=True)
+                        "detect: results/<study>/detect/tug/<detector>/<trial>.parquet), "
+                        "used instead of detecting again (default: none, the step detects)")
+    s.add_argument("--out", required=True, help="the per-scan track, Parquet, sensor frame "
+                   "and clock, metres (results/<study>/track/<method>/<trial>.parquet)")
     s.set_defaults(func=cmd_track)
 
     s = sub.add_parser("detect", help="one TUG trial's leg observations by one detector, "
                                       "for every method with that detector")
-    s.add_argument("--sensor", required=True, help="ingested sensor.parquet")
-    s.add_argument("--sheet", required=True)
-    s.add_argument("--subjects", required=True)
-    s.add_argument("--trial", required=True)
+    s.add_argument("--sensor", required=True, help="the trial's ingested scan log "
+                   "(results/<study>/ingest/<trial>/sensor.parquet)")
+    s.add_argument("--sheet", required=True, help=_SHEET)
+    s.add_argument("--subjects", required=True, help=_SUBJECTS)
+    s.add_argument("--trial", required=True, help=_TRIAL)
     s.add_argument("--detector", required=True, help="the detector spec as JSON, e.g. "
                    "'{\"name\": \"leg_patterns\", \"use_fs_u\": true}'")
-    s.add_argument("--config", required=True,
-                   help="a config (view) JSON: registration.default_leg_width_m")
-    s.add_argument("--out", required=True)
+    s.add_argument("--config", required=True, metavar="JSON",
+                   help="a config (view) JSON (results/<study>/config_views/tug/study.json): "
+                   "registration.default_leg_width_m for a subject without leg_width_m")
+    s.add_argument("--out", required=True, help="the observation table, Parquet "
+                   "(results/<study>/detect/tug/<detector>/<trial>.parquet)")
     s.set_defaults(func=cmd_detect)
 
     s = sub.add_parser("evaluate-tug", help="evaluate one tracked TUG trial against its "
@@ -353,15 +401,17 @@ def _add_lrs_verbs(sub) -> None:
                    "(results/<study>/register/tug/<trial>/): mocap legs at the laser's "
                    "height, on the sensor clock")
     s.add_argument("--registration", required=True, help="the trial's registration.json "
-                   "(a refused registration: the trial is counted as not registered)")
+                   "(results/<study>/register/tug/<trial>/; a refused registration: the "
+                   "trial is counted as not registered)")
     s.add_argument("--trial", required=True, help="trial id (named in errors and outputs)")
     s.add_argument("--method", required=True, help="the method's name (its label in the "
                    "tables)")
     s.add_argument("--config", required=True, help="the method's config view "
                    "(results/<study>/config_views/tug/<method>.json): its evaluation.tug "
                    "thresholds and tug: section")
-    s.add_argument("--out", required=True, help="folder: frames.parquet, events.parquet, "
-                   "stance.parquet, summary.parquet")
+    s.add_argument("--out", required=True, help="folder (results/<study>/evaluate/<method>/"
+                   "<trial>): frames.parquet, events.parquet, stance.parquet, "
+                   "summary.parquet")
     s.set_defaults(func=cmd_evaluate_tug)
 
     # external tracks (issue 37): docs/formats.md, "Leg tracks"
@@ -398,7 +448,8 @@ def _add_lrs_verbs(sub) -> None:
     s.add_argument("--protocol", help="the trial's protocol (written into summary.json)")
     s.add_argument("--gate-m", type=float, default=0.30, help="a detection farther than "
                    "this from a leg is not that leg's (default 0.30 m)")
-    s.add_argument("--out", required=True, help="folder: per_scan.parquet, summary.json")
+    s.add_argument("--out", required=True, help="folder (results/<study>/leg_detections/"
+                   "<detector>/<trial>): per_scan.parquet, summary.json")
     s.set_defaults(func=cmd_leg_detections)
 
     s = sub.add_parser("leg-detections-table", help="the detection table of external leg "
@@ -416,27 +467,34 @@ def _add_lrs_verbs(sub) -> None:
                        "one trial as gaitval's track (sensor clock and frame)")
     s.add_argument("--tracks", required=True, help="*.tracks.csv or *.tracks.parquet, or a "
                    "ROS bag with a tracker's topic (--config names topic and legs)")
-    s.add_argument("--sensor", required=True, help="ingested sensor.parquet (time span)")
+    s.add_argument("--sensor", required=True, help="the trial's ingested sensor.parquet "
+                   "(results/<study>/ingest/<trial>/; its time span)")
     s.add_argument("--registration", help="the trial's registration.json (pose and clock "
                    "offset, for a file in the mocap frame or clock; none: a trial without "
                    "mocap, the file must be on the sensor clock in the sensor frame)")
     s.add_argument("--trial", required=True, help="trial id (named in errors)")
     s.add_argument("--method", required=True, help="the external method's name")
-    s.add_argument("--config", help="the method's config view: tracking.external.<method> "
-                   "gives a bag's topic and legs")
+    s.add_argument("--config", help="the method's config view (results/<study>/"
+                   "config_views/<family>/<method>.json): tracking.external.<method> gives "
+                   "a bag's topic and legs")
     s.add_argument("--moving-sensor", action="store_true",
                    help="the laser moves (rollator): refuse tracks in the mocap frame")
-    s.add_argument("--out", required=True, help="the per-scan track (Parquet; "
-                   "results/<study>/track/<method>/<trial>.parquet in the workflow)")
+    s.add_argument("--out", required=True, help="the per-scan track (Parquet; in the "
+                   "workflow results/<study>/track/<method>/<trial>.parquet, for MTST "
+                   "mtst_track/<method>/<trial>.parquet, for the rollator "
+                   "rollator/<method>/<trial>.track.parquet)")
     s.set_defaults(func=cmd_import_tracks)
 
     s = sub.add_parser("tug-tables", help="seed 000 Tables 2-5 and figures")
-    s.add_argument("inputs", nargs="+", help="per-(trial, method) evaluation folders")
-    s.add_argument("--methods", nargs="+", default=["tug_m1", "tug_m2", "tug_m3"])
-    s.add_argument("--tables-dir", required=True)
-    s.add_argument("--figures-dir", required=True)
-    s.add_argument("--reports-dir", default="reports")
-    s.add_argument("--config-hash", default="")
+    s.add_argument("inputs", nargs="+", metavar="EVAL_DIR",
+                   help="per-(trial, method) evaluation folders of evaluate-tug "
+                   "(results/<study>/evaluate/<method>/<trial>)")
+    s.add_argument("--methods", nargs="+", default=["tug_m1", "tug_m2", "tug_m3"],
+                   help="the methods, in table order (default: tug_m1 tug_m2 tug_m3)")
+    s.add_argument("--tables-dir", required=True, help=_TABLES)
+    s.add_argument("--figures-dir", required=True, help=_FIGURES)
+    s.add_argument("--reports-dir", default="reports", help=_REPORTS)
+    s.add_argument("--config-hash", default="", help=_HASH)
     s.add_argument("--configs", nargs="+", default=None,
                    help="each study's config.json or its method views (config_views/tug/"
                         "<method>.json) for Table 2; default: the config.json above each "
@@ -447,41 +505,64 @@ def _add_lrs_verbs(sub) -> None:
 def _add_ultrasonic_verbs(sub) -> None:
     """The ultrasonic study (seed 003): noise identification, UKF tracking, gait parameters."""
     s = sub.add_parser("ultrasonic-noise", help="V and W from pendulum trials; Table 1")
-    s.add_argument("--ingest", nargs="+", required=True, help="pendulum ingest folders")
-    s.add_argument("--trials", nargs="+", required=True, help="their trial ids, same order")
-    s.add_argument("--config", required=True)
-    s.add_argument("--out", required=True, help="noise.json")
-    s.add_argument("--table-stem", required=True)
-    s.add_argument("--reports-dir", default="reports")
-    s.add_argument("--config-hash", default="")
+    s.add_argument("--ingest", nargs="+", required=True, metavar="DIR",
+                   help="pendulum ingest folders (results/<study>/ingest/<trial>: the "
+                   "ultrasonic log sensor.parquet and mocap.parquet)")
+    s.add_argument("--trials", nargs="+", required=True, metavar="TRIAL",
+                   help="their trial ids, same order")
+    s.add_argument("--config", required=True, metavar="JSON", help="a config (view) JSON "
+                   "(results/<study>/config_views/ultrasonic/study.json): its ultrasonic: "
+                   "section")
+    s.add_argument("--out", required=True, help="noise.json: V per anchor, W, bias, RMSE "
+                   "(results/ultrasonic_noise.json)")
+    s.add_argument("--table-stem", required=True, help="Table 1's path without suffix "
+                   "(reports/<run>/tables/ultrasonic_table1; writes .csv, .md, .tex)")
+    s.add_argument("--reports-dir", default="reports", help=_REPORTS)
+    s.add_argument("--config-hash", default="", help=_HASH)
     s.set_defaults(func=cmd_ultrasonic_noise)
 
     s = sub.add_parser("ultrasonic-track", help="UKF track of one ultrasonic trial")
-    s.add_argument("--ingest", required=True)
-    s.add_argument("--trial", required=True)
-    s.add_argument("--config", required=True)
-    s.add_argument("--noise", required=True, help="noise.json of ultrasonic-noise")
-    s.add_argument("--out", required=True)
+    s.add_argument("--ingest", required=True, metavar="DIR", help="the treadmill trial's "
+                   "ingest folder (results/<study>/ingest/<trial>: the ultrasonic log "
+                   "sensor.parquet)")
+    s.add_argument("--trial", required=True, help=_TRIAL)
+    s.add_argument("--config", required=True, metavar="JSON", help="a config (view) JSON "
+                   "(results/<study>/config_views/ultrasonic/study.json): ultrasonic.ukf, "
+                   "ultrasonic.use_identified_W")
+    s.add_argument("--noise", required=True, help="noise.json of ultrasonic-noise "
+                   "(results/ultrasonic_noise.json): the identified V")
+    s.add_argument("--out", required=True, help="the UKF track, Parquet "
+                   "(results/<study>/ultrasonic/track/<trial>.parquet)")
     s.set_defaults(func=cmd_ultrasonic_track)
 
     s = sub.add_parser("gait-parameters", help="per-stride parameters, reference vs system")
-    s.add_argument("--track", required=True)
-    s.add_argument("--ingest", required=True)
-    s.add_argument("--sheet", required=True)
-    s.add_argument("--subjects", required=True)
-    s.add_argument("--trial", required=True)
-    s.add_argument("--config", required=True)
-    s.add_argument("--out", required=True)
+    s.add_argument("--track", required=True, help="the trial's UKF track of ultrasonic-track "
+                   "(results/<study>/ultrasonic/track/<trial>.parquet)")
+    s.add_argument("--ingest", required=True, metavar="DIR", help="the trial's ingest folder "
+                   "(results/<study>/ingest/<trial>: sensor.parquet for the anchors, "
+                   "mocap.parquet for the reference)")
+    s.add_argument("--sheet", required=True, help=_SHEET)
+    s.add_argument("--subjects", required=True, help=_SUBJECTS)
+    s.add_argument("--trial", required=True, help=_TRIAL)
+    s.add_argument("--config", required=True, metavar="JSON", help="a config (view) JSON "
+                   "(results/<study>/config_views/ultrasonic/study.json): its ultrasonic: "
+                   "section")
+    s.add_argument("--out", required=True, help="one row per stride, reference and system "
+                   "(seed 003 eq. 16-22), Parquet (results/<study>/ultrasonic/gait/"
+                   "<trial>.parquet)")
     s.set_defaults(func=cmd_gait_parameters)
 
     s = sub.add_parser("ultrasonic-tables", help="seed 003 Tables 2-8, C1 and figures")
-    s.add_argument("inputs", nargs="+", help="per-trial gait parameter files")
-    s.add_argument("--tables-dir", required=True)
-    s.add_argument("--figures-dir", required=True)
-    s.add_argument("--reports-dir", default="reports")
-    s.add_argument("--config-hash", default="")
+    s.add_argument("inputs", nargs="+", metavar="GAIT_PARQUET",
+                   help="per-trial gait parameter files of gait-parameters "
+                   "(results/<study>/ultrasonic/gait/<trial>.parquet)")
+    s.add_argument("--tables-dir", required=True, help=_TABLES)
+    s.add_argument("--figures-dir", required=True, help=_FIGURES)
+    s.add_argument("--reports-dir", default="reports", help=_REPORTS)
+    s.add_argument("--config-hash", default="", help=_HASH)
     s.add_argument("--config", default=None,
-                   help="config (view) JSON: ultrasonic.tables, the strides the tables use")
+                   help="config (view) JSON: ultrasonic.tables, the strides the tables use "
+                   "(default: the paper's 10 per subject)")
     s.set_defaults(func=cmd_ultrasonic_tables)
 
 
@@ -555,33 +636,68 @@ def _add_mtst_verbs(sub) -> None:
                                a.config_hash, methods=a.methods, config_json=a.config)
         return 0
 
-    def common(s, *names):
-        for n in names:
-            s.add_argument(f"--{n}", required=True)
+    def common(s, **helps):
+        """Required options ``--<name>`` (``_`` -> ``-``), each with its help text."""
+        for n, text in helps.items():
+            s.add_argument(f"--{n.replace('_', '-')}", required=True, help=text)
         s.set_defaults(func=run)
 
+    sensor = ("the trial's scan log: results/<study>/ingest/<trial>/sensor.parquet, or for "
+              "a trial without mocap the raw scan log or bag the trial sheet names")
+    registration = ("the trial's registration.json (results/<study>/register/mtst/<trial>/); "
+                    "none: the pose from mtst.poles_m, the clock offset from the trial "
+                    "sheet's clock_offset_s")
     s = sub.add_parser("mtst-track", help="track one MTST trial (every scan at Δt = 0.05 s)")
-    s.add_argument("--registration", help="registration.json (none: mtst.poles_m)")
+    s.add_argument("--registration", help=registration)
     s.add_argument("--detections", default=None,
                    help="the trial's observations by this method's detector (gaitval "
-                        "mtst-detect), used instead of detecting again")
-    common(s, "sensor", "sheet", "subjects", "trial", "method", "config", "out")
+                        "mtst-detect: results/<study>/detect/mtst/<detector>/<trial>.parquet), "
+                        "used instead of detecting again (default: none, the step detects)")
+    common(s, sensor=sensor, sheet=_SHEET, subjects=_SUBJECTS, trial=_TRIAL,
+           method="the method's name: a built-in (mtst_m1, mtst_m2, mtst_m3, mtst_proposed, "
+           "people) or one of tracking.methods",
+           config="the method's config view (results/<study>/config_views/mtst/"
+           "<method>.json): the mtst: section (scan_period_s, mat), tracking.methods and "
+           "tracking.overrides",
+           out="the per-scan track, Parquet, sensor frame and clock, metres, every scan at "
+           "mtst.scan_period_s (results/<study>/mtst_track/<method>/<trial>.parquet)")
     s = sub.add_parser("mtst-detect", help="one MTST trial's leg observations by one "
                                            "detector, for every method with that detector")
     s.add_argument("--detector", required=True, help="the detector spec as JSON")
-    common(s, "sensor", "sheet", "subjects", "trial", "config", "out")
+    common(s, sensor=sensor, sheet=_SHEET, subjects=_SUBJECTS, trial=_TRIAL,
+           config="a config (view) JSON (results/<study>/config_views/mtst/study.json): "
+           "mtst.scan_period_s",
+           out="the observation table, Parquet "
+           "(results/<study>/detect/mtst/<detector>/<trial>.parquet)")
     s = sub.add_parser("mtst-evaluate", help="contacts, target and cross steps of one trial, "
                                              "against annotations (and mocap)")
-    s.add_argument("--registration", help="registration.json (none: mtst.poles_m)")
-    s.add_argument("--groundtruth", help="groundtruth.parquet (mocap studies)")
-    common(s, "track", "sheet", "subjects", "trial", "method", "config", "out")
+    s.add_argument("--registration", help=registration)
+    s.add_argument("--groundtruth", help="the trial's groundtruth.parquet "
+                   "(results/<study>/register/mtst/<trial>/; studies with mocap; none: "
+                   "against the annotations only)")
+    common(s, track="the trial's track of mtst-track or import-tracks "
+           "(results/<study>/mtst_track/<method>/<trial>.parquet)",
+           sheet=_SHEET + "; names the trial's annotation file",
+           subjects=_SUBJECTS, trial=_TRIAL,
+           method="the method's name (its label in the tables)",
+           config="the method's config view (results/<study>/config_views/mtst/"
+           "<method>.json): the mtst: section (targets, mat, gates)",
+           out="folder (results/<study>/mtst_eval/<method>/<trial>): contacts, steps, "
+           "events, gates, track_field, summary, targets (.parquet)")
     s = sub.add_parser("mtst-tables", help="seed 001 Tables 1, 3, 4 and the trial figure")
-    s.add_argument("inputs", nargs="+", help="per-(trial, method) evaluation folders")
-    s.add_argument("--methods", nargs="+", default=None)
-    s.add_argument("--config", help="a study's config.json (mtst section)")
-    s.add_argument("--reports-dir", default="reports")
-    s.add_argument("--config-hash", default="")
-    common(s, "tables-dir", "figures-dir")
+    s.add_argument("inputs", nargs="+", metavar="EVAL_DIR",
+                   help="per-(trial, method) evaluation folders of mtst-evaluate "
+                   "(results/<study>/mtst_eval/<method>/<trial>)")
+    s.add_argument("--methods", nargs="+", default=None,
+                   help="the methods, in table order; one not in mtst.methods is shown as "
+                   "an external tracker (default: mtst.methods of --config, else mtst_m1 "
+                   "mtst_m2 mtst_m3 mtst_proposed)")
+    s.add_argument("--config", help="a study's config (view) JSON (results/<study>/"
+                   "config_views/mtst/study.json): the mtst: section; the method views "
+                   "beside it name a method run with tracking.overrides")
+    s.add_argument("--reports-dir", default="reports", help=_REPORTS)
+    s.add_argument("--config-hash", default="", help=_HASH)
+    common(s, tables_dir=_TABLES, figures_dir=_FIGURES)
 
 
 def _add_rollator_verbs(sub) -> None:
@@ -604,38 +720,77 @@ def _add_rollator_verbs(sub) -> None:
                                    models=a.models, config_json=a.config)
         return 0
 
-    def common(s, *names):
-        for n in names:
-            s.add_argument(f"--{n}", required=True)
+    def common(s, **helps):
+        """Required options ``--<name>`` (``_`` -> ``-``), each with its help text."""
+        for n, text in helps.items():
+            s.add_argument(f"--{n.replace('_', '-')}", required=True, help=text)
         s.set_defaults(func=run)
 
+    view = ("the method's config view (results/<study>/config_views/rollator/<method>.json): "
+            "the rollator: section, tracking.methods and tracking.overrides")
     s = sub.add_parser("rollator-train", help="learn the PF model for one held-out subject")
-    s.add_argument("--results", required=True, help="results/<study> (ingest/, register/)")
-    common(s, "sheet", "subjects", "subject", "config", "out")
+    s.add_argument("--results", required=True, metavar="DIR",
+                   help="results/<study>: the other subjects' rollator trials' "
+                   "ingest/<trial>/sensor.parquet and register/rollator/<trial>/")
+    common(s, sheet=_SHEET, subjects=_SUBJECTS,
+           subject="the held-out subject's id: the model learns from every other subject's "
+           "rollator trials",
+           config="a config (view) JSON (results/<study>/config_views/rollator/study.json): "
+           "rollator.train_seed; registration.default_leg_width_m",
+           out="the PF model, JSON (results/<study>/rollator/model/<subject>.json)")
     s = sub.add_parser("rollator-track", help="track one rollator trial with the KF or PF")
-    s.add_argument("--model", help="the held-out subject's PF model (PF methods)")
-    common(s, "sensor", "sheet", "subjects", "trial", "method", "config", "out")
+    s.add_argument("--model", help="the held-out subject's PF model of rollator-train "
+                   "(results/<study>/rollator/model/<subject>.json; PF methods)")
+    common(s, sensor="the trial's ingested scan log "
+           "(results/<study>/ingest/<trial>/sensor.parquet)",
+           sheet=_SHEET, subjects=_SUBJECTS, trial=_TRIAL,
+           method="rollator_kf, rollator_pf or one of rollator.methods (e.g. people)",
+           config=view,
+           out="the per-scan track, Parquet, in the laser's (moving) frame, metres "
+           "(results/<study>/rollator/<method>/<trial>.track.parquet)")
     s = sub.add_parser("rollator-evaluate", help="evaluate one tracked rollator trial")
-    s.add_argument("--ingest", required=True, help="the trial's ingest folder (mocap)")
-    common(s, "track", "groundtruth", "registration", "sheet", "subjects", "trial", "method",
-           "config", "out")
+    s.add_argument("--ingest", required=True, metavar="DIR", help="the trial's ingest folder "
+                   "(results/<study>/ingest/<trial>: mocap.parquet with the rollator's "
+                   "markers)")
+    common(s, track="the trial's track of rollator-track or import-tracks "
+           "(results/<study>/rollator/<method>/<trial>.track.parquet)",
+           groundtruth="the trial's groundtruth.parquet "
+           "(results/<study>/register/rollator/<trial>/)",
+           registration="the trial's registration.json "
+           "(results/<study>/register/rollator/<trial>/): clock offset and drift, status",
+           sheet=_SHEET, subjects=_SUBJECTS, trial=_TRIAL,
+           method="the method's name (its label in the tables)", config=view,
+           out="folder (results/<study>/rollator/<method>/<trial>): frames.parquet, "
+           "summary.parquet")
     s = sub.add_parser("rollator-tables", help="seed 002 Tables I, II and the figure")
-    s.add_argument("inputs", nargs="+", help="per-(trial, method) evaluation folders")
-    s.add_argument("--kf", default="rollator_kf")
-    s.add_argument("--pf", default="rollator_pf")
-    s.add_argument("--models", nargs="*", default=[], help="the PF models used")
-    s.add_argument("--config", help="a study's config.json (rollator section)")
-    s.add_argument("--reports-dir", default="reports")
-    s.add_argument("--config-hash", default="")
-    common(s, "tables-dir", "figures-dir")
-
+    s.add_argument("inputs", nargs="+", metavar="EVAL_DIR",
+                   help="per-(trial, method) evaluation folders of rollator-evaluate "
+                   "(results/<study>/rollator/<method>/<trial>)")
+    s.add_argument("--kf", default="rollator_kf",
+                   help="the KF method's name (rollator.kf_method; default rollator_kf)")
+    s.add_argument("--pf", default="rollator_pf",
+                   help="the PF method's name (rollator.pf_method; default rollator_pf)")
+    s.add_argument("--models", nargs="*", default=[],
+                   help="the PF models used (results/<study>/rollator/model/<subject>.json); "
+                   "the tables name their training source (default: none)")
+    s.add_argument("--config", help="a study's config (view) JSON (results/<study>/"
+                   "config_views/rollator/study.json): the rollator: section; the method "
+                   "views beside it name a method run with tracking.overrides")
+    s.add_argument("--reports-dir", default="reports", help=_REPORTS)
+    s.add_argument("--config-hash", default="", help=_HASH)
+    common(s, tables_dir=_TABLES, figures_dir=_FIGURES)
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``gaitval`` argument parser: one sub-command per verb, in pipeline order."""
-    p = argparse.ArgumentParser(prog="gaitval", description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(
+        prog="gaitval", description=__doc__.splitlines()[0].replace("``", ""),
+        epilog="'gaitval VERB --help': what the verb reads and writes (the paths the "
+               "workflow uses, formats, units, defaults). Exit codes: 0 done, 1 a data "
+               "error, 2 a usage error (README, 'When something goes wrong').")
     from gaitval import __version__
     p.add_argument("--version", action="version", version=f"gaitval {__version__}")
-    sub = p.add_subparsers(dest="verb", required=True)
+    sub = p.add_subparsers(dest="verb", required=True, metavar="VERB",
+                           title="verbs (in pipeline order)")
     _add_input_verbs(sub)
     _add_lrs_verbs(sub)
     _add_ultrasonic_verbs(sub)
@@ -645,19 +800,27 @@ def build_parser() -> argparse.ArgumentParser:
     from gaitval.pipeline.legbench import add_legbench_verbs
     add_legbench_verbs(sub)              # annotated recordings without mocap (issue 18)
 
-    s = sub.add_parser("report", help="write reports/index.md and index.html")
-    s.add_argument("--reports-dir", default="reports")
-    s.add_argument("--studies", nargs="*", default=[])
+    s = sub.add_parser("report", help="write reports/<run>/index.md, index.html and the "
+                       "verdict table from the report folder's tables and figures")
+    s.add_argument("--reports-dir", default="reports", metavar="DIR",
+                   help="the report folder (reports/<run>: tables/, figures/, provenance/); "
+                   "writes index.md, index.html, verdicts.csv/.md/.tex there (default: "
+                   "reports)")
+    s.add_argument("--studies", nargs="*", default=[], metavar="STUDY",
+                   help="the run's study ids (default: 'run' of <reports-dir>/provenance/"
+                   "config.yaml)")
     s.set_defaults(func=cmd_report)
     s = sub.add_parser("compare-tables", help="two report folders' tables within a stated "
                        "tolerance (docs/numerics.md)")
     from gaitval.report.compare import add_arguments
     add_arguments(s)
     s.set_defaults(func=cmd_compare_tables)
+    for choice in sub._choices_actions:  # `gaitval VERB --help` opens with what the verb does
+        if sub.choices[choice.dest].description is None:
+            sub.choices[choice.dest].description = choice.help
     from gaitval.cli_exit import add_verbosity
     add_verbosity(p, sub)
     return p
-
 
 @functools.cache
 def parser() -> argparse.ArgumentParser:

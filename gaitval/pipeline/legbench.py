@@ -378,46 +378,77 @@ def add_legbench_verbs(sub) -> None:
                                  views_dir=a.views_dir)
         return 0
 
+    reports = ("the report folder (reports/<run> in the workflow): the step's provenance "
+               "record goes to its provenance/ (default: reports)")
+    ann_topic = ("the bag's annotation topic, e.g. /ground_truth_people_tracks (default: "
+                 "the only one; docs/formats.md, Annotated person positions)")
+    scan_topic = "the bag's LaserScan topic (default: the only one)"
     s = sub.add_parser("legbench-track", help="track an annotated recording (bag or scan "
                                               "log, no mocap) with one method")
-    s.add_argument("--sensor", required=True, help="ROS bag or *.scan.parquet")
-    s.add_argument("--scan-topic", help="LaserScan topic (bags with several)")
-    s.add_argument("--method", required=True)
+    s.add_argument("--sensor", required=True, help="ROS 1 *.bag, ROS 2 bag folder or "
+                   "*.scan.parquet (the trial sheet's sensor_file)")
+    s.add_argument("--scan-topic", help=scan_topic)
+    s.add_argument("--method", required=True, help="the method's name: a built-in (e.g. "
+                   "tug_m1, tug_m2, tug_m3) or one of tracking.methods (legbench.methods)")
     s.add_argument("--init", choices=INITS, default="own",
-                   help="own: the method's initialiser; annotation: the first annotation")
-    s.add_argument("--annotations", help="bag with the annotation topic, or *.positions.csv")
-    s.add_argument("--annotation-topic")
-    s.add_argument("--leg-width-m", type=float, default=0.10)
-    s.add_argument("--config", help="a study's config.json (tracking section)")
-    s.add_argument("--trial")
-    s.add_argument("--out", required=True)
+                   help="own: the method's initialiser; annotation: the first annotation "
+                   "(default: own)")
+    s.add_argument("--annotations", help="bag with the annotation topic, or *.positions.csv "
+                   "(read by --init annotation)")
+    s.add_argument("--annotation-topic", help=ann_topic)
+    s.add_argument("--leg-width-m", type=float, default=0.10, help="the subject's shank "
+                   "width (subjects.csv leg_width_m; m, default 0.10)")
+    s.add_argument("--config", help="a config (view) JSON (results/<study>/config_views/all/"
+                   "<method>.json): tracking.methods and tracking.overrides (default: the "
+                   "built-in method as it is)")
+    s.add_argument("--trial", help="trial id, named in errors and the track (default: the "
+                   "sensor file's name)")
+    s.add_argument("--out", required=True, help="the per-scan track, Parquet, sensor frame "
+                   "and clock, metres (results/<study>/legbench/<method>/<init>/<trial>/"
+                   "track.parquet)")
     s.set_defaults(func=run)
     s = sub.add_parser("legbench-evaluate", help="CLEAR-MOT (0.75 m) and false leg tracks "
                                                  "of a legbench track")
-    s.add_argument("--track", required=True)
-    s.add_argument("--annotations", required=True)
-    s.add_argument("--annotation-topic")
-    s.add_argument("--scan-topic")
-    s.add_argument("--match-m", type=float, default=0.75)
-    s.add_argument("--min-false-s", type=float, default=0.5)
+    s.add_argument("--track", required=True, help="the track of legbench-track "
+                   "(results/<study>/legbench/<method>/<init>/<trial>/track.parquet)")
+    s.add_argument("--annotations", required=True, help="bag with the annotation topic, or "
+                   "*.positions.csv")
+    s.add_argument("--annotation-topic", help=ann_topic)
+    s.add_argument("--scan-topic", help=scan_topic + ": the scan times the annotations "
+                   "are matched to")
+    s.add_argument("--match-m", type=float, default=0.75, help="a tracked person (midpoint "
+                   "of its two legs) matches an annotated one within this distance (m; "
+                   "default 0.75, the leg_tracker benchmark's)")
+    s.add_argument("--min-false-s", type=float, default=0.5, help="a leg estimate with no "
+                   "annotated person within --match-m for at least this long is a false "
+                   "leg track (s; default 0.5)")
     s.add_argument("--sector-deg", type=float, nargs=2, metavar=("LO", "HI"),
                    help="score only what lies at bearings LO..HI degrees (the general "
-                   "tracking sets: -80 12)")
+                   "tracking sets: -80 12; default: the whole scan)")
     s.add_argument("--benchmark-set", default="",
                    help="the published set the recording belongs to (e.g. "
-                   "following_outdoor): its published rows stand beside gaitval's")
-    s.add_argument("--trial")
-    s.add_argument("--out", required=True)
+                   "following_outdoor): its published rows stand beside gaitval's "
+                   "(default: none)")
+    s.add_argument("--trial", help="trial id (default: the one in the track)")
+    s.add_argument("--out", required=True, help="folder (results/<study>/legbench_eval/"
+                   "<method>/<init>/<trial>): summary.parquet, frames.parquet")
     s.set_defaults(func=run)
     s = sub.add_parser("legbench-tables", help="CLEAR-MOT table and figure of legbench runs")
-    s.add_argument("inputs", nargs="+", help="legbench-evaluate output folders")
-    s.add_argument("--methods", nargs="+", default=None)
-    s.add_argument("--inits", nargs="+", default=None)
+    s.add_argument("inputs", nargs="+", metavar="EVAL_DIR", help="legbench-evaluate output "
+                   "folders (results/<study>/legbench_eval/<method>/<init>/<trial>)")
+    s.add_argument("--methods", nargs="+", default=None, help="the methods, in table order "
+                   "(default: the inputs' order)")
+    s.add_argument("--inits", nargs="+", default=None, help="the initialisations, in table "
+                   "order (default: the inputs' order)")
     s.add_argument("--views-dir", default=None,
                    help="folder of the method config views the tracks ran with (names a "
-                        "method run with tracking.overrides with its changes)")
-    s.add_argument("--tables-dir", required=True)
-    s.add_argument("--figures-dir", required=True)
-    s.add_argument("--reports-dir", default="reports")
-    s.add_argument("--config-hash", default="")
+                        "method run with tracking.overrides with its changes; "
+                        "results/<study>/config_views/all)")
+    s.add_argument("--tables-dir", required=True, help="folder the table goes to "
+                   "(legbench_clearmot.csv, .md, ...; reports/<run>/tables)")
+    s.add_argument("--figures-dir", required=True, help="folder the figure goes to "
+                   "(legbench_tracks.png; reports/<run>/figures)")
+    s.add_argument("--reports-dir", default="reports", help=reports)
+    s.add_argument("--config-hash", default="", help="the run's config hash, written into "
+                   "the provenance record (default: empty)")
     s.set_defaults(func=run)
