@@ -26,6 +26,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 import yaml
@@ -419,3 +420,23 @@ def test_a_tracker_recorded_in_the_sensor_bags_is_offered_commented(tiny_files, 
     (lab / "study.yaml").write_text(text + f"external_methods:\n  ext_people_tracked: {entry}\n")
     from gaitval.configcheck import check_study_file
     check_study_file(yaml.safe_load((lab / "study.yaml").read_text()), lab / "study.yaml")
+
+
+def test_heel_trajectories_named_by_trial_become_a_treadmill_method(tiny_files, tmp_path):
+    """A foot-tracking system's *.foot.csv beside treadmill recordings: init-study declares
+    it with protocols [treadmill] (docs/formats.md, Foot trajectories)."""
+    from gaitval.io.foot import write_foot
+
+    lab = tmp_path / "lab"
+    (lab / "feet").mkdir(parents=True)
+    rows = pd.DataFrame({"t_s": np.arange(12) * 0.02, "x": np.linspace(0, 1, 12),
+                         "y": 0.0, "z": 0.1})
+    for t in ("us_US01_normal", "us_US01_fast"):
+        shutil.copy(tiny_files / "ultrasonic" / f"{t}.us.parquet", lab / f"{t}.us.parquet")
+        shutil.copy(tiny_files / "ultrasonic" / f"{t}.c3d", lab / f"{t}.c3d")
+        write_foot(rows, lab / "feet" / f"{t}.foot.csv")
+    res = run_cli("init-study", str(lab))
+    cal = yaml.safe_load((lab / "study.yaml").read_text())
+    assert cal["external_methods"] == {"ext_feet": {
+        "path": "feet/{trial}.foot.csv", "protocols": ["treadmill"]}}, res.stdout
+    assert "external_methods.ext_feet: feet/{trial}.foot.csv (treadmill trials)" in res.stdout

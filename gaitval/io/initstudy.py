@@ -71,7 +71,11 @@ SKIP_DIRS = {"truth", "results", "reports", "logs", ".snakemake"}
 SUFFIXES = (("c3d", (".c3d",)), ("scanlog", (".scan.parquet",)),
             ("ultrasonic", (".us.parquet",)), ("annotations", (".annotations.csv",)),
             ("positions", (".positions.csv",)), ("targets", (".targets.csv",)),
-            ("tracks", (".tracks.csv", ".tracks.parquet")), ("bag", (".bag",)))
+            ("tracks", (".tracks.csv", ".tracks.parquet")),
+            ("foot", (".foot.csv", ".foot.parquet")), ("bag", (".bag",)))
+#: the protocols an external file of each kind can cover (leg tracks: a fixed or moving
+#: laser; heel trajectories: the treadmill, docs/formats.md "Foot trajectories")
+EXTERNAL_KINDS = {"tracks": {"tug", "mtst", "rollator"}, "foot": {"treadmill"}}
 
 
 @dataclass
@@ -604,29 +608,30 @@ def _bag_detections(trials: list[dict], bag_detectors: dict[str, list[str]],
 
 def _external_methods(trials: list[dict], files: list[Found], res: InitResult,
                       yaml_path: Path) -> dict:
-    """External trackers' files (``<folder>/<trial>.tracks.csv`` or ``.parquet``): one
-    method per folder and suffix whose files are named by trial ids, named after the
-    folder; its protocols those of its trials (docs/formats.md, *External methods*): the
+    """External trackers' files (``<folder>/<trial>.tracks.csv`` or ``.parquet``, and
+    foot-tracking systems' ``<folder>/<trial>.foot.csv`` or ``.parquet``): one method per
+    folder and suffix whose files are named by trial ids, named after the folder; its
+    protocols those of its trials (:data:`EXTERNAL_KINDS`) (docs/formats.md, *External methods*): the
     study.yaml's ``external_methods:``, each entry checked against the schema a
     hand-written one is (:func:`gaitval.configcheck.check_study_file`)."""
     from gaitval.configcheck import check_study_file
 
     proto = {r["trial"]: r.get("protocol") for r in trials}
-    groups: dict[tuple[str, str], list[str]] = {}
+    groups: dict[tuple[str, str, str], list[str]] = {}
     for f in files:
-        if f.kind != "tracks":
+        if f.kind not in EXTERNAL_KINDS:
             continue
         parent = str(Path(f.rel).parent)
         suffix = Path(f.rel).name[len(f.stem):]
-        groups.setdefault((parent, suffix), []).append(f.stem)
+        groups.setdefault((parent, suffix, f.kind), []).append(f.stem)
     out: dict = {}
-    for (parent, suffix), stems in sorted(groups.items()):
+    for (parent, suffix, kind), stems in sorted(groups.items()):
         known = [t for t in stems if t in proto]
         if not known:
-            res.unpaired += [f"{parent}/{t}{suffix}: external tracks of no trial id"
-                             for t in stems]
+            what = "external tracks" if kind == "tracks" else "heel trajectories"
+            res.unpaired += [f"{parent}/{t}{suffix}: {what} of no trial id" for t in stems]
             continue
-        protos = sorted({proto[t] for t in known} & {"tug", "mtst", "rollator"})
+        protos = sorted({proto[t] for t in known} & EXTERNAL_KINDS[kind])
         name = _ID_BAD.sub("_", Path(parent).name if parent != "." else "external")
         name = f"ext_{name}" if not name.startswith("ext") else name
         path = (f"{parent}/{{trial}}{suffix}" if parent != "." else f"{{trial}}{suffix}")
