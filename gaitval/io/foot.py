@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from gaitval.io.tracks import (UNITS, VERSION, _check_meta, _columns_of, _err, _floats,
-                               _on_header_clock, _write_rows)
+from gaitval.io.tracks import (UNITS, VERSION, _check_meta, _err, _floats,
+                               _on_header_clock, _write_rows, open_exchange)
 
 FOOT_FORMAT = "gaitval-foot"
 FOOT_META_KEY = b"gaitval:foot"
@@ -52,19 +52,9 @@ def read_foot(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataFra
         and not all three, fewer than :data:`MIN_SAMPLES` positions.
     """
     p = Path(path)
-    meta, names, cols, where, meta_lines, first_line = _columns_of(
-        p, trial, "foot", FOOT_FORMAT, FOOT_META_KEY)
-    meta = _check_meta(meta, p, trial, meta_lines, fmt=FOOT_FORMAT, meta_key=FOOT_META_KEY)
-    unknown = [n for n in names if n not in FOOT_COLUMNS]
-    if unknown:
-        raise _err(p, f"unknown column(s) {', '.join(map(repr, unknown))}", trial,
-                   hint=f"the columns are {', '.join(FOOT_COLUMNS)} (one foot: the one "
-                        "the reference marker is on)")
-    for c in FOOT_COLUMNS:
-        if c not in names:
-            raise _err(p, f"column {c!r} is missing", trial)
-    if not cols["t_s"]:
-        raise _err(p, "no rows", trial)
+    meta, names, cols, where, meta_lines, first_line = open_exchange(
+        p, trial, "foot", FOOT_FORMAT, FOOT_META_KEY, FOOT_COLUMNS, FOOT_COLUMNS,
+        "one foot: the one the reference marker is on")
     scale = UNITS[meta["units"]]
     t = _on_header_clock(_floats(p, "t_s", cols["t_s"], where, trial, finite=True), meta)
     back = np.flatnonzero(np.diff(t) <= 0)

@@ -172,6 +172,26 @@ def _columns_of(p: Path, trial, kind: str, fmt: str = FORMAT, meta_key: bytes = 
     return meta, names, cols, where, meta_lines, first_line
 
 
+def open_exchange(p: Path, trial, kind: str, fmt: str, meta_key: bytes, allowed,
+                  required, why: str):
+    """A detections or foot file (``kind``) opened and its header checked: as
+    :func:`_columns_of`, after refusing a column not in ``allowed`` (``why`` says what
+    the columns are for), a missing one of ``required``, and a file without rows."""
+    meta, names, cols, where, meta_lines, first_line = _columns_of(p, trial, kind, fmt,
+                                                                   meta_key)
+    meta = _check_meta(meta, p, trial, meta_lines, fmt=fmt, meta_key=meta_key)
+    unknown = [n for n in names if n not in allowed]
+    if unknown:
+        raise _err(p, f"unknown column(s) {', '.join(map(repr, unknown))}", trial,
+                   hint=f"the columns are {', '.join(allowed)} ({why})")
+    for c in required:
+        if c not in names:
+            raise _err(p, f"column {c!r} is missing", trial)
+    if not cols[required[0]]:
+        raise _err(p, "no rows", trial)
+    return meta, names, cols, where, meta_lines, first_line
+
+
 def _read_parquet(path: Path, trial, fmt: str = FORMAT, meta_key: bytes = META_KEY
                   ) -> tuple[dict, pd.DataFrame]:
     import pyarrow.parquet as pq
@@ -877,19 +897,9 @@ def read_detections(path: str | Path, *, trial: str | None = None
         non-number, one of ``x``, ``y`` empty without the other, no rows.
     """
     p = Path(path)
-    meta, names, cols, where, meta_lines, first_line = _columns_of(
-        p, trial, "detections", DET_FORMAT, DET_META_KEY)
-    meta = _check_meta(meta, p, trial, meta_lines, fmt=DET_FORMAT, meta_key=DET_META_KEY)
-    unknown = [n for n in names if n not in DET_COLUMNS]
-    if unknown:
-        raise _err(p, f"unknown column(s) {', '.join(map(repr, unknown))}", trial,
-                   hint=f"the columns are {', '.join(DET_COLUMNS)} (detections have no "
-                        "side or person: a file with legs' identities is a track file)")
-    for c in ("t_s", "x", "y"):
-        if c not in names:
-            raise _err(p, f"column {c!r} is missing", trial)
-    if not cols["t_s"]:
-        raise _err(p, "no rows", trial)
+    meta, names, cols, where, meta_lines, first_line = open_exchange(
+        p, trial, "detections", DET_FORMAT, DET_META_KEY, DET_COLUMNS, ("t_s", "x", "y"),
+        "detections have no side or person: a file with legs' identities is a track file")
     scale = UNITS[meta["units"]]
     t = _on_header_clock(_floats(p, "t_s", cols["t_s"], where, trial, finite=True), meta)
     x = _floats(p, "x", cols["x"], where, trial, finite=False) * scale

@@ -506,10 +506,9 @@ def ultrasonic_track_step(ingest_dir, trial: str, config_json, noise_json, out_p
     return track
 
 
-def gait_parameters_step(track_parquet, ingest_dir, sheet, subjects, trial: str,
-                         config_json, out_parquet) -> pd.DataFrame:
-    """Gait parameters per stride for reference and system (seed 003 eq. 16-22)."""
-    from gaitval.evaluate.ultrasonic import gait_parameters
+def _treadmill_trial(ingest_dir, sheet, subjects, trial: str, config_json) -> tuple:
+    """What a treadmill trial's stride extraction reads: the ``ultrasonic`` config section,
+    the trial's sheet row and subject, its ultrasonic log (the anchors) and its mocap."""
     from gaitval.io.ingest import read_mocap_parquet
     from gaitval.io.ultrasonic import read_ultrasonic
 
@@ -519,6 +518,16 @@ def gait_parameters_step(track_parquet, ingest_dir, sheet, subjects, trial: str,
     log = read_ultrasonic(d / "sensor.parquet", trial=trial)
     mocap = read_mocap_parquet(d / "mocap.parquet", source=row.get("mocap_path") or None,
                                trial=trial)
+    return cfg, row, subj, log, mocap
+
+
+def gait_parameters_step(track_parquet, ingest_dir, sheet, subjects, trial: str,
+                         config_json, out_parquet) -> pd.DataFrame:
+    """Gait parameters per stride for reference and system (seed 003 eq. 16-22)."""
+    from gaitval.evaluate.ultrasonic import gait_parameters
+
+    cfg, row, subj, log, mocap = _treadmill_trial(ingest_dir, sheet, subjects, trial,
+                                                  config_json)
     track = read_parquet(track_parquet)
     gp = gait_parameters(track, mocap, row, subj, cfg, anchors=log.anchors)
     write_parquet(gp.reset_index(drop=True), out_parquet)
@@ -560,16 +569,10 @@ def external_gait_parameters_step(foot_file, ingest_dir, sheet, subjects, trial:
     from gaitval.evaluate.ultrasonic_config import reference_kwargs, resolve_cfg
     from gaitval.groundtruth.reference import MAX_ANCHOR_RESIDUAL_M
     from gaitval.io.foot import read_foot
-    from gaitval.io.ingest import read_mocap_parquet
-    from gaitval.io.ultrasonic import read_ultrasonic
     from gaitval.registration.anchors import fit_anchor_frame
 
-    cfg = load_json(config_json).get("ultrasonic") or {}
-    row, subj = trial_and_subject(sheet, subjects, trial)
-    d = Path(ingest_dir)
-    log = read_ultrasonic(d / "sensor.parquet", trial=trial)
-    mocap = read_mocap_parquet(d / "mocap.parquet", source=row.get("mocap_path") or None,
-                               trial=trial)
+    cfg, row, subj, log, mocap = _treadmill_trial(ingest_dir, sheet, subjects, trial,
+                                                  config_json)
     foot, meta = read_foot(foot_file, trial=trial)
     if meta["frame"] == "mocap":
         fit = fit_anchor_frame(mocap, log.anchors, reference_kwargs(resolve_cfg(cfg))
