@@ -116,3 +116,33 @@ def test_validate_deep_reads_heel_trajectories(tmp_path):
         "\n".join(HEAD + GOOD[:2] + ["0.0,1,1,1"]) + "\n")
     probs = external_problems(sheet, deep=True)
     assert len(probs) == 1 and "us_B_normal" in probs[0] and "not after" in probs[0], probs
+
+
+def _checked(tmp_path, rows, **head):
+    from gaitval.io.foot import check_foot
+    p = write_foot(rows, tmp_path / "c.foot.csv", **head)
+    foot, meta = read_foot(p, trial="us_S1_normal")
+    check_foot(foot, meta, t_range=(3.0, 3.9), tolerance_s=0.02,
+               centre=np.array([0.0, 0.0, 0.0]), path=p, trial="us_S1_normal")
+    return p
+
+
+def test_heel_trajectory_inside_the_recording_and_in_metres(tmp_path):
+    """The recording and units checks of an external system's heel trajectory: a file
+    on another clock (no offset), in millimetres declared as metres, or in metres
+    declared as millimetres is one error naming the file, the row and the header."""
+    rows = ukf_track_to_foot(ukf_like()).fillna(0.1)     # 3.00-3.98 s, ~0.3 m from 0
+    _checked(tmp_path, rows)                              # most stamps inside: accepted
+    late = rows.assign(t_s=rows["t_s"] + 1.7e9)
+    with pytest.raises(FileFormatError) as exc:
+        _checked(tmp_path, late)
+    msg = str(exc.value)
+    for w in ("line 6, column 't_s'", "outside the recording", "sensor clock",
+              "at least 10 must be inside", "trial us_S1_normal", "c.foot.csv"):
+        assert w in msg, (w, msg)
+    _checked(tmp_path, late, clock_offset_s=-1.7e9)       # the third clock's offset given
+    mm = rows.assign(x=rows["x"] * 1000, y=rows["y"] * 1000, z=rows["z"] * 1000)
+    with pytest.raises(FileFormatError, match=r"from the receivers' centre.*units 'm'"):
+        _checked(tmp_path, mm)
+    with pytest.raises(FileFormatError, match=r"within 2 cm of the receivers' centre"):
+        _checked(tmp_path, rows, units="mm")

@@ -31,6 +31,12 @@ FOOT_META_KEY = b"gaitval:foot"
 FOOT_COLUMNS = ("t_s", "x", "y", "z")
 #: at least this many finite positions (the alignment needs a trajectory)
 MIN_SAMPLES = 10
+#: most positions farther than this from the receivers' centre: not the treadmill's heel
+#: in metres in that frame (millimetres declared as metres, or another frame); the
+#: receivers of seed 003 stand within about 1 m of the walking heel
+MAX_FROM_RECEIVERS_M = 5.0
+#: every position within this of the receivers' centre: metres declared as millimetres
+MIN_FROM_RECEIVERS_M = 0.02
 
 
 def read_foot(path: str | Path, *, trial: str | None = None) -> tuple[pd.DataFrame, dict]:
@@ -106,3 +112,52 @@ def write_foot(rows: pd.DataFrame, path: str | Path, *, units: str = "m",
     meta.update({k: str(v) for k, v in extra.items()})
     rows = rows[list(FOOT_COLUMNS)].reset_index(drop=True)
     return _write_rows(p, rows, meta, FOOT_FORMAT, FOOT_META_KEY, "foot", all_float=True)
+
+
+def check_foot(foot: pd.DataFrame, meta: dict, *, t_range: tuple[float, float],
+               tolerance_s: float, centre: np.ndarray, path=None,
+               trial: str | None = None) -> None:
+    """A heel trajectory that can be this trial's: at least :data:`MIN_SAMPLES` time
+    stamps inside the recording on the header's clock (``t_range`` ± ``tolerance_s``: the
+    ultrasonic log's span for ``clock: sensor``, the C3D's for ``clock: mocap``; another
+    system may record longer than either, so stamps outside are allowed while enough are
+    inside) and positions (in the receivers' frame, metres) whose median distance from the
+    receivers' ``centre`` is at most :data:`MAX_FROM_RECEIVERS_M` and not all within
+    :data:`MIN_FROM_RECEIVERS_M`.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file, the trial, the row (CSV line or Parquet row) and the header's
+        clock, or units and frame."""
+    kind, first = meta.get("_row", ("row", 1))
+    t = foot["t_s"].to_numpy(float)
+    lo, hi = t_range[0] - tolerance_s, t_range[1] + tolerance_s
+    out = (t < lo) | (t > hi)
+    if (~out).sum() < MIN_SAMPLES:
+        i = int(np.flatnonzero(out)[0])
+        c0 = float(meta.get("clock_offset_s") or 0.0)
+        off = f" after the header's clock_offset_s {c0!r} s" if c0 else ""
+        raise _err(path, f"{kind} {first + i}, column 't_s': time stamp {t[i] - c0!r} s "
+                   f"({meta['clock']} clock{off}) is outside the recording ({t_range[0]:.4f} "
+                   f"to {t_range[1]:.4f} s on that clock), as are {int(out.sum())} of "
+                   f"{len(t)} time stamps (at least {MIN_SAMPLES} must be inside)", trial,
+                   hint="check the header's clock (sensor: the ultrasonic log's; mocap: the "
+                        "C3D's) and clock_offset_s")
+    xyz = foot[["x_m", "y_m", "z_m"]].to_numpy(float)
+    d = np.linalg.norm(xyz - np.asarray(centre, float), axis=1)
+    ok = np.isfinite(d)
+    head = f"header units {meta['units']!r}, frame {meta['frame']!r}"
+    if np.median(d[ok]) > MAX_FROM_RECEIVERS_M:
+        i = int(np.flatnonzero(ok & (d > MAX_FROM_RECEIVERS_M))[0])
+        raise _err(path, f"{kind} {first + i}, column 'x': the position is {d[i]:.1f} m from "
+                   f"the receivers' centre, as is the median position ({np.median(d[ok]):.1f} "
+                   f"m; more than {MAX_FROM_RECEIVERS_M:g} m: not the heel on the treadmill; "
+                   f"{head})", trial, hint="positions in millimetres need 'units: mm'; "
+                   "positions in the mocap field need 'frame: mocap'")
+    if d[ok].max() < MIN_FROM_RECEIVERS_M:
+        i = int(np.flatnonzero(ok)[0])
+        raise _err(path, f"{kind} {first + i}, column 'x': every position lies within "
+                   f"{MIN_FROM_RECEIVERS_M * 100:g} cm of the receivers' centre (largest "
+                   f"{d[ok].max():.3g} m; {head})", trial,
+                   hint="positions in metres need 'units: m'")

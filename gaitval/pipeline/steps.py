@@ -568,7 +568,7 @@ def external_gait_parameters_step(foot_file, ingest_dir, sheet, subjects, trial:
     from gaitval.evaluate.ultrasonic import gait_parameters
     from gaitval.evaluate.ultrasonic_config import reference_kwargs, resolve_cfg
     from gaitval.groundtruth.reference import MAX_ANCHOR_RESIDUAL_M
-    from gaitval.io.foot import read_foot
+    from gaitval.io.foot import check_foot, read_foot
     from gaitval.registration.anchors import fit_anchor_frame
 
     cfg, row, subj, log, mocap = _treadmill_trial(ingest_dir, sheet, subjects, trial,
@@ -580,6 +580,12 @@ def external_gait_parameters_step(foot_file, ingest_dir, sheet, subjects, trial:
                                max_residual_m=MAX_ANCHOR_RESIDUAL_M, trial=trial)
         foot[["x_m", "y_m", "z_m"]] = fit.to_ultrasonic(
             foot[["x_m", "y_m", "z_m"]].to_numpy(float))        # p_us = R^T (p_f - t)
+    t_log = np.asarray(log.t, float)
+    t_rec = (t_log if meta["clock"] == "sensor" else np.asarray(mocap.t, float))
+    anchors = log.anchors[["x_m", "y_m", "z_m"]].to_numpy(float)
+    check_foot(foot, meta, t_range=(float(t_rec[0]), float(t_rec[-1])),
+               tolerance_s=float(np.median(np.diff(t_rec))) if len(t_rec) > 1 else 0.0,
+               centre=anchors.mean(axis=0), path=foot_file, trial=trial)
     if meta["clock"] == "mocap":
         row = {**row, "clock_offset_s": 0.0}      # t_system = t_mocap: no offset to find
     try:
