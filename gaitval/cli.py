@@ -160,7 +160,8 @@ def cmd_leg_detections(a) -> int:
                                          trial=a.trial, gate_m=a.gate_m,
                                          registration_json=a.registration,
                                          sensor_parquet=a.sensor, method=a.method,
-                                         protocol=a.protocol),
+                                         protocol=a.protocol,
+                                         moving_sensor=a.moving_sensor),
                      sort_keys=True))
     return 0
 
@@ -450,6 +451,9 @@ def _add_lrs_verbs(sub) -> None:
                    "this from a leg is not that leg's (default 0.30 m)")
     s.add_argument("--out", required=True, help="folder (results/<study>/leg_detections/"
                    "<detector>/<trial>): per_scan.parquet, summary.json")
+    s.add_argument("--moving-sensor", action="store_true",
+                   help="the laser moves (rollator trials): refuse detections in the "
+                   "mocap frame (the laser's pose changes every frame)")
     s.set_defaults(func=cmd_leg_detections)
 
     s = sub.add_parser("leg-detections-table", help="the detection table of external leg "

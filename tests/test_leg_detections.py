@@ -228,3 +228,33 @@ def test_the_detection_table_and_its_report_section(tmp_path):
     assert item["stem"] == "detections_table" and "no row in the tracking tables" in \
         " ".join(item["notes"])
     assert "left_detection_pct" in [h for h, _ in item["header"]]
+
+
+def test_rollator_detections_in_the_mocap_frame_are_refused_and_a_third_clock_is_offset(
+        tmp_path):
+    """On a rollator trial the laser moves: detections in the mocap frame are refused with
+    one error naming the file and the header field; detections stamped on a third clock
+    score like the sensor-clock file once the header gives the offset."""
+    from gaitval.pipeline.steps import leg_detections_step
+
+    gt = tmp_path / "groundtruth.parquet"
+    truth().to_parquet(gt)
+    reg = tmp_path / "registration.json"
+    reg.write_text(json.dumps({"status": "ok", "clock_offset_s": 0.0, "x_m": None,
+                               "y_m": None, "yaw_rad": None}))
+    f = detections_csv(tmp_path / "m.detections.csv", CSV_BODY, frame="mocap")
+    with pytest.raises(FileFormatError) as exc:
+        leg_detections_step(f, gt, tmp_path / "o", trial="rollator_P1", moving_sensor=True,
+                            registration_json=reg)
+    msg = str(exc.value)
+    assert "'frame' is 'mocap'" in msg and "laser moves" in msg and str(f) in msg
+    plain = leg_detections_step(detections_csv(tmp_path / "s.detections.csv", CSV_BODY),
+                                gt, tmp_path / "o1", trial="rollator_P1", moving_sensor=True)
+    third = tmp_path / "t.detections.csv"             # a clock that started 100 s later
+    third.write_text("# gaitval-detections v1\n# units: m\n# frame: sensor\n"
+                     "# clock: sensor\n# clock_offset_s: 100.0\n"
+                     + CSV_BODY.replace("100.", "0."))
+    got = leg_detections_step(third, gt, tmp_path / "o2", trial="rollator_P1",
+                              moving_sensor=True)
+    for k in ("n_scans", "detection_rate_L", "detection_rate_R", "false_per_scan"):
+        assert got[k] == plain[k], k

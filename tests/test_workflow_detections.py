@@ -144,6 +144,20 @@ def det_run(tiny_run, tmp_path_factory):
         write_detections(to_mocap(rows, reg), study / "det" / f"{t}.detections.csv",
                          frame="mocap", clock="mocap", source="synthetic")
         drawn["det_csv"].append(d)
+    rollator = sorted(p.name for p in (done / "register" / "rollator").iterdir()
+                      if (p / "groundtruth.parquet").is_file())
+    assert rollator
+    drawn["det_rollator"] = []
+    for i, t in enumerate(rollator):       # the moving laser's frame, the mocap clock
+        truth = pd.read_parquet(done / "register" / "rollator" / t / "groundtruth.parquet")
+        reg = json.loads((done / "register" / "rollator" / t / "registration.json")
+                         .read_text())
+        assert reg["status"] == "ok"
+        rows, d = _draw(truth, seed=300 + i)
+        drift = 1.0 + float(reg.get("clock_drift_ppm") or 0.0) * 1e-6
+        rows["t_s"] = (rows["t_s"] - reg["clock_offset_s"]) / drift
+        write_detections(rows, study / "detr" / f"{t}.detections.csv", clock="mocap")
+        drawn["det_rollator"].append(d)
     cal = study / "study.yaml"
     doc = yaml.safe_load(cal.read_text()) or {}
     doc["external_detections"] = {"det_bag": {"path": "det/{trial}.bag",
@@ -151,7 +165,9 @@ def det_run(tiny_run, tmp_path_factory):
                                               "protocols": ["tug"]}}
     cal.write_text(yaml.safe_dump(doc))
     (study / "external.yaml").write_text(yaml.safe_dump({"external_detections": {
-        "det_csv": {"path": "det/{trial}.detections.csv", "protocols": ["tug"]}}}))
+        "det_csv": {"path": "det/{trial}.detections.csv", "protocols": ["tug"]},
+        "det_rollator": {"path": "detr/{trial}.detections.csv",
+                         "protocols": ["rollator"]}}}))
     res = tiny_workflow(work, targets=[TABLE])
     assert res.returncode == 0, res.stderr[-4000:]
     return work, drawn
@@ -161,12 +177,13 @@ def det_run(tiny_run, tmp_path_factory):
 def test_the_table_gives_back_the_detectors_known_rates_and_noise(det_run):
     work, drawn = det_run
     table = pd.read_csv(work / TABLE).set_index("method")
-    assert list(table.index) == ["det_bag", "det_csv"]
+    assert list(table.index) == ["det_bag", "det_csv", "det_rollator"]
     for m, ds in drawn.items():
         row = table.loc[m]
         legs, hits = sum(d["legs"] for d in ds), sum(d["hits"] for d in ds)
         n_scans = sum(d["n_scans"] for d in ds)
-        assert row["protocol"] == "tug" and row["n_trials"] == len(ds)
+        assert row["protocol"] == ("rollator" if m == "det_rollator" else "tug")
+        assert row["n_trials"] == len(ds)
         assert row["n_scans"] == n_scans and row["n_not_registered"] == 0
         # every drawn detection found, every false one counted: what was drawn (to the
         # CSV's 6 significant digits)
@@ -234,7 +251,7 @@ def _study(tmp_path: Path, side: dict | None = None, own: dict | None = None) ->
      ["external.yaml", "external_detections.d", "topics", "did you mean"]),
     ({"external_detections": {"d": {"path": "det/tug_a.bag"}}}, None,
      ["external.yaml", "external_detections.d.path", "{trial}"]),
-    (None, {"external_detections": {"d": {"path": "det/{trial}.bag", "protocols": ["rollator"]}}},
+    (None, {"external_detections": {"d": {"path": "det/{trial}.bag", "protocols": ["treadmill"]}}},
      ["study.yaml", "external_detections.d.protocols"]),
     (None, {"external_detections": {"tug_m1": {"path": "det/{trial}.bag"}}},
      ["study.yaml", "external_detections.tug_m1", "already a method name"]),

@@ -1024,7 +1024,8 @@ def read_external_detections(path, topic: str | None = None, trial: str | None =
 def leg_detections_step(detections, groundtruth_parquet, out_dir, *, topic: str | None = None,
                         trial: str | None = None, gate_m: float = 0.30,
                         registration_json=None, sensor_parquet=None,
-                        method: str | None = None, protocol: str | None = None) -> dict:
+                        method: str | None = None, protocol: str | None = None,
+                        moving_sensor: bool = False) -> dict:
     """A detector's leg detections of one trial (leg_tracker's ``leg_tracker/LegArray``
     in a bag, or a ``*.detections.csv``/``.parquet``; no identity, no side) scored against
     the trial's mocap legs (:func:`gaitval.evaluate.leg_detections.detection_statistics`);
@@ -1033,11 +1034,20 @@ def leg_detections_step(detections, groundtruth_parquet, out_dir, *, topic: str 
     the trial's registration (``registration_json``); with the trial's scan log
     (``sensor_parquet``) time stamps outside the recording and positions in the wrong
     units are refused naming the row (:func:`gaitval.io.tracks.detections_to_sensor`).
-    Stamps on the sensor clock must be the scans' (the ground truth's ``t_sensor_s``)."""
+    Stamps on the sensor clock must be the scans' (the ground truth's ``t_sensor_s``).
+    ``moving_sensor`` (the rollator): a file in the mocap frame is refused, as
+    :func:`import_tracks_step` refuses one (the ground truth is in the moving laser's
+    frame, scan by scan)."""
     from gaitval.evaluate.leg_detections import detection_statistics
     from gaitval.io.tracks import detections_to_sensor
 
     det, meta = read_external_detections(detections, topic, trial)
+    if moving_sensor and meta.get("frame", "sensor") == "mocap":
+        raise FileFormatError(
+            "header field 'frame' is 'mocap', but this trial's laser moves (rollator): "
+            "gaitval converts only a fixed laser's detections from the mocap frame",
+            path=detections, trial=trial, hint="write the detections in the laser's frame "
+            "(frame: sensor)")
     rec = load_json(registration_json) if registration_json else None
     out = Path(out_dir)
     if rec is not None and rec.get("status") != "ok":

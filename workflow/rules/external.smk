@@ -49,8 +49,9 @@ rule rollator_track_external:
 # issue 37): per scan, legs without identity or side (leg_tracker/LegArray in a bag, or a
 # *.detections.csv), scored per trial against the registered mocap legs (`gaitval
 # leg-detections`, gaitval.evaluate.leg_detections); one job per (study, detector), its
-# trials in a process pool.  No track, so no row in the tracking tables: the detection
-# table (detections_table) is theirs.  The entry is a param, so a changed entry (path,
+# trials in a process pool; on rollator trials (protocols: [rollator]) the laser moves,
+# so their files must be in its frame (--moving-sensor).  No track, so no row in the
+# tracking tables: the detection table (detections_table) is theirs.  The entry is a param, so a changed entry (path,
 # topic, protocols) reruns its own job and the table, not another detector's.
 rule leg_detections:
     input:
@@ -81,6 +82,7 @@ rule leg_detections:
                        "--registration", f"{reg}/{p}/{t}/registration.json",
                        "--sensor", f"{input.ingest}/{t}/sensor.parquet",
                        "--trial", t, "--method", wildcards.detector, "--protocol", p,
+                       ["--moving-sensor"] if p == "rollator" else [],
                        "--out", f"{output[0]}/{t}")])
              for (t, p), f in zip(params.trials, input.files)],
             threads, log[0], outdirs=output,
