@@ -566,3 +566,23 @@ def test_ultrasonic_agreement_table_rows_and_figure(tmp_path):
     b = bland_altman_figure(sub, "reference", "system", tmp_path / "b.png",
                             subject="subject", limits=row)
     assert a.read_bytes() == b.read_bytes()
+
+
+def test_satterthwaite_df_is_stable_for_a_small_design():
+    """Four windows of two subjects (the tiny study's horizontal symmetry at fast speed,
+    differences of order 1e-3): a change of the data by 1e-13 (relative, as another BLAS
+    build makes) moved the numerical-Hessian df by 3e-4 with a fixed step of 1e-4; with
+    the steps scaled to the log-variances it stays within 1e-5 (docs/numerics.md)."""
+    from gaitval.stats._mixed import _fit_random_intercept
+
+    d = np.array([-0.00148918, -0.00126077, -0.00171348, 0.00073965])
+    a = np.array([1.00274923, 1.00507449, 0.99622574, 1.00460631])
+    X = np.column_stack([np.ones(4), a])
+    codes = np.array([0, 0, 1, 1])
+    c = np.array([0.0, 1.0])
+    base = _fit_random_intercept(d, X, codes, c)
+    assert 0.9 < base["df"] < 1.2 and base["var_between"] > base["var_within"] > 0
+    for eps in (1e-13, -1e-13, 3e-13):
+        f = _fit_random_intercept(d * (1 + eps), X, codes, c)
+        assert f["df"] == pytest.approx(base["df"], rel=1e-5), eps
+        assert f["se"] == pytest.approx(base["se"], rel=1e-5), eps
