@@ -518,7 +518,7 @@ def _add_ultrasonic_verbs(sub) -> None:
                    "(results/<study>/config_views/ultrasonic/study.json): its ultrasonic: "
                    "section")
     s.add_argument("--out", required=True, help="noise.json: V per anchor, W, bias, RMSE "
-                   "(results/ultrasonic_noise.json)")
+                   "(results/runs/<run>/ultrasonic_noise.json)")
     s.add_argument("--table-stem", required=True, help="Table 1's path without suffix "
                    "(reports/<run>/tables/ultrasonic_table1; writes .csv, .md, .tex)")
     s.add_argument("--reports-dir", default="reports", help=_REPORTS)
@@ -534,7 +534,7 @@ def _add_ultrasonic_verbs(sub) -> None:
                    "(results/<study>/config_views/ultrasonic/study.json): ultrasonic.ukf, "
                    "ultrasonic.use_identified_W")
     s.add_argument("--noise", required=True, help="noise.json of ultrasonic-noise "
-                   "(results/ultrasonic_noise.json): the identified V")
+                   "(results/runs/<run>/ultrasonic_noise.json): the identified V")
     s.add_argument("--out", required=True, help="the UKF track, Parquet "
                    "(results/<study>/ultrasonic/track/<trial>.parquet)")
     s.set_defaults(func=cmd_ultrasonic_track)

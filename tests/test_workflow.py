@@ -107,7 +107,9 @@ def test_tables_equal_the_stored_reference_within_the_tolerance(tiny_run):
 @pytest.mark.slow
 def test_switching_run_rebuilds_into_that_runs_folder(tiny_run):
     """After the tiny report, the tiny run is up to date and a default run asks for its
-    own reports/default/ (issue 14: it used to say "Nothing to be done" and serve tiny)."""
+    own reports/default/ (issue 14: it used to say "Nothing to be done" and serve tiny) and
+    its own pendulum noise file (a shared one made the other run's ultrasonic jobs rerun
+    after every switch)."""
     same = run_workflow(tiny_run, "-n")
     assert same.returncode == 0 and "Nothing to be done" in same.stdout + same.stderr
     other = subprocess.run(
@@ -117,6 +119,12 @@ def test_switching_run_rebuilds_into_that_runs_folder(tiny_run):
     assert other.returncode == 0, other.stderr[-3000:]
     assert "reports/default/index.md" in other.stdout
     assert "reports/tiny/index.md" not in other.stdout
+    # the pendulum noise identification is the run's own (results/runs/<run>/): the
+    # default run (its jobs after the simulation are not listed yet) touches nothing of
+    # tiny's, so switching back reruns no ultrasonic job of tiny's
+    assert "results/runs/tiny/" not in other.stdout
+    assert (tiny_run / "results" / "runs" / "tiny" / "ultrasonic_noise.json").is_file()
+    assert not (tiny_run / "results" / "ultrasonic_noise.json").exists()
 
 
 def _planned(res: subprocess.CompletedProcess) -> dict[str, int]:

@@ -2,6 +2,9 @@
 # (Table 1), UKF track per treadmill trial, gait parameters, Tables 2-8, C1 and figures.
 # Like every paper table, these pool the studies in `run`; the pendulum noise
 # identification is shared by them (run studies with different hardware separately).
+# Its result is the run's (results/runs/<run-name>/): another run (run=["tiny"]) has its
+# own, so switching runs reruns neither's ultrasonic jobs.
+NOISE = f"{RESULTS}/runs/{RUN_NAME}/ultrasonic_noise.json"
 
 
 rule ultrasonic_noise:
@@ -14,7 +17,7 @@ rule ultrasonic_noise:
         # simulated study, which a cluster job's Snakemake must see as an input)
         sheets=lambda w: [sheet_path(s) for s in config["run"]],
     output:
-        noise=f"{RESULTS}/ultrasonic_noise.json",
+        noise=NOISE,
         table=report(
             f"{REPORTS}/tables/ultrasonic_table1.csv",
             caption="../report/ultrasonic.rst",
@@ -31,7 +34,7 @@ rule ultrasonic_noise:
         # "derived" params are not compared); the config it reads is its input above.
         chash=config_hash_when_run,
     log:
-        "logs/ultrasonic_noise.log",
+        f"logs/ultrasonic_noise/{RUN_NAME}.log",
     run:
         run_verb_job(
             verb("ultrasonic-noise", "--ingest", params.dirs, "--trials", params.trials,
@@ -48,7 +51,7 @@ rule ultrasonic_track:
     input:
         ingest=f"{RESULTS}/{{study}}/ingest",
         config=f"{RESULTS}/{{study}}/config_views/ultrasonic/{STUDY_VIEW}.json",
-        noise=f"{RESULTS}/ultrasonic_noise.json",
+        noise=NOISE,
         sheet=lambda w: sheet_path(w.study),
     output:
         directory(f"{RESULTS}/{{study}}/ultrasonic"),
