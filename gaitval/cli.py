@@ -417,10 +417,13 @@ def _add_lrs_verbs(sub) -> None:
 
     # external tracks (issue 37): docs/formats.md, "Leg tracks"
     s = sub.add_parser("export-tracks", help="one of gaitval's track files (or a bag's people "
-                       "topic) in the leg-track exchange format (*.tracks.csv / .parquet)")
-    s.add_argument("track", help="results/<study>/track/<method>/<trial>.parquet, or a ROS "
-                   "bag with a tracker's people topic")
-    s.add_argument("out", help="*.tracks.csv or *.tracks.parquet")
+                       "topic) in the leg-track exchange format (*.tracks.csv / .parquet); "
+                       "an ultrasonic UKF track as a heel trajectory (*.foot.csv / .parquet)")
+    s.add_argument("track", help="results/<study>/track/<method>/<trial>.parquet, a ROS "
+                   "bag with a tracker's people topic, or an ultrasonic track "
+                   "results/<study>/ultrasonic/track/<trial>.parquet")
+    s.add_argument("out", help="*.tracks.csv or *.tracks.parquet (leg tracks); *.foot.csv "
+                   "or *.foot.parquet (a heel trajectory, from an ultrasonic track)")
     s.add_argument("--units", choices=("m", "mm"), default="m", help="the file's position "
                    "unit (header units:; default m)")
     s.add_argument("--topic", help="bags: the leg_tracker/PersonArray or people_msgs/People "

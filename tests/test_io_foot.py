@@ -146,3 +146,27 @@ def test_heel_trajectory_inside_the_recording_and_in_metres(tmp_path):
         _checked(tmp_path, mm)
     with pytest.raises(FileFormatError, match=r"within 2 cm of the receivers' centre"):
         _checked(tmp_path, rows, units="mm")
+
+
+def test_export_tracks_writes_an_ultrasonic_track_as_a_heel_trajectory(tmp_path):
+    """`gaitval export-tracks <ultrasonic track> OUT.foot.csv`: the UKF's trajectory, read
+    back exactly (millimetres too); a leg track asked for as a foot file is refused."""
+    from gaitval.cli import main
+
+    track = ukf_like().assign(vx_mps=0.0)          # as the UKF writes it, extra columns
+    src = tmp_path / "us_S1_normal.parquet"
+    track.to_parquet(src)
+    assert main(["export-tracks", str(src), str(tmp_path / "a.foot.csv")]) == 0
+    rows, meta = read_foot(tmp_path / "a.foot.csv")
+    pd.testing.assert_frame_equal(rows, track[["t_s", "x_m", "y_m", "z_m"]],
+                                  check_exact=True)
+    assert meta["source"] == "gaitval ultrasonic UKF"
+    assert main(["export-tracks", str(src), str(tmp_path / "b.foot.parquet"),
+                 "--units", "mm"]) == 0
+    mm, meta = read_foot(tmp_path / "b.foot.parquet")
+    assert meta["units"] == "mm"
+    np.testing.assert_allclose(mm["x_m"], track["x_m"], rtol=1e-12)
+    legs = tmp_path / "legs.parquet"
+    pd.DataFrame({"t_sensor_s": [0.0], "k": [0], "side": ["L"], "x_m": [1.0],
+                  "y_m": [0.0]}).to_parquet(legs)
+    assert main(["export-tracks", str(legs), str(tmp_path / "c.foot.csv")]) == 1

@@ -627,7 +627,9 @@ def export_tracks_step(track_parquet, out, units: str = "m", topic: str | None =
     """One of gaitval's own track files (``results/<study>/track/<method>/<trial>.parquet``)
     in the exchange format (sensor frame and clock), CSV or Parquet by ``out``'s suffix; or
     a tracker's people topic of a ROS bag (``*.bag`` or a ROS 2 bag folder; ``topic``:
-    leg_tracker/PersonArray or people_msgs/People, :func:`gaitval.io.tracks.read_bag_tracks`)."""
+    leg_tracker/PersonArray or people_msgs/People, :func:`gaitval.io.tracks.read_bag_tracks`);
+    with ``out`` a ``*.foot.csv``/``.parquet``, gaitval's ultrasonic UKF track as a heel
+    trajectory (:mod:`gaitval.io.foot`)."""
     from gaitval.io.tracks import read_bag_tracks, track_to_exchange, write_tracks
 
     src_path = Path(track_parquet)
@@ -641,6 +643,19 @@ def export_tracks_step(track_parquet, out, units: str = "m", topic: str | None =
             rows[["x", "y"]] = rows[["x", "y"]] * 1000.0
         return write_tracks(rows, out, units=units, source=meta["source"])
     track = read_parquet(track_parquet)
+    if Path(out).name.endswith((".foot.csv", ".foot.parquet")):
+        # gaitval's ultrasonic UKF track (results/<study>/ultrasonic/track/<trial>.parquet)
+        # as a heel trajectory (gaitval.io.foot; ultrasonic frame and clock)
+        from gaitval.io.foot import ukf_track_to_foot, write_foot
+        if not {"t_s", "x_m", "y_m", "z_m"} <= set(track.columns):
+            raise FileFormatError("a *.foot.csv/parquet is a heel trajectory: the input "
+                                  "is no ultrasonic track (columns t_s, x_m, y_m, z_m)",
+                                  path=track_parquet, hint="export a leg track as "
+                                  "*.tracks.csv, an ultrasonic track as *.foot.csv")
+        rows = ukf_track_to_foot(track)
+        if units == "mm":
+            rows[["x", "y", "z"]] = rows[["x", "y", "z"]] * 1000.0
+        return write_foot(rows, out, units=units, source="gaitval ultrasonic UKF")
     rows = track_to_exchange(track)
     if units == "mm":
         for c in ("x", "y", "vx", "vy"):
