@@ -103,9 +103,18 @@ def cmd_ingest_summary(a) -> int:
 
 
 def cmd_peer(a) -> int:
+    from gaitval.errors import ConfigError
     from gaitval.report.provenance import stamp
     from gaitval.tables.peer import write_peer_table
-    paths = write_peer_table(a.parquet, a.out_stem)
+    units = {}
+    for item in a.units or []:
+        k, sep, v = item.partition("=")
+        if not sep or not k.strip():
+            raise ConfigError(f"--units {item!r}: give NAME=UNIT, e.g. stride_length=m")
+        units[k.strip()] = v.strip()
+    paths = write_peer_table(a.parquet, a.out_stem, name=a.name, system=a.system_prefix,
+                             reference=a.reference_prefix, subject=a.subject,
+                             units=units if a.units else None)
     stamp(Path(a.out_stem).name, paths, a.reports_dir, config_hash_=a.config_hash)
     return 0
 
@@ -315,7 +324,21 @@ def _add_input_verbs(sub) -> None:
                        "t-test) of any system's paired results against a reference: one "
                        "row per walk or stride, us_<name> / gt_<name> column pairs (e.g. "
                        "an external system's stride parameters against the mocap's)")
-    s.add_argument("parquet", help="Parquet file with us_<name> / gt_<name> column pairs")
+    s.add_argument("parquet", help="Parquet or CSV file with us_<name> / gt_<name> column "
+                   "pairs (other prefixes: --system-prefix, --reference-prefix), one row "
+                   "per walk or stride")
+    s.add_argument("--system-prefix", default="us_", help="the system's column prefix "
+                   "(default us_)")
+    s.add_argument("--reference-prefix", default="gt_", help="the reference's column "
+                   "prefix (default gt_)")
+    s.add_argument("--subject", help="the column naming each row's participant (default: "
+                   "the first of subject, participant, subject_id, participant_id); "
+                   "without one, no repeated-measures statistics")
+    s.add_argument("--units", nargs="+", metavar="NAME=UNIT", help="each parameter's unit "
+                   "for the unit column, e.g. stride_length=m stride_time=s (default: the "
+                   "peer data's: cm, s, cm/s, steps/min)")
+    s.add_argument("--name", help="the system's name: a study's own paired results "
+                   "(agreement_files.<name>) instead of the peer's worked example")
     s.add_argument("--out-stem", required=True, help="e.g. reports/<run>/tables/"
                    "peer_agreement (writes .csv, .md, .tex)")
     s.add_argument("--reports-dir", default="reports", help="the report folder "

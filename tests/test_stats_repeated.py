@@ -586,3 +586,36 @@ def test_satterthwaite_df_is_stable_for_a_small_design():
         f = _fit_random_intercept(d * (1 + eps), X, codes, c)
         assert f["df"] == pytest.approx(base["df"], rel=1e-5), eps
         assert f["se"] == pytest.approx(base["se"], rel=1e-5), eps
+
+
+def test_a_studys_own_paired_results_as_csv_with_its_prefixes_and_units(tmp_path,
+                                                                       ejection):
+    """agreement_files: the same statistics from a CSV with other column prefixes, the
+    participant column named, units given; a non-number is one error naming the column
+    and the row; no pair with these prefixes names the columns there are."""
+    from gaitval.errors import FileFormatError
+    from gaitval.tables.peer import peer_agreement_table, write_peer_table
+    ref = peer_agreement_table(_peer_file(tmp_path, ejection))
+    df = pd.DataFrame({"walker": ejection["subject"].map(lambda s: f"P_{s:02d}"),
+                       "sys_ef": ejection["rv"], "vicon_ef": ejection["ic"]})
+    csv = tmp_path / "mine.csv"
+    df.to_csv(csv, index=False)
+    t = peer_agreement_table(csv, "walker", system="sys_", reference="vicon_",
+                             units={"ef": "%"})
+    assert t["unit"].tolist() == ["%"]
+    cols = [c for c in ref.columns if c != "unit"]
+    pd.testing.assert_frame_equal(t[cols], ref[cols], check_exact=False, rtol=1e-12)
+    paths = write_peer_table(csv, tmp_path / "peer_mine", name="mine", system="sys_",
+                             reference="vicon_", subject="walker", units={"ef": "%"})
+    md = paths[1].read_text()
+    assert "Agreement of mine (sys_*) with its reference (vicon_*)" in md
+    assert "times as wide as the pooled ones" in md
+    bad = df.astype({"sys_ef": object})
+    bad.loc[3, "sys_ef"] = "n/a?"
+    bad.to_csv(tmp_path / "bad.csv", index=False)
+    with pytest.raises(FileFormatError, match=r"column 'sys_ef', data row 4: 'n/a\?' is not"):
+        peer_agreement_table(tmp_path / "bad.csv", system="sys_", reference="vicon_")
+    with pytest.raises(FileFormatError, match=r"no paired us_<name> / gt_<name>.*sys_ef"):
+        peer_agreement_table(csv)
+    with pytest.raises(FileFormatError, match="not found"):
+        peer_agreement_table(tmp_path / "none.csv")

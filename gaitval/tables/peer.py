@@ -49,22 +49,31 @@ PROP_BIAS = {"prop_bias_slope": "slope", "prop_bias_slope_ci_low": "slope_ci_low
 SUBJECT_COLUMNS = ("subject", "participant", "subject_id", "participant_id")
 
 
-def _read(parquet_path: str | Path) -> pd.DataFrame:
-    path = Path(parquet_path)
+def _read(path_: str | Path) -> pd.DataFrame:
+    """A paired-results file: Parquet, or CSV (one header line of column names)."""
+    path = Path(path_)
+    if not path.is_file():
+        raise FileFormatError("paired results file not found", path=path)
+    if path.suffix.lower() == ".csv":
+        try:
+            return pd.read_csv(path)
+        except Exception as exc:  # noqa: BLE001 - pandas raises several types
+            raise FileFormatError(f"cannot read paired results as CSV ({exc})",
+                                  path=path) from None
     try:
         return read_parquet(path)
-    except FileNotFoundError:
-        raise FileFormatError("peer results file not found", path=path) from None
     except Exception as exc:  # pyarrow raises several types for a non-parquet file
-        raise FileFormatError(f"cannot read peer results as Parquet ({exc})",
-                              path=path) from None
+        raise FileFormatError(f"cannot read paired results as Parquet ({exc})",
+                              path=path, hint="a *.parquet or *.csv file") from None
 
 
-def peer_pairs(columns) -> list[str]:
-    """Names ``x`` for which both ``us_x`` and ``gt_x`` are columns (file order)."""
+def peer_pairs(columns, system: str = SYSTEM_PREFIX,
+               reference: str = REFERENCE_PREFIX) -> list[str]:
+    """Names ``x`` for which both ``<system>x`` and ``<reference>x`` are columns (file
+    order; by default ``us_x`` and ``gt_x``)."""
     cols = [str(c) for c in columns]
-    return [c[len(SYSTEM_PREFIX):] for c in cols if c.startswith(SYSTEM_PREFIX)
-            and REFERENCE_PREFIX + c[len(SYSTEM_PREFIX):] in cols]
+    return [c[len(system):] for c in cols if c.startswith(system)
+            and reference + c[len(system):] in cols]
 
 
 def subject_column(columns) -> str | None:
@@ -90,19 +99,26 @@ def _repeated(df: pd.DataFrame, ref: str, pro: str, subject: str | None) -> dict
     return row
 
 
-def peer_agreement_table(parquet_path: str | Path, subject: str | None = None
-                         ) -> pd.DataFrame:
+def peer_agreement_table(parquet_path: str | Path, subject: str | None = None, *,
+                         system: str = SYSTEM_PREFIX, reference: str = REFERENCE_PREFIX,
+                         units: dict | None = None) -> pd.DataFrame:
     """Agreement statistics for every ``us_*``/``gt_*`` pair of a peer results file.
 
     Parameters
     ----------
     parquet_path : path
-        Parquet file with paired columns ``us_<name>`` (system) and ``gt_<name>``
-        (reference), one row per walk.
+        Parquet (or CSV) file with paired columns ``us_<name>`` (system) and
+        ``gt_<name>`` (reference), one row per walk or stride.
     subject : str, optional
         Column naming each row's participant; by default the first of
         :data:`SUBJECT_COLUMNS` present.  Without one, the repeated-measures columns are
         NaN (the published file of Single et al. has none).
+    system, reference : str
+        The column prefixes of the system's and the reference's values (default ``us_``
+        and ``gt_``).
+    units : dict, optional
+        Parameter name -> its unit, shown in the ``unit`` column (default: the peer
+        data's, :data:`PEER_UNITS`).
 
     Returns
     -------
@@ -132,12 +148,21 @@ def peer_agreement_table(parquet_path: str | Path, subject: str | None = None
         ``subject`` column.
     """
     df = _read(parquet_path)
-    names = peer_pairs(df.columns)
+    names = peer_pairs(df.columns, system, reference)
     if not names:
-        raise FileFormatError("no paired us_<name> / gt_<name> columns found",
-                              path=parquet_path,
-                              hint="the system's columns start with 'us_', the "
-                                   "reference's with 'gt_'")
+        raise FileFormatError(f"no paired {system}<name> / {reference}<name> columns "
+                              "found", path=parquet_path,
+                              hint=f"the system's columns start with {system!r}, the "
+                                   f"reference's with {reference!r}; columns: "
+                                   f"{[str(c) for c in df.columns][:12]}")
+    for name in names:
+        for col in (system + name, reference + name):
+            bad = pd.to_numeric(df[col], errors="coerce").isna() & df[col].notna()
+            if bad.any():
+                i = int(bad.to_numpy().nonzero()[0][0])
+                raise FileFormatError(f"column {col!r}, data row {i + 1}: {df[col].iloc[i]!r} "
+                                      "is not a number", path=parquet_path)
+    units = PEER_UNITS if units is None else dict(units)
     if subject is not None and subject not in df.columns:
         raise FileFormatError(f"participant column {subject!r} not in the file",
                               path=parquet_path,
@@ -145,10 +170,10 @@ def peer_agreement_table(parquet_path: str | Path, subject: str | None = None
     subject = subject or subject_column(df.columns)
     rows = []
     for name in names:
-        ref, pro = REFERENCE_PREFIX + name, SYSTEM_PREFIX + name
+        ref, pro = reference + name, system + name
         a = agreement(df, ref, pro).iloc[0]
         row = {"parameter": name,
-               "unit": PEER_UNITS.get(name, "").replace("_per_", "/").replace("_", " ")}
+               "unit": str(units.get(name, "")).replace("_per_", "/").replace("_", " ")}
         for st in STATISTICS:
             row[st] = int(a[st]) if st in ("n", "df") else float(a[st])
         row.update(_repeated(df, ref, pro, subject))
@@ -158,18 +183,30 @@ def peer_agreement_table(parquet_path: str | Path, subject: str | None = None
     return pd.DataFrame(rows)
 
 
-def write_peer_table(parquet_path: str | Path, out_stem: str | Path) -> list[Path]:
-    """Render :func:`peer_agreement_table` as ``<out_stem>.csv/.md/.tex``."""
-    table = peer_agreement_table(parquet_path)
-    caption = ("Agreement of the lidar gait method (us_*) with the pressure walkway (gt_*) "
-               "computed by gaitval from the published paired results of " + SINGLE2024
-               + "; a worked example of gaitval's statistics on someone else's results.")
+def write_peer_table(parquet_path: str | Path, out_stem: str | Path, *,
+                     name: str | None = None, system: str = SYSTEM_PREFIX,
+                     reference: str = REFERENCE_PREFIX, subject: str | None = None,
+                     units: dict | None = None) -> list[Path]:
+    """Render :func:`peer_agreement_table` as ``<out_stem>.csv/.md/.tex``.  Without
+    ``name``: the worked example on Single et al.'s published results; with it, a
+    study's own paired results (config ``agreement_files.<name>``)."""
+    table = peer_agreement_table(parquet_path, subject, system=system,
+                                 reference=reference, units=units)
+    if name is None:
+        caption = ("Agreement of the lidar gait method (us_*) with the pressure walkway "
+                   "(gt_*) computed by gaitval from the published paired results of "
+                   + SINGLE2024 + "; a worked example of gaitval's statistics on someone "
+                   "else's results.")
+    else:
+        caption = (f"Agreement of {name} ({system}*) with its reference ({reference}*): "
+                   f"paired results per walk or stride from {Path(parquet_path).name} "
+                   "(agreement_files), analysed by gaitval's agreement statistics.")
     notes = ["Differences are system - reference. Pooled columns (bias ... p, no suffix) "
              "treat every row as an independent pair: bias CI t-based; limits of "
              "agreement bias -/+ 1.96 sd with approximate 95% CIs from SE = sqrt(3 sd^2/n) "
              "(Bland & Altman 1999); ICC(A,1)/ICC(C,1): two-way model, McGraw & Wong "
              "(1996); t/df/p: paired t-test of the bias.",
-             _rm_note(table),
+             _rm_note(table, worked_example=name is None),
              "prop_bias_*: slope of the difference on the mean of both systems (Bland & "
              "Altman 1999 sec. 3.2) with its 95% CI and p; ordinary least squares over "
              "all rows when participants are unknown, else with a participant random "
@@ -179,7 +216,7 @@ def write_peer_table(parquet_path: str | Path, out_stem: str | Path) -> list[Pat
     return write_table(table, out_stem, caption=caption, notes=notes)
 
 
-def _rm_note(table: pd.DataFrame) -> str:
+def _rm_note(table: pd.DataFrame, worked_example: bool = True) -> str:
     """Table note on the repeated-measures (``*_rm``) columns, quoting how much wider."""
     what = ("Repeated-measures columns (*_rm) treat participants as a random effect "
             "(Bland & Altman 2007; Zou 2013): bias and its 95% CI from a random-intercept "
@@ -189,6 +226,10 @@ def _rm_note(table: pd.DataFrame) -> str:
             "variance components; loa_width_ratio = repeated-measures / pooled limit "
             "width.")
     ratio = table["loa_width_ratio"].dropna()
+    if ratio.empty and not worked_example:
+        return (what + " They are empty here: the file names no participant column ("
+                + ", ".join(SUBJECT_COLUMNS) + "), so the pooled columns treat rows of one "
+                "participant as independent.")
     if ratio.empty:
         return (what + " They are empty here: the published file does not say which "
                 "participant each walk belongs to (its 90 walks are a subset of the 123 "

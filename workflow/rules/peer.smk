@@ -34,3 +34,54 @@ REPORT_ITEM_FUNCS.append(
         else []
     )
 )
+
+
+# A study's own paired results (config agreement_files: name -> {path, system, reference,
+# subject, units}, issue 37): per walk or stride, a system's value beside its reference's
+# (a vendor's gait software against the mocap, say), analysed as the peer's worked example
+# is -- pooled and repeated-measures agreement -- into tables/peer_<name>.  Each file is
+# checked at start; the entry is a param, so an edited entry reruns its own table.
+AGREEMENT_FILES = dict(config.get("agreement_files") or {})
+for _name, _entry in AGREEMENT_FILES.items():
+    if not Path(_entry["path"]).is_file():
+        sys.exit(f"ConfigError: agreement_files.{_name}.path: {_entry['path']!r} is not a "
+                 "file (paths are relative to the working directory)")
+
+
+rule agreement_file:
+    input:
+        lambda w: AGREEMENT_FILES[w.name]["path"],
+    output:
+        csv=report(f"{REPORTS}/tables/peer_{{name}}.csv", category="Agreement"),
+        md=f"{REPORTS}/tables/peer_{{name}}.md",
+        tex=f"{REPORTS}/tables/peer_{{name}}.tex",
+    wildcard_constraints:
+        name="|".join(re.escape(n) for n in AGREEMENT_FILES) or "(?!x)x",
+    params:
+        entry=lambda w: json.dumps(AGREEMENT_FILES[w.name], sort_keys=True),
+        opts=lambda w: [
+            "--name", w.name,
+            "--system-prefix", AGREEMENT_FILES[w.name].get("system", "us_"),
+            "--reference-prefix", AGREEMENT_FILES[w.name].get("reference", "gt_"),
+            *(["--subject", AGREEMENT_FILES[w.name]["subject"]]
+              if AGREEMENT_FILES[w.name].get("subject") else []),
+            *(["--units", *(f"{k}={v}" for k, v in
+                            sorted(AGREEMENT_FILES[w.name]["units"].items()))]
+              if AGREEMENT_FILES[w.name].get("units") else []),
+        ],
+        stem=lambda w, output: output.csv[: -len(".csv")],
+        reports=parent_of("csv", up=1),
+        chash=config_hash_when_run,
+    log:
+        "logs/agreement_file/{name}.log",
+    run:
+        run_verb_job(
+            verb("peer", input[0], params.opts, "--out-stem", params.stem,
+                 "--reports-dir", params.reports, "--config-hash", params.chash),
+            log[0],
+        )
+
+
+REPORT_ITEM_FUNCS.append(
+    lambda study: [f"{REPORTS}/tables/peer_{n}.csv" for n in AGREEMENT_FILES]
+)

@@ -21,6 +21,7 @@ rule report_config:
                for s in config["run"] if is_simulated(s)}
             | ({config["peer_results"]} if config.get("peer_results")
                and Path(config["peer_results"]).is_file() else set())
+            | {str(Path(e["path"]).resolve()) for e in AGREEMENT_FILES.values()}
         ),
     output:
         config=f"{REPORTS}/provenance/config.yaml",
