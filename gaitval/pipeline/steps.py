@@ -569,6 +569,7 @@ def external_gait_parameters_step(foot_file, ingest_dir, sheet, subjects, trial:
     from gaitval.evaluate.ultrasonic_config import reference_kwargs, resolve_cfg
     from gaitval.groundtruth.reference import MAX_ANCHOR_RESIDUAL_M
     from gaitval.io.foot import check_foot, read_foot
+    from gaitval.io.ultrasonic import anchor_positions
     from gaitval.registration.anchors import fit_anchor_frame
 
     cfg, row, subj, log, mocap = _treadmill_trial(ingest_dir, sheet, subjects, trial,
@@ -580,12 +581,11 @@ def external_gait_parameters_step(foot_file, ingest_dir, sheet, subjects, trial:
                                max_residual_m=MAX_ANCHOR_RESIDUAL_M, trial=trial)
         foot[["x_m", "y_m", "z_m"]] = fit.to_ultrasonic(
             foot[["x_m", "y_m", "z_m"]].to_numpy(float))        # p_us = R^T (p_f - t)
-    t_log = np.asarray(log.t, float)
-    t_rec = (t_log if meta["clock"] == "sensor" else np.asarray(mocap.t, float))
-    anchors = log.anchors[["x_m", "y_m", "z_m"]].to_numpy(float)
+    t_rec = np.asarray(log.t if meta["clock"] == "sensor" else mocap.t, float)
     check_foot(foot, meta, t_range=(float(t_rec[0]), float(t_rec[-1])),
                tolerance_s=float(np.median(np.diff(t_rec))) if len(t_rec) > 1 else 0.0,
-               centre=anchors.mean(axis=0), path=foot_file, trial=trial)
+               centre=anchor_positions(log.anchors).mean(axis=0), path=foot_file,
+               trial=trial)
     if meta["clock"] == "mocap":
         row = {**row, "clock_offset_s": 0.0}      # t_system = t_mocap: no offset to find
     try:
@@ -1036,6 +1036,18 @@ def read_external_detections(path, topic: str | None = None, trial: str | None =
     return read_detections(path, trial=trial)
 
 
+def _refuse_mocap_frame(meta: dict, path, trial, what: str) -> None:
+    """A file in the mocap frame on a trial whose laser moves (the rollator): refused with
+    one error naming the file and the header field (only a fixed laser's pose converts
+    the field frame into the laser's)."""
+    if meta.get("frame", "sensor") == "mocap":
+        raise FileFormatError(
+            "header field 'frame' is 'mocap', but this trial's laser moves (rollator): "
+            f"gaitval converts only a fixed laser's {what} from the mocap frame",
+            path=path, trial=trial, hint=f"write the {what} in the laser's frame "
+            "(frame: sensor)")
+
+
 def leg_detections_step(detections, groundtruth_parquet, out_dir, *, topic: str | None = None,
                         trial: str | None = None, gate_m: float = 0.30,
                         registration_json=None, sensor_parquet=None,
@@ -1057,12 +1069,8 @@ def leg_detections_step(detections, groundtruth_parquet, out_dir, *, topic: str 
     from gaitval.io.tracks import detections_to_sensor
 
     det, meta = read_external_detections(detections, topic, trial)
-    if moving_sensor and meta.get("frame", "sensor") == "mocap":
-        raise FileFormatError(
-            "header field 'frame' is 'mocap', but this trial's laser moves (rollator): "
-            "gaitval converts only a fixed laser's detections from the mocap frame",
-            path=detections, trial=trial, hint="write the detections in the laser's frame "
-            "(frame: sensor)")
+    if moving_sensor:
+        _refuse_mocap_frame(meta, detections, trial, "detections")
     rec = load_json(registration_json) if registration_json else None
     out = Path(out_dir)
     if rec is not None and rec.get("status") != "ok":
@@ -1124,12 +1132,8 @@ def import_tracks_step(tracks_file, sensor_parquet, registration_json, trial: st
     from gaitval.io.tracks import TRACK_COLUMNS, tracks_to_sensor
 
     rows, meta = read_external(tracks_file, external_entry(config_json, method), trial)
-    if moving_sensor and meta["frame"] == "mocap":
-        raise FileFormatError(
-            "header field 'frame' is 'mocap', but this trial's laser moves (rollator): "
-            "gaitval converts only a fixed laser's tracks from the mocap frame",
-            path=tracks_file, trial=trial, hint="write the tracks in the laser's frame "
-            "(frame: sensor)")
+    if moving_sensor:
+        _refuse_mocap_frame(meta, tracks_file, trial, "tracks")
     rec = load_json(registration_json) if registration_json else None
     needs_reg = "mocap" in (meta["frame"], meta["clock"])
     if needs_reg and rec is not None and rec.get("status") != "ok":

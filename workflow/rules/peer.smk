@@ -48,6 +48,16 @@ for _name, _entry in AGREEMENT_FILES.items():
                  "file (paths are relative to the working directory)")
 
 
+def agreement_options(name):
+    """`gaitval peer`'s options for agreement_files.<name>."""
+    e = AGREEMENT_FILES[name]
+    units = sorted((e.get("units") or {}).items())
+    return (["--name", name, "--system-prefix", e.get("system", "us_"),
+             "--reference-prefix", e.get("reference", "gt_")]
+            + (["--subject", e["subject"]] if e.get("subject") else [])
+            + (["--units", *(f"{k}={v}" for k, v in units)] if units else []))
+
+
 rule agreement_file:
     input:
         lambda w: AGREEMENT_FILES[w.name]["path"],
@@ -59,16 +69,7 @@ rule agreement_file:
         name="|".join(re.escape(n) for n in AGREEMENT_FILES) or "(?!x)x",
     params:
         entry=lambda w: json.dumps(AGREEMENT_FILES[w.name], sort_keys=True),
-        opts=lambda w: [
-            "--name", w.name,
-            "--system-prefix", AGREEMENT_FILES[w.name].get("system", "us_"),
-            "--reference-prefix", AGREEMENT_FILES[w.name].get("reference", "gt_"),
-            *(["--subject", AGREEMENT_FILES[w.name]["subject"]]
-              if AGREEMENT_FILES[w.name].get("subject") else []),
-            *(["--units", *(f"{k}={v}" for k, v in
-                            sorted(AGREEMENT_FILES[w.name]["units"].items()))]
-              if AGREEMENT_FILES[w.name].get("units") else []),
-        ],
+        opts=lambda w: agreement_options(w.name),
         stem=lambda w, output: output.csv[: -len(".csv")],
         reports=parent_of("csv", up=1),
         chash=config_hash_when_run,
