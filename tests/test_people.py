@@ -485,3 +485,35 @@ def test_leg_classifier_in_the_empty_room_each_laser_held_out(realdata):
         assert lt.n_confirmed < lt_plain.n_confirmed, topic
         travel[topic] = lt.n_confirmed + lt.n_refound
     assert sum(travel.values()) > 0, travel
+
+
+# -- the protocol tables: a laser that stands still -----------------------------------------
+def test_the_papers_standing_laser_gives_the_people_tracker_no_scan_matching():
+    """TUG and MTST (seed 000, seed 001) put the LRS on a stand: their track steps give the
+    ``people`` kind ``ego_motion: none`` (issue 38), every other method nothing, and a
+    config-defined method of kind ``people`` the same as the built-in one."""
+    from gaitval.pipeline.steps import fixed_sensor_overrides
+
+    assert fixed_sensor_overrides("people") == {"kind__ego_motion": "none"}
+    own = {**METHODS["people"], "label": "my people tracker"}
+    assert fixed_sensor_overrides(own) == {"kind__ego_motion": "none"}
+    for paper_method in ("tug_m1", "mtst_proposed", "rollator_kf", "rollator_pf"):
+        assert fixed_sensor_overrides(paper_method) == {}
+
+
+def test_scan_matching_on_a_standing_laser_finds_motion_that_is_not_there(tiny_simulated):
+    """Why the standing laser gets no scan matching: on a TUG trial, whose laser stands
+    still, scan-to-scan ICP against a scene with a walking person in it drifts by
+    centimetres (the default study's tug_Y01_t1: 7 cm, 0.9°), while the standing-sensor
+    role reports the truth, no motion at all."""
+    from gaitval.io.scanlog import read_scanlog
+    from gaitval.track.staticmap import EGO_MOTIONS
+
+    scans = read_scanlog(tiny_simulated / "lrs" / "tug_Y01_t1.scan.parquet",
+                         trial="tug_Y01_t1")
+    icp = EGO_MOTIONS.build(METHODS["people"]["kind"]["ego_motion"])
+    poses, _ = icp.poses(scans)
+    drift = np.hypot(poses[:, 0], poses[:, 1]).max()
+    assert drift > 0.01                                       # metres of a laser that stood
+    still, segment = EGO_MOTIONS.build("none").poses(scans)
+    assert not still.any() and not segment.any()

@@ -38,8 +38,9 @@ from gaitval.errors import ConfigError, FileFormatError, GaitvalError
 from gaitval.io.atomic import write_parquet
 from gaitval.pipeline.memo import FileMemo
 from gaitval.io.parquet import read_parquet
-from gaitval.pipeline.steps import (load_json, method_definition, method_display_names,
-                                    track_and_write, trial_and_subject)
+from gaitval.pipeline.steps import (fixed_sensor_overrides, load_json, method_definition,
+                                    method_display_names, track_and_write,
+                                    trial_and_subject)
 
 TARGET_COLUMNS = ("target", "x_m", "y_m", "color", "assigned")
 EVAL_TABLES = ("contacts", "steps", "events", "gates", "track_field", "summary", "targets")
@@ -176,8 +177,9 @@ def mtst_track_step(sensor, sheet, subjects, trial: str, method: str, config_jso
         return track
     scans = keep_every(read_scans(sensor, row), float(s["scan_period_s"]), trial=trial)
     pose, _ = pose_and_clock(rec, row, scans, s, cfg, trial)
-    overrides = dict(((cfg.get("tracking") or {}).get("overrides") or {}).get(method) or {})
     mdef = method_definition(cfg, method)
+    overrides = {**fixed_sensor_overrides(mdef),                 # the LRS stands still
+                 **(((cfg.get("tracking") or {}).get("overrides") or {}).get(method) or {})}
     if "init" in get_method(mdef):      # the papers' methods start on the mat's lane; the
         overrides.setdefault("init__lane", mat_lane(pose, s["mat"]))   # people tracker: own
     return track_and_write(scans, mdef, float(subj["leg_width_m"]), overrides, trial=trial,

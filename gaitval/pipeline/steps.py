@@ -288,6 +288,23 @@ def tug_leg_width(subj: dict, cfg: dict) -> float:
     return float(w)
 
 
+def fixed_sensor_overrides(definition) -> dict:
+    """The people tracker's setup on a laser that stands still (TUG, MTST; issue 38):
+    ``kind__ego_motion: none``.  Seed 000 and seed 001 put the LRS on a stand in the
+    room, and gaitval's registration (calibration poles, one fixed pose per trial) rests
+    on that; estimating the laser's motion from its own scans (``scan_matching``, for
+    robots that move without odometry, e.g. the leg-tracker benchmark's bags) can only
+    find a motion that is not there, at about half the people tracker's cost per scan.
+    The rollator's carried laser keeps it (:func:`gaitval.pipeline.rollator.
+    rollator_people_overrides`).  Empty for a method that is not of kind ``people``; the
+    method's own ``tracking.overrides`` apply on top."""
+    from gaitval.methods import get_method, kind_name
+
+    if kind_name(get_method(definition)) != "people":
+        return {}
+    return {"kind__ego_motion": "none"}
+
+
 def track_step(sensor_parquet, sheet, subjects, trial: str, method: str, config_json,
                out_parquet, detections=None) -> pd.DataFrame:
     """Run one tracker method on one LRS trial; write the per-scan track (sensor frame).
@@ -299,8 +316,10 @@ def track_step(sensor_parquet, sheet, subjects, trial: str, method: str, config_
     row, subj = trial_and_subject(sheet, subjects, trial)
     scans = read_scanlog(sensor_parquet, trial=trial)
     w = tug_leg_width(subj, cfg)
-    overrides = ((cfg.get("tracking") or {}).get("overrides") or {}).get(method)
-    return track_and_write(scans, method_definition(cfg, method), w, overrides,
+    mdef = method_definition(cfg, method)
+    overrides = {**fixed_sensor_overrides(mdef),
+                 **(((cfg.get("tracking") or {}).get("overrides") or {}).get(method) or {})}
+    return track_and_write(scans, mdef, w, overrides,
                            trial=trial, method=method, source=sensor_parquet,
                            out_parquet=out_parquet, detections=detections)
 
