@@ -349,7 +349,10 @@ def config_view_in(scope):
 # core, so a table started while batch jobs wait ran with the other core idle (~7 core-s
 # in a default run, benchmarks/batch_tails.py and the run's Snakemake log); at -10 they
 # wait until no batch job is left and then run two at a time, ultrasonic_tables (-5, the
-# longest) beside the three others in turn: 5.8 against 5.8 CPU-s.
+# longest) beside the three others in turn: 5.8 against 5.8 CPU-s.  registration_summary
+# (0.1 s) is at -10 too: at 0 it started, for its large input, as soon as the last MTST
+# track ended, on one core, a table took the other, and the TUG tracks, which need both,
+# waited 4.6 s (the run's Snakemake log, issue 38).
 # config_view 200: the views take milliseconds each, but at priority 0 they ran only when
 # a core was free of batch jobs, so the jobs that read them waited -- the ultrasonic chain
 # (noise 100, tracks 50) started only after every MTST track, and its table then ran alone

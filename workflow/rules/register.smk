@@ -104,6 +104,10 @@ rule registration_summary:
         stem=lambda w, output: output.table[: -len(".csv")],
         reports=parent_of("table", up=1),
         chash=config_hash_when_run,
+    # with the tables (PRIORITIES in common.smk): at 0 it was picked, for its large input,
+    # as soon as the last MTST track ended; on one core, with a table filling the other,
+    # while the TUG tracks, which need both cores, waited (4.6 s, the run's Snakemake log)
+    priority: -10
     log:
         "logs/registration_summary/{study}.log",
     run:
