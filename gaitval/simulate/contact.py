@@ -169,25 +169,28 @@ def swing_detours(plan, leg_fn, leg_width_m: float, heights=CHECK_HEIGHTS_M,
         if np.hypot(*chord) > 0.05:
             nrm = np.array([-chord[1], chord[0]]) / np.hypot(*chord)
             dirs = [nrm if float(away @ nrm) >= 0.0 else -nrm, away]
+        # every (direction, peak time) candidate at once: the smallest detour b that keeps
+        # the shanks `goal` apart, by bisection on [0, MAX_DETOUR_M] (a candidate that does
+        # not clear even at MAX_DETOUR_M gets MAX_DETOUR_M); elementwise the same numbers
+        # as one candidate at a time
+        cands = [(nrm, tc) for nrm in dirs for tc in TAU_C]
+        profs = np.stack([bump(tau, tc)[:, None, None] * nrm for nrm, tc in cands])
+
+        def clears(b):                                  # (C,) detours -> (C,) bool
+            d = diff[None] + b[:, None, None, None] * profs  # (C, N_TAU, H, 2)
+            return np.hypot(d[..., 0], d[..., 1]).min(axis=(1, 2)) >= goal
+
+        lo, hi = np.zeros(len(cands)), np.full(len(cands), MAX_DETOUR_M)
+        at_max = clears(hi)
+        for _ in range(30):
+            mid = 0.5 * (lo + hi)
+            ok = clears(mid)
+            lo, hi = np.where(ok, lo, mid), np.where(ok, mid, hi)
+        cand = np.where(at_max, hi, MAX_DETOUR_M)
         best = None
-        for nrm in dirs:
-            for tc in TAU_C:
-                prof = bump(tau, tc)[:, None, None] * nrm            # (N_TAU, 1, 2)
-
-                def ok(b):
-                    d = diff + b * prof
-                    return float(np.hypot(d[..., 0], d[..., 1]).min()) >= goal
-
-                if not ok(MAX_DETOUR_M):
-                    cand = MAX_DETOUR_M
-                else:
-                    lo, hi = 0.0, MAX_DETOUR_M
-                    for _ in range(30):
-                        mid = 0.5 * (lo + hi)
-                        lo, hi = (lo, mid) if ok(mid) else (mid, hi)
-                    cand = hi
-                if best is None or cand < best[0] - 1e-9:
-                    best = (cand, tc, nrm)
+        for c, (nrm, tc) in enumerate(cands):           # the first of the smallest
+            if best is None or cand[c] < best[0] - 1e-9:
+                best = (float(cand[c]), tc, nrm)
         b, tc, nrm = best
         out[i] = (b, tc, nrm[0], nrm[1])
     return out
