@@ -70,7 +70,6 @@ import math
 from collections import deque
 
 import numpy as np
-from scipy.stats import norm
 
 from gaitval.registry import Registry
 from gaitval.track.init import leg_pairs
@@ -369,6 +368,9 @@ class LegTravel(Confirmer):
                  percentile: float = 0.90, assoc_extra_m: float = 0.4):
         self.percentile = percentile
         self.assoc_extra_m = assoc_extra_m
+        # scipy here, not at the top: the Snakefile imports this module (the role registries)
+        from scipy.stats import norm
+
         self.gate2 = float(norm.ppf(1.0 - (1.0 - percentile) / 2.0)) ** 2     # 1.645²
         self.var_assoc = (std_obs_m + assoc_extra_m) ** 2
         self.min_travel_m = min_travel_m

@@ -49,7 +49,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import linear_sum_assignment
 
 from gaitval.detect import DETECTORS
 from gaitval.detect.base import split_observations
@@ -216,6 +215,9 @@ class PeopleTracker(TrackerKind):
         ``scan_hypotheses`` (per scan: time spent, person hypotheses alive) as attributes of
         the result (benchmarks/people_tracker.py), and ``scan_static`` (per scan: for each
         observation, whether it lay on a static cell of the map; benchmarks/people_misses.py)."""
+        # scipy here, not at the top: the Snakefile imports this module (the kind registry)
+        from scipy.optimize import linear_sum_assignment
+
         from time import perf_counter
         t = np.asarray(scans.t, dtype=float)
         n = len(t)

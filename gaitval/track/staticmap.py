@@ -35,7 +35,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from gaitval.registry import Registry
 
@@ -107,6 +106,9 @@ class ScanMatching(EgoMotion):
         """(x, y, θ) of the current scan in the previous scan's frame; None: unknown."""
         if len(prev) < self.min_pairs or len(cur) < self.min_pairs:
             return None
+        # scipy here, not at the top: the Snakefile imports this module (the role registries)
+        from scipy.spatial import cKDTree
+
         tree = cKDTree(prev)
         x, y, th = guess
         for _ in range(self.iterations):
