@@ -50,6 +50,14 @@ class Gate:
     def admits(self, lam2: float, dist: float, ctx: GateContext | None) -> bool:
         raise NotImplementedError
 
+    def candidates_at(self, filter, prior, obs, leg_width_m: float, dt: float, speed: float,
+                      swing: bool, n_unobserved: int) -> list[tuple[int, float]]:
+        """:meth:`candidates` with the :class:`GateContext` fields as arguments: the
+        tracker loop's call for a gate that needs the context (a gate that overrides it
+        spares the loop a GateContext per leg and scan)."""
+        return self.candidates(filter, prior, obs,
+                               GateContext(leg_width_m, dt, speed, swing, n_unobserved))
+
     def candidates(self, filter, prior, obs, ctx: GateContext | None
                    ) -> list[tuple[int, float]]:
         """``(j, λ²)`` of the gated observations (j = 1..J) of one leg."""
@@ -181,16 +189,24 @@ class VariableValidationRegion(Gate):
                 + ("_unobservable" if ctx.n_unobserved > 0 else "_observable"))
 
     def radius(self, ctx: GateContext) -> float:
-        w, dt, h = ctx.leg_width_m, ctx.dt, ctx.n_unobserved
-        if ctx.swing:
-            r = self.swing_leg_widths * w + dt * ctx.speed         # seed001 Table 1, swing
+        return self.radius_of(ctx.leg_width_m, ctx.dt, ctx.speed, ctx.swing, ctx.n_unobserved)
+
+    def radius_of(self, w: float, dt: float, speed: float, swing: bool, h: int) -> float:
+        """r_val of seed001 Table 1 for leg width ``w``, scan period ``dt``, ‖v_{k−1}‖
+        ``speed``, phase ``swing`` at k−1 and ``h`` consecutive unobserved scans."""
+        if swing:
+            r = self.swing_leg_widths * w + dt * speed         # seed001 Table 1, swing
             return r + dt * h * self.v_sw if h > 0 else r
         if h > 0:
             return self.stance_leg_widths * w + dt * h * self.v_st  # seed001 Table 1, stance
-        return self.stance_leg_widths * w + dt * ctx.speed
+        return self.stance_leg_widths * w + dt * speed
 
     def admits(self, lam2, dist, ctx):
         return dist < self.radius(ctx)              # seed001 eq. (5)
 
     def candidates(self, filter, prior, obs, ctx):
         return self.within_radius(filter, prior, obs, self.radius(ctx))   # seed001 eq. (5)
+
+    def candidates_at(self, filter, prior, obs, leg_width_m, dt, speed, swing, n_unobserved):
+        return self.within_radius(filter, prior, obs, self.radius_of(   # seed001 eq. (5)
+            leg_width_m, dt, speed, swing, n_unobserved))

@@ -131,6 +131,7 @@ class Tracker:
         hyp = Hypotheses(run)
         candidates, select, reset, phase_of = (gate.candidates, assoc.select, hyp.reset,
                                                hyp.phase_of)
+        candidates_at = gate.candidates_at
         uses_phase = assoc.uses_phase
         after_scan = (occ.after_scan if type(occ).after_scan is not OcclusionHandler.after_scan
                       else None)                                  # predict only: nothing to do
@@ -165,12 +166,12 @@ class Tracker:
             else:                                                 # detect
                 obs, pats = at(k, prior)
             if context:                                           # seed000 eq. (11)–(13)
-                # TrackingRun.gate_context written out
+                # TrackingRun.gate_context written out, its fields as arguments
                 sw = swing_of[ph]
-                cl = candidates(F, pl, obs, GateContext(w_l, dt, hypot(sl[2], sl[3]), sw[0],
-                                                        L.n_unobserved))
-                cr = candidates(F, pr, obs, GateContext(w_l, dt, hypot(sr[2], sr[3]), sw[1],
-                                                        R.n_unobserved))
+                cl = candidates_at(F, pl, obs, w_l, dt, hypot(sl[2], sl[3]), sw[0],
+                                   L.n_unobserved)
+                cr = candidates_at(F, pr, obs, w_l, dt, hypot(sr[2], sr[3]), sw[1],
+                                   R.n_unobserved)
             else:
                 cl, cr = candidates(F, pl, obs, None), candidates(F, pr, obs, None)
             # TrackingRun.commit written out: seed000 eq. (14)–(16) (corrected states) and
