@@ -8,7 +8,9 @@ observation, where ``dist`` is the Euclidean distance to the predicted position.
 
 ``ctx`` (:class:`GateContext`) is only built for gates with ``needs_context = True``: the
 leg width w_l, Δt, the leg's speed ‖v_{k−1}‖, whether it was swinging at k−1 and H, the
-number of consecutive scans it has been unobserved (UO) up to k−1.
+number of consecutive scans it has been unobserved (UO) up to k−1.  The tracker loop calls
+``candidates_at`` with those five values as arguments; the base class builds the
+GateContext from them, a gate may compute from them directly.
 
 References
 ----------
