@@ -114,6 +114,14 @@ def test_variable_validation_region_table1(swing, h, speed, want_cell, want_r):
     assert g.radius(ctx) == pytest.approx(want_r, abs=1e-12)
     assert g.admits(1e9, want_r - 1e-6, ctx)           # Euclidean, seed001 eq. (5):
     assert not g.admits(0.0, want_r + 1e-6, ctx)       # λ² plays no part
+    # the tracker loop's call (candidates_at, no GateContext) gates exactly as candidates
+    from gaitval.track.kalman import FILTERS
+    F = FILTERS.build({"name": "kf", "q_accel_sd_mps2": 5.0, "r_sd_m": 0.05})
+    prior = F.init(1.0, 0.0)                           # a leg predicted at (1, 0)
+    obs = [(1.0 + want_r - 1e-6, 0.0), (1.0, want_r + 1e-6), (1.0 - 0.5 * want_r, 0.0)]
+    via_ctx = g.candidates(F, prior, obs, ctx)
+    assert [j for j, _ in via_ctx] == [1, 3]
+    assert g.candidates_at(F, prior, obs, 0.10, 0.05, speed, swing, h) == via_ctx
 
 
 def test_variable_region_recaptures_a_leg_that_moved_while_hidden():
