@@ -1,5 +1,6 @@
 # Worked example: gaitval's agreement statistics on a peer's published paired results
 # (config key peer_results; skipped when the file is absent, e.g. without ../shared).
+include: "peer_common.smk"
 
 
 rule peer_agreement:
@@ -34,28 +35,6 @@ REPORT_ITEM_FUNCS.append(
         else []
     )
 )
-
-
-# A study's own paired results (config agreement_files: name -> {path, system, reference,
-# subject, units}, issue 37): per walk or stride, a system's value beside its reference's
-# (a vendor's gait software against the mocap, say), analysed as the peer's worked example
-# is -- pooled and repeated-measures agreement -- into tables/peer_<name>.  Each file is
-# checked at start; the entry is a param, so an edited entry reruns its own table.
-AGREEMENT_FILES = dict(config.get("agreement_files") or {})
-for _name, _entry in AGREEMENT_FILES.items():
-    if not Path(_entry["path"]).is_file():
-        sys.exit(f"ConfigError: agreement_files.{_name}.path: {_entry['path']!r} is not a "
-                 "file (paths are relative to the working directory)")
-
-
-def agreement_options(name):
-    """`gaitval peer`'s options for agreement_files.<name>."""
-    e = AGREEMENT_FILES[name]
-    units = sorted((e.get("units") or {}).items())
-    return (["--name", name, "--system-prefix", e.get("system", "us_"),
-             "--reference-prefix", e.get("reference", "gt_")]
-            + (["--subject", e["subject"]] if e.get("subject") else [])
-            + (["--units", *(f"{k}={v}" for k, v in units)] if units else []))
 
 
 rule agreement_file:
