@@ -33,7 +33,7 @@ import pandas as pd
 from gaitval.errors import ConfigError, GaitvalError
 from gaitval.io.atomic import write_parquet
 from gaitval.io.parquet import read_parquet
-from gaitval.pipeline.steps import load_json, method_definition
+from gaitval.pipeline.steps import load_json, method_definition, method_overrides
 
 INITS = ("own", "annotation")
 #: How many of the person's later clicks the annotation initialiser is given: at least its
@@ -108,7 +108,7 @@ def legbench_track_step(sensor, method: str, out_parquet, *, init: str = "own",
     trial = trial or Path(sensor).name
     scans = read_scans(sensor, scan_topic, trial)
     mdef = method_definition(cfg, method)
-    overrides = dict(((cfg.get("tracking") or {}).get("overrides") or {}).get(method) or {})
+    overrides = method_overrides(cfg, method)
     if init == "annotation":
         if annotations is None:
             raise GaitvalError("init 'annotation' needs --annotations", trial=trial)

@@ -39,8 +39,8 @@ from gaitval.io.atomic import write_parquet
 from gaitval.pipeline.memo import FileMemo
 from gaitval.io.parquet import read_parquet
 from gaitval.pipeline.steps import (fixed_sensor_overrides, load_json, method_definition,
-                                    method_display_names, track_and_write,
-                                    trial_and_subject)
+                                    method_display_names, method_overrides,
+                                    track_and_write, trial_and_subject)
 
 TARGET_COLUMNS = ("target", "x_m", "y_m", "color", "assigned")
 EVAL_TABLES = ("contacts", "steps", "events", "gates", "track_field", "summary", "targets")
@@ -179,7 +179,7 @@ def mtst_track_step(sensor, sheet, subjects, trial: str, method: str, config_jso
     pose, _ = pose_and_clock(rec, row, scans, s, cfg, trial)
     mdef = method_definition(cfg, method)
     overrides = {**fixed_sensor_overrides(mdef),                 # the LRS stands still
-                 **(((cfg.get("tracking") or {}).get("overrides") or {}).get(method) or {})}
+                 **method_overrides(cfg, method)}
     if "init" in get_method(mdef):      # the papers' methods start on the mat's lane; the
         overrides.setdefault("init__lane", mat_lane(pose, s["mat"]))   # people tracker: own
     return track_and_write(scans, mdef, float(subj["leg_width_m"]), overrides, trial=trial,
@@ -290,7 +290,7 @@ def _gate(cfg: dict, method: str):
     if method in ((cfg.get("tracking") or {}).get("external") or {}):
         return None                    # an external tracker (issue 37): gate unknown
     m = set_params(get_method(method_definition(cfg, method)),
-                   ((cfg.get("tracking") or {}).get("overrides") or {}).get(method))
+                   method_overrides(cfg, method))
     spec = m.get("gate")
     name = spec if isinstance(spec, str) else (spec or {}).get("name")
     return GATES.build(spec) if name == "variable_region" else None

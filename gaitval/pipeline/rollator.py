@@ -33,7 +33,8 @@ from gaitval.io.atomic import write_parquet, write_text
 from gaitval.pipeline.memo import FileMemo, file_identity
 from gaitval.io.parquet import read_parquet
 from gaitval.pipeline.steps import (PROTOCOL_SCOPE, load_json, method_definition,
-                                    method_display_names, trial_and_subject)
+                                    method_display_names, method_overrides,
+                                    trial_and_subject)
 
 #: defaults of the ``rollator:`` keys read here
 DEFAULTS = {"kf_method": "rollator_kf", "pf_method": "rollator_pf", "methods": ["people"],
@@ -159,7 +160,7 @@ def rollator_track_step(sensor_parquet, sheet, subjects, trial: str, method: str
     rc = rollator_cfg(cfg)
     row, subj = trial_and_subject(sheet, subjects, trial)
     scans = read_scanlog(sensor_parquet, trial=trial)
-    overrides = dict(((cfg.get("tracking") or {}).get("overrides") or {}).get(method) or {})
+    overrides = method_overrides(cfg, method)
     if model_json is not None:
         overrides = {"kind__model": load_json(model_json),
                      "kind__seed": int(rc["pf_seed"]), **overrides}

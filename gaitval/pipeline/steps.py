@@ -269,7 +269,7 @@ def method_display_names(view_dir: str | Path, methods) -> dict[str, str]:
             if m in ((cfg.get("tracking") or {}).get("external") or {}):
                 continue                      # an external method (issue 37): its name
             d = set_params(get_method(method_definition(cfg, m)),
-                           ((cfg.get("tracking") or {}).get("overrides") or {}).get(m))
+                           method_overrides(cfg, m))
             out[m] = display_name(m, d)
     return out
 
@@ -278,6 +278,12 @@ def method_definition(cfg: dict, method: str):
     """A method's definition: ``tracking.methods.<name>`` from config, else the built-in."""
     custom = (cfg.get("tracking") or {}).get("methods") or {}
     return custom.get(method, method)
+
+
+def method_overrides(cfg: dict, method: str) -> dict:
+    """The user's ``tracking.overrides.<name>`` (``role__param: value``), a new dict, empty
+    when there are none."""
+    return dict(((cfg.get("tracking") or {}).get("overrides") or {}).get(method) or {})
 
 
 def tug_leg_width(subj: dict, cfg: dict) -> float:
@@ -318,7 +324,7 @@ def track_step(sensor_parquet, sheet, subjects, trial: str, method: str, config_
     w = tug_leg_width(subj, cfg)
     mdef = method_definition(cfg, method)
     overrides = {**fixed_sensor_overrides(mdef),
-                 **(((cfg.get("tracking") or {}).get("overrides") or {}).get(method) or {})}
+                 **method_overrides(cfg, method)}
     return track_and_write(scans, mdef, w, overrides,
                            trial=trial, method=method, source=sensor_parquet,
                            out_parquet=out_parquet, detections=detections)
@@ -458,7 +464,7 @@ def tug_tables_step(eval_dirs: list[str | Path], tables_dir, figures_dir, report
                for cfg in cfgs.values()):
             continue                    # an external tracker: no parameters of gaitval's
         runs = {study: set_params(get_method(method_definition(cfg, m)),
-                                  ((cfg.get("tracking") or {}).get("overrides") or {}).get(m))
+                                  method_overrides(cfg, m))
                 for study, cfg in cfgs.items()}
         distinct = {json.dumps(d, sort_keys=True, default=str) for d in runs.values()}
         if len(distinct) == 1:
