@@ -12,7 +12,10 @@ from gaitval.simulate.physics import TUG_PHASE_LEG_SCANS
 
 
 def tug_occlusion_variant(preset: str | dict = "default", marker_in_scan_plane: bool = True,
-                          turn_step_factor: float | None = None) -> pd.DataFrame:
+                          turn_step_factor: float | None = None,
+                          marker_scan_radius_m: float | None = None,
+                          sensor_nominal_pose: tuple[float, float, float] | None = None
+                          ) -> pd.DataFrame:
     """The TUG trials of a preset re-rendered in memory with one scene or gait choice
     changed, and their truth phase durations and occlusion (the ``tug_phase_duration`` and
     ``tug_occlusion`` rows' measures; nothing is written).
@@ -21,8 +24,12 @@ def tug_occlusion_variant(preset: str | dict = "default", marker_in_scan_plane: 
     turning occlusion and return rows failed"): ``marker_in_scan_plane=False`` leaves the
     turn marker out of the laser's scene (a marker lower than the scan plane; the walker's
     path still goes around its base), ``turn_step_factor`` replaces the walkers'
-    ``GaitParams.turn_step_factor``.  Every trial keeps its random streams, so with the
-    defaults the figures are those of the written study.
+    ``GaitParams.turn_step_factor``, ``marker_scan_radius_m`` the marker's section in the
+    scan plane (the preset's ``tug.marker_scan_radius_m``; 0 = below the plane; the path
+    around the marker is unchanged), ``sensor_nominal_pose`` the preset's
+    ``tug.sensor_nominal_pose`` (``x, y, yaw``; each participant's jitter is drawn from
+    the same stream).  Every trial keeps its random streams, so with the defaults the
+    figures are those of the written study.
 
     Returns
     -------
@@ -37,6 +44,10 @@ def tug_occlusion_variant(preset: str | dict = "default", marker_in_scan_plane: 
     from gaitval.simulate.scene import ID_MARKER
 
     cfg = S.load_preset(preset)
+    if marker_scan_radius_m is not None:
+        cfg["tug"]["marker_scan_radius_m"] = float(marker_scan_radius_m)
+    if sensor_nominal_pose is not None:
+        cfg["tug"]["sensor_nominal_pose"] = [float(v) for v in sensor_nominal_pose]
     seed = int(cfg["seed"])
     tasks = [t for t in S._lrs_tasks(cfg, cfg["study"], seed, [])
              if t[1] == "tug"]
