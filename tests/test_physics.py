@@ -227,8 +227,7 @@ def test_tug_occlusion_notes_name_the_screens_and_the_return_split(tiny, physics
     spans around it are labelled "seated"."""
     import re
 
-    from gaitval.simulate.physics import occluders, tug_span, tug_timeline
-    from gaitval.simulate.tug import scene_circles
+    from gaitval.simulate.physics import occluders, tug_scene_circles, tug_span, tug_timeline
 
     occ = physics[physics["check"] == "tug_occlusion"].set_index("phase")
     counts = {}
@@ -254,7 +253,7 @@ def test_tug_occlusion_notes_name_the_screens_and_the_return_split(tiny, physics
         t_end = float(legs["t_s"].max())
         s = s[(s["t_mocap_s"] >= 0) & (s["t_mocap_s"] <= t_end)]
         o = occluders(s, poses.loc[tr["trial"], ["x_m", "y_m", "yaw_rad"]].to_numpy(float),
-                      float(subj.loc[tr["subject"], "leg_width_m"]), scene_circles())
+                      float(subj.loc[tr["subject"], "leg_width_m"]), tug_scene_circles(tiny))
         n_turn += int((o["phase"] == "turning").sum())
         ev = pd.read_csv(d / "events.csv")
         tl = tug_timeline(ev, s, t_end)
@@ -304,3 +303,40 @@ def test_tug_variant_reproduces_the_study_and_the_marker_screens_only_the_turn(p
     leg_only = int(re.search(r"the other leg only (\d+)",
                              rows.loc[("tug_occlusion", "turning"), "note"]).group(1))
     assert low.loc["turning", "occluded"] >= leg_only
+
+
+def test_the_study_records_its_tug_scene_and_the_marker_section_reaches_the_laser(tiny):
+    """The preset's ``tug.marker_scan_radius_m`` (the turn marker's section in the scan
+    plane, docs/simulator.md "The TUG scene") is what the laser sees: the study writes it
+    into ``truth/tug_scene.csv`` (read back by the physics rows), a radius of 0 leaves the
+    marker out of the scene, exactly as a marker below the plane, and the walker's path
+    does not depend on it (same phases, same leg-scans)."""
+    import yaml
+
+    from gaitval.simulate.physics import tug_scene_circles
+    from gaitval.simulate.scene import ID_MARKER
+    from gaitval.simulate.study import PRESET_DIR
+    from gaitval.simulate.tug import MARKER_RADIUS_M, TUG_MARKER_XY, scene_circles
+    from gaitval.simulate.tug_variants import tug_occlusion_variant
+
+    preset = yaml.safe_load((PRESET_DIR / "tiny.yaml").read_text())
+    radius = float(preset["tug"]["marker_scan_radius_m"])
+    scene = pd.read_csv(tiny / "truth" / "tug_scene.csv")
+    marker = scene[scene["object"] == "turn_marker"]
+    assert len(marker) == 1 and marker["radius_m"].iloc[0] == pytest.approx(radius)
+    assert tuple(marker[["x_m", "y_m"]].iloc[0]) == pytest.approx(TUG_MARKER_XY)
+    assert np.array_equal(tug_scene_circles(tiny), scene_circles(radius))
+    assert ID_MARKER not in scene_circles(0.0)[:, 3]
+    assert len(scene_circles(0.0)) == len(scene_circles(MARKER_RADIUS_M)) - 1
+    with pytest.raises(ValueError, match="marker_scan_radius_m"):
+        scene_circles(-0.01)
+    below = tug_occlusion_variant("tiny", marker_in_scan_plane=False)
+    zero = tug_occlusion_variant("tiny", marker_scan_radius_m=0.0)
+    wide = tug_occlusion_variant("tiny", marker_scan_radius_m=MARKER_RADIUS_M)
+    assert zero.equals(below)
+    assert wide["leg_scans"].equals(zero["leg_scans"]) and wide["seconds"].equals(zero["seconds"])
+    # a marker in the plane hides turning leg-scans; on the way out the walker never has
+    # it between the leg and the sensor (it can, at the start of the return)
+    assert wide.loc["turning", "occluded"] > zero.loc["turning", "occluded"]
+    assert wide.loc["forward", "occluded"] == zero.loc["forward", "occluded"]
+    assert wide.loc["return", "occluded"] >= zero.loc["return", "occluded"]

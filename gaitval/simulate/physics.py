@@ -38,13 +38,18 @@ tug_phase_duration        forward / turning / return seconds per trial vs seed 0
                           whole-capture values are in the notes).  Tolerance unchanged
 tug_occlusion             per TUG phase, leg-scans with < 3 returning beams vs seed 000
                           Table 4 (Method 2: 3.5 / 11.3 / 5.1 %); pass: ratio in [2/3, 3/2];
-                          the note names what is on the line of sight (:func:`occluders`)
+                          the note names what is on the line of sight (:func:`occluders`).
+                          The forward and turning rows are the calibration targets of the
+                          TUG sensor placement and the marker's section in the scan plane
+                          (``benchmarks/tug_scene_calibration.py``), so only the return
+                          row is an independent check; seed 000 counts the tracker's
+                          unobservable steps, the twin the truth (docs/simulator.md)
 tug_turn_to_sit           seconds from the last return-line contact to the last contact
                           before sitting vs 1.7 ± 0.5 s (final 180° turn of the TUG,
                           healthy adults); pass: inside mean ± 2 SD
 tug_return_to_chair       lateral distance of the return path from the chair's axis where
                           the turn to sit starts (out-and-back, seed 000 §1); pass: ≤ 0.25 m
-tug_marker_clearance      closest approach of a shank's surface to the marker cone's surface
+tug_marker_clearance      closest approach of a shank's surface to the marker's footprint
                           over the whole trial (the legs go around it, not through it;
                           before issue 34's turn model, over the turning phase); pass: > 0
 tug_turn_radius           mean distance of the turning footholds from the marker; no
@@ -397,9 +402,20 @@ def tug_timeline(ev: pd.DataFrame, phase_of_scans: pd.DataFrame, t_end: float) -
             "seated_before": t_rise, "seated_after": t_end - t_seated}
 
 
-def _tug_phase_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
+def tug_scene_circles(study_dir: str | Path) -> np.ndarray:
+    """The TUG scene's static circles ``(k, 4)``: ``x, y, radius, id`` (field frame) of a
+    simulated study, from its ``truth/tug_scene.csv``; a study written before that file
+    existed had the default scene (:func:`gaitval.simulate.tug.scene_circles`)."""
     from gaitval.simulate.tug import scene_circles
 
+    f = Path(study_dir) / "truth" / "tug_scene.csv"
+    if not f.is_file():
+        return scene_circles()
+    t = pd.read_csv(f)
+    return t[["x_m", "y_m", "radius_m", "object_id"]].to_numpy(float)
+
+
+def _tug_phase_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
     durations = {ph: [] for ph in TUG_PHASE_LEG_SCANS}
     occ = {ph: [0, 0] for ph in TUG_PHASE_LEG_SCANS}
     by_steps = {ph: [] for ph in TUG_PHASE_LEG_SCANS}
@@ -408,7 +424,7 @@ def _tug_phase_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
     timeline = []
     subj = pd.read_csv(study_dir / "subjects.csv").set_index("subject")
     poses = pd.read_csv(study_dir / "truth" / "sensor_pose.csv").set_index("trial")
-    circles = scene_circles()
+    circles = tug_scene_circles(study_dir)
     for _, tr in trials.iterrows():
         t = tr["trial"]
         ev = pd.read_csv(study_dir / "truth" / t / "events.csv")
@@ -526,7 +542,8 @@ def _tug_path_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
              "1991", group="young", note="feet midpoint off the chair axis at the turn to sit"),
         _row("tug_marker_clearance", "tug", float(np.min(clear)) if clear else np.nan, 0.0,
              0.0, None, "m", "> 0 (worst trial)", "physics: the legs go around the marker",
-             group="young", note="shank surface to the cone's surface at shin height"),
+             group="young", note="shank surface to the marker's footprint at shin height "
+                                 "(0.06 m radius, what the path goes around)"),
         _row("tug_turn_radius", "tug", float(np.mean(radii)) if radii else np.nan, np.nan,
              None, None, "m", "no published value", "docs/simulator.md (choice of the "
              "path)", group="young", note="mean distance of the turning footholds from the "

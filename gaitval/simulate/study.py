@@ -226,6 +226,20 @@ def _subject_trials(proto: str, c: dict, study: str, subj: dict, gp: GaitParams,
     return []
 
 
+def tug_scene_table(tug_cfg: dict) -> pd.DataFrame:
+    """The TUG scene's static objects at shin height as the study's truth
+    (``truth/tug_scene.csv``): ``x_m, y_m, radius_m`` in the field frame, ``object_id`` and
+    ``object`` (:data:`gaitval.simulate.scene.ID_NAMES`).  The turn marker is there only
+    when the preset's ``tug.marker_scan_radius_m`` puts it in the scan plane."""
+    from gaitval.simulate.scene import ID_NAMES
+    from gaitval.simulate.tug import MARKER_RADIUS_M, scene_circles
+
+    c = scene_circles(float(tug_cfg.get("marker_scan_radius_m", MARKER_RADIUS_M)))
+    return pd.DataFrame({"x_m": c[:, 0], "y_m": c[:, 1], "radius_m": c[:, 2],
+                         "object_id": c[:, 3].astype(int),
+                         "object": [ID_NAMES[int(k)] for k in c[:, 3]]})
+
+
 def _lrs_tasks(cfg: dict, study: str, seed: int, subjects: list) -> list[tuple]:
     """Every LRS trial (TUG, MTST, rollator) of the preset as the arguments of
     :func:`_simulate_trial`, in trial order; appends the participants to ``subjects``.
@@ -379,6 +393,9 @@ def generate_study(out_dir: Path, preset: str | dict = "default", seed: int | No
     write_csv(pd.DataFrame(poses, columns=["trial", "x_m", "y_m", "yaw_rad", "clock_offset_s",
                                            "clock_drift_ppm"]),
               out / "truth" / "sensor_pose.csv", float_format="%.9g")
+    if (cfg.get("tug") or {}).get("n_subjects"):
+        write_csv(tug_scene_table(cfg["tug"]), out / "truth" / "tug_scene.csv",
+                  float_format="%.9g")
     if realism:
         write_csv(summarise_realism(realism), out / "realism.csv", float_format="%.6g")
     # the physical checks of the twin (gaitval.simulate.physics): data/<study>/physics.csv;

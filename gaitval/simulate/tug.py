@@ -25,8 +25,12 @@ from gaitval.simulate.trialsim import POLE_RADIUS_M, TrialSim, _walls
 #: the course axis: "walks three meters, turns around a marker, walks back to the chair and
 #: sits down" (seed 000 §1; Podsiadlo & Richardson 1991: a line 3 m away).
 TUG_MARKER_XY = (3.0, 0.0)
-#: The marker cone's radius at shin height (m) and the clearance (m) its surface keeps from
-#: a shank's surface when the inner foot swings past it.
+#: The marker's footprint the walker goes around (m: a cone's radius at shin height, as a
+#: 45 cm traffic cone) and the clearance (m) its surface keeps from a shank's surface when
+#: the inner foot swings past it.  The path uses this radius; what the *laser* sees of the
+#: marker in its scan plane is the preset's ``tug.marker_scan_radius_m`` (default: this
+#: radius), a separate setting because seed 000 gives no marker at all beyond "turns
+#: around a marker" (docs/simulator.md, "The turn marker in the scan plane").
 MARKER_RADIUS_M = 0.06
 MARKER_CLEARANCE_M = 0.05
 #: The chair's four legs (field frame, m; the front edge at x = 0) and their radius at
@@ -137,11 +141,19 @@ def turn_phase_bounds(walker: Walker, t_end: float, rate_hz: float, height_m: fl
     return float(b["t_turn_start_s"]), float(b["t_turn_end_s"])
 
 
-def scene_circles() -> np.ndarray:
+def scene_circles(marker_scan_radius_m: float = MARKER_RADIUS_M) -> np.ndarray:
     """The TUG scene's static circles at shin height, ``(k, 4)``: ``x, y, radius, id``
-    (field frame): the chair's legs, the turn marker and the calibration poles."""
+    (field frame): the chair's legs, the turn marker and the calibration poles.
+
+    ``marker_scan_radius_m`` is the marker's section in the scan plane (m); 0 leaves the
+    marker out of the laser's scene (a marker lower than the scan plane, such as a line
+    or a spot on the floor).
+    """
+    if not marker_scan_radius_m >= 0:
+        raise ValueError(f"marker_scan_radius_m must be >= 0, got {marker_scan_radius_m!r}")
     circles = [(x, y, CHAIR_LEG_RADIUS_M, ID_CHAIR) for x, y in CHAIR_LEGS_XY]
-    circles.append((*TUG_MARKER_XY, MARKER_RADIUS_M, ID_MARKER))
+    if marker_scan_radius_m > 0:
+        circles.append((*TUG_MARKER_XY, float(marker_scan_radius_m), ID_MARKER))
     circles += [(x, y, POLE_RADIUS_M, ID_POLE) for x, y in TUG_POLES_XY]
     return np.array(circles, dtype=float)
 
@@ -209,7 +221,9 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     return TrialSim(study=study, protocol="tug", subject=subj["subject"], trial=trial,
                     walker=walker, sensor="utm30lx", sensor_height_m=cfg["sensor_height_m"],
                     mocap_rate_hz=cfg["mocap_rate_hz"], t_end_s=t_end,
-                    circles=scene_circles(), walls=_walls(-2.0, 5.5, -2.5, 2.5),
+                    circles=scene_circles(float(cfg.get("marker_scan_radius_m",
+                                                        MARKER_RADIUS_M))),
+                    walls=_walls(-2.0, 5.5, -2.5, 2.5),
                     poles=poles, fixed_pose=sensor_pose, phase_fn=phase, repetition=rep,
                     speed="fast", variant={"t_phase": (t_turn0, t_turn1),
                                            "t_tug": (t_rise, t_seated)})
