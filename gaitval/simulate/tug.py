@@ -21,7 +21,7 @@ from gaitval.simulate.kinematics import make_path, plan_steps
 from gaitval.simulate.scene import ID_CHAIR, ID_MARKER, ID_POLE, Walker
 from gaitval.simulate.trialsim import POLE_RADIUS_M, TrialSim, _walls
 
-#: The turn marker (a cone, 0.06 m radius at shin height) 3 m from the chair's front edge on
+#: The turn marker 3 m from the chair's front edge on
 #: the course axis: "walks three meters, turns around a marker, walks back to the chair and
 #: sits down" (seed 000 §1; Podsiadlo & Richardson 1991: a line 3 m away).
 TUG_MARKER_XY = (3.0, 0.0)
@@ -30,7 +30,7 @@ TUG_MARKER_XY = (3.0, 0.0)
 #: the inner foot swings past it.  The path uses this radius; what the *laser* sees of the
 #: marker in its scan plane is the preset's ``tug.marker_scan_radius_m`` (default: this
 #: radius), a separate setting because seed 000 gives no marker at all beyond "turns
-#: around a marker" (docs/simulator.md, "The turn marker in the scan plane").
+#: around a marker" (docs/simulator.md, "The TUG scene calibrated").
 MARKER_RADIUS_M = 0.06
 MARKER_CLEARANCE_M = 0.05
 #: The chair's four legs (field frame, m; the front edge at x = 0) and their radius at
