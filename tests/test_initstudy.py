@@ -175,12 +175,23 @@ def test_a_tiny_study_without_poles_runs_end_to_end_on_a_measured_pose(tiny, tmp
     # the pose's millimetres; the counts of Table 3 and the MTST tables are identical
     for name in ("tug_table3.csv", "mtst_table1.csv", "mtst_table3.csv", "mtst_table4.csv"):
         assert got[name] == want[name], name
+    # Tables 4-5 count leg-steps inside the ground truth's span, and the clock offset is
+    # estimated from the legs projected with the pose (here 73 us apart on tug_Y01_t2):
+    # a scan at either end of a trial's span may come or go: at most one per leg and end
+    # of each TUG trial (Table 5 sums the phases: the same bound)
+    n_tug = len(asked) - 1
     for name in ("tug_table4.csv", "tug_table5.csv"):
         a = pd.read_csv(io.StringIO(got[name]))
         b = pd.read_csv(io.StringIO(want[name]))
         assert a.shape == b.shape and len(a) > 0
-        counts = [c for c in a.columns if c.startswith("n_")]
-        pd.testing.assert_frame_equal(a[counts], b[counts])
+        counts = [c for c in a.columns if (c.startswith("n_") or c == "time_steps")
+                  and c != "n_success_trials" and not c.endswith("_published")]
+        assert counts, name
+        assert (a[counts] - b[counts]).abs().to_numpy().max() <= 2 * 2 * n_tug, name
+        pub = [c for c in a.columns if c.endswith("_published")]
+        pd.testing.assert_frame_equal(a[pub], b[pub])
+        if "n_success_trials" in a:
+            assert a["n_success_trials"].equals(b["n_success_trials"]), name
 
 
 # -- small folders --------------------------------------------------------------------------
