@@ -71,33 +71,38 @@ def _line(label, v):
             f"{s['forward']:.3f} / {s['turning']:.3f} / {s['return']:.3f} |")
 
 
+def _choose(title, label, fmt, grid, sweep, phase, target):
+    """Print one sweep as a table and return the grid value whose ``phase`` occlusion is
+    closest to the target; a tie goes to the larger value (the smaller lateral offset, the
+    larger marker radius)."""
+    print(title)
+    print(f"| {label} | forward | turning | return | phase durations (s/trial) |\n"
+          "|---|---|---|---|---|")
+    for g, v in zip(grid, sweep):
+        print(_line(fmt.format(g), v))
+    err = [abs(v.loc[phase, "occlusion"] - target[phase]) for v in sweep]
+    return grid[min(range(len(err)), key=lambda i: (err[i], -grid[i]))]
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--preset", default="default")
     ap.add_argument("--workers", type=int, default=2)
     a = ap.parse_args(argv)
     target = {ph: k / m for ph, (k, m) in TUG_OCCLUSION.items()}
-    head = ("| {} | forward | turning | return | phase durations (s/trial) |\n"
-            "|---|---|---|---|---|")
     t0 = time.perf_counter()
     with cf.ProcessPoolExecutor(a.workers) as ex:
         sweep1 = list(ex.map(_run, [(a.preset, pose_for(y), None) for y in LATERAL_GRID_M]))
-        print(f"1. sensor placement, target forward {target['forward']:.2%}")
-        print(head.format("lateral offset y (m)"))
-        for y, v in zip(LATERAL_GRID_M, sweep1):
-            print(_line(f"{y:+.1f}", v))
-        err = [abs(v.loc["forward", "occlusion"] - target["forward"]) for v in sweep1]
-        y_best = LATERAL_GRID_M[min(range(len(err)), key=lambda i: (err[i], -LATERAL_GRID_M[i]))]
+        y_best = _choose(f"1. sensor placement, target forward {target['forward']:.2%}",
+                         "lateral offset y (m)", "{:+.1f}", LATERAL_GRID_M, sweep1,
+                         "forward", target)
         pose = pose_for(y_best)
         print(f"chosen: y = {y_best:+.1f} m, pose ({pose[0]:.2f}, {pose[1]:.2f}, "
               f"{pose[2]:.4f} rad)\n")
         sweep2 = list(ex.map(_run, [(a.preset, pose, r) for r in MARKER_GRID_M]))
-    print(f"2. marker section in the scan plane, target turning {target['turning']:.2%}")
-    print(head.format("radius (m)"))
-    for r, v in zip(MARKER_GRID_M, sweep2):
-        print(_line(f"{r:.2f}", v))
-    err = [abs(v.loc["turning", "occlusion"] - target["turning"]) for v in sweep2]
-    r_best = MARKER_GRID_M[min(range(len(err)), key=lambda i: (err[i], -MARKER_GRID_M[i]))]
+    r_best = _choose(f"2. marker section in the scan plane, target turning "
+                     f"{target['turning']:.2%}", "radius (m)", "{:.2f}", MARKER_GRID_M, sweep2,
+                     "turning", target)
     print(f"chosen: marker_scan_radius_m = {r_best:.2f}")
     print(f"({len(sweep1) + len(sweep2)} variants in {time.perf_counter() - t0:.0f} s)")
     return 0
