@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from gaitval.report.datakind import paper_data, run_data
+from gaitval.report.datakind import headline, paper_data, run_data
 from gaitval.report.index import build_index, display_table
 from gaitval.report.verdicts import build_verdicts, summary_lines, wilson
 from gaitval.tables import write_table
@@ -234,3 +234,30 @@ def test_a_method_run_with_overrides_keeps_its_table4_verdict_and_says_so():
     r = [x for x in rows if x["source"] == "Table 4"]
     assert len(r) == 1 and r[0]["outcome"] == "reproduced"
     assert r[0]["why"].startswith("tug_m3 (occlusion.max_n = 10) ran with tracking.overrides")
+
+
+def test_the_top_says_how_the_twin_fares_on_its_physical_checks(tmp_path):
+    """A simulated study's report says, before any verdict, how many of the twin's
+    physical checks (``physics.csv`` beside its trial sheet) pass, how many have no
+    reference, and names each one that fails; a study without the file says nothing."""
+    rd = tmp_path / "reports" / "tiny"
+    _provenance_config(rd, tmp_path / "data", sheet_rows=[
+        ("tiny", "tug", "Y01", "tug_Y01_t1"), ("tiny", "tug", "Y01", "tug_Y01_t2")])
+    assert run_data(rd, ["tiny"])[0].checks is None
+    assert not any("physical checks" in ln for ln in headline(run_data(rd, ["tiny"])))
+    pd.DataFrame({"check": ["tug_occlusion", "tug_occlusion", "cadence", "tug_turn_radius"],
+                  "protocol": ["tug", "tug", "tug", "tug"],
+                  "phase": ["forward", "turning", None, None],
+                  "passed": [True, False, True, None]}).to_csv(
+        tmp_path / "data" / "tiny" / "physics.csv", index=False)
+    c = run_data(rd, ["tiny"])[0].checks
+    assert (c["n"], c["passed"], c["unchecked"]) == (4, 2, 1)
+    assert c["failed"] == ["tug_occlusion (tug, turning)"]
+    write_table(_tug_t3(), rd / "tables" / "tug_table3", caption="Success")
+    md, html = build_index(rd, study_names=["tiny"])
+    h = html.read_text()
+    top = h[:h.index('id="verdicts"')]
+    assert "passes 2 of its 4 physical checks" in top
+    assert "1 has no reference and is shown only" in top
+    assert "1 fail</strong>: tug_occlusion (tug, turning)" in top
+    assert "passes 2 of its 4 physical checks" in md.read_text()

@@ -48,6 +48,25 @@ class StudyData:
     kind: str                          # simulated | replay | real | unknown
     label: str                         # "simulated replica (default, seed 20150904)"
     sizes: dict[str, tuple[int, int]] = field(default_factory=dict)   # protocol -> (subj, trials)
+    #: the twin's physical checks (``physics.csv`` beside a simulated study's trial
+    #: sheet): ``path``, ``n``, ``passed``, ``unchecked`` and the ``failed`` rows' names
+    checks: dict | None = None
+
+
+def physics_checks(path: Path) -> dict | None:
+    """Summary of a simulated study's ``physics.csv`` (gaitval.simulate.physics: the twin's
+    physical checks against real gait and the papers' observation statistics), or None
+    when the study has none.  A row without a pass/fail (no reference) is *unchecked*."""
+    try:
+        df = pd.read_csv(path, usecols=["check", "protocol", "phase", "passed"])
+    except (OSError, ValueError):
+        return None
+    ok = df["passed"].astype(str).str.lower()
+    failed = df[ok == "false"]
+    names = [f"{r.check} ({r.protocol}" + (f", {r.phase})" if isinstance(r.phase, str)
+                                             else ")") for r in failed.itertuples()]
+    return {"path": str(path), "n": len(df), "passed": int((ok == "true").sum()),
+            "unchecked": int((~ok.isin(["true", "false"])).sum()), "failed": names}
 
 
 def _load_yaml(path: Path) -> dict:
@@ -78,11 +97,12 @@ def study_data(name: str, config: dict, base: Path = Path(".")) -> StudyData:
                        .get("seed", "?"))
         pcfg = _load_yaml(REPO / "config" / "studies" / f"{preset}.yaml")
         sheet = base / config.get("data_dir", "data") / name / "trials.csv"
+        checks = physics_checks(sheet.parent / "physics.csv")
         if pcfg.get("replay"):
             return StudyData(name, "replay", f"replay of real mocap ({preset}, seed {seed})",
-                             _sizes(sheet))
+                             _sizes(sheet), checks)
         return StudyData(name, "simulated", f"simulated replica ({preset}, seed {seed})",
-                         _sizes(sheet))
+                         _sizes(sheet), checks)
     if entry.get("trial_sheet"):
         sheet = Path(entry["trial_sheet"])
         return StudyData(name, "real", f"real recordings ({name})",
@@ -137,6 +157,22 @@ def headline(studies: list[StudyData]) -> list[str]:
             out.append(f"**{s.name}** has fewer subjects than the paper for "
                        f"{', '.join(small)}: a comparison it is too small for is reported "
                        "as _not comparable (too small)_, and the others rest on few walks.")
+    for s in studies:
+        c = s.checks
+        if not c:
+            continue
+        line = (f"**{s.name}**'s twin passes {c['passed']} of its {c['n']} physical checks "
+                f"(`{c['path']}`: gait and contact physics against real walks, the papers' "
+                f"occlusion rates, phase durations and step counts; docs/simulator.md, "
+                f"\"Physical checks\")")
+        if c["unchecked"]:
+            n = c["unchecked"]
+            line += (f"; {n} {'has' if n == 1 else 'have'} no reference and "
+                     f"{'is' if n == 1 else 'are'} shown only")
+        if c["failed"]:
+            line += (f"; **{len(c['failed'])} fail**: {', '.join(c['failed'])}, which the "
+                     "verdicts on those protocols inherit")
+        out.append(line + ".")
     kinds = dict.fromkeys(s.kind for s in studies)
     out += [MEANING[k] for k in kinds if k in MEANING]
     if any(k == "unknown" for k in kinds):
