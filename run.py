@@ -182,7 +182,7 @@ def ensure_pdflatex_on_ci() -> None:
 
 #: The twin's free choices varied by ``run.py sensitivity`` (docs/simulator.md, "Free
 #: choices of the twin"): one study per alternative, defined in config/config.yaml.
-SENSITIVITY_STUDIES = ("mtst_sensor_beside", "mtst_attendant_left")
+SENSITIVITY_STUDIES = ("mtst_sensor_beside", "mtst_attendant_left", "tug_sit_turn_right")
 
 
 def sensitivity(rest: list[str], env: dict) -> int:

@@ -517,6 +517,51 @@ def test_sensitivity_presets_change_one_choice(preset, key, value):
     assert np.allclose(p["mtst"][key], value) if key != "attendant" else p["mtst"][key] == value
 
 
+def test_tug_sensitivity_preset_changes_the_turn_to_sit_only():
+    """The TUG sensitivity preset is the default study with the turn to sit to the right:
+    same seed, MTST and rollator sections, one TUG key changed."""
+    d, p = load_preset("default"), load_preset("tug_sit_turn_right")
+    assert p["seed"] == d["seed"] and p["mtst"] == d["mtst"] and p["rollator"] == d["rollator"]
+    assert "ultrasonic" not in p
+    changed = {k for k in set(d["tug"]) | set(p["tug"]) if d["tug"].get(k) != p["tug"].get(k)}
+    assert changed == {"turn_to_sit"} and p["tug"]["turn_to_sit"] == "right"
+
+
+def test_turn_to_sit_direction_turns_the_pivot_steps_the_other_way():
+    """``tug.turn_to_sit`` sets which way the pivot steps turn: the same trial up to the
+    last return contact, then the body's heading runs from about π down to 0 (right,
+    clockwise) instead of up to 2π (left); both end seated at the chair facing +x, feet
+    at hip width, without a cross step; an unknown way is a ConfigError."""
+    from gaitval.simulate import study as S
+    from gaitval.simulate.tug import SEAT_X_M, SEATED_HALF_WIDTH_M
+
+    cfg = load_preset("tiny")
+    seed = int(cfg["seed"])
+    idx, _, build, bargs, _, _ = [t for t in S._lrs_tasks(cfg, "tiny", seed, [])
+                                  if t[1] == "tug"][0]
+    sims = {}
+    for way in ("left", "right"):
+        args = list(bargs)
+        args[6] = {**bargs[6], "turn_to_sit": way}
+        sims[way] = build(S._rng(seed, 3, idx), *args).walker.plan
+    left, right = sims["left"], sims["right"]
+    piv = np.flatnonzero(np.asarray(left.label) == "turn_to_sit")
+    assert len(piv) >= 3 and np.array_equal(np.asarray(right.label), np.asarray(left.label))
+    assert not left.cross[piv].any() and not right.cross[piv].any()
+    k0 = piv[0]
+    assert np.array_equal(left.xy[:k0], right.xy[:k0])
+    assert np.all(np.diff(left.heading[k0 - 1:]) >= 0) and left.heading[-1] == pytest.approx(2 * np.pi)
+    assert np.all(np.diff(right.heading[k0 - 1:]) <= 0) and right.heading[-1] == pytest.approx(0.0)
+    for plan in (left, right):
+        end = plan.xy[-2:]
+        assert np.allclose(end[:, 0], SEAT_X_M, atol=0.05)
+        assert abs(abs(end[0, 1] - end[1, 1]) - 2 * SEATED_HALF_WIDTH_M) < 0.05
+    args = list(bargs)
+    args[6] = {**bargs[6], "turn_to_sit": "backwards"}
+    with pytest.raises(ConfigError, match="turn_to_sit"):
+        build(S._rng(seed, 3, idx), *args)
+
+
 def test_attendant_side_moves_the_attendant_only():
     """The attendant's side is read from the preset: mirrored across the mat, the
     participant's own plan unchanged; an unknown side is a ConfigError."""

@@ -46,6 +46,11 @@ SEAT_X_M = 0.12
 #: Half the distance between the feet when seated, at the start and again at the end (m):
 #: seated people keep the feet about hip width apart.
 SEATED_HALF_WIDTH_M = 0.10
+#: Which way the participant turns to sit, seen from above: ``"left"`` (counter-clockwise,
+#: the way the twin's walkers turn at the marker) or ``"right"``; no source says which,
+#: so it is a free choice of the twin, the preset's ``tug.turn_to_sit`` (docs/simulator.md,
+#: "Free choices of the twin"; the sensitivity preset ``tug_sit_turn_right``).
+TURN_TO_SIT_DIRECTIONS = {"left": 2 * np.pi, "right": 0.0}     # heading when seated
 #: Pivot steps of the turn to sit (180° in equal parts), the closing step not counted:
 #: 60° per step, a turn without crossing the legs (docs/simulator.md, issue 34).
 TURN_TO_SIT_STEPS = 3
@@ -158,6 +163,18 @@ def scene_circles(marker_scan_radius_m: float = MARKER_RADIUS_M) -> np.ndarray:
     return np.array(circles, dtype=float)
 
 
+def _seated_heading(cfg: dict) -> float:
+    """The heading (rad) the turn to sit ends at, from the preset's ``tug.turn_to_sit``
+    (:data:`TURN_TO_SIT_DIRECTIONS`; the walker returns heading about π)."""
+    from gaitval.errors import ConfigError
+
+    way = cfg.get("turn_to_sit", "left")
+    if way not in TURN_TO_SIT_DIRECTIONS:
+        raise ConfigError(f"tug.turn_to_sit must be one of {sorted(TURN_TO_SIT_DIRECTIONS)}, "
+                          f"got {way!r}", hint="the simulation preset's tug section")
+    return TURN_TO_SIT_DIRECTIONS[way]
+
+
 def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     """Timed Up and Go: rise, walk 3 m, turn around a marker, walk back, turn, sit.
 
@@ -177,7 +194,7 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     gp = replace(gp, turn_time_factor=TURN_TIME_FACTOR)
     path = tug_path(turn_radius(gp, subj["leg_width_m"]))
     plan = plan_steps(path, gp, rng, t0=t0, first_side=int(rng.integers(0, 2)),
-                      end_pose=(SEAT_X_M, 0.0, 2 * np.pi, TURN_TO_SIT_STEPS),
+                      end_pose=(SEAT_X_M, 0.0, _seated_heading(cfg), TURN_TO_SIT_STEPS),
                       start_half_width=SEATED_HALF_WIDTH_M, end_label="turn_to_sit",
                       end_half_width=SEATED_HALF_WIDTH_M)
     # the descent begins as the last pivot step lands: the trailing foot joins while the
