@@ -12,7 +12,8 @@ unstated choice is reported as such, not as a finding about the methods.
 Usage::
 
     python -m gaitval.tables.sensitivity reports/default reports/mtst_sensor_beside \\
-        reports/mtst_attendant_left --out reports/default/tables/sensitivity
+        reports/mtst_attendant_left reports/tug_sit_turn_right \\
+        --out reports/default/tables/sensitivity
 
 (the first report is the reference; ``--out`` is a stem: ``.csv``, ``.md``, ``.tex``).
 """
