@@ -232,9 +232,9 @@ def tug_scene_table(tug_cfg: dict) -> pd.DataFrame:
     ``object`` (:data:`gaitval.simulate.scene.ID_NAMES`).  The turn marker is there only
     when the preset's ``tug.marker_scan_radius_m`` puts it in the scan plane."""
     from gaitval.simulate.scene import ID_NAMES
-    from gaitval.simulate.tug import MARKER_RADIUS_M, scene_circles
+    from gaitval.simulate.tug import marker_scan_radius, scene_circles
 
-    c = scene_circles(float(tug_cfg.get("marker_scan_radius_m", MARKER_RADIUS_M)))
+    c = scene_circles(marker_scan_radius(tug_cfg))
     return pd.DataFrame({"x_m": c[:, 0], "y_m": c[:, 1], "radius_m": c[:, 2],
                          "object_id": c[:, 3].astype(int),
                          "object": [ID_NAMES[int(k)] for k in c[:, 3]]})

@@ -163,6 +163,12 @@ def scene_circles(marker_scan_radius_m: float = MARKER_RADIUS_M) -> np.ndarray:
     return np.array(circles, dtype=float)
 
 
+def marker_scan_radius(cfg: dict) -> float:
+    """The turn marker's section in the scan plane (m) of a preset's ``tug`` section
+    (``marker_scan_radius_m``; default :data:`MARKER_RADIUS_M`)."""
+    return float(cfg.get("marker_scan_radius_m", MARKER_RADIUS_M))
+
+
 def _seated_heading(cfg: dict) -> float:
     """The heading (rad) the turn to sit ends at, from the preset's ``tug.turn_to_sit``
     (:data:`TURN_TO_SIT_DIRECTIONS`; the walker returns heading about π)."""
@@ -238,8 +244,7 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     return TrialSim(study=study, protocol="tug", subject=subj["subject"], trial=trial,
                     walker=walker, sensor="utm30lx", sensor_height_m=cfg["sensor_height_m"],
                     mocap_rate_hz=cfg["mocap_rate_hz"], t_end_s=t_end,
-                    circles=scene_circles(float(cfg.get("marker_scan_radius_m",
-                                                        MARKER_RADIUS_M))),
+                    circles=scene_circles(marker_scan_radius(cfg)),
                     walls=_walls(-2.0, 5.5, -2.5, 2.5),
                     poles=poles, fixed_pose=sensor_pose, phase_fn=phase, repetition=rep,
                     speed="fast", variant={"t_phase": (t_turn0, t_turn1),

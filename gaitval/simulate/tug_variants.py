@@ -41,9 +41,10 @@ def tug_occlusion_variant(preset: str | dict = "default", marker_in_scan_plane: 
 
     from gaitval.simulate import render as RD
     from gaitval.simulate import study as S
-    from gaitval.simulate.scene import ID_MARKER
 
     cfg = S.load_preset(preset)
+    if not marker_in_scan_plane:                  # a marker below the plane: radius 0
+        marker_scan_radius_m = 0.0
     if marker_scan_radius_m is not None:
         cfg["tug"]["marker_scan_radius_m"] = float(marker_scan_radius_m)
     if sensor_nominal_pose is not None:
@@ -61,8 +62,6 @@ def tug_occlusion_variant(preset: str | dict = "default", marker_in_scan_plane: 
         sim = build(rng_t, *bargs)
         sim.variant.update(S._variant(rng_t, cfg))
         clock = {**S.sensor_clock(rng_t, cfg.get("clock", {})), "clock_drift_ppm": drift}
-        if not marker_in_scan_plane:
-            sim.circles = sim.circles[sim.circles[:, 3] != ID_MARKER]
         _, scans, _, _ = RD.render_laser(sim, clock, S._rng(seed, 11, idx))
         t_end = float(RD.mocap_frames(sim)[-1])
         s = scans[(scans["t_mocap_s"] >= 0) & (scans["t_mocap_s"] <= t_end)]
