@@ -101,7 +101,7 @@ def positive_bag(path: Path, recipe=RECIPE):
         if not len(cen):
             continue
         r = ranges[k]
-        labels = cluster_scan(np.where(np.isfinite(r), r, np.nan), float(m.angle_min),
+        labels, _ = cluster_scan(np.where(np.isfinite(r), r, np.nan), float(m.angle_min),
                               float(m.angle_increment), float(m.range_min),
                               float(m.range_max), float(recipe["cluster_dist_euclid"]),
                               int(recipe["min_points_per_cluster"]))
@@ -164,7 +164,7 @@ def main() -> None:
 
     # 2-3. negative_2 per laser, with the forest that did not see that laser
     from gaitval.io.rosbag import read_rosbag_scans
-    from gaitval.track.kinds import build_method
+    from gaitval.methods import build_method
     a.out.mkdir(parents=True, exist_ok=True)
     forests = {}
     for topic in NEGATIVE_TOPICS:
