@@ -475,6 +475,10 @@ METHODS["people"] = {
                             "iterations": 20, "beam_step": 2, "min_pairs": 20},
              "static_map": {"name": "recent_hits", "cell_m": 0.1, "min_static_s": 1.4,
                             "tau_s": 5.0, "neighbourhood": 1},
+             # a person who walks in and stands is not confirmed by arrival in free space:
+             # `free_space` confirms furniture from a moving robot (docs/people.md,
+             # benchmarks/people_arrival.py); written out, not left to the default
+             "arrival": {"name": "none"},
              "init": None, "max_leg_separation_m": 0.8, "person_points_m": 0.13, "dt_s": None,
              "sides": "walking_direction"},
 }

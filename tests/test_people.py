@@ -517,3 +517,44 @@ def test_scan_matching_on_a_standing_laser_finds_motion_that_is_not_there(tiny_s
     assert drift > 0.01                                       # metres of a laser that stood
     still, segment = EGO_MOTIONS.build("none").poses(scans)
     assert not still.any() and not segment.any()
+
+
+def _arrival_scene(n=60, k_in=20):
+    """A standing laser, a wall at 4 m, two posts 0.3 m apart at (2, −1) from the first
+    scan, and a person whose legs appear at (1.5, 0.6) on scan ``k_in`` (stepped in from
+    out of view) and who then stands."""
+    posts = [(2.0, -1.0), (2.0, -0.7)]
+    person = [(1.5, 0.5), (1.5, 0.7)]
+    legs = [posts + (person if k >= k_in else []) for k in range(n)]
+    xy, pats = _observations(legs, np.random.default_rng(3), sd=0.005)
+    scans = _scans(n)
+    scans = ScanSeries(t=scans.t, ranges=np.stack([_ranges_with(p) for p in legs]),
+                       angle_min=scans.angle_min, angle_increment=scans.angle_increment,
+                       range_min=scans.range_min, range_max=scans.range_max)
+    return scans, xy, pats
+
+
+def test_arrival_in_free_space_confirms_a_person_who_walks_in_and_stands():
+    """``arrival: free_space`` (not the people default, docs/people.md *A person who walks
+    in and stands*): the place where the person now stands was seen through on the scans
+    before, the posts' places never were.  The walking confirmer alone confirms nobody
+    (the person stands); with arrival the person, and only the person, is confirmed
+    within 0.7 s of stepping in plus a scan, and the posts never are."""
+    from gaitval.track.staticmap import ARRIVALS
+
+    assert {"none", "free_space"} <= set(ARRIVALS.names())
+    scans, xy, pats = _arrival_scene()
+    still = _tracker(ego_motion="none").run(scans, xy, pats, 0.10)
+    assert still.n_confirmed == 0
+    res = _tracker(ego_motion="none", arrival={"name": "free_space"}).run(scans, xy, pats, 0.10)
+    assert res.n_confirmed == 1
+    p = res.people
+    assert 20 + 6 <= p["k"].min() <= 20 + 8
+    assert np.allclose(p[["x_m"]].mean(), 1.5, atol=0.05)
+    assert (p["y_m"] > 0.3).all()                              # never the posts
+    assert p["k"].max() == len(scans.t) - 1                    # kept while standing
+    # the posts alone, from the first scan: nobody
+    posts_only = [o[:2] for o in xy]
+    none = _tracker(ego_motion="none", arrival={"name": "free_space"}).run(
+        scans, posts_only, [q[:2] for q in pats], 0.10)
+    assert none.n_confirmed == 0

@@ -63,7 +63,8 @@ from gaitval.track.lifecycle import (AREAS, BIRTHS, COASTING, CONFIRMED, CONFIRM
 from gaitval.track.motion import MOTION_MODELS
 from gaitval.track.observations import DetectionSeries
 from gaitval.track.phase import PHASE_MODELS
-from gaitval.track.staticmap import EGO_MOTIONS, STATIC_MAPS, scan_points, to_world
+from gaitval.track.staticmap import (ARRIVALS, EGO_MOTIONS, STATIC_MAPS, scan_points,
+                                     to_world)
 from gaitval.track.tracker import _SWING, step_durations
 
 #: columns of :attr:`PeopleResult.people` (one row per scan, reported person and leg)
@@ -93,7 +94,7 @@ class Person:
 
     __slots__ = ("pid", "status", "post", "prior", "seen", "pattern", "obs_j", "phase",
                  "windows", "t_last_seen", "confirm_memory", "n_unobs", "k_born", "n_obs",
-                 "world_centre", "seen_centre", "z", "zp", "look")
+                 "world_centre", "seen_centre", "z", "zp", "look", "n_both")
 
     def __init__(self, pid, filter, zl, zr, pl, pr, jl, jr, k, t, windows, memory,
                  status=TENTATIVE, scores=(1.0, 1.0), look=None):
@@ -117,6 +118,7 @@ class Person:
         self.z = [(float(zl[0]), float(zl[1])), (float(zr[0]), float(zr[1]))]  # observations
         self.zp = [float(scores[0]), float(scores[1])]  # their appearance scores (None: unseen)
         self.look = look                       # the appearance role's memory
+        self.n_both = 1                        # scans with both legs observed since birth
 
     def pos(self, f: int) -> tuple[float, float]:
         s = self.post[f]
@@ -174,7 +176,7 @@ class PeopleTracker(TrackerKind):
                  confirmer="m_of_n_moving", deleter="unsupported_time",
                  area="field_of_view", ego_motion="none", static_map="none",
                  init=None, tentative_gate=None, refind="leg_tracker_gate",
-                 appearance="none",
+                 appearance="none", arrival="none",
                  max_leg_separation_m: float = 0.8, person_points_m: float = 0.13,
                  dt_s: float | None = None, sides: str = "walking_direction"):
         self.detector = DETECTORS.build(detector)
@@ -191,6 +193,7 @@ class PeopleTracker(TrackerKind):
         self.appearance = APPEARANCES.build(appearance)
         self.ego_motion = EGO_MOTIONS.build(ego_motion)
         self.static_map = STATIC_MAPS.build(static_map)
+        self.arrival = ARRIVALS.build(arrival)
         self.init = INITIALISERS.build(init) if init else None
         self.max_leg_separation_m = max_leg_separation_m
         self.person_points_m = person_points_m
@@ -234,7 +237,7 @@ class PeopleTracker(TrackerKind):
         poses, segment = self.ego_motion.poses(scans)
         look = self.appearance
         score = look.scores(scans, xy)          # per scan, P(leg) of each observation
-        smap, seg = None, None
+        smap, arrived, seg = None, None, None
         seeded = None
         if self.init is not None:
             seeded = self.init.find(DetectionSeries(xy, pats), leg_width_m)
@@ -257,6 +260,7 @@ class PeopleTracker(TrackerKind):
             if segment[k] != seg:          # the sensor's motion was lost: a new map
                 seg = int(segment[k])
                 smap = self.static_map.start(scans, poses)
+                arrived = self.arrival.start(scans, poses)
                 confirmer.scan(k, None)
             else:
                 confirmer.scan(k, _relative(poses[k - 1], pose))
@@ -336,6 +340,7 @@ class PeopleTracker(TrackerKind):
                         p.obs_j[f] = j
                         p.n_unobs[f] = 0
                         p.n_obs[f] += 1
+                p.n_both += p.seen[0] and p.seen[1]
                 look.update(p)
                 if p.seen[0] or p.seen[1]:
                     p.t_last_seen = tk
@@ -357,6 +362,7 @@ class PeopleTracker(TrackerKind):
                 d2 = ((pts[:, None, :] - lx[None, :, :]) ** 2).sum(axis=2).min(axis=1)
                 pts = pts[d2 > self.person_points_m ** 2]
             smap.update(k, to_world(pose, pts))
+            arrived.update(k, pose)
             # life cycle
             for p in persons:
                 if p.status == TENTATIVE:
@@ -364,7 +370,10 @@ class PeopleTracker(TrackerKind):
                         p.status = ENDED
                         continue
                     p.world_centre = (seg, *to_world(pose, np.array([p.centre()]))[0].tolist())
-                    if confirmer.step(p, k) and not _on_static(p, pose, smap):
+                    walked = confirmer.step(p, k)
+                    if (walked or arrived.confirms(p, to_world(pose, np.array(p.z)).tolist()
+                                                   if p.seen[0] and p.seen[1] else None, tk)
+                            ) and not _on_static(p, pose, smap):
                         p.status = CONFIRMED
                         look.confirmed(p)
                         n_conf += 1
