@@ -92,15 +92,21 @@ class ScanMatching(EgoMotion):
         Every n-th beam is used (speed).
     min_pairs : int
         Fewer usable pairs: the step is unknown (module notes).
+    fallback_every_beam : bool
+        A step that fails on every ``beam_step``-th beam is tried once more with every beam
+        before the motion is called unknown (sparse scans, e.g. outdoors with most beams
+        returning nothing: benchmarks/scan_matching_fallback.py).  A step that succeeds on
+        the subsampled beams is unchanged.
     """
 
     def __init__(self, max_pair_m: float = 0.5, trim: float = 0.8, iterations: int = 20,
-                 beam_step: int = 2, min_pairs: int = 20):
+                 beam_step: int = 2, min_pairs: int = 20, fallback_every_beam: bool = True):
         self.max_pair_m = max_pair_m
         self.trim = trim
         self.iterations = iterations
         self.beam_step = beam_step
         self.min_pairs = min_pairs
+        self.fallback_every_beam = fallback_every_beam
 
     def step(self, prev: np.ndarray, cur: np.ndarray, guess):
         """(x, y, θ) of the current scan in the previous scan's frame; None: unknown."""
@@ -140,10 +146,13 @@ class ScanMatching(EgoMotion):
         out = np.zeros((n, 3))
         seg = np.zeros(n, dtype=np.int64)
         prev = scan_points(scans, 0, self.beam_step) if n else None
+        again = self.fallback_every_beam and self.beam_step > 1
         rel = (0.0, 0.0, 0.0)
         for k in range(1, n):
             cur = scan_points(scans, k, self.beam_step)
             step = self.step(prev, cur, rel)
+            if step is None and again:           # too few points: every beam, once more
+                step = self.step(scan_points(scans, k - 1), scan_points(scans, k), rel)
             prev = cur
             if step is None:                 # unknown motion: a new frame from here on
                 seg[k] = seg[k - 1] + 1
