@@ -56,8 +56,6 @@ angusleigh/leg_tracker (the positive bags and negative_2.bag).
 from __future__ import annotations
 
 import argparse
-import json
-import subprocess
 import sys
 import tempfile
 import time
@@ -71,6 +69,7 @@ sys.path.insert(0, str(ROOT))
 from gaitval.track.legforest import (NEGATIVE_TOPICS, POSITIVE_BAGS, RECIPE,  # noqa: E402
                                      _bag_messages, _clusters, load_forest,
                                      negative_features, train)
+from outdoor_score import score_outdoor  # noqa: E402
 
 STATIC_TOL_M = 0.05
 STATIC_SHARE = 0.80
@@ -211,20 +210,7 @@ def main() -> None:
                 over = {"kind__appearance": {"name": "leg_forest", "forest": forest}}
                 if confirmer == "leg_travel":
                     over["kind__confirmer"] = "leg_travel"
-                cfg = a.out / f"cfg_{variant}_{confirmer}.json".replace("+", "_")
-                cfg.write_text(json.dumps({"tracking": {"overrides": {"people": over}}}))
-                tr = a.out / f"track_{cfg.stem}.parquet"
-                ev = a.out / f"eval_{cfg.stem}"
-                gv = [sys.executable, "-m", "gaitval"]
-                subprocess.run(gv + ["legbench-track", "--sensor", str(bag), "--scan-topic",
-                                     "/scan_base2", "--method", "people", "--config", str(cfg),
-                                     "--out", str(tr)], check=True, capture_output=True)
-                out = subprocess.run(
-                    gv + ["legbench-evaluate", "--track", str(tr), "--annotations", str(bag),
-                          "--annotation-topic", "/ground_truth_people_tracks", "--scan-topic",
-                          "/scan_base2", "--benchmark-set", "following_outdoor", "--out",
-                          str(ev)], check=True, capture_output=True, text=True)
-                print(f"  {variant:10s} {confirmer:14s}", out.stdout.strip().splitlines()[-1])
+                print(f"  {variant:10s} {confirmer:14s}", score_outdoor(over, bag))
 
 
 if __name__ == "__main__":

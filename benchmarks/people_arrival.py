@@ -59,12 +59,11 @@ Leigh, A. et al. ICRA 2015 (leg_tracker's ``in_free_space``).
 from __future__ import annotations
 
 import argparse
-import json
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from outdoor_score import score_outdoor
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared" / "realdata" / "lrs"
@@ -95,24 +94,9 @@ def main() -> None:
         print(f"  {topic:12s} {scans.n_scans} scans   " + "  |  ".join(row))
 
     if a.outdoor:
-        bag = SHARED / "person_following_outdoor_1.bag"
         print("\nperson_following_outdoor_1, following mode (for the record; decides nothing):")
-        with tempfile.TemporaryDirectory() as d:
-            d = Path(d)
-            for name, over in (("people", {}), ("people + arrival", {"kind__arrival": ARRIVAL})):
-                cfg = d / "cfg.json"
-                cfg.write_text(json.dumps({"tracking": {"overrides": {"people": over}}}))
-                tr, ev = d / f"t{len(over)}.parquet", d / f"e{len(over)}"
-                gv = [sys.executable, "-m", "gaitval"]
-                subprocess.run(gv + ["legbench-track", "--sensor", str(bag), "--scan-topic",
-                                     "/scan_base2", "--method", "people", "--config", str(cfg),
-                                     "--out", str(tr)], check=True, capture_output=True)
-                out = subprocess.run(
-                    gv + ["legbench-evaluate", "--track", str(tr), "--annotations", str(bag),
-                          "--annotation-topic", "/ground_truth_people_tracks", "--scan-topic",
-                          "/scan_base2", "--benchmark-set", "following_outdoor", "--out",
-                          str(ev)], check=True, capture_output=True, text=True)
-                print(f"  {name:18s}", out.stdout.strip().splitlines()[-1])
+        for name, over in (("people", {}), ("people + arrival", {"kind__arrival": ARRIVAL})):
+            print(f"  {name:18s}", score_outdoor(over))
 
 
 if __name__ == "__main__":

@@ -36,11 +36,11 @@ it decides nothing.
 from __future__ import annotations
 
 import argparse
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from outdoor_score import score_outdoor
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared" / "realdata" / "lrs"
@@ -79,20 +79,8 @@ def main() -> None:
             print(f"    people: confirmed {r.n_confirmed}, re-found {r.n_refound}")
 
     if a.outdoor:
-        bag = SHARED / "person_following_outdoor_1.bag"
         print("\nperson_following_outdoor_1, following mode (for the record; decides nothing):")
-        with tempfile.TemporaryDirectory() as d:
-            d = Path(d)
-            gv = [sys.executable, "-m", "gaitval"]
-            subprocess.run(gv + ["legbench-track", "--sensor", str(bag), "--scan-topic",
-                                 "/scan_base2", "--method", "people", "--out",
-                                 str(d / "t.parquet")], check=True, capture_output=True)
-            out = subprocess.run(
-                gv + ["legbench-evaluate", "--track", str(d / "t.parquet"), "--annotations",
-                      str(bag), "--annotation-topic", "/ground_truth_people_tracks",
-                      "--scan-topic", "/scan_base2", "--benchmark-set", "following_outdoor",
-                      "--out", str(d / "e")], check=True, capture_output=True, text=True)
-            print("  people", out.stdout.strip().splitlines()[-1])
+        print("  people", score_outdoor())
 
 
 if __name__ == "__main__":
