@@ -74,17 +74,56 @@ BAGS = (("negative_2.bag", "/left_scan"), ("negative_2.bag", "/rear_scan"),
         ("person_following_outdoor_1.bag", "/scan_base2"))
 
 
+def step_speeds(scans, spec) -> str:
+    """Speed and turn rate each ICP step of ``spec`` (without bounds) implies, split into
+    steps found on the subsampled beams and steps found only by the every-beam retry."""
+    import math
+
+    import numpy as np
+
+    from gaitval.track.staticmap import EGO_MOTIONS, scan_points
+
+    icp = EGO_MOTIONS.build({**spec, "fallback_every_beam": False})
+    found = {"subsampled": [], "every beam": []}
+    prev, rel = scan_points(scans, 0, icp.beam_step), (0.0, 0.0, 0.0)
+    for k in range(1, scans.n_scans):
+        dt = float(scans.t[k] - scans.t[k - 1])
+        cur = scan_points(scans, k, icp.beam_step)
+        st, how = icp.step(prev, cur, rel), "subsampled"
+        if st is None:
+            st, how = icp.step(scan_points(scans, k - 1), scan_points(scans, k), rel), "every beam"
+        if st is not None and dt > 0:
+            found[how].append((math.hypot(st[0], st[1]) / dt, abs(st[2]) / dt))
+        rel, prev = (st if st is not None else (0.0, 0.0, 0.0)), cur
+    out = []
+    for how, v in found.items():
+        if not v:
+            out.append(f"{how}: no step")
+            continue
+        v = np.array(v)
+        out.append(f"{how}: {len(v)} steps, speed median {np.median(v[:, 0]):.2f} m/s, "
+                   f"> 2 m/s {np.mean(v[:, 0] > 2):.0%}, turn > 1.5 rad/s "
+                   f"{np.mean(v[:, 1] > 1.5):.0%}")
+    return "; ".join(out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--outdoor", action="store_true",
                     help="also score person_following_outdoor_1 once (decides nothing)")
+    ap.add_argument("--steps", action="store_true",
+                    help="also print the speeds the ICP steps imply (v7's steps)")
     a = ap.parse_args()
     from gaitval.io.rosbag import describe_rosbag, read_rosbag_scans
     from gaitval.methods import METHODS, build_method
     from gaitval.track.staticmap import EGO_MOTIONS
 
     spec = dict(METHODS["people"]["kind"]["ego_motion"])
-    print("world frames (segments) per bag: every beam on failure | never (the old role)")
+    variants = (("v8", spec),
+                ("v7", {**spec, "max_speed_mps": None, "max_turn_rps": None}),
+                ("v6", {**spec, "max_speed_mps": None, "max_turn_rps": None,
+                        "fallback_every_beam": False}))
+    print("world frames (segments) per bag: " + " | ".join(v for v, _ in variants))
     for name, topic in BAGS:
         bag = SHARED / name
         if not bag.exists():
@@ -93,11 +132,13 @@ def main() -> None:
         topic = topic or next(iter(describe_rosbag(bag)["scans"]))
         scans = read_rosbag_scans(bag, topic)
         row = []
-        for fallback in (True, False):
+        for _, v in variants:
             t0 = time.perf_counter()
-            _, seg = EGO_MOTIONS.build({**spec, "fallback_every_beam": fallback}).poses(scans)
+            _, seg = EGO_MOTIONS.build(v).poses(scans)
             row.append(f"{int(seg.max()) + 1} ({time.perf_counter() - t0:.1f} s)")
         print(f"  {name} {topic}: {scans.n_scans} scans   " + " | ".join(row))
+        if a.steps:
+            print("    " + step_speeds(scans, variants[1][1]))
         if name == "negative_2.bag":
             r = build_method("people").track(scans, 0.10)
             print(f"    people: confirmed {r.n_confirmed}, re-found {r.n_refound}")

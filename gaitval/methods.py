@@ -472,7 +472,9 @@ METHODS["people"] = {
              # no odometry in the recordings: the sensor's motion from its scans, and a map
              # of what stays put (leg_tracker's local occupancy grid), both online
              "ego_motion": {"name": "scan_matching", "max_pair_m": 0.5, "trim": 0.8,
-                            "iterations": 20, "beam_step": 2, "min_pairs": 20},
+                            "iterations": 20, "beam_step": 2, "min_pairs": 20,
+                            "fallback_every_beam": True, "max_speed_mps": 2.0,
+                            "max_turn_rps": 1.5},
              "static_map": {"name": "recent_hits", "cell_m": 0.1, "min_static_s": 1.4,
                             "tau_s": 5.0, "neighbourhood": 1},
              # a person who walks in and stands is not confirmed by arrival in free space:

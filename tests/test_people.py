@@ -560,15 +560,9 @@ def test_arrival_in_free_space_confirms_a_person_who_walks_in_and_stands():
     assert none.n_confirmed == 0
 
 
-def test_scan_matching_uses_every_beam_before_it_calls_the_motion_unknown():
-    """A sparse scan (outdoors most beams return nothing): sixteen poles, 30–33 returns of
-    181 beams.  On every 2nd beam ICP has fewer than its 20 pairs, and the old role called
-    every step's motion unknown (a new world frame each scan).  It now retries the step
-    with every beam and follows the sensor's 3 cm per scan in one frame
-    (benchmarks/scan_matching_fallback.py: the outdoor bag's 4,227 frames become 598)."""
-    from gaitval.track.staticmap import EGO_MOTIONS
-
-    n, step_m, rad = 20, 0.03, 0.07
+def _pole_scans(n, step_m, rad=0.07):
+    """A sensor moving ``step_m`` per 0.1 s scan along x past sixteen poles (sparse: 30–33
+    returns of 181 beams, as outdoors where most beams return nothing)."""
     poles = [(2.0 + 0.3 * i, (-1) ** i * (0.3 + 0.2 * i)) for i in range(16)]
     ang = -math.pi / 2 + math.pi / 180 * np.arange(181)
     ranges = np.full((n, 181), np.nan)
@@ -583,10 +577,24 @@ def test_scan_matching_uses_every_beam_before_it_calls_the_motion_unknown():
                     r = b - math.sqrt(disc)
                     if not ranges[k, i] <= r:
                         ranges[k, i] = r
+    return ScanSeries(t=np.arange(n) * DT, ranges=ranges, angle_min=-math.pi / 2,
+                      angle_increment=math.pi / 180, range_min=0.02, range_max=8.0)
+
+
+def test_scan_matching_uses_every_beam_before_it_calls_the_motion_unknown():
+    """A sparse scan (outdoors most beams return nothing): sixteen poles, 30–33 returns of
+    181 beams.  On every 2nd beam ICP has fewer than its 20 pairs, and the old role called
+    every step's motion unknown (a new world frame each scan).  It now retries the step
+    with every beam and follows the sensor's 3 cm per scan in one frame
+    (benchmarks/scan_matching_fallback.py: on the outdoor bag 4,227 frames become 598, and
+    1,865 once implausible steps are unknown too)."""
+    from gaitval.track.staticmap import EGO_MOTIONS
+
+    n, step_m = 20, 0.03
+    scans = _pole_scans(n, step_m)
+    ranges = scans.ranges
     every = np.isfinite(ranges).sum(axis=1)
     assert (every >= 30).all() and (np.isfinite(ranges[:, ::2]).sum(axis=1) < 20).all()
-    scans = ScanSeries(t=np.arange(n) * DT, ranges=ranges, angle_min=-math.pi / 2,
-                       angle_increment=math.pi / 180, range_min=0.02, range_max=8.0)
     spec = METHODS["people"]["kind"]["ego_motion"]
     assert spec["beam_step"] == 2 and spec["min_pairs"] == 20
     _, seg_old = EGO_MOTIONS.build({**spec, "fallback_every_beam": False}).poses(scans)
@@ -598,3 +606,25 @@ def test_scan_matching_uses_every_beam_before_it_calls_the_motion_unknown():
     assert np.allclose(np.diff(poses[:, 0]), step_m, atol=0.005)
     assert np.allclose(poses[:, 1], 0.0, atol=0.02)
     assert np.allclose(poses[:, 2], 0.0, atol=0.01)
+
+
+def test_scan_matching_calls_a_step_faster_than_the_sensor_moves_unknown():
+    """A step that moves the sensor faster than 2 m/s or turns it faster than 1.5 rad/s (the
+    motion the role's 0.5 m pairing distance assumes) is not the sensor's motion — outdoors
+    ICP aligns the followed person, half the returns — and starts a new world frame.  The
+    same poles passed at 3 m/s (0.3 m a scan, which ICP itself can follow) give a frame per
+    scan; without the bounds, one frame."""
+    from gaitval.track.staticmap import EGO_MOTIONS
+
+    n = 10
+    scans = _pole_scans(n, 0.3)
+    spec = METHODS["people"]["kind"]["ego_motion"]
+    assert (spec["max_speed_mps"], spec["max_turn_rps"]) == (2.0, 1.5)
+    free, seg_free = EGO_MOTIONS.build({**spec, "max_speed_mps": None,
+                                        "max_turn_rps": None}).poses(scans)
+    assert seg_free.max() == 0 and abs(free[-1, 0] - 0.3 * (n - 1)) < 0.3
+    _, seg = EGO_MOTIONS.build(spec).poses(scans)
+    assert seg.max() + 1 == n
+    # at 1.5 m/s the bound lets the steps through
+    _, seg_slow = EGO_MOTIONS.build(spec).poses(_pole_scans(n, 0.15))
+    assert seg_slow.max() == 0

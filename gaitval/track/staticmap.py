@@ -97,16 +97,34 @@ class ScanMatching(EgoMotion):
         before the motion is called unknown (sparse scans, e.g. outdoors with most beams
         returning nothing: benchmarks/scan_matching_fallback.py).  A step that succeeds on
         the subsampled beams is unchanged.
+    max_speed_mps, max_turn_rps : float or None
+        A step that moves the sensor faster than this (translation / Δt, |turn| / Δt) is an
+        unknown step: ICP aligned something that is not the static scene (outdoors, the
+        followed person gives half the returns; benchmarks/scan_matching_fallback.py).
+        2 m/s and 1.5 rad/s: the motion ``max_pair_m`` already assumes.  None: no bound.
     """
 
     def __init__(self, max_pair_m: float = 0.5, trim: float = 0.8, iterations: int = 20,
-                 beam_step: int = 2, min_pairs: int = 20, fallback_every_beam: bool = True):
+                 beam_step: int = 2, min_pairs: int = 20, fallback_every_beam: bool = True,
+                 max_speed_mps: float | None = 2.0, max_turn_rps: float | None = 1.5):
         self.max_pair_m = max_pair_m
         self.trim = trim
         self.iterations = iterations
         self.beam_step = beam_step
         self.min_pairs = min_pairs
         self.fallback_every_beam = fallback_every_beam
+        self.max_speed_mps = max_speed_mps
+        self.max_turn_rps = max_turn_rps
+
+    def plausible(self, step, dt: float) -> bool:
+        """The step is within the sensor's stated speed and turn rate (``max_*``)."""
+        if step is None:
+            return False
+        if dt <= 0:
+            return True
+        x, y, th = step
+        return ((self.max_speed_mps is None or math.hypot(x, y) <= self.max_speed_mps * dt)
+                and (self.max_turn_rps is None or abs(th) <= self.max_turn_rps * dt))
 
     def step(self, prev: np.ndarray, cur: np.ndarray, guess):
         """(x, y, θ) of the current scan in the previous scan's frame; None: unknown."""
@@ -150,9 +168,12 @@ class ScanMatching(EgoMotion):
         rel = (0.0, 0.0, 0.0)
         for k in range(1, n):
             cur = scan_points(scans, k, self.beam_step)
+            dt = float(scans.t[k] - scans.t[k - 1])
             step = self.step(prev, cur, rel)
             if step is None and again:           # too few points: every beam, once more
                 step = self.step(scan_points(scans, k - 1), scan_points(scans, k), rel)
+            if not self.plausible(step, dt):     # faster than the sensor moves: unknown
+                step = None
             prev = cur
             if step is None:                 # unknown motion: a new frame from here on
                 seg[k] = seg[k - 1] + 1
