@@ -370,10 +370,8 @@ class PeopleTracker(TrackerKind):
                         p.status = ENDED
                         continue
                     p.world_centre = (seg, *to_world(pose, np.array([p.centre()]))[0].tolist())
-                    walked = confirmer.step(p, k)
-                    if (walked or arrived.confirms(p, to_world(pose, np.array(p.z)).tolist()
-                                                   if p.seen[0] and p.seen[1] else None, tk)
-                            ) and not _on_static(p, pose, smap):
+                    if (confirmer.step(p, k) or arrived.confirms(p, pose, tk)) \
+                            and not _on_static(p, pose, smap):
                         p.status = CONFIRMED
                         look.confirmed(p)
                         n_conf += 1

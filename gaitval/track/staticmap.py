@@ -285,7 +285,7 @@ ARRIVALS = Registry("arrival")
 
 class Arrival:
     """Role base: ``start(scans, poses)`` (a new world frame), per scan ``update(k, pose)``
-    after the scan's observations were used, and ``confirms(person, world_legs, t)``: does
+    after the scan's observations were used, and ``confirms(person, pose, t)``: does
     a tentative person stand where the scan saw free space a moment ago."""
 
     def start(self, scans, poses) -> "Arrival":
@@ -294,9 +294,10 @@ class Arrival:
     def update(self, k: int, pose) -> None:
         pass
 
-    def confirms(self, person, world_legs, t: float) -> bool:
-        """``world_legs``: both legs' observations of this scan in the world frame (None:
-        not both observed); ``person.n_both``: scans with both legs observed since birth."""
+    def confirms(self, person, pose, t: float) -> bool:
+        """``person.z``: its legs' observations of this scan (sensor frame; None: unseen),
+        ``pose``: the sensor's pose in the world frame, ``person.n_both``: scans with both
+        legs observed since birth."""
         return False
 
 
@@ -397,11 +398,11 @@ class FreeSpaceArrival(Arrival):
         key = key[~np.isin(key, hkey, assume_unique=True)]
         self._free.ravel()[key] = self._t[k]
 
-    def confirms(self, person, world_legs, t):
-        if world_legs is None or person.n_both < self._support:
+    def confirms(self, person, pose, t):
+        if not (person.seen[0] and person.seen[1]) or person.n_both < self._support:
             return False
         n, cm, since = self.neighbourhood, self.cell_m, t - self.memory_s
-        for wx, wy in world_legs:
+        for wx, wy in to_world(pose, np.array(person.z)).tolist():
             i = int(math.floor(wx / cm)) - int(self._lo[0])
             j = int(math.floor(wy / cm)) - int(self._lo[1])
             if i - n < 0 or j - n < 0 or i + n >= self._free.shape[0] \
