@@ -462,6 +462,12 @@ class Refind:
     def match(self, persons, t: float) -> list:
         return []
 
+    def take_over(self, tentative, coasting, t: float) -> list:
+        """Pairs (tentative person, coasting person): the tentative hypothesis is the
+        coasting person, found where it was last seen while its prediction went elsewhere
+        (``[]``: a coasting person only coasts)."""
+        return []
+
 
 @REFINDS.register("none")
 class NoRefind(Refind):
@@ -527,23 +533,37 @@ class LegTrackerGate(Refind):
     After leg_tracker's deletion time (3.0 s at 10 Hz) nobody is re-found.  Each ended
     person is re-found once, by the nearest such hypothesis.
 
+    With ``coasting`` the same gate also applies to a person that is *coasting* (confirmed,
+    neither leg observed on this scan): a tentative hypothesis with both legs observed
+    within g(n) of the coasting person's last observed centre (n scans since it was last
+    observed) is that person, and the coasting hypothesis ends (:meth:`take_over`).  The
+    people tracker predicts an unseen leg with its own velocity (constant velocity, seed 001
+    eq. (2)); one wrong association can give a standing leg metres per second, and the
+    prediction then leaves the person, whose observations start a new hypothesis.
+    leg_tracker matches detections to an unobserved person around its person filter's
+    prediction, which moves at the person's walking speed; the last observed centre stands
+    in for it here, as for an ended person (docs/people.md, *Re-finding*).
+
     Parameters are leg_tracker's defaults (``max_std`` 0.9 m, ``confidence_percentile``
-    0.90, observation std 0.1 m, +0.4 m for association, P₀ = 0.5 I, process std 0.5·Δt).
+    0.90, observation std 0.1 m, +0.4 m for association, P₀ = 0.5 I, process std 0.5·Δt);
+    ``coasting`` (default False) switches the take-over on.
     """
 
     def __init__(self, max_std_m: float = 0.9, percentile: float = 0.90,
-                 std_obs_m: float = 0.1, assoc_extra_m: float = 0.4):
+                 std_obs_m: float = 0.1, assoc_extra_m: float = 0.4,
+                 coasting: bool = False):
         self.max_std_m = max_std_m
         self.percentile = percentile
         self.std_obs_m = std_obs_m
         self.assoc_extra_m = assoc_extra_m
+        self.coasting = bool(coasting)
         self.gate_m = np.zeros(1)
         self.dt = 0.1
         self.ended: list[tuple[int, float, float, float]] = []
 
     def bind(self, dt):
         out = LegTrackerGate(self.max_std_m, self.percentile, self.std_obs_m,
-                             self.assoc_extra_m)
+                             self.assoc_extra_m, self.coasting)
         out.dt = float(dt)
         out.gate_m = leg_tracker_person_gate(out.dt, self.max_std_m, self.percentile,
                                              self.std_obs_m, self.assoc_extra_m)
@@ -560,25 +580,38 @@ class LegTrackerGate(Refind):
         self.ended = [e for e in self.ended if self._gate(t - e[1]) >= 0.0]
         if not self.ended:
             return []
-        cand = []
-        for i, (pid, t_e, ex, ey) in enumerate(self.ended):
-            g = self._gate(t - t_e)
-            for q, p in enumerate(persons):
-                if not (p.seen[0] and p.seen[1]):
-                    continue
-                cx, cy = p.centre()
-                d = math.hypot(cx - ex, cy - ey)
-                if d <= g:
-                    cand.append((d, i, q))
-        out, used_e, used_p = [], set(), set()
-        for d, i, q in sorted(cand):
-            if i in used_e or q in used_p:
-                continue
-            used_e.add(i)
-            used_p.add(q)
-            out.append((persons[q], self.ended[i][0]))
-        self.ended = [e for i, e in enumerate(self.ended) if i not in used_e]
-        return out
+        got = _nearest_pairs(
+            [(e, p) for e in self.ended for p in persons if p.seen[0] and p.seen[1]],
+            lambda e, p: math.hypot(p.centre()[0] - e[2], p.centre()[1] - e[3]),
+            lambda e, p: self._gate(t - e[1]))
+        used = {id(e) for e, _ in got}
+        self.ended = [e for e in self.ended if id(e) not in used]
+        return [(p, e[0]) for e, p in got]
+
+    def take_over(self, tentative, coasting, t):
+        if not self.coasting or not tentative or not coasting:
+            return []
+        return _nearest_pairs(
+            [(p, q) for p in tentative if p.seen[0] and p.seen[1] for q in coasting],
+            lambda p, q: math.hypot(p.centre()[0] - q.seen_centre[0],
+                                    p.centre()[1] - q.seen_centre[1]),
+            lambda p, q: self._gate(t - q.t_last_seen))
+
+
+def _nearest_pairs(pairs, dist, gate) -> list:
+    """One-to-one pairs (a, b) of ``pairs`` with dist(a, b) ≤ gate(a, b) (gate < 0: none),
+    nearest first."""
+    cand = sorted(((dist(a, b), i) for i, (a, b) in enumerate(pairs)
+                   if dist(a, b) <= gate(a, b)), key=lambda c: c[0])
+    out, used_a, used_b = [], set(), set()
+    for _, i in cand:
+        a, b = pairs[i]
+        if id(a) in used_a or id(b) in used_b:
+            continue
+        used_a.add(id(a))
+        used_b.add(id(b))
+        out.append((a, b))
+    return out
 
 
 # -- deletion ------------------------------------------------------------------------------

@@ -426,6 +426,17 @@ class PeopleTracker(TrackerKind):
                 look.confirmed(p)
                 p.pid = pid
                 n_refound += 1
+            # ... and a coasting person found where it was last seen, its prediction elsewhere
+            taken_over = refind.take_over([p for p in persons if p.status == TENTATIVE],
+                                          [p for p in persons if p.status == COASTING], tk)
+            for p, q in taken_over:
+                p.status = CONFIRMED
+                look.confirmed(p)
+                p.pid = q.pid
+                q.status = ENDED
+                n_refound += 1
+            if taken_over:
+                persons = [p for p in persons if p.status != ENDED]
             # record the reported persons
             for p in persons:
                 if p.reported:
