@@ -111,6 +111,43 @@ Criteria, stated before the first run.  (i) alone (``METHODS["people"]`` unchang
 (``coasting`` true) is adopted only if (a)–(d) all hold against the tables *before* (i)
 (``/tmp`` copy of the current ``reports/default/tables``), i.e. the same bar v9b failed.
 The outdoor score of both is measured once afterwards, for the record; it decides nothing.
+
+Result (v10): **neither is kept.**
+* (i) alone: (a) met (0+0), (c) met, (d) not affected; (b1) 22 → 22, (b2) 17 → 17, but
+  (b3) rollator people error frames 2,274 → 2,524.  Per-step cause
+  (``rollator_P04_obstacle_r2``, +183 error frames from scan 368): the person was lost
+  *because* its legs had gone wrong — at scan 363 its left leg sat on the user's right
+  leg and its right leg had run off to (0.0, −0.8) m — so the last observed labels were
+  already swapped, and continuing them continues the swap; the new hypothesis's own
+  labelling (the scan's bearing order, then the walking-direction handedness) was right.
+  The premise "the last observed labels are right" does not hold where re-finding
+  matters.  The rule written above would keep (i) on (a), (c), (d); I do not keep it, and
+  say so here: the measurement refuted the reason it was called a correction.
+* (i) + (ii): (a) met, (b1) 22 → 22, (b2) 17 → 18, (b3) **not met** (2,274 → 2,601),
+  (c) met.  Outdoors, for the record: 5,327 matched (as v9b; the benchmark scores persons,
+  not sides).
+
+What the three results share: a confirmed leg that takes a wrong observation gets a
+velocity of metres per second, and the constant-velocity prediction carries it away while
+it is unobserved (outdoors at scan 4738; in the rollator obstacle trials at scans 360–366
+of P04 r2 and 404–412 of P02 r2).  Re-finding after the fact cannot repair a person whose
+labels were lost with it.
+
+Fourth change (v11), written with its criteria before it was first run, after v9–v10's
+results above were known.
+
+The change.  ``METHODS["people"]["kind"]["motion"]`` = seed 000's gait-phase input
+(``gait_phase_accel``, N_ac = 40 steps, Table 2; with gaitval's braking limit, as in the
+TUG methods) in place of the constant-velocity model (seed 001 eq. (2)).  Seed 000 eq. (20)
+decelerates a swing leg that has passed the stance leg (Phase 2/4) by the leg's mean swing
+acceleration of the last N_ac steps, and the braking limit stops it without reversing
+it: an unobserved leg comes to rest instead of running on at its last velocity.  On
+scan 4738 the runaway leg moves away from the stance leg (Phase 4).  Nothing else changes;
+``refind`` stays as it is (no take-over, no side continuity).
+
+Criteria, stated before the first run: (a)–(d) as for v9, against the tables before v9
+(``--variant motion`` for (a)).  The outdoor score is measured once afterwards, for the
+record; it decides nothing.
 """
 from __future__ import annotations
 
@@ -129,6 +166,10 @@ CHI2 = {"name": "chi2", "g": 13.82}                                # seed 000 Ta
 REFIND = {"name": "leg_tracker_gate", "max_std_m": 0.9, "percentile": 0.90,
           "std_obs_m": 0.1, "assoc_extra_m": 0.4}                  # METHODS["people"]
 VARIANTS = {"gate": ("χ² gate", {"kind__gate": CHI2}, "variable region", {"kind__gate": GATE}),
+            "motion": ("constant velocity", {"kind__motion": {"name": "constant_velocity"}},
+                       "gait-phase input",
+                       {"kind__motion": {"name": "gait_phase_accel", "n_ac": 40,
+                                         "limit_braking": True}}),
             "coasting": ("re-find ended", {"kind__refind": REFIND}, "re-find coasting too",
                          {"kind__refind": {**REFIND, "coasting": True}})}
 
@@ -206,7 +247,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--compare", nargs=2, type=Path, metavar=("CURRENT", "NEW"))
     ap.add_argument("--variant", choices=sorted(VARIANTS), default="gate",
-                    help="gate: v9 (variable region); coasting: v9b (re-find coasting persons)")
+                    help="gate: v9 (variable region); coasting: v9b (re-find coasting persons); "
+                         "motion: v11 (seed 000's gait-phase input)")
     ap.add_argument("--outdoor", action="store_true",
                     help="score person_following_outdoor_1 once (decides nothing)")
     a = ap.parse_args()

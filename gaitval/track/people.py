@@ -94,7 +94,7 @@ class Person:
 
     __slots__ = ("pid", "status", "post", "prior", "seen", "pattern", "obs_j", "phase",
                  "windows", "t_last_seen", "confirm_memory", "n_unobs", "k_born", "n_obs",
-                 "world_centre", "seen_centre", "z", "zp", "look", "n_both", "last_z")
+                 "world_centre", "seen_centre", "z", "zp", "look", "n_both")
 
     def __init__(self, pid, filter, zl, zr, pl, pr, jl, jr, k, t, windows, memory,
                  status=TENTATIVE, scores=(1.0, 1.0), look=None):
@@ -119,27 +119,6 @@ class Person:
         self.zp = [float(scores[0]), float(scores[1])]  # their appearance scores (None: unseen)
         self.look = look                       # the appearance role's memory
         self.n_both = 1                        # scans with both legs observed since birth
-        self.last_z = list(self.z)             # each leg's last observation
-
-    _PER_LEG = ("post", "prior", "seen", "pattern", "obs_j", "windows", "n_unobs", "n_obs",
-                "z", "zp", "last_z")
-
-    def swap_legs(self) -> None:
-        """Exchange the two legs (every per-leg state)."""
-        for name in self._PER_LEG:
-            v = getattr(self, name)
-            v[0], v[1] = v[1], v[0]
-
-    def continue_sides(self, legs) -> None:
-        """Label this hypothesis's legs as the person it now is: ``legs`` = that person's
-        last observed (left, right) positions; the labelling with the smaller summed
-        distance to them is kept (a person found again keeps its left and right)."""
-        if legs is None:
-            return
-        (al, ar), (bl, br) = self.last_z, legs
-        keep = math.dist(al, bl) + math.dist(ar, br)
-        if math.dist(al, br) + math.dist(ar, bl) < keep:
-            self.swap_legs()
 
     def pos(self, f: int) -> tuple[float, float]:
         s = self.post[f]
@@ -266,7 +245,6 @@ class PeopleTracker(TrackerKind):
         rows: list[tuple] = []
         next_id = 1
         n_born = n_conf = n_refound = 0
-        ended_legs: dict[int, tuple] = {}       # an ended person's last observed legs
         predict, correct, identify = F.predict, F.correct, self.phase.identify
         inputs = self.motion.inputs
         sep2 = self.max_leg_separation_m ** 2
@@ -357,7 +335,6 @@ class PeopleTracker(TrackerKind):
                         p.post[f] = correct(p.prior[f], obs[j][0], obs[j][1])
                         p.seen[f] = True
                         p.z[f] = obs[j]
-                        p.last_z[f] = obs[j]
                         p.zp[f] = float(score[k][j])
                         p.pattern[f] = pats[k][j]
                         p.obs_j[f] = j
@@ -410,7 +387,6 @@ class PeopleTracker(TrackerKind):
                 if why:
                     if p.reported:
                         refind.remember(p.pid, p.t_last_seen, p.seen_centre)
-                        ended_legs[p.pid] = tuple(p.last_z)
                     p.status = ENDED
                 elif p.reported:
                     p.status = CONFIRMED if (p.seen[0] or p.seen[1]) else COASTING
@@ -449,7 +425,6 @@ class PeopleTracker(TrackerKind):
                 p.status = CONFIRMED
                 look.confirmed(p)
                 p.pid = pid
-                p.continue_sides(ended_legs.get(pid))
                 n_refound += 1
             # ... and a coasting person found where it was last seen, its prediction elsewhere
             taken_over = refind.take_over([p for p in persons if p.status == TENTATIVE],
@@ -458,7 +433,6 @@ class PeopleTracker(TrackerKind):
                 p.status = CONFIRMED
                 look.confirmed(p)
                 p.pid = q.pid
-                p.continue_sides(q.last_z)
                 q.status = ENDED
                 n_refound += 1
             if taken_over:
