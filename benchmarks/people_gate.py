@@ -148,6 +148,32 @@ scan 4738 the runaway leg moves away from the stance leg (Phase 4).  Nothing els
 Criteria, stated before the first run: (a)–(d) as for v9, against the tables before v9
 (``--variant motion`` for (a)).  The outdoor score is measured once afterwards, for the
 record; it decides nothing.
+
+Result (v11): **not adopted**: (a) **not met** — 1+0 / 2+0 / 0+0 persons confirmed on
+negative_2's left / rear / right lasers.  (b) met: TUG successes 22 → 26 of 28, MTST
+(mocap) 17 → 17 of 48, rollator people error frames 2,274 → 2,258, median RMSE ratio
+1.033; (c) met.  The outdoor score was not measured (a failed first).
+
+Fifth change (v12), written with its criteria before it was first run, after v11's
+results above were known.
+
+Why.  The confirmer's tests (the legs pass each other, r spans d_c, the body walks d_w)
+read the legs' *filtered* positions, so they see whatever the motion model adds.  Seed
+000's input accelerates a leg in an "accelerating" phase along its velocity; on a pair of
+chair legs with a little observation noise that manufactures motion the scan never saw —
+the likely reason v11 confirmed furniture (not traced per step: the next change tests it).
+Evidence for "this pair walks" should come from the observations.
+
+The change.  (i) ``m_of_n_moving`` with ``evidence: observations``: r = z_L − z_R and the
+body centre (z_L + z_R)/2 from the observations assigned to the legs on the scans with both
+legs observed (the window only ever held such scans); values unchanged.  (ii) (i) + v11's
+gait-phase motion input.
+
+Criteria, stated before the first run: (a)–(d) against the tables before v9, for each.
+(ii) is adopted if it meets all of them; otherwise (i) if it meets all of them; otherwise
+neither.  (ii) is preferred because v11 showed its TUG gain (22 → 26), and that is said
+here.  ``--variant evidence`` and ``--variant evidence_motion`` for (a).  The outdoor
+score of each is measured once afterwards, for the record; it decides nothing.
 """
 from __future__ import annotations
 
@@ -165,11 +191,19 @@ GATE = {"name": "variable_region", "v_sw": 1.1, "v_st": 0.55}     # seed 001 Tab
 CHI2 = {"name": "chi2", "g": 13.82}                                # seed 000 Table 2
 REFIND = {"name": "leg_tracker_gate", "max_std_m": 0.9, "percentile": 0.90,
           "std_obs_m": 0.1, "assoc_extra_m": 0.4}                  # METHODS["people"]
+OBS_CONFIRMER = {"name": "m_of_n_moving", "window_s": 1.4, "m_fraction": 0.5,
+                 "min_relative_travel_m": 0.5, "pass_leg_widths": 1.0, "min_travel_m": 0.5,
+                 "evidence": "observations"}                       # METHODS["people"] + v12
 VARIANTS = {"gate": ("χ² gate", {"kind__gate": CHI2}, "variable region", {"kind__gate": GATE}),
             "motion": ("constant velocity", {"kind__motion": {"name": "constant_velocity"}},
                        "gait-phase input",
                        {"kind__motion": {"name": "gait_phase_accel", "n_ac": 40,
                                          "limit_braking": True}}),
+            "evidence": ("estimates", {}, "observations", {"kind__confirmer": OBS_CONFIRMER}),
+            "evidence_motion": ("estimates, CV", {}, "observations, gait-phase input",
+                                {"kind__confirmer": OBS_CONFIRMER,
+                                 "kind__motion": {"name": "gait_phase_accel", "n_ac": 40,
+                                                  "limit_braking": True}}),
             "coasting": ("re-find ended", {"kind__refind": REFIND}, "re-find coasting too",
                          {"kind__refind": {**REFIND, "coasting": True}})}
 
@@ -248,7 +282,7 @@ def main() -> None:
     ap.add_argument("--compare", nargs=2, type=Path, metavar=("CURRENT", "NEW"))
     ap.add_argument("--variant", choices=sorted(VARIANTS), default="gate",
                     help="gate: v9 (variable region); coasting: v9b (re-find coasting persons); "
-                         "motion: v11 (seed 000's gait-phase input)")
+                         "motion: v11 (seed 000's gait-phase input); evidence, evidence_motion: v12")
     ap.add_argument("--outdoor", action="store_true",
                     help="score person_following_outdoor_1 once (decides nothing)")
     a = ap.parse_args()

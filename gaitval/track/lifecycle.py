@@ -182,7 +182,12 @@ class UnexplainedPairs(Birth):
 
 # -- confirmation --------------------------------------------------------------------------
 class Confirmer:
-    """Role base."""
+    """Role base.  ``evidence``: what the tests look at — ``"estimates"`` (the legs'
+    filtered positions) or ``"observations"`` (the observations assigned to the legs on
+    the scans with both legs observed); the tracker gives ``person.world_centre`` from the
+    same."""
+
+    evidence = "estimates"
 
     def bind(self, dt: float, leg_width_m: float = 0.10) -> "Confirmer":
         return self
@@ -227,11 +232,19 @@ class MOfNMoving(Confirmer):
         was lost inside the window (more than one segment) the world frame is unknown and
         this test is not made.  leg_tracker's 0.5 m of travel in the odometry
         frame; over 1.4 s it asks for at least 0.36 m/s, a slow walk.
+    evidence : {"estimates", "observations"}
+        r and the body centre from the legs' filtered positions (default) or from the
+        observations assigned to them: with ``observations`` the tests see only what the
+        scan saw, whatever the motion model predicts (benchmarks/people_gate.py, v12).
     """
 
     def __init__(self, window_s: float = 1.4, m_fraction: float = 0.5,
                  min_relative_travel_m: float = 0.5, pass_leg_widths: float = 1.0,
-                 min_travel_m: float = 0.0):
+                 min_travel_m: float = 0.0, evidence: str = "estimates"):
+        if evidence not in ("estimates", "observations"):
+            raise ValueError(f"m_of_n_moving: evidence must be 'estimates' or "
+                             f"'observations', not {evidence!r}")
+        self.evidence = evidence
         self.window_s = window_s
         self.m_fraction = m_fraction
         self.min_relative_travel_m = min_relative_travel_m
@@ -243,7 +256,7 @@ class MOfNMoving(Confirmer):
 
     def bind(self, dt, leg_width_m: float = 0.10):
         out = MOfNMoving(self.window_s, self.m_fraction, self.min_relative_travel_m,
-                         self.pass_leg_widths, self.min_travel_m)
+                         self.pass_leg_widths, self.min_travel_m, self.evidence)
         out.n = max(1, int(round(self.window_s / dt)))
         out.m = max(1, math.ceil(self.m_fraction * out.n))
         out.leg_width_m = leg_width_m
@@ -258,7 +271,8 @@ class MOfNMoving(Confirmer):
         mem = person.confirm_memory
         both = person.seen[0] and person.seen[1]
         if both:
-            (xl, yl), (xr, yr) = person.pos(0), person.pos(1)
+            (xl, yl), (xr, yr) = ((person.z[0], person.z[1]) if self.evidence == "observations"
+                                  else (person.pos(0), person.pos(1)))
             mem["win"].append((xl - xr, yl - yr))
             mem["world"].append(person.world_centre)
         else:

@@ -369,7 +369,8 @@ class PeopleTracker(TrackerKind):
                     if not look.keeps(p):               # no longer looks like two legs
                         p.status = ENDED
                         continue
-                    p.world_centre = (seg, *to_world(pose, np.array([p.centre()]))[0].tolist())
+                    p.world_centre = (seg, *to_world(pose, np.array([_evidence_centre(
+                        p, confirmer.evidence)]))[0].tolist())
                     if (confirmer.step(p, k) or arrived.confirms(p, pose, tk)) \
                             and not _on_static(p, pose, smap):
                         p.status = CONFIRMED
@@ -487,6 +488,14 @@ class PeopleTracker(TrackerKind):
         if self.sides == "walking_direction" and handedness(res) < 0:
             swap_sides(res)
         return res
+
+
+def _evidence_centre(p: Person, evidence: str) -> tuple[float, float]:
+    """The body centre the confirmer's tests look at: the mean of the two observations on
+    a scan that saw both legs (``evidence`` = "observations"), else of the estimates."""
+    if evidence == "observations" and p.seen[0] and p.seen[1]:
+        return 0.5 * (p.z[0][0] + p.z[1][0]), 0.5 * (p.z[0][1] + p.z[1][1])
+    return p.centre()
 
 
 def _relative(a, b) -> tuple[float, float, float]:
