@@ -461,7 +461,7 @@ METHODS["people"] = {
              # classifier)
              "confirmer": {"name": "m_of_n_moving", "window_s": 1.4, "m_fraction": 0.5,
                            "min_relative_travel_m": 0.5, "pass_leg_widths": 1.0,
-                           "min_travel_m": 0.5},
+                           "min_travel_m": 0.5, "evidence": "observations"},
              "deleter": {"name": "unsupported_time", "max_unsupported_s": 3.0,
                          "tentative_unsupported_s": 0.2},
              "area": {"name": "field_of_view", "margin_m": 0.25},
