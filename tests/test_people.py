@@ -628,3 +628,73 @@ def test_scan_matching_calls_a_step_faster_than_the_sensor_moves_unknown():
     # at 1.5 m/s the bound lets the steps through
     _, seg_slow = EGO_MOTIONS.build(spec).poses(_pole_scans(n, 0.15))
     assert seg_slow.max() == 0
+
+
+# -- issue 36, v9–v12 (benchmarks/people_gate.py) -------------------------------------------
+def test_a_coasting_person_is_taken_over_where_it_was_last_seen():
+    """``refind: leg_tracker_gate`` with ``coasting: true`` (not the default): a walker
+    (1 m/s) stops and is unseen for 0.8 s; its constant-velocity prediction runs on, so
+    when its legs are seen again, standing where it stopped, they are outside its gates.
+    With the take-over the new hypothesis there is that person at once (same id, confirmed,
+    kept while it stands); without it the prediction coasts on to the end and the
+    standing person is never confirmed (nothing is re-found: the person ends 3 s later,
+    at leg_tracker's deletion time)."""
+    n, k_stop, gap = 80, 22, 8
+    t = np.arange(n) * DT
+    _, left, right = _walker((0.5, 0.0), (1.0, 0.0), t)
+    stand = np.vstack([left[k_stop - 1], right[k_stop - 1]])
+    legs = [np.vstack([left[k], right[k]]) if k < k_stop else
+            (np.zeros((0, 2)) if k < k_stop + gap else stand) for k in range(n)]
+    xy, pats = _observations(legs, np.random.default_rng(7))
+    area = {"name": "rectangle", "x_m": [0.0, 8.0], "y_m": [-2.0, 2.0]}
+    refind = dict(METHODS["people"]["kind"]["refind"])
+    off = _tracker(area=area, refind=refind).run(_scans(n), xy, pats, 0.10)
+    assert off.n_refound == 0 and off.people["k"].max() < n - 1
+    last = off.people[off.people["k"] == off.people["k"].max()]
+    assert (last["x_m"] > stand[:, 0].max() + 2.0).all()       # coasted far past the person
+    on = _tracker(area=area, refind={**refind, "coasting": True}).run(_scans(n), xy, pats,
+                                                                      0.10)
+    p = on.people
+    assert on.n_confirmed == 1 and on.n_refound == 1
+    assert p["person_id"].nunique() == 1 and p["k"].max() == n - 1
+    after = p[p["k"] >= k_stop + gap]
+    assert set(after["status"]) == {"confirmed"}
+    assert np.hypot(after["x_m"].to_numpy()[:, None] - stand[:, 0],
+                    after["y_m"].to_numpy()[:, None] - stand[:, 1]).min(axis=1).max() < 0.05
+
+
+def test_the_confirmer_reads_the_observations_not_the_filtered_legs():
+    """``m_of_n_moving`` with ``evidence: observations`` (the people method's, v12) tests
+    the observations assigned to the legs: filtered legs that swing past each other over
+    observations of a still pair confirm nothing, and observations of swinging legs
+    confirm whatever the estimates say.  ``estimates`` reads the filtered legs.  An
+    unknown evidence is refused."""
+    from types import SimpleNamespace
+
+    assert METHODS["people"]["kind"]["confirmer"]["evidence"] == "observations"
+    n = 20
+    t = np.arange(n) * DT
+    _, left, right = _walker((2.0, 0.0), (1e-6, 0.0), t, step_m=0.6)   # legs swing, body stays
+    still = [(2.0, 0.1), (2.0, -0.1)]
+
+    def confirmed(evidence, pos, z):
+        c = CONFIRMERS.build({"name": "m_of_n_moving", "window_s": 1.4, "m_fraction": 0.5,
+                              "min_relative_travel_m": 0.5, "pass_leg_widths": 1.0,
+                              "min_travel_m": 0.0, "evidence": evidence}).bind(DT, 0.10)
+        p = SimpleNamespace(seen=[True, True], confirm_memory=c.new_memory(),
+                            world_centre=(0, 2.0, 0.0))
+        out = []
+        for k in range(n):
+            p.z = [tuple(z[k][0]), tuple(z[k][1])]
+            p.pos = lambda f, k=k: tuple(pos[k][f])
+            out.append(c.step(p, k))
+        return any(out)
+
+    swing = [(left[k], right[k]) for k in range(n)]
+    stay = [still] * n
+    assert confirmed("estimates", swing, stay)
+    assert not confirmed("observations", swing, stay)
+    assert confirmed("observations", stay, swing)
+    assert not confirmed("estimates", stay, swing)
+    with pytest.raises(ValueError, match="evidence"):
+        CONFIRMERS.build({"name": "m_of_n_moving", "evidence": "priors"})
