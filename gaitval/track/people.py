@@ -143,6 +143,9 @@ class PeopleTracker(TrackerKind):
         The leg roles (registries of :mod:`gaitval.detect` and :mod:`gaitval.track`).
     tentative_gate : spec or None
         The gate of tentative persons' legs (None: ``gate``).
+    tentative_motion : spec or None
+        The motion input of tentative persons' legs (None: ``motion``): a hypothesis that
+        is not yet a person has no gait to model (benchmarks/people_gate.py, v13).
     birth, confirmer, deleter, area, refind : spec
         The life-cycle roles (:mod:`gaitval.track.lifecycle`); ``refind`` (default
         ``leg_tracker_gate``; ``none``: an ended person stays ended) gives a recently ended
@@ -175,7 +178,8 @@ class PeopleTracker(TrackerKind):
                  phase="speed_thresholds", gate="chi2", birth="unexplained_pairs",
                  confirmer="m_of_n_moving", deleter="unsupported_time",
                  area="field_of_view", ego_motion="none", static_map="none",
-                 init=None, tentative_gate=None, refind="leg_tracker_gate",
+                 init=None, tentative_gate=None, tentative_motion=None,
+                 refind="leg_tracker_gate",
                  appearance="none", arrival="none",
                  max_leg_separation_m: float = 0.8, person_points_m: float = 0.13,
                  dt_s: float | None = None, sides: str = "walking_direction"):
@@ -185,6 +189,8 @@ class PeopleTracker(TrackerKind):
         self.phase = PHASE_MODELS.build(phase)
         self.gate = GATES.build(gate)
         self.tentative_gate = GATES.build(tentative_gate) if tentative_gate else None
+        self.tentative_motion = (MOTION_MODELS.build(tentative_motion) if tentative_motion
+                                 else None)
         self.birth = BIRTHS.build(birth)
         self.confirmer = CONFIRMERS.build(confirmer)
         self.deleter = DELETERS.build(deleter)
@@ -247,6 +253,7 @@ class PeopleTracker(TrackerKind):
         n_born = n_conf = n_refound = 0
         predict, correct, identify = F.predict, F.correct, self.phase.identify
         inputs = self.motion.inputs
+        tentative_inputs = (self.tentative_motion or self.motion).inputs
         sep2 = self.max_leg_separation_m ** 2
         dts = dts.tolist()
         cost, alive, on_static = ([], [], []) if profile else (None, None, None)
@@ -272,9 +279,10 @@ class PeopleTracker(TrackerKind):
             for p in persons:
                 a, b = p.post
                 w = p.windows
-                ul, ur = inputs(p.phase, (a[2], a[3]), (b[2], b[3]),
-                                w[0].mean if w[0] is not None else 0.0,
-                                w[1].mean if w[1] is not None else 0.0, dt)
+                ul, ur = (tentative_inputs if p.status == TENTATIVE else inputs)(
+                    p.phase, (a[2], a[3]), (b[2], b[3]),
+                    w[0].mean if w[0] is not None else 0.0,
+                    w[1].mean if w[1] is not None else 0.0, dt)
                 p.prior = [predict(a, dt, ul[0], ul[1]), predict(b, dt, ur[0], ur[1])]
             taken = [False] * J
             explained = [False] * J
