@@ -449,7 +449,8 @@ METHODS["people"] = {
              "detector": copy.deepcopy(_TUG_COMMON["detector"]),
              "filter": {"name": "kf", "q_accel_sd_mps2": 15.0, "r_sd_m": 0.04,
                         "p0_pos_sd_m": 0.04, "p0_vel_sd_mps": 0.5},
-             "motion": {"name": "constant_velocity"},
+             "motion": {"name": "gait_phase_accel", "n_ac": 40, "limit_braking": True},
+             "tentative_motion": {"name": "constant_velocity"},
              "phase": {"name": "speed_thresholds", "v_st_th": 0.47, "v_sw_th": 0.93},
              "gate": {"name": "chi2", "g": 13.82},
              # seed 001's variable validation region (Table 1) while a person is tentative
