@@ -159,3 +159,32 @@ def test_the_lock_pins_every_dependency_of_pyproject_with_hashes():
         assert name in locked, (req, "not in requirements.lock")
     pins = [ln for ln in text.splitlines() if "==" in ln and not ln.startswith(("#", " "))]
     assert len(pins) == len(locked) and all(ln.rstrip().endswith("\\") for ln in pins)
+
+
+def test_the_source_digest_changes_with_gaitvals_code_and_nothing_else(tmp_path):
+    """The workflow puts gaitval's source digest into every job's config-view params, so
+    that new code reruns the jobs (Snakemake's `code` trigger sees only a rule's own code):
+    the digest follows every file's path and content, data files included, and ignores
+    ``__pycache__``; the installed package's digest is the workflow's."""
+    from pathlib import Path
+
+    import gaitval
+    from gaitval.report.provenance import source_digest
+
+    pkg = tmp_path / "gaitval"
+    (pkg / "track" / "data").mkdir(parents=True)
+    (pkg / "methods.py").write_text('METHODS = {"people": {"motion": "cv"}}\n')
+    (pkg / "track" / "data" / "forest.npz").write_bytes(b"\x00\x01")
+    d0 = source_digest(pkg)
+    assert len(d0) == 12 and source_digest(pkg) == d0
+    (pkg / "__pycache__").mkdir()
+    (pkg / "__pycache__" / "methods.cpython-311.pyc").write_bytes(b"compiled")
+    assert source_digest(pkg) == d0
+    (pkg / "methods.py").write_text('METHODS = {"people": {"motion": "gait"}}\n')
+    d1 = source_digest(pkg)
+    assert d1 != d0
+    (pkg / "track" / "data" / "forest.npz").write_bytes(b"\x00\x02")
+    assert source_digest(pkg) not in (d0, d1)
+    assert source_digest() == source_digest(Path(gaitval.__file__).parent)
+    smk = (Path(__file__).resolve().parents[1] / "workflow" / "rules" / "common.smk").read_text()
+    assert 'sections["gaitval_source"] = SOURCE_DIGEST' in smk

@@ -47,6 +47,22 @@ def config_hash(config: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:12]
 
 
+def source_digest(package: Path | None = None) -> str:
+    """First 12 hex digits of the SHA-256 over gaitval's own files: every file of the
+    package (its code and its data, e.g. the leg forests), by relative path and content,
+    ``__pycache__`` left out.  The workflow puts it in every job's config-view params, so
+    a change of gaitval's code (a new version, an edited method) reruns the jobs whose
+    results it could change, as a change of the config does; a rerun with the same code
+    and config still does nothing."""
+    root = Path(package) if package is not None else Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for f in sorted(p for p in root.rglob("*")
+                    if p.is_file() and "__pycache__" not in p.parts):
+        h.update(f.relative_to(root).as_posix().encode() + b"\0")
+        h.update(hashlib.sha256(f.read_bytes()).digest())
+    return h.hexdigest()[:12]
+
+
 def git_commit(repo: Path = REPO) -> str:
     """``git rev-parse HEAD`` of the checkout (``+dirty`` if tracked files changed).
 

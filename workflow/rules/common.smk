@@ -13,7 +13,7 @@ from gaitval.configcheck import (check_config, check_study_file, display_path,
                                  run_problems, with_sources)
 from gaitval.errors import ConfigError
 from gaitval.io.trialsheet import load_trial_sheet
-from gaitval.report.provenance import config_hash
+from gaitval.report.provenance import config_hash, source_digest
 from gaitval.methods import METHODS, get_method, override_problems, set_params
 from gaitval.pipeline.steps import (ALL_SCOPE, ANALYSIS_SECTIONS, EXTERNAL_PROTOCOLS,
                                     PROTOCOL_SCOPE, SCOPES, STUDY_VIEW,
@@ -267,12 +267,17 @@ wildcard_constraints:
 
 # Hash of the analysis sections only: changing `run` or paths must not rerun the tables.
 CONFIG_HASH = config_hash({k: config[k] for k in ANALYSIS_SECTIONS if k in config})
+# gaitval's own files (code and data): part of every view's params below, so that new code
+# reruns what it could change (Snakemake's `code` trigger sees a rule's own code only)
+SOURCE_DIGEST = source_digest()
 
 
 
 def analysis_sections_json(view=None, scope=ALL_SCOPE):
     """The analysis sections as canonical JSON (sorted keys), or one view of them
-    (gaitval.pipeline.steps.method_view): the params of rules study_config and config_view."""
+    (gaitval.pipeline.steps.method_view): the params of rules study_config and config_view,
+    with gaitval's source digest (SOURCE_DIGEST: new code reruns the views, hence every job
+    that reads one; study_config ignores the key)."""
     sections = {k: config[k] for k in ANALYSIS_SECTIONS if k in config}
     if view is not None:
         sections = method_view(sections, view, scope)
@@ -283,6 +288,7 @@ def analysis_sections_json(view=None, scope=ALL_SCOPE):
         by_study = {s: e[view] for s, e in _EXTERNAL.items() if view in e}
         if by_study and not in_config:
             sections["external_methods_of_studies"] = by_study
+    sections["gaitval_source"] = SOURCE_DIGEST
     return json.dumps(sections, sort_keys=True, default=str)
 
 
