@@ -242,6 +242,11 @@ def test_leg_tracker_person_gate_follows_its_filter():
     assert g10[-1] <= 1.645 * 0.9 + 1e-9                 # never beyond the deletion bound
 
 
+#: the re-finding scenarios need a prediction that runs on at the last velocity (the
+#: constant-velocity model); the people method's gait input (v13) decelerates it
+CV = {"name": "constant_velocity"}
+
+
 def _stop_at_the_edge(k_stop=22, k_back=25, n=80, moved_m=(0.0, 0.0)):
     """A walker (1 m/s along x) stops at x = 2.6 m, 0.25 m inside the area's edge, unseen
     for k_back − k_stop scans; its coasting prediction carries it out of the area (the
@@ -264,15 +269,22 @@ def test_a_person_whose_track_ended_is_found_again_and_kept_while_standing():
     confirmed while it stands (support = observations).  Without re-finding the standing
     person is never confirmed again."""
     xy, pats, area, n = _stop_at_the_edge()
-    res = _tracker(area=area).run(_scans(n), xy, pats, 0.10)
+    res = _tracker(area=area, motion=CV).run(_scans(n), xy, pats, 0.10)
     p = res.people
     assert res.n_confirmed == 1 and res.n_refound == 1
     assert p["person_id"].nunique() == 1                     # the same id throughout
     assert p["k"].max() == n - 1 and p.loc[p["k"] >= 25, "k"].nunique() == n - 25
     assert set(p.loc[p["k"] >= 25, "status"]) == {"confirmed"}
-    alone = _tracker(area=area, refind="none").run(_scans(n), xy, pats, 0.10)
+    alone = _tracker(area=area, refind="none", motion=CV).run(_scans(n), xy, pats, 0.10)
     assert alone.n_confirmed == 1 and alone.n_refound == 0
     assert alone.people["k"].max() < 25                      # ended, and never again
+    # the people method's own motion (seed 000's gait input once confirmed, v13) stops the
+    # legs of the walker that stopped: its track never leaves the area, so the person
+    # coasts and keeps its id, with nothing to re-find
+    own = _tracker(area=area).run(_scans(n), xy, pats, 0.10)
+    assert own.n_confirmed == 1 and own.n_refound == 0
+    assert own.people["person_id"].nunique() == 1 and own.people["k"].max() == n - 1
+    assert set(own.people.loc[own.people["k"] >= 25, "status"]) == {"confirmed"}
 
 
 def test_a_hypothesis_beyond_the_gate_or_too_late_is_not_the_ended_person():
@@ -282,10 +294,10 @@ def test_a_hypothesis_beyond_the_gate_or_too_late_is_not_the_ended_person():
     pair 1.5 m away is, once the gate has grown to 1.5 m, as leg_tracker's coasting
     person would take it.)"""
     xy, pats, area, n = _stop_at_the_edge(moved_m=(-2.0, 0.0))
-    far = _tracker(area=area).run(_scans(n), xy, pats, 0.10)
+    far = _tracker(area=area, motion=CV).run(_scans(n), xy, pats, 0.10)
     assert far.n_refound == 0 and far.people["k"].max() < 25
     xy, pats, area, n = _stop_at_the_edge(k_back=22 + 32)
-    late = _tracker(area=area).run(_scans(n), xy, pats, 0.10)
+    late = _tracker(area=area, motion=CV).run(_scans(n), xy, pats, 0.10)
     assert late.n_refound == 0 and late.people["k"].max() < 22 + 32
 
 
@@ -648,12 +660,12 @@ def test_a_coasting_person_is_taken_over_where_it_was_last_seen():
     xy, pats = _observations(legs, np.random.default_rng(7))
     area = {"name": "rectangle", "x_m": [0.0, 8.0], "y_m": [-2.0, 2.0]}
     refind = dict(METHODS["people"]["kind"]["refind"])
-    off = _tracker(area=area, refind=refind).run(_scans(n), xy, pats, 0.10)
+    off = _tracker(area=area, refind=refind, motion=CV).run(_scans(n), xy, pats, 0.10)
     assert off.n_refound == 0 and off.people["k"].max() < n - 1
     last = off.people[off.people["k"] == off.people["k"].max()]
     assert (last["x_m"] > stand[:, 0].max() + 2.0).all()       # coasted far past the person
-    on = _tracker(area=area, refind={**refind, "coasting": True}).run(_scans(n), xy, pats,
-                                                                      0.10)
+    on = _tracker(area=area, refind={**refind, "coasting": True}, motion=CV).run(
+        _scans(n), xy, pats, 0.10)
     p = on.people
     assert on.n_confirmed == 1 and on.n_refound == 1
     assert p["person_id"].nunique() == 1 and p["k"].max() == n - 1

@@ -236,11 +236,18 @@ class MOfNMoving(Confirmer):
         r and the body centre from the legs' filtered positions (default) or from the
         observations assigned to them: with ``observations`` the tests see only what the
         scan saw, whatever the motion model predicts (benchmarks/people_gate.py, v12).
+    walk_suffices : bool
+        Where the world frame is known over the window and ``min_travel_m`` > 0, the body's
+        steady walk (with the gap test) alone confirms, without the two gait tests (the
+        legs pass, r spans d_c); where it is not known, the gait tests alone decide, as
+        before.  False (default): every test is asked (benchmarks/people_gate.py, v14).
     """
 
     def __init__(self, window_s: float = 1.4, m_fraction: float = 0.5,
                  min_relative_travel_m: float = 0.5, pass_leg_widths: float = 1.0,
-                 min_travel_m: float = 0.0, evidence: str = "estimates"):
+                 min_travel_m: float = 0.0, evidence: str = "estimates",
+                 walk_suffices: bool = False):
+        self.walk_suffices = bool(walk_suffices)
         if evidence not in ("estimates", "observations"):
             raise ValueError(f"m_of_n_moving: evidence must be 'estimates' or "
                              f"'observations', not {evidence!r}")
@@ -256,7 +263,8 @@ class MOfNMoving(Confirmer):
 
     def bind(self, dt, leg_width_m: float = 0.10):
         out = MOfNMoving(self.window_s, self.m_fraction, self.min_relative_travel_m,
-                         self.pass_leg_widths, self.min_travel_m, self.evidence)
+                         self.pass_leg_widths, self.min_travel_m, self.evidence,
+                         self.walk_suffices)
         out.n = max(1, int(round(self.window_s / dt)))
         out.m = max(1, math.ceil(self.m_fraction * out.n))
         out.leg_width_m = leg_width_m
@@ -285,6 +293,14 @@ class MOfNMoving(Confirmer):
         rs = [r for r in win if r is not None]
         if len(rs) < self.m:
             return False
+        world_known = len({c[0] for c in mem["world"] if c is not None}) == 1
+        walk_asked = self.min_travel_m > 0 and world_known
+        if self.walk_suffices and walk_asked:
+            return self._walks(mem)
+        return self._legs_walk(rs) and (not walk_asked or self._walks(mem))
+
+    def _legs_walk(self, rs) -> bool:
+        """The gait tests: the legs pass each other along the longest r, and r spans d_c."""
         # the legs pass each other: r on both sides of zero along the longest r
         ux, uy = max(rs, key=lambda r: r[0] * r[0] + r[1] * r[1])
         norm = math.hypot(ux, uy)
@@ -294,37 +310,36 @@ class MOfNMoving(Confirmer):
         w = self.pass_leg_widths * self.leg_width_m
         if min(proj) > -w or max(proj) < w:
             return False
-        # ... the body walked d_w in the world, steadily: a straight-line fit c(t) = c0 + v t
-        # to the world centres of the window's scans with both legs spans d_w, with an RMS
-        # residual below one leg width (a pair flickering between objects jumps instead)
-        world_known = len({c[0] for c in mem["world"] if c is not None}) == 1
-        if self.min_travel_m > 0 and world_known:
-            idx = [i for i, c in enumerate(mem["world"]) if c is not None]
-            # the walk is seen throughout: no gap between scans with both legs longer than a
-            # third of the window (across a gap, two clusters of a flickering pair would
-            # fit a line)
-            if max(b - a - 1 for a, b in zip(idx[:-1], idx[1:])) > len(mem["world"]) // 3:
-                return False
-            cs = [mem["world"][i][1:] for i in idx]
-            ti = [float(i) for i in idx]
-            tm = sum(ti) / len(ti)
-            stt = sum((x - tm) ** 2 for x in ti)
-            if stt <= 0:
-                return False
-            res2 = 0.0
-            span2 = 0.0
-            for ax in (0, 1):
-                v = [c[ax] for c in cs]
-                vm = sum(v) / len(v)
-                slope = sum((x - tm) * (y - vm) for x, y in zip(ti, v)) / stt
-                res2 += sum((y - vm - slope * (x - tm)) ** 2 for x, y in zip(ti, v))
-                span2 += (slope * (ti[-1] - ti[0])) ** 2
-            if span2 < self.min_travel_m ** 2 or res2 / len(cs) > self.leg_width_m ** 2:
-                return False
         # ... and r spans d_c (the diameter of the set of r)
         d2 = self.min_relative_travel_m ** 2
         return any((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 >= d2
                    for i, a in enumerate(rs) for b in rs[i + 1:])
+
+    def _walks(self, mem) -> bool:
+        """The body walked d_w in the world, steadily: a straight-line fit c(t) = c0 + v t
+        to the world centres of the window's scans with both legs spans d_w, with an RMS
+        residual below one leg width (a pair flickering between objects jumps instead)."""
+        idx = [i for i, c in enumerate(mem["world"]) if c is not None]
+        # the walk is seen throughout: no gap between scans with both legs longer than a
+        # third of the window (across a gap, two clusters of a flickering pair would fit a
+        # line)
+        if max(b - a - 1 for a, b in zip(idx[:-1], idx[1:])) > len(mem["world"]) // 3:
+            return False
+        cs = [mem["world"][i][1:] for i in idx]
+        ti = [float(i) for i in idx]
+        tm = sum(ti) / len(ti)
+        stt = sum((x - tm) ** 2 for x in ti)
+        if stt <= 0:
+            return False
+        res2 = 0.0
+        span2 = 0.0
+        for ax in (0, 1):
+            v = [c[ax] for c in cs]
+            vm = sum(v) / len(v)
+            slope = sum((x - tm) * (y - vm) for x, y in zip(ti, v)) / stt
+            res2 += sum((y - vm - slope * (x - tm)) ** 2 for x, y in zip(ti, v))
+            span2 += (slope * (ti[-1] - ti[0])) ** 2
+        return span2 >= self.min_travel_m ** 2 and res2 / len(cs) <= self.leg_width_m ** 2
 
     def failed(self, person):
         mem = person.confirm_memory
