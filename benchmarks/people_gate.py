@@ -238,6 +238,14 @@ Criteria, stated before the first run: (a)–(d) as for v9, against v13's tables
 (``--variant walk`` for (a)).  The outdoor score is measured once afterwards, for the
 record; it decides nothing.  The motive came from this bag's misses, and that is said
 here.
+
+Result (v14): **not adopted**: (a) **not met** — 3+0 / 4+1 / 0+0 persons confirmed (+
+re-found) on negative_2's left / rear / right lasers; the gait tests are what keeps the
+empty room empty on a moving robot.  Outdoors, for the record: 5,228 matched, 947 misses,
+4 / 4 ID switches, MOTP 0.085 m — the same matched count as v13 (full-mode false
+positives 569 → 860).  So the gait tests are not what stands between the outdoor person
+and confirmation: where "the legs do not pass" is the first test a hypothesis near the
+person fails, the walk (0.5 m steadily in 1.4 s in a known world frame) fails too.
 """
 from __future__ import annotations
 
