@@ -710,3 +710,33 @@ def test_the_confirmer_reads_the_observations_not_the_filtered_legs():
     assert not confirmed("estimates", stay, swing)
     with pytest.raises(ValueError, match="evidence"):
         CONFIRMERS.build({"name": "m_of_n_moving", "evidence": "priors"})
+
+
+def test_the_walk_alone_confirms_a_side_stepper_only_when_asked_and_the_world_is_known():
+    """``walk_suffices`` (v14, not the default): a person who side-steps 0.6 m in 1.4 s
+    with the legs never passing each other fails the gait tests; with ``walk_suffices``
+    the steady world-frame walk confirms them, but only while the world frame is known
+    (one ego-motion segment over the window)."""
+    from types import SimpleNamespace
+
+    assert not METHODS["people"]["kind"]["confirmer"].get("walk_suffices", False)
+    n = 20
+    cx = 2.0 + 0.05 * np.arange(n)                       # 0.5 m/s along x
+    legs = [((x + 0.05, 0.1), (x - 0.05, -0.1)) for x in cx]   # the same leg leads
+
+    def confirmed(walk_suffices, segments):
+        c = CONFIRMERS.build({"name": "m_of_n_moving", "window_s": 1.4, "m_fraction": 0.5,
+                              "min_relative_travel_m": 0.5, "pass_leg_widths": 1.0,
+                              "min_travel_m": 0.5, "evidence": "observations",
+                              "walk_suffices": walk_suffices}).bind(DT, 0.10)
+        p = SimpleNamespace(seen=[True, True], confirm_memory=c.new_memory())
+        out = []
+        for k in range(n):
+            p.z = [legs[k][0], legs[k][1]]
+            p.world_centre = (segments(k), float(cx[k]), 0.0)
+            out.append(c.step(p, k))
+        return any(out)
+
+    assert not confirmed(False, lambda k: 0)
+    assert confirmed(True, lambda k: 0)
+    assert not confirmed(True, lambda k: k % 2)          # the world frame keeps breaking
