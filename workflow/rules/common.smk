@@ -597,18 +597,6 @@ def treadmill_trials():
     return [(s, t) for s in config["run"] for t in trial_ids(s, ["treadmill"])]
 
 
-# the simulator's source digest, a param of the simulate checkpoint (simulate.smk)
-def twin_digest():
-    """sha256 of the simulator's source files (names and bytes), first 16 hex digits."""
-    import hashlib
-
-    h = hashlib.sha256()
-    src = Path(workflow.basedir) / "gaitval" / "simulate"
-    for f in sorted(src.rglob("*.py")):
-        h.update(f.relative_to(src).as_posix().encode())
-        h.update(b"\0")
-        h.update(f.read_bytes())
-    return h.hexdigest()[:16]
-
-
-TWIN = twin_digest()
+# the simulator's source digest, a param of the simulate checkpoint (simulate.smk): its
+# files (names and bytes), gaitval.report.provenance.source_digest of gaitval/simulate/
+TWIN = source_digest(Path(workflow.basedir) / "gaitval" / "simulate")
