@@ -23,6 +23,11 @@ counts as a miss is put in one class, the first that applies:
 ``no hypothesis``
     observations, but no hypothesis near (they were explained, static, or unpaired).
 
+For the misses whose first failed test is "legs do not pass", whether the hypothesis near
+also fails the world-frame walk, has no known world frame over its window, or walks (the
+test that v14 of benchmarks/people_gate.py let confirm alone): the first failed test is
+not the only one.
+
 Then every confirmed person that ended: the scan, why (``left the area`` / ``unsupported``),
 how long it had been unseen, how far its last observed centre was from the annotation
 (the latest click of the last 5 scans), and on how many of the annotated scans of the next 3 s a leg observation lay
@@ -107,6 +112,7 @@ def main() -> None:
     seen = collections.defaultdict(list)            # k -> [(status, cx, cy, why)]
     why: dict[int, str] = {}                        # person id -> last failed test
     spread: dict[int, float] = {}                   # person id -> r spread in the window
+    walk: dict[int, str] = {}                       # person id -> walk_state
     ended = kind.deleter.ended
     ends = []                                       # (k, pid, why, unseen s, last centre)
     refound = []                                    # (t, pid, centre)
@@ -114,7 +120,7 @@ def main() -> None:
     def observed_ended(p, k, tk, area):
         out = ended(p, k, tk, area)
         seen[k].append((p.status, *p.centre(), why.get(p.pid, "young"),
-                        spread.get(p.pid)))
+                        spread.get(p.pid), walk.get(p.pid)))
         if out and p.reported:
             ends.append((k, p.pid, out, tk - p.t_last_seen, p.seen_centre))
         return out
@@ -141,6 +147,7 @@ def main() -> None:
         def observed_step(p, k):
             ok = step(p, k)
             why[p.pid] = "static" if ok else why_not(c, p)
+            walk[p.pid] = walk_state(c, p)
             rs = [r for r in p.confirm_memory["win"] if r is not None]
             if len(rs) >= 2:
                 ux, uy = principal_axis(rs)
@@ -163,6 +170,7 @@ def main() -> None:
     f = f[np.isfinite(f["gt_x_m"])]
     classes = collections.Counter()
     class_of = {}
+    near_of = {}
     n_known = n_still = 0
     for r in f[f["event"] == "MISS"].itertuples():
         g = (r.gt_x_m, r.gt_y_m)
@@ -179,6 +187,7 @@ def main() -> None:
             c = "no hypothesis"
         classes[c] += 1
         class_of[int(r.k)] = c
+        near_of[int(r.k)] = near
         hs = [h for h in near if h[4] is not None]
         if hs:
             n_known += 1
@@ -187,6 +196,14 @@ def main() -> None:
     print(f"{n} misses of {len(f)} annotated scans")
     for c, k in classes.most_common():
         print(f"  {k:5d} ({100 * k / n:4.1f} %)  {c}")
+    # the first failed test is not the only one: would the walk alone have passed?
+    gait = [near_of[k] for k, c in class_of.items() if c == "tentative: legs do not pass"]
+    states = collections.Counter(
+        max((h[5] for h in hs if h[0] == lc.TENTATIVE and getattr_why(h) == "legs do not pass"),
+            key=lambda w: WALK_RANK.get(w, -1), default=None) for hs in gait)
+    print(f"  of the {len(gait)} 'legs do not pass' misses, the hypothesis near also fails "
+          f"the walk on {states['no walk']}, has no known world frame over its window on "
+          f"{states['world unknown']}, and walks (d_w steadily) on {states['walks']}")
     print(f"  on {n_still} of the {n_known} misses with a hypothesis near, its legs are still "
           "(r spread < w_l over 1.4 s)")
     # the confirmed persons that ended, and the re-finds
@@ -247,6 +264,23 @@ def main() -> None:
               f"observation within 0.5 m on a static cell on {absorbed}")
         print("    " + "; ".join(f"{c}: {n}" for c, n in collections.Counter(
             class_of[int(k)] for k in run).most_common()))
+
+
+WALK_RANK = {"world unknown": 0, "no walk": 1, "walks": 2}
+
+
+def walk_state(c, person) -> str | None:
+    """Whether the body's steady walk in the world frame (``MOfNMoving._walks``, the test
+    that v14 let confirm alone) holds over ``person``'s window: ``walks`` / ``no walk``, or
+    ``world unknown`` (the window spans more than one ego-motion segment); None before the
+    window is full or fails M of N."""
+    mem = person.confirm_memory
+    if len(mem["win"]) < c.n or sum(r is not None for r in mem["win"]) < c.m:
+        return None
+    segs = {x[0] for x in mem["world"] if x is not None}
+    if len(segs) != 1:
+        return "world unknown" if segs else "no walk"
+    return "walks" if c._walks(mem) else "no walk"
 
 
 def getattr_why(h) -> str:
