@@ -642,7 +642,7 @@ def test_scan_matching_calls_a_step_faster_than_the_sensor_moves_unknown():
     assert seg_slow.max() == 0
 
 
-# -- issue 36, v9–v12 (benchmarks/people_gate.py) -------------------------------------------
+# -- issue 36, v9–v14 (benchmarks/people_gate.py) -------------------------------------------
 def test_a_coasting_person_is_taken_over_where_it_was_last_seen():
     """``refind: leg_tracker_gate`` with ``coasting: true`` (not the default): a walker
     (1 m/s) stops and is unseen for 0.8 s; its constant-velocity prediction runs on, so
