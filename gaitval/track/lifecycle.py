@@ -630,8 +630,12 @@ class LegTrackerGate(Refind):
 def _nearest_pairs(pairs, dist, gate) -> list:
     """One-to-one pairs (a, b) of ``pairs`` with dist(a, b) ≤ gate(a, b) (gate < 0: none),
     nearest first."""
-    cand = sorted(((dist(a, b), i) for i, (a, b) in enumerate(pairs)
-                   if dist(a, b) <= gate(a, b)), key=lambda c: c[0])
+    cand = []
+    for i, (a, b) in enumerate(pairs):
+        d = dist(a, b)
+        if d <= gate(a, b):
+            cand.append((d, i))
+    cand.sort(key=lambda c: c[0])
     out, used_a, used_b = [], set(), set()
     for _, i in cand:
         a, b = pairs[i]

@@ -430,19 +430,19 @@ class PeopleTracker(TrackerKind):
                     confirmer.step(p, k)
                 persons.append(p)
             # a recently ended person found again keeps its confirmation and its id
-            for p, pid in refind.match([p for p in persons if p.status == TENTATIVE], tk):
+            # ... and a coasting person found where it was last seen, its prediction elsewhere
+            tentative = [p for p in persons if p.status == TENTATIVE]
+            found = refind.match(tentative, tk)
+            refound = {id(p) for p, _ in found}
+            taken_over = refind.take_over([p for p in tentative if id(p) not in refound],
+                                          [p for p in persons if p.status == COASTING], tk)
+            for p, q in taken_over:
+                q.status = ENDED
+                found.append((p, q.pid))
+            for p, pid in found:
                 p.status = CONFIRMED
                 look.confirmed(p)
                 p.pid = pid
-                n_refound += 1
-            # ... and a coasting person found where it was last seen, its prediction elsewhere
-            taken_over = refind.take_over([p for p in persons if p.status == TENTATIVE],
-                                          [p for p in persons if p.status == COASTING], tk)
-            for p, q in taken_over:
-                p.status = CONFIRMED
-                look.confirmed(p)
-                p.pid = q.pid
-                q.status = ENDED
                 n_refound += 1
             if taken_over:
                 persons = [p for p in persons if p.status != ENDED]
