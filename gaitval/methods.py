@@ -469,7 +469,7 @@ METHODS["people"] = {
              # an ended person found again near where it was last seen (leg_tracker's person
              # gate and deletion bound, lifecycle.LegTrackerGate)
              "refind": {"name": "leg_tracker_gate", "max_std_m": 0.9, "percentile": 0.90,
-                        "std_obs_m": 0.1, "assoc_extra_m": 0.4},
+                        "std_obs_m": 0.1, "assoc_extra_m": 0.4, "coasting": True},
              # no odometry in the recordings: the sensor's motion from its scans, and a map
              # of what stays put (leg_tracker's local occupancy grid), both online
              "ego_motion": {"name": "scan_matching", "max_pair_m": 0.5, "trim": 0.8,

@@ -321,7 +321,7 @@ def test_the_people_method_names_its_refind_role():
     of leaving them to the constructor's default."""
     kind = METHODS["people"]["kind"]
     assert kind["refind"] == {"name": "leg_tracker_gate", "max_std_m": 0.9, "percentile": 0.90,
-                              "std_obs_m": 0.1, "assoc_extra_m": 0.4}
+                              "std_obs_m": 0.1, "assoc_extra_m": 0.4, "coasting": True}
     assert type(build_method("people").refind).__name__ == "LegTrackerGate"
 
 
@@ -644,7 +644,7 @@ def test_scan_matching_calls_a_step_faster_than_the_sensor_moves_unknown():
 
 # -- issue 36, v9–v14 (benchmarks/people_gate.py) -------------------------------------------
 def test_a_coasting_person_is_taken_over_where_it_was_last_seen():
-    """``refind: leg_tracker_gate`` with ``coasting: true`` (not the default): a walker
+    """``refind: leg_tracker_gate`` with ``coasting: true`` (the default since v15): a walker
     (1 m/s) stops and is unseen for 0.8 s; its constant-velocity prediction runs on, so
     when its legs are seen again, standing where it stopped, they are outside its gates.
     With the take-over the new hypothesis there is that person at once (same id, confirmed,
@@ -659,7 +659,7 @@ def test_a_coasting_person_is_taken_over_where_it_was_last_seen():
             (np.zeros((0, 2)) if k < k_stop + gap else stand) for k in range(n)]
     xy, pats = _observations(legs, np.random.default_rng(7))
     area = {"name": "rectangle", "x_m": [0.0, 8.0], "y_m": [-2.0, 2.0]}
-    refind = dict(METHODS["people"]["kind"]["refind"])
+    refind = {**METHODS["people"]["kind"]["refind"], "coasting": False}
     off = _tracker(area=area, refind=refind, motion=CV).run(_scans(n), xy, pats, 0.10)
     assert off.n_refound == 0 and off.people["k"].max() < n - 1
     last = off.people[off.people["k"] == off.people["k"].max()]
