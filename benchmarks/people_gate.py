@@ -383,6 +383,33 @@ scans to the persons and the labels the online method reports.  Nothing else cha
 
 Criteria (a)–(d) as for v16, against v15's tables.  The outdoor score is measured once
 afterwards, reported as the offline method's beside the online row.
+
+Result (v18): **not adopted**: (a) met (0 / 0 / 0 reported).  (b) **not met**: TUG
+23 → 23 of 28, MTST (mocap) 18 → 17 of 48 (one trial changed: ``mtst_E07_t1`` success →
+false swap), rollator 2,258 → 2,258 error frames, median RMSE ratio 1.000.  (c) met.  (d)
+and outdoors: not run.  Per-step cause (``mtst_E07_t1``): the backward pass follows the
+participant from scan 165 down to scan 0 and swaps its two legs at scan 92 (forward time),
+where they cross; from there to the forward pass's first scan (58) its labels are the
+opposite of the forward pass's (summed leg distance 0.2–1.0 m "same" against 0.01–0.07 m
+"swapped" on every scan 58–90), on 92–165 the same (≤ 0.03 against 0.8–1.1 m).  v16's rule
+aligns a backward person's labels by the *whole* overlap (74 scans against 34), so the
+extension 27–57 inherited the swapped labels (31 scans swapped against the mocap; every
+scan the forward pass reports is right).
+
+Twelfth change (v19), written with its criteria before its first run, after v18's results
+above were known.
+
+The change.  v18, with the backward rows aligned where they are spliced in: the backward
+rows a group takes (the scans no forward member reports) fall into runs of consecutive
+scans of one backward member; each run's labels are swapped when that brings the member's
+legs nearer to the forward member's on the scans *next to the run* that both report —
+those within one confirmation window (1.4 s, the ``m_of_n_moving`` window) before the
+run's first scan and after its last (summed distance).  A run with no such scan keeps
+v16's whole-overlap rule.  The labels are thus continued across each splice from the
+online method's own labels there.  Nothing else changes.
+
+Criteria (a)–(d) as for v16, against v15's tables.  The outdoor score is measured once
+afterwards, reported as the offline method's beside the online row.
 """
 from __future__ import annotations
 
