@@ -41,6 +41,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("lasers", nargs="*", default=DEFAULT)
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--method", default="people",
+                    help="people (online) or people_offline (both passes, v16-v17)")
     args = ap.parse_args()
     from gaitval.detect.base import split_observations
     from gaitval.io.rosbag import read_rosbag_scans
@@ -53,7 +55,7 @@ def main() -> None:
         span = float(scans.t[-1] - scans.t[0] + np.median(d[d > 0]))
         cpu = []
         for _ in range(args.repeats):
-            kind = build_method("people")
+            kind = build_method(args.method)
             c0 = time.process_time()
             kind.track(scans, 0.10)
             cpu.append(time.process_time() - c0)
@@ -62,7 +64,7 @@ def main() -> None:
         print(f"{name}: {scans.n_scans} scans, {span:.1f} s recorded, CPU "
               f"{', '.join(f'{c:.2f}' for c in cpu)} s -> real-time factor "
               f"{span / med:.1f}x (median of {args.repeats})")
-        kind = build_method("people")
+        kind = build_method(args.method)
         xy, pats = split_observations(kind.detector.detect(scans, 0.10), scans.n_scans)
         res = kind.run(scans, xy, pats, 0.10, profile=True)
         people = res.people.groupby("k")["person_id"].nunique().reindex(

@@ -485,3 +485,14 @@ METHODS["people"] = {
              "init": None, "max_leg_separation_m": 0.8, "person_points_m": 0.13, "dt_s": None,
              "sides": "walking_direction"},
 }
+
+# The same tracker reading the recording forwards and backwards (issue 36, v16,
+# benchmarks/people_gate.py; gaitval/track/passes.py): an offline method, since the backward
+# pass uses scans after the one it reports.  Not comparable with an online tracker
+# (leg_tracker); `people` stays the online one.
+METHODS["people_offline"] = copy.deepcopy(METHODS["people"])
+METHODS["people_offline"]["label"] = ("People tracker, offline (forward and backward passes "
+                                      "joined)")
+METHODS["people_offline"]["kind"]["passes"] = {
+    "name": "forward_backward", "max_std_m": 0.9, "percentile": 0.90, "std_obs_m": 0.1,
+    "assoc_extra_m": 0.4, "extend_only": True, "splice_window_s": 1.4}

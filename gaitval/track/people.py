@@ -45,7 +45,7 @@ scanners. IEEE ICRA 2015 (life cycle defaults, see :mod:`gaitval.track.lifecycle
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -62,6 +62,7 @@ from gaitval.track.lifecycle import (AREAS, BIRTHS, COASTING, CONFIRMED, CONFIRM
                                      DELETERS, ENDED, REFINDS, TENTATIVE)
 from gaitval.track.motion import MOTION_MODELS
 from gaitval.track.observations import DetectionSeries
+from gaitval.track.passes import PASSES, reverse_rows
 from gaitval.track.phase import PHASE_MODELS
 from gaitval.track.staticmap import (ARRIVALS, EGO_MOTIONS, STATIC_MAPS, scan_points,
                                      to_world)
@@ -159,8 +160,12 @@ class PeopleTracker(TrackerKind):
         The sensor's motion and the map of what never moves (:mod:`gaitval.track.staticmap`):
         an observation on a static cell starts no person, and a tentative person with
         both legs on static cells is not confirmed (leg_tracker's "in free space").
+    passes : spec
+        ``forward`` (online, the default) or ``forward_backward`` (offline: the scans are
+        also read in reverse order and the passes joined; :mod:`gaitval.track.passes`).
     init : spec or None
-        An initialiser whose pair starts a confirmed person (module notes).
+        An initialiser whose pair starts a confirmed person (module notes; forward pass
+        only).
     max_leg_separation_m : float
         An observation further than this from a person's other leg (predicted) is not that
         person's leg (leg_tracker's ``max_leg_pairing_dist``, 0.8 m).
@@ -180,7 +185,7 @@ class PeopleTracker(TrackerKind):
                  area="field_of_view", ego_motion="none", static_map="none",
                  init=None, tentative_gate=None, tentative_motion=None,
                  refind="leg_tracker_gate",
-                 appearance="none", arrival="none",
+                 appearance="none", arrival="none", passes="forward",
                  max_leg_separation_m: float = 0.8, person_points_m: float = 0.13,
                  dt_s: float | None = None, sides: str = "walking_direction"):
         self.detector = DETECTORS.build(detector)
@@ -200,6 +205,7 @@ class PeopleTracker(TrackerKind):
         self.ego_motion = EGO_MOTIONS.build(ego_motion)
         self.static_map = STATIC_MAPS.build(static_map)
         self.arrival = ARRIVALS.build(arrival)
+        self.passes = PASSES.build(passes)
         self.init = INITIALISERS.build(init) if init else None
         self.max_leg_separation_m = max_leg_separation_m
         self.person_points_m = person_points_m
@@ -221,17 +227,51 @@ class PeopleTracker(TrackerKind):
             ) -> PeopleResult:
         """Track every person through precomputed per-scan observations (``xy[k]``: (J, 2)
         array, ``pats[k]``: their patterns).  ``profile``: also return ``scan_seconds`` and
-        ``scan_hypotheses`` (per scan: time spent, person hypotheses alive) as attributes of
-        the result (benchmarks/people_tracker.py), and ``scan_static`` (per scan: for each
-        observation, whether it lay on a static cell of the map; benchmarks/people_misses.py)."""
+        ``scan_hypotheses`` (per scan: time spent, person hypotheses alive; both passes
+        summed) as attributes of the result (benchmarks/people_tracker.py), and
+        ``scan_static`` (per scan: for each observation, whether it lay on a static cell of
+        the forward pass's map; benchmarks/people_misses.py).
+
+        With ``passes: forward_backward`` the same loop also reads the scans in reverse
+        order and the two passes are joined (:mod:`gaitval.track.passes`)."""
+        t = np.asarray(scans.t, dtype=float)
+        n = len(t)
+        if n == 0:
+            return _empty(t)
+        rows, n_born, n_conf, n_refound, prof = self._pass(scans, xy, pats, leg_width_m,
+                                                           profile, self.init)
+        people = _people_frame(rows)
+        subject = None
+        if self.passes.backward:
+            rscans = replace(scans, t=(t[0] + t[-1]) - t[::-1],
+                             ranges=np.ascontiguousarray(scans.ranges[::-1]))
+            brows, b_born, b_conf, b_refound, bprof = self._pass(
+                rscans, list(xy)[::-1], list(pats)[::-1], leg_width_m, profile, None)
+            back = reverse_rows(_people_frame(brows), t)
+            dt0 = float(step_durations(t, self.dt_s)[0]) if n > 1 else float(self.dt_s or 0.1)
+            # the subject and its labels are the forward (online) pass's (v18)
+            ahead = self._result(t, people, n_born, n_conf)
+            people, ids = self.passes.join(people, back, dt0)
+            if ahead.subject_id >= 0:
+                subject = (ids.get(ahead.subject_id, ahead.subject_id), ahead.swapped_sides)
+            n_born, n_conf, n_refound = n_born + b_born, n_conf + b_conf, n_refound + b_refound
+            if profile:
+                prof = (prof[0] + bprof[0][::-1], prof[1] + bprof[1][::-1], prof[2])
+        res = self._result(t, people, n_born, n_conf, subject)
+        res.n_refound = n_refound
+        if profile:
+            res.scan_seconds, res.scan_hypotheses, res.scan_static = prof
+        return res
+
+    def _pass(self, scans, xy, pats, leg_width_m: float, profile: bool, init):
+        """One pass of the loop over the scans in their order (module notes): the reported
+        rows, hypotheses born / confirmed / re-found, and the profile (or None)."""
         # scipy here, not at the top: the Snakefile imports this module (the kind registry)
         from scipy.optimize import linear_sum_assignment
 
         from time import perf_counter
         t = np.asarray(scans.t, dtype=float)
         n = len(t)
-        if n == 0:
-            return _empty(t)
         dts = (step_durations(t, self.dt_s)[1] if n > 1 else np.array([self.dt_s or 0.1]))
         dt0 = float(step_durations(t, self.dt_s)[0]) if n > 1 else float(dts[0])
         F = self.filter.for_leg_width(leg_width_m)
@@ -245,8 +285,8 @@ class PeopleTracker(TrackerKind):
         score = look.scores(scans, xy)          # per scan, P(leg) of each observation
         smap, arrived, seg = None, None, None
         seeded = None
-        if self.init is not None:
-            seeded = self.init.find(DetectionSeries(xy, pats), leg_width_m)
+        if init is not None:
+            seeded = init.find(DetectionSeries(xy, pats), leg_width_m)
         persons: list[Person] = []
         rows: list[tuple] = []
         next_id = 1
@@ -457,28 +497,28 @@ class PeopleTracker(TrackerKind):
                 cost.append(perf_counter() - t_start)
                 alive.append(len(persons))
                 on_static.append(static)
-        people = pd.DataFrame.from_records(rows, columns=list(PEOPLE_COLUMNS))
-        people = people.astype({"k": np.int64, "person_id": np.int64, "phase": np.int64,
-                                "observed": bool})
-        res = self._result(t, people, n_born, n_conf)
-        res.n_refound = n_refound
-        if profile:
-            res.scan_seconds = np.asarray(cost)
-            res.scan_hypotheses = np.asarray(alive, dtype=np.int64)
-            res.scan_static = on_static
-        return res
+        prof = ((np.asarray(cost), np.asarray(alive, dtype=np.int64), on_static) if profile
+                else None)
+        return rows, n_born, n_conf, n_refound, prof
 
     # -- output ------------------------------------------------------------------------------
-    def _result(self, t, people: pd.DataFrame, n_born: int, n_conf: int) -> PeopleResult:
+    def _result(self, t, people: pd.DataFrame, n_born: int, n_conf: int,
+                subject: tuple[int, bool] | None = None) -> PeopleResult:
+        """``subject``: (person id, swap its labels) decided elsewhere (the forward pass's,
+        with ``passes: forward_backward``); None: the person observed on most scans,
+        labelled by its walking direction (``sides``)."""
         res = _empty(t)
         res.people, res.n_born, res.n_confirmed = people, n_born, n_conf
         if people.empty:
             return res
-        seen = people[people["observed"]].groupby("person_id")["k"].nunique()
-        if seen.empty:
-            seen = people.groupby("person_id")["k"].nunique()
-        best = seen.max()
-        sid = int(seen[seen == best].index.min())        # ties: the earliest person
+        if subject is not None:
+            sid = int(subject[0])
+        else:
+            seen = people[people["observed"]].groupby("person_id")["k"].nunique()
+            if seen.empty:
+                seen = people.groupby("person_id")["k"].nunique()
+            best = seen.max()
+            sid = int(seen[seen == best].index.min())    # ties: the earliest person
         res.subject_id = sid
         sub = people[people["person_id"] == sid]
         for f, side in enumerate("LR"):
@@ -493,9 +533,18 @@ class PeopleTracker(TrackerKind):
             if f == 0:
                 res.phase[k] = leg["phase"].to_numpy(np.int8)
         res.k_init = int(sub["k"].min())
-        if self.sides == "walking_direction" and handedness(res) < 0:
+        if subject is not None:
+            if subject[1]:
+                swap_sides(res)
+        elif self.sides == "walking_direction" and handedness(res) < 0:
             swap_sides(res)
         return res
+
+
+def _people_frame(rows: list[tuple]) -> pd.DataFrame:
+    people = pd.DataFrame.from_records(rows, columns=list(PEOPLE_COLUMNS))
+    return people.astype({"k": np.int64, "person_id": np.int64, "phase": np.int64,
+                          "observed": bool})
 
 
 def _evidence_centre(p: Person, evidence: str) -> tuple[float, float]:
