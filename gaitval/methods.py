@@ -496,3 +496,11 @@ METHODS["people_offline"]["label"] = ("People tracker, offline (forward and back
 METHODS["people_offline"]["kind"]["passes"] = {
     "name": "forward_backward", "max_std_m": 0.9, "percentile": 0.90, "std_obs_m": 0.1,
     "assoc_extra_m": 0.4, "extend_only": True, "splice_window_s": 1.4}
+
+
+def reads_later_scans(name: str) -> bool:
+    """Does method ``name`` report a scan using scans recorded after it (an offline method:
+    the people tracker's ``forward_backward`` passes)?  Unknown names: False."""
+    kind = METHODS.get(name, {}).get("kind", {})
+    passes = kind.get("passes") if isinstance(kind, dict) else None
+    return (passes.get("name") if isinstance(passes, dict) else passes) == "forward_backward"

@@ -25,7 +25,7 @@ The join (per pair of persons, forward f and backward b, reported on common scan
 
     d(f, b) = median over the scans both report of |c_f(k) − c_b(k)|   (c: body centre)
     f ~ b   ⇔  d(f, b) ≤ g(0)      (leg_tracker's person gate with no unobserved scan,
-                                    lifecycle.leg_tracker_person_gate; 0.84 m at 10 Hz)
+                                    lifecycle.leg_tracker_person_gate; 0.83 m at 10 Hz and 7.5 Hz)
 
 Links are taken nearest first (smallest d, then the forward id, then the backward id);
 two groups are joined only if the result holds at most one person of each pass on any
