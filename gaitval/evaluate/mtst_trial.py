@@ -29,7 +29,8 @@ from gaitval.registration.rigid import sensor_to_field
 
 #: The ``mtst:`` config section and its defaults (schema: workflow/schemas/config.schema.yaml)
 DEFAULTS: dict = {
-    "methods": ["mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed", "people"],
+    "methods": ["mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed", "people",
+                "people_offline"],
     "scan_period_s": 0.05,
     "targets": None,
     "target_size_m": [0.165, 0.160],

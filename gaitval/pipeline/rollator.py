@@ -37,7 +37,8 @@ from gaitval.pipeline.steps import (PROTOCOL_SCOPE, load_json, method_definition
                                     trial_and_subject)
 
 #: defaults of the ``rollator:`` keys read here
-DEFAULTS = {"kf_method": "rollator_kf", "pf_method": "rollator_pf", "methods": ["people"],
+DEFAULTS = {"kf_method": "rollator_kf", "pf_method": "rollator_pf",
+            "methods": ["people", "people_offline"],
             "pf_seed": 2017,
             "train_seed": 0, "error_m": 0.10, "figure_trial": None}
 

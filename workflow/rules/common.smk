@@ -488,7 +488,8 @@ def parent_of(name, up=0):
 
 def tug_methods():
     """The TUG tracker methods to run (config tug.methods)."""
-    return list(config.get("tug", {}).get("methods", ["tug_m1", "tug_m2", "tug_m3", "people"]))
+    return list(config.get("tug", {}).get("methods", ["tug_m1", "tug_m2", "tug_m3", "people",
+                                                        "people_offline"]))
 
 
 def _reading_variants():
