@@ -209,7 +209,10 @@ def test_a_rollator_setting_reruns_only_the_rollator_trials(tiny_run, tmp_path):
     sheet = pd.read_csv(tiny_run / "data" / "tiny" / "trials.csv")
     n_rollator = int((sheet["protocol"] == "rollator").sum())
     assert n_rollator > 0
-    assert planned["rollator_track"] == 3          # KF, PF and people (rollator.methods)
+    import yaml
+    extra = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["rollator"]["methods"]
+    assert extra == ["people", "people_offline"]
+    assert planned["rollator_track"] == 2 + len(extra)    # KF, PF and rollator.methods
     assert planned["rollator_tables"] == 1
     assert planned["register"] == 1                # the rollator family's job only
     import re

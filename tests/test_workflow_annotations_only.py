@@ -23,7 +23,8 @@ from gaitval.evaluate.mtst_tracking import CATEGORIES
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = Path(sys.executable).parent / "snakemake"
 STUDY = "mtst_annot"
-METHODS = ["mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed", "people"]   # config mtst.methods
+#: config mtst.methods (the paper's four, people and people_offline)
+METHODS = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["mtst"]["methods"]
 
 
 def build_study(out: Path, sim: Path | None = None) -> Path:
