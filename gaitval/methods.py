@@ -498,9 +498,9 @@ METHODS["people_offline"]["kind"]["passes"] = {
     "assoc_extra_m": 0.4, "extend_only": True, "splice_window_s": 1.4}
 
 
-def reads_later_scans(name: str) -> bool:
-    """Does method ``name`` report a scan using scans recorded after it (an offline method:
-    the people tracker's ``forward_backward`` passes)?  Unknown names: False."""
-    kind = METHODS.get(name, {}).get("kind", {})
+def reads_later_scans(definition: dict[str, Any]) -> bool:
+    """Does a method (its definition, :func:`get_method`) report a scan using scans recorded
+    after it — an offline method: the people tracker's ``forward_backward`` passes?"""
+    kind = definition.get("kind")
     passes = kind.get("passes") if isinstance(kind, dict) else None
     return (passes.get("name") if isinstance(passes, dict) else passes) == "forward_backward"

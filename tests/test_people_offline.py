@@ -34,8 +34,8 @@ def _side_at(df, pid, k, side):
 def test_the_offline_method_is_the_people_method_read_both_ways():
     assert OFFLINE["name"] == "forward_backward" and OFFLINE["extend_only"]
     assert "passes" not in METHODS["people"]["kind"]           # people stays online
-    assert reads_later_scans("people_offline") and not reads_later_scans("people")
-    assert not reads_later_scans("no such method")
+    assert reads_later_scans(METHODS["people_offline"])
+    assert not reads_later_scans(METHODS["people"]) and not reads_later_scans(METHODS["tug_m1"])
     assert set(PASSES.names()) >= {"forward", "forward_backward"}
     # the link gate is leg_tracker's person gate with no unobserved scan (0.83 m at 10 Hz)
     gate = PASSES.build(OFFLINE).link_gate(0.1)
@@ -138,3 +138,20 @@ def test_nothing_to_join_leaves_the_forward_pass_as_it_is():
     fwd = _rows(1, range(3), lambda k: (1.0, 0.1), lambda k: (1.0, -0.1))
     out, ids = join_passes(fwd, fwd.iloc[0:0], 0.84, extend_only=True)
     assert out is fwd and ids == {}
+
+
+def test_the_benchmark_table_marks_offline_whatever_the_method_is_called(tmp_path):
+    """The ``online`` column follows the definition the track ran with (its method view):
+    a study's own method composing ``forward_backward``, or ``people`` switched to it by an
+    override, is offline; ``people`` as built in is not."""
+    import json
+
+    from gaitval.pipeline.steps import offline_methods
+    mine = {"label": "mine", "kind": dict(METHODS["people_offline"]["kind"])}
+    views = {"mine": {"tracking": {"methods": {"mine": mine}}},
+             "people": {"tracking": {"overrides": {"people": {"kind__passes": OFFLINE}}}},
+             "tug_m1": {}}
+    for m, cfg in views.items():
+        (tmp_path / f"{m}.json").write_text(json.dumps(cfg))
+    assert offline_methods(tmp_path, ["mine", "people", "tug_m1"]) == {"mine", "people"}
+    assert offline_methods(None, ["people", "people_offline", "x"]) == {"people_offline"}

@@ -33,7 +33,8 @@ import pandas as pd
 from gaitval.errors import ConfigError, GaitvalError
 from gaitval.io.atomic import write_parquet
 from gaitval.io.parquet import read_parquet
-from gaitval.pipeline.steps import load_json, method_definition, method_overrides
+from gaitval.pipeline.steps import (load_json, method_definition, method_display_names,
+                                    method_overrides, offline_methods)
 
 INITS = ("own", "annotation")
 #: How many of the person's later clicks the annotation initialiser is given: at least its
@@ -333,15 +334,16 @@ def legbench_tables_step(inputs, tables_dir, figures_dir, reports_dir, config_ha
         r = s.iloc[0]
         frames[(r["trial"], r["method"], r["init"])] = read_parquet(d / FRAMES_FILE)
     summary = pd.concat(summaries, ignore_index=True)
+    offline = offline_methods(views_dir, list(dict.fromkeys(summary["method"])))
     if views_dir:
-        from gaitval.pipeline.steps import method_display_names
         shown = method_display_names(views_dir, list(dict.fromkeys(summary["method"])))
         if any(shown.get(m, m) != m for m in shown):
             summary["method"] = summary["method"].map(lambda m: shown.get(m, m))
             frames = {(t, shown.get(m, m), i): f for (t, m, i), f in frames.items()}
             methods = [shown.get(m, m) for m in methods] if methods else methods
+            offline = {shown.get(m, m) for m in offline}
     paths = write_legbench_table(summary, Path(tables_dir) / "legbench_clearmot",
-                                 methods=methods, inits=inits)
+                                 methods=methods, inits=inits, offline=offline)
     fig = write_legbench_figure(frames, summary, Path(figures_dir) / "legbench_tracks.png",
                                 methods=methods, inits=inits)
     stamp("legbench_tables", [*paths, fig], reports_dir, config_hash_=config_hash)

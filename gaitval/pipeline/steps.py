@@ -259,19 +259,45 @@ def method_display_names(view_dir: str | Path, methods) -> dict[str, str]:
     """method -> its name in the tables (``tug_m3 (occlusion.max_n = 10)`` when run with
     overrides), from the method views ``<view_dir>/<method>.json`` beside a tables step's
     study view (the views its tracks ran with); a method without a view keeps its name."""
-    from gaitval.methods import display_name, get_method, set_params
+    from gaitval.methods import display_name
 
     out = {}
     for m in methods:
-        p = Path(view_dir) / f"{m}.json"
-        if p.is_file():
-            cfg = load_json(p)
-            if m in ((cfg.get("tracking") or {}).get("external") or {}):
-                continue                      # an external method (issue 37): its name
-            d = set_params(get_method(method_definition(cfg, m)),
-                           method_overrides(cfg, m))
+        d = _resolved_method(view_dir, m)
+        if d is not None:
             out[m] = display_name(m, d)
     return out
+
+
+def offline_methods(view_dir: str | Path | None, methods) -> set[str]:
+    """The methods that report a scan using scans recorded after it (issue 36:
+    ``people_offline``), judged on the definitions the tracks ran with (the method views in
+    ``view_dir``; a method without a view: its built-in definition, if there is one)."""
+    from gaitval.methods import METHODS, get_method, reads_later_scans
+
+    out = set()
+    for m in methods:
+        d = _resolved_method(view_dir, m) if view_dir else None
+        if d is None and m in METHODS:
+            d = get_method(m)
+        if d is not None and reads_later_scans(d):
+            out.add(m)
+    return out
+
+
+def _resolved_method(view_dir: str | Path, m: str) -> dict | None:
+    """Method ``m``'s definition as its view ``<view_dir>/<m>.json`` resolves it
+    (``tracking.methods`` and ``tracking.overrides``); None without a view, or for an
+    external method (issue 37)."""
+    from gaitval.methods import get_method, set_params
+
+    p = Path(view_dir) / f"{m}.json"
+    if not p.is_file():
+        return None
+    cfg = load_json(p)
+    if m in ((cfg.get("tracking") or {}).get("external") or {}):
+        return None
+    return set_params(get_method(method_definition(cfg, m)), method_overrides(cfg, m))
 
 
 def method_definition(cfg: dict, method: str):

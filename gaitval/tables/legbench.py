@@ -83,7 +83,8 @@ BENCH_COLUMNS = ["benchmark_set", "tracker", "source", "online", "annotations", 
                  "matched_pct", "misses", "idsw", "idsw_ref", "fp", "mota_pct", "motp_m"]
 
 
-def benchmark_table(summary: pd.DataFrame, methods=None, inits=None) -> pd.DataFrame:
+def benchmark_table(summary: pd.DataFrame, methods=None, inits=None, offline=()
+                    ) -> pd.DataFrame:
     """The published rows of each benchmark set beside gaitval's, counted the way the
     set's authors count (issue 36; spec ``leg-tracker-benchmark.md``).
 
@@ -96,10 +97,9 @@ def benchmark_table(summary: pd.DataFrame, methods=None, inits=None) -> pd.DataF
     less the reference script's ID switches (matched + ``idsw_ref`` + misses =
     annotations).  ``idsw`` is py-motmetrics' count (a person matched to another
     hypothesis), ``idsw_ref`` the reference script's (also a hypothesis matched to another
-    person); published rows have only the reference count.
+    person); published rows have only the reference count.  ``offline``: the methods that
+    read scans recorded after the one they report (column ``online`` "no").
     """
-    from gaitval.methods import reads_later_scans     # here: the table's import stays light
-
     rows = []
     sets = [b for b in BENCHMARK_SETS if "benchmark_set" in summary.columns
             and (summary["benchmark_set"] == b).any()]
@@ -125,7 +125,7 @@ def benchmark_table(summary: pd.DataFrame, methods=None, inits=None) -> pd.DataF
             d = (ex["motp_m"].fillna(0.0) * pairs).sum()
             rows.append({"benchmark_set": b, "tracker": f"gaitval {m} ({i} init)",
                          "source": "reproduced",
-                         "online": "no (reads later scans)" if reads_later_scans(m) else "yes",
+                         "online": "no (reads later scans)" if m in offline else "yes",
                          "annotations": gt, "matched": matched,
                          "matched_pct": 100.0 * matched / gt if gt else np.nan,
                          "misses": fn, "idsw": sw, "idsw_ref": int(g["idsw_ref"].sum()),
@@ -155,8 +155,9 @@ def _bench_notes(b: pd.DataFrame) -> list[str]:
     if (b["online"] != "yes").any():
         notes.append("online: does the tracker report a scan from that scan and the ones "
                      "before it (as a robot must, and as the published trackers do)? An "
-                     "offline gaitval method (people_offline) also reads the recording "
-                     "backwards: its rows are not comparable with the published ones.")
+                     "offline gaitval method (such as people_offline) also reads the "
+                     "recording backwards: its rows are not comparable with the published "
+                     "ones.")
     for bset, g in b.groupby("benchmark_set", sort=False):
         pub = g[g["source"] != "reproduced"]
         if pub.empty:
@@ -180,12 +181,12 @@ def _bench_notes(b: pd.DataFrame) -> list[str]:
     return notes
 
 
-def write_legbench_table(summary: pd.DataFrame, stem, methods=None, inits=None
-                         ) -> list[Path]:
+def write_legbench_table(summary: pd.DataFrame, stem, methods=None, inits=None,
+                         offline=()) -> list[Path]:
     """Write ``<stem>.csv/.md/.tex`` and, when a recording belongs to a published
     benchmark set, ``legbench_benchmark.*`` beside it."""
     t = legbench_table(summary, methods, inits)
-    b = benchmark_table(summary, methods, inits)
+    b = benchmark_table(summary, methods, inits, offline)
     extra = []
     if not len(b):                      # no published set any more: no stale table left
         for suffix in (".csv", ".md", ".tex"):

@@ -144,8 +144,7 @@ def join_passes(fwd: pd.DataFrame, bwd: pd.DataFrame, gate_m: float,
         return x
 
     def scans_of(g, side):
-        sets = [kf[p] if s == "f" else kb[p] for s, p in members[g] if s == side]
-        return sets
+        return [kf[p] if s == "f" else kb[p] for s, p in members[g] if s == side]
 
     for _, f, b in links:
         a, c = root(("f", f)), root(("b", b))
@@ -165,7 +164,7 @@ def join_passes(fwd: pd.DataFrame, bwd: pd.DataFrame, gate_m: float,
     fid = {p: min(q for s, q in members[root(("f", p))] if s == "f") for p in kf}
     out = [fwd.assign(person_id=fwd["person_id"].map(fid))]
     bparts = []
-    for g, mem in sorted(members.items()):
+    for _, mem in sorted(members.items()):
         bs = sorted(q for s, q in mem if s == "b")
         if not bs:
             continue
