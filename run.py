@@ -218,6 +218,8 @@ def main(argv: list[str]) -> int:
         print(__doc__)
         return 2
     verb, rest = argv[0], argv[1:]
+    accept_refusals = "--accept-refusals" in rest
+    rest = [a for a in rest if a != "--accept-refusals"]
     os.chdir(ROOT)
     env = dict(os.environ, MPLBACKEND="Agg", PATH=f"{BIN}{os.pathsep}{os.environ['PATH']}")
     if verb == "sensitivity":
@@ -234,13 +236,48 @@ def main(argv: list[str]) -> int:
     else:
         ensure_env("test,bench")
         cmd = [str(PY), *rest]
+    target = _workdir(rest) / "logs" / "run_target.json"
+    if verb == "report" and target.is_file():
+        target.unlink()                   # rewritten by the workflow as it reads its config
     print("[run.py] " + " ".join(cmd), flush=True)
     rc = subprocess.call(cmd, env=env)
     if verb == "report" and rc == 0:
         index = _report_index(rest)
         if index is not None and index.is_file():
             print(f"[run.py] report: {index}", flush=True)
+        if not any(a in ("-n", "--dry-run", "--dryrun") for a in rest):
+            rc = closing_summary(target, accept_refusals)
     return rc
+
+
+#: ``run.py report``'s exit code when the report was built but trials were refused.
+EXIT_REFUSED = 3
+
+
+def closing_summary(target: Path, accept_refusals: bool) -> int:
+    """Say how many trials the report analysed and why the others were refused (from the
+    report's ``analysed.json``); :data:`EXIT_REFUSED` when any was, unless accepted."""
+    import json
+    try:
+        reports = Path(json.loads(target.read_text())["reports"])
+        if not reports.is_absolute():
+            reports = target.parent.parent / reports
+        rec = json.loads((reports / "analysed.json").read_text())
+    except (OSError, ValueError, KeyError, TypeError):
+        return 0                               # no report was asked for (a single target)
+    total = sum(int(v["trials"]) for v in rec.values())
+    done = sum(int(v["analysed"]) for v in rec.values())
+    refused = [(st, t, r) for st, v in rec.items() for t, r in v["refused"].items()]
+    print(f"[run.py] analysed {done} of {total} trials"
+          + (f"; {len(refused)} refused:" if refused else ""), flush=True)
+    for st, t, r in refused:
+        print(f"[run.py]   REFUSED {st}/{t} ({r['protocol']}): {r['reason']}", flush=True)
+    if refused and not accept_refusals:
+        print(f"[run.py] exit code {EXIT_REFUSED}: the report leaves the refused trials out "
+              "(its top box says so); fix them, or accept the refusals with "
+              "`python3 run.py report --accept-refusals ...`", flush=True)
+        return EXIT_REFUSED
+    return 0
 
 
 def _report_index(args: list[str]) -> Path | None:

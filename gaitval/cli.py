@@ -34,6 +34,9 @@ def cmd_validate(a) -> int:
     if not a.no_file_check:        # the study's external methods (study.yaml, issue 37)
         from gaitval.pipeline.steps import external_problems
         problems += external_problems(a.sheet, deep=a.deep)
+    from gaitval.io.trialsheet import sheet_warnings
+    for w in sheet_warnings(df):
+        print(f"gaitval: warning: [file {a.sheet}] {w}", file=sys.stderr)
     if problems:
         for p in problems:
             print(f"gaitval: error: {p}", file=sys.stderr)

@@ -359,6 +359,11 @@ def _absolute(base: Path, rel: str) -> str:
         return str(base / rel)
 
 
+#: A hand-measured laser position farther than this from the mocap origin (metres) is no
+#: room's: the largest gait laboratories and motion-capture halls span a few tens of metres,
+#: while a position typed in millimetres is hundreds to thousands.
+MAX_ROOM_M = 50.0
+
 _SENSOR_SUFFIXES = {"ultrasonic": (".us.parquet",),
                     "lrs": (".scan.parquet", ".bag", ".db3", ".mcap", "")}
 
@@ -523,3 +528,31 @@ def load_trial_row(path: str | Path, subjects: str | Path | None, trial: str, *,
         raise TrialSheetError(f"trial {trial!r} is not in the trial sheet", path=path,
                               trial=trial)
     return df.loc[trial].to_dict()
+
+
+def sheet_warnings(df: pd.DataFrame) -> list[str]:
+    """What a sheet holds that is legal but probably a mistake, for ``gaitval validate`` to
+    print beside its problems (the run's registration check refuses the trials that the
+    mistake actually breaks: :mod:`gaitval.registration.plausibility`).
+
+    * a hand-measured position more than :data:`MAX_ROOM_M` from the mocap origin:
+      millimetres look like metres;
+    * every hand-measured yaw within +-2 pi, not all zero: degrees look like radians (a laser
+      aligned with the mocap axes gives 0 or about +-90, +-180 degrees, rarely all below 6.3).
+    """
+    out = []
+    for col in ("sensor_x_m", "sensor_y_m"):
+        v = pd.to_numeric(df[col], errors="coerce") if col in df else pd.Series(dtype=float)
+        for trial, x in v[v.abs() > MAX_ROOM_M].items():
+            out.append(f"trial {trial!r}, column {col!r}: {x:g} m puts the laser beyond any "
+                       f"motion-capture room (more than {MAX_ROOM_M:g} m from the mocap "
+                       "origin): millimetres typed as metres? (the run refuses the trial "
+                       "if its legs then land outside the laser's view)")
+    if "sensor_yaw_deg" in df:
+        yaw = pd.to_numeric(df["sensor_yaw_deg"], errors="coerce").dropna()
+        if len(yaw) and (yaw.abs() <= 2 * np.pi).all() and (yaw != 0).any():
+            out.append(f"every sensor_yaw_deg lies within +-2 pi ({yaw.min():g} .. "
+                       f"{yaw.max():g}): degrees typed as radians? (the column is in "
+                       "degrees; the run refuses a trial whose legs then land outside the "
+                       "laser's view)")
+    return out

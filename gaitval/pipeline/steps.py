@@ -205,7 +205,8 @@ def register_step(ingest_dir, sheet, subjects, trial: str, config_json, out_dir)
     rec: dict = {C.TRIAL: trial, "protocol": row["protocol"], C.SUBJECT: row[C.SUBJECT]}
     try:
         legs = sensor_leg_points(mocap, sensor, row, subj, cfg)       # once per trial
-        reg = register_trial(mocap, sensor, row, subj, cfg, legs=legs)
+        reg = register_trial(mocap, sensor, row, subj, cfg, legs=legs,
+                             other_poses=sheet_poses(sheet))
         gt = ground_truth(mocap, sensor, reg, row, subj, cfg, legs=legs)
         rec.update({k: _clean(v) for k, v in reg.as_row().items()})
         rec.update(status="ok", reason="")
@@ -218,6 +219,24 @@ def register_step(ingest_dir, sheet, subjects, trial: str, config_json, out_dir)
     write_parquet(gt.reset_index(drop=True), out / "groundtruth.parquet")
     write_text(out / "registration.json", json.dumps(rec, indent=1, sort_keys=True) + "\n")
     return rec
+
+
+def sheet_poses(sheet) -> dict:
+    """trial -> ``(x_m, y_m, yaw_rad)`` of every row of the sheet with a pose measured by
+    hand (rows with a partial pose are left to their own trial's error)."""
+    from gaitval.errors import RegistrationError
+    from gaitval.registration.trial import manual_pose
+
+    df = pd.read_csv(sheet, dtype=str, keep_default_na=False)
+    out = {}
+    for row in df.to_dict("records"):
+        try:
+            p = manual_pose(row)
+        except RegistrationError:
+            continue
+        if p is not None:
+            out[str(row[C.TRIAL])] = p
+    return out
 
 
 def registration_summary(inputs: list[str | Path], study: str, out_csv, out_stem,

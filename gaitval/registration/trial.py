@@ -39,6 +39,7 @@ from gaitval.config import as_float, section
 from gaitval.errors import RegistrationError
 from gaitval.io.ultrasonic import log_distances
 from gaitval.registration import clock as CK
+from gaitval.registration import plausibility as PL
 from gaitval.registration import poles as PO
 from gaitval.registration.anchors import fit_anchor_frame
 from gaitval.registration.legmotion import LegMotion, legs_in_sensor_frame, pole_evidence
@@ -50,7 +51,8 @@ from gaitval.types import MocapTrial, ScanSeries, UltrasonicLog
 #: Columns of ``registration.csv`` (issue 4), in order.
 RECORD_FIELDS = (C.TRIAL, C.X, C.Y, "yaw_rad", C.CLOCK_OFFSET, "clock_drift_ppm",
                  "pole_residual_m", "sync_peak", "joint_centre_source", "gt_frames_excluded",
-                 "pose_source", "manual_pose_diff_m", "manual_pose_diff_deg")
+                 "pose_source", "manual_pose_diff_m", "manual_pose_diff_deg",
+                 "legs_in_view", "legs_seen")
 #: Trial-sheet columns of a pose measured by hand (field frame; metres, degrees).
 MANUAL_POSE_COLUMNS = ("sensor_x_m", "sensor_y_m", "sensor_yaw_deg")
 
@@ -88,6 +90,10 @@ class RegistrationRecord:
     manual_pose_diff_m, manual_pose_diff_deg : float
         Pole pose minus the pose measured by hand (position distance, yaw difference);
         NaN without one of the two.
+    legs_in_view, legs_seen : float
+        The registration's plausibility (:mod:`gaitval.registration.plausibility`): share
+        of the walk with a mocap leg in the laser's view, and of those frames with a laser
+        return near a leg; NaN for ultrasonic trials.
     """
 
     trial: str
@@ -103,6 +109,8 @@ class RegistrationRecord:
     pose_source: str = "poles"
     manual_pose_diff_m: float = float("nan")
     manual_pose_diff_deg: float = float("nan")
+    legs_in_view: float = float("nan")
+    legs_seen: float = float("nan")
 
     def as_row(self) -> dict:
         return asdict(self)
@@ -118,6 +126,7 @@ def reg_cfg(cfg: dict | None) -> dict:
     c = dict(DEFAULTS)
     c.update(PO.DEFAULTS)
     c.update(CK.DEFAULTS)
+    c.update(PL.DEFAULTS)
     c.update(section(cfg, "registration"))
     return c
 
@@ -154,7 +163,8 @@ def _leg_width(subject, c) -> float:
 
 
 def register_trial(mocap: MocapTrial, sensor, trial: dict, subject: dict | None,
-                   cfg: dict | None, *, legs: LegMotion | None = None) -> RegistrationRecord:
+                   cfg: dict | None, *, legs: LegMotion | None = None,
+                   other_poses: dict | None = None) -> RegistrationRecord:
     """Register one trial (pose, clock) and summarise its ground truth.
 
     Parameters
@@ -176,6 +186,9 @@ def register_trial(mocap: MocapTrial, sensor, trial: dict, subject: dict | None,
         (the same object then goes to its ``ground_truth``): LRS trials the subject's leg
         points at sensor height for every mocap frame; an ultrasonic log the gap-filled
         heel transmitter.
+    other_poses : dict, optional
+        trial -> ``(x_m, y_m, yaw_rad)`` measured by hand in other rows of the sheet: the
+        candidates "another trial's pose" of a failed plausibility check.
 
     Returns
     -------
@@ -200,13 +213,14 @@ def register_trial(mocap: MocapTrial, sensor, trial: dict, subject: dict | None,
         if isinstance(sensor, UltrasonicLog):
             return _register_ultrasonic(mocap, sensor, trial, cfg, tid, legs)
         if isinstance(sensor, ScanSeries):
-            return _register_lrs(mocap, sensor, trial, subject, cfg, tid, legs)
+            return _register_lrs(mocap, sensor, trial, subject, cfg, tid, legs,
+                                 other_poses or {})
     except RegistrationError as e:
         raise e.with_context(path=getattr(sensor, "source", None) or mocap.path, trial=tid)
     raise TypeError(f"register_trial: unsupported sensor type {type(sensor).__name__}")
 
 
-def _register_lrs(mocap, sensor, trial, subject, cfg, tid, legs):
+def _register_lrs(mocap, sensor, trial, subject, cfg, tid, legs, other_poses):
     c = reg_cfg(cfg)
     moving = is_moving(trial)
     by_hand = manual_pose(trial)
@@ -226,21 +240,98 @@ def _register_lrs(mocap, sensor, trial, subject, cfg, tid, legs):
         if by_hand is not None:                    # checked against the poles
             diff_m = math.hypot(x - by_hand[0], y - by_hand[1])
             diff_deg = math.degrees(float(wrap_angle(yaw - by_hand[2])))
+    attempt = _Attempt(mocap, sensor, legs, trial, subject, cfg, c, moving)
     manual = _manual_offset(trial)
-    if manual is not None:
-        ce = CK.ClockEstimate(manual, 0.0, float("nan"), "manual")
-    else:
-        legs_s = legs_in_sensor_frame(mocap, legs, trial, cfg, pose)
-        legs_s[~legs.valid] = np.nan
-        bg, _ = static_background(sensor, {**c, "pole_window_s": None})
-        obs, obs_t, pred = CK.lrs_occupancy_signals(sensor, bg, legs_s,
-                                                    _leg_width(subject, c) / 2.0, c,
-                                                    moving=moving)
-        ce = CK.estimate_clock(legs.t, pred, obs_t, obs, c)
-        _check_peak(ce, c, sensor.source, tid)
+    ce, pl = attempt(pose, manual)
+    if not (attempt.clock_ok(ce) and pl.ok):
+        raise _implausible(attempt, ce, pl, pose, source, manual, trial, other_poses, tid)
     return RegistrationRecord(tid, x, y, yaw, ce.clock_offset_s, ce.clock_drift_ppm, resid,
                               ce.sync_peak, legs.source, legs.n_excluded, source, diff_m,
-                              diff_deg)
+                              diff_deg, pl.in_view, pl.seen)
+
+
+class _Attempt:
+    """A trial's registration checked under one pose and clock: the clock estimated (or
+    taken from the sheet) and the plausibility of the result.  Callable, so that the
+    diagnosis of a failed trial tries each candidate mistake the same way."""
+
+    def __init__(self, mocap, sensor, legs, trial, subject, cfg, c, moving):
+        self.mocap, self.sensor, self.legs, self.trial = mocap, sensor, legs, trial
+        self.cfg, self.c, self.moving = cfg, c, moving
+        self.radius = _leg_width(subject, c) / 2.0
+        self.bg, _ = static_background(sensor, {**c, "pole_window_s": None})
+        self.fg = PL.foreground(sensor, self.bg, c, moving=moving)
+
+    def __call__(self, pose, manual_offset):
+        legs_s = legs_in_sensor_frame(self.mocap, self.legs, self.trial, self.cfg, pose)
+        legs_s[~self.legs.valid] = np.nan
+        if manual_offset is not None:
+            ce = CK.ClockEstimate(manual_offset, 0.0, float("nan"), "manual")
+        else:
+            obs, obs_t, pred = CK.lrs_occupancy_signals(self.sensor, self.bg, legs_s,
+                                                        self.radius, self.c,
+                                                        moving=self.moving)
+            ce = CK.estimate_clock(self.legs.t, pred, obs_t, obs, self.c)
+        pl = PL.check(self.sensor, self.legs.t, legs_s, self.legs.valid, ce.clock_offset_s,
+                      ce.clock_drift_ppm, self.radius, self.fg, self.c)
+        return ce, pl
+
+    def clock_ok(self, ce) -> bool:
+        return ce.method == "manual" or (np.isfinite(ce.clock_offset_s)
+                                         and ce.sync_peak >= float(self.c["sync_min_peak"]))
+
+
+def _implausible(attempt, ce, pl, pose, source, manual, trial, other_poses, tid):
+    """The error of a registration that failed its clock or plausibility check, with the
+    probable cause found by trying the usual mistakes (:mod:`.plausibility`)."""
+    c = attempt.c
+    src = (trial or {}).get("sensor_path") or attempt.sensor.source    # the raw file
+    if not attempt.clock_ok(ce):
+        what = (f"clock synchronisation failed with this pose: correlation peak "
+                f"{ce.sync_peak:.2f} is below registration.sync_min_peak = "
+                f"{c['sync_min_peak']}")
+    else:
+        what = "the registration is implausible: " + pl.describe()
+    cands = []
+    if source == "manual":
+        yaw_typed = as_float((trial or {}).get("sensor_yaw_deg"))
+        others = {t: p for t, p in other_poses.items() if t != tid}
+        cands += PL.pose_candidates(pose, yaw_typed, others)
+    if manual is not None:
+        cands.insert(0, PL.Candidate(f"the clock offset in the sheet ({manual:g} s) looks "
+                                     "wrong", "correct clock_offset_s, or leave it empty to "
+                                     "estimate it from the subject's motion", pose, None))
+    best = None
+    for cand in cands:
+        ce2, pl2 = attempt(cand.pose, manual if cand.clock_offset_s is None and
+                           cand.pose is not pose else cand.clock_offset_s)
+        if attempt.clock_ok(ce2) and pl2.ok and (best is None or pl2.seen > best[2].seen):
+            best = (cand, ce2, pl2)
+    if best is not None:
+        cand, ce2, pl2 = best
+        cause = cand.cause
+        if cand.pose is pose and manual is not None:        # the clock candidate
+            cause += (f": the subject's motion gives {ce2.clock_offset_s:.3f} s "
+                      f"({ce2.clock_offset_s - manual:+.2f} s)")
+        return RegistrationError(f"{what}; probable cause: {cause} (with that correction "
+                                 f"the laser sees the legs in {pl2.seen:.0%} of the walk)",
+                                 path=src, trial=tid, hint=cand.fix)
+    if source == "manual":
+        same = PL.same_pose_as(pose, {t: p for t, p in other_poses.items() if t != tid})
+        copied = (f"; its pose is the same as trial {', '.join(same)}'s (copied?)"
+                  if same else "")
+        hint = ("check the sensor pose in the trial sheet first (sensor_x_m, sensor_y_m in "
+                "metres, sensor_yaw_deg in degrees, in the mocap frame); if it is right, "
+                "check the clock (clock_offset_s, registration.sync_max_lag_s)")
+        return RegistrationError(f"{what}{copied}; none of the usual mistakes (millimetres, "
+                                 "radians, x/y exchanged, yaw off by 180 degrees, another "
+                                 "trial's pose, the clock) explains it", path=src,
+                                 trial=tid, hint=hint)
+    hint = ("give the offset by hand in the trial sheet's clock_offset_s, or widen "
+            "registration.sync_max_lag_s" if not attempt.clock_ok(ce) else
+            "check the pose source (the calibration poles, or the rollator's mount in "
+            "study.yaml) and the clock (clock_offset_s)")
+    return RegistrationError(what, path=src, trial=tid, hint=hint)
 
 
 def _check_peak(ce, c, path, tid):

@@ -51,6 +51,27 @@ class StudyData:
     #: the twin's physical checks (``physics.csv`` beside a simulated study's trial
     #: sheet): ``path``, ``n``, ``passed``, ``unchecked`` and the ``failed`` rows' names
     checks: dict | None = None
+    #: trials refused at registration (``tables/study_registration_<study>.csv``):
+    #: trial -> (protocol, reason); they are in no table of the run
+    refused: dict[str, tuple[str, str]] = field(default_factory=dict)
+
+    @property
+    def n_trials(self) -> int:
+        return sum(v[1] for v in self.sizes.values())
+
+    @property
+    def analysed(self) -> dict[str, tuple[int, int]]:
+        """protocol -> (subjects, trials) analysed: the sheet's less the refused trials
+        (a subject all of whose trials were refused is not counted)."""
+        out = {}
+        for p, (n_subj, n_tr) in self.sizes.items():
+            gone = sum(1 for proto, _ in self.refused.values() if proto == p)
+            lost = self.lost_subjects.get(p, 0)
+            out[p] = (n_subj - lost, n_tr - gone)
+        return out
+
+    #: protocol -> subjects with no analysed trial left
+    lost_subjects: dict[str, int] = field(default_factory=dict)
 
 
 def physics_checks(path: Path) -> dict | None:
@@ -75,6 +96,30 @@ def _load_yaml(path: Path) -> dict:
             return yaml.safe_load(fh) or {}
     except (OSError, yaml.YAMLError):
         return {}
+
+
+def refusals(reports_dir: Path, name: str) -> tuple[dict, dict]:
+    """Trials of study ``name`` refused at registration, from the study's registration
+    table in the report: (trial -> (protocol, reason), protocol -> subjects without any
+    registered trial)."""
+    try:
+        df = pd.read_csv(Path(reports_dir) / "tables" / f"study_registration_{name}.csv",
+                         dtype=str, keep_default_na=False)
+    except (OSError, ValueError):
+        return {}, {}
+    if not {"trial", "status"} <= set(df.columns):
+        return {}, {}
+    bad = df[df["status"] != "ok"]
+    refused = {str(r["trial"]): (str(r.get("protocol", "")), str(r.get("reason", "")))
+               for r in bad.to_dict("records")}
+    lost = {}
+    if "subject" in df.columns:
+        for proto, g in df.groupby("protocol"):
+            ok = set(g.loc[g["status"] == "ok", "subject"])
+            n = len(set(g["subject"]) - ok)
+            if n:
+                lost[str(proto)] = n
+    return refused, lost
 
 
 def _sizes(sheet: Path) -> dict[str, tuple[int, int]]:
@@ -119,7 +164,10 @@ def run_data(reports_dir: str | Path, study_names: list[str] | None,
     if not config:
         return [StudyData(n, "unknown", f"{n} (data kind unknown: no provenance/config.yaml)")
                 for n in names]
-    return [study_data(n, config, base) for n in names]
+    out = [study_data(n, config, base) for n in names]
+    for s in out:
+        s.refused, s.lost_subjects = refusals(Path(reports_dir), s.name)
+    return out
 
 
 def paper_data(studies: list[StudyData], paper: str) -> str:
@@ -129,7 +177,7 @@ def paper_data(studies: list[StudyData], paper: str) -> str:
     protos = PAPER_PROTOCOLS.get(paper, (paper,))
     parts = []
     for s in studies:
-        have = {p: s.sizes[p] for p in protos if p in s.sizes}
+        have = {p: s.analysed[p] for p in protos if p in s.sizes}
         if s.sizes and not have:
             continue
         text = s.label
@@ -137,9 +185,14 @@ def paper_data(studies: list[StudyData], paper: str) -> str:
             subj = max(v[0] for v in have.values())
             trials = sum(v[1] for v in have.values())
             ps, pt = PAPER_SIZE.get(paper, (0, 0))
+            n_ref = sum(1 for proto, _ in s.refused.values() if proto in protos)
             if subj < ps:
                 text += (f"; smaller than the paper: {subj} subject{'s' * (subj != 1)}, "
-                         f"{trials} trial{'s' * (trials != 1)} (paper {ps}, {pt})")
+                         f"{trials} trial{'s' * (trials != 1)} analysed (paper {ps}, {pt})")
+            elif n_ref:
+                text += f"; {trials} trial{'s' * (trials != 1)} analysed"
+            if n_ref:
+                text += f", {n_ref} refused at registration"
         parts.append(text)
     return " + ".join(parts) if parts else "no study of the run has this protocol"
 
@@ -150,9 +203,17 @@ def headline(studies: list[StudyData]) -> list[str]:
         return ["Data: no study named (an index built outside the workflow)."]
     out = ["Data: " + "; ".join(f"**{s.name}**: {s.label}" for s in studies) + "."]
     for s in studies:
+        if s.refused:
+            n_an = s.n_trials - len(s.refused)
+            reasons = "; ".join(f"`{t}` ({proto}): {why}" for t, (proto, why)
+                                in sorted(s.refused.items()))
+            out.append(f"**{s.name}: {n_an} of {s.n_trials} trials analysed; "
+                       f"{len(s.refused)} refused at registration** and left out of every "
+                       f"table and verdict: {reasons}")
+    for s in studies:
         small = [paper for paper, protos in PAPER_PROTOCOLS.items()
                  if any(p in s.sizes for p in protos) and max(
-                     s.sizes[p][0] for p in protos if p in s.sizes) < PAPER_SIZE[paper][0]]
+                     s.analysed[p][0] for p in protos if p in s.sizes) < PAPER_SIZE[paper][0]]
         if small:
             out.append(f"**{s.name}** has fewer subjects than the paper for "
                        f"{', '.join(small)}: a comparison it is too small for is reported "

@@ -20,6 +20,7 @@ reproduced column it belongs to and every number printed by
 from __future__ import annotations
 
 import html
+import json
 import re
 from pathlib import Path
 
@@ -291,7 +292,17 @@ def collect(reports_dir: str | Path, study_names: list[str] | None = None,
             "data": headline(studies), "verdict_summary": summary_lines(verdicts),
             "verdicts": verdicts,
             "verdict_header": list(VERDICT_COLUMNS), "verdict_rows": vd.values.tolist(),
-            "sections": sections, "provenance": _provenance(rd, report_prov)}
+            "sections": sections, "provenance": _provenance(rd, report_prov),
+            "analysed": analysed_record(studies)}
+
+
+def analysed_record(studies) -> dict:
+    """What ``analysed.json`` holds: per study its trials, how many were analysed and each
+    refused trial's reason (read by ``run.py`` for the run's closing summary and exit code)."""
+    return {s.name: {"trials": s.n_trials, "analysed": s.n_trials - len(s.refused),
+                     "refused": {t: {"protocol": proto, "reason": why}
+                                 for t, (proto, why) in sorted(s.refused.items())}}
+            for s in studies}
 
 
 def render_markdown(c: dict) -> str:
@@ -352,5 +363,6 @@ def build_index(reports_dir: str | Path, *, study_names: list[str] | None = None
                 caption="Published comparisons of the seed papers: reproduced, not "
                 "reproduced or not comparable, and why (gaitval.report.verdicts).",
                 notes=c["data"] + c["verdict_summary"])
+    write_text(rd / "analysed.json", json.dumps(c["analysed"], indent=1, sort_keys=True) + "\n")
     return (write_text(rd / "index.md", render_markdown(c)),
             write_text(rd / "index.html", render_html(c)))

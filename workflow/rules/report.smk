@@ -2,12 +2,20 @@
 # with the verdict table (verdicts.*) on top, and, once per report, what a reviewer needs
 # to rerun it (provenance/: resolved config, sha256 of every input file, exact package
 # versions, git commit, the rebuild command; gaitval.report.provenance).
+import json
+
+from gaitval.io.atomic import write_text
 from gaitval.report.provenance import (config_hash, rebuild_command, study_input_files,
                                        write_workflow_record)
 
 
 localrules:
     report_config,
+
+
+# Where this run's report goes, for `run.py report` to read the report's analysed.json
+# after Snakemake ends (its closing summary of refused trials and its exit code).
+write_text("logs/run_target.json", json.dumps({"reports": REPORTS, "run": list(config["run"])}) + "\n")
 
 
 rule report_config:
@@ -50,6 +58,7 @@ rule report:
         md=report(f"{REPORTS}/index.md", caption="../report/index.rst", category="Report"),
         html=f"{REPORTS}/index.html",
         verdicts=multiext(f"{REPORTS}/verdicts", ".csv", ".md", ".tex"),
+        analysed=f"{REPORTS}/analysed.json",
     params:
         reports=parent_of("md"),
         studies=list(config["run"]),
