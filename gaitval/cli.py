@@ -11,6 +11,7 @@ import argparse
 import functools
 import json
 import logging
+import re
 import sys
 from pathlib import Path
 
@@ -30,9 +31,13 @@ def cmd_validate(a) -> int:
                                   allow_outside_paths=a.allow_outside_paths or None)
     if a.deep and not a.no_file_check:
         from gaitval.io.deepcheck import deep_problems
-        problems += deep_problems(df, a.sheet, jobs=a.jobs)
-    if not a.no_file_check:        # the study's external methods (study.yaml, issue 37)
-        from gaitval.pipeline.steps import external_problems
+        said = {(p.trial, m.group(1)) for p in problems
+                if (m := re.search(r"column '(\w+)': file .* not found", str(p)))}
+        problems += [p for p in deep_problems(df, a.sheet, jobs=a.jobs)
+                     if not any(p.trial == t and f"column {c!r}" in str(p) for t, c in said)]
+    if not a.no_file_check:        # the study's external methods and study.yaml's keys
+        from gaitval.pipeline.steps import external_problems, study_yaml_problems
+        problems += study_yaml_problems(a.sheet)
         problems += external_problems(a.sheet, deep=a.deep)
     from gaitval.io.trialsheet import sheet_warnings
     for w in sheet_warnings(df):

@@ -97,3 +97,30 @@ def build(sim: Path, out: Path, variant: str | None = None) -> Path:
     shutil.copy(sim / "subjects.csv", out / "subjects.csv")
     sheet.to_csv(out / "trials.csv", index=False)
     return out / "trials.csv"
+
+
+def build_mixed(sim: Path, out: Path) -> Path:
+    """One study holding the three correct trials and, per mistake of :data:`VARIANTS`, a
+    copy of :data:`TARGET` (``<TARGET>_<variant>``, its own files) whose row carries that
+    mistake alone (``rad``: this row's yaw in radians).  One workflow run then shows every
+    refusal beside the trials that pass."""
+    correct = pd.read_csv(build(sim, out, None), dtype=str, keep_default_na=False)
+    rows = [correct]
+    base = correct[correct["trial"] == TARGET].iloc[0]
+    for v in VARIANTS:
+        one = pd.read_csv(build(sim, out / f"_{v}", v), dtype=str, keep_default_na=False)
+        row = one[one["trial"] == TARGET].copy()
+        tid = f"{TARGET}_{v}"
+        row["trial"] = tid
+        if v == "rad":
+            row["sensor_yaw_deg"] = f"{math.radians(float(base['sensor_yaw_deg'])):.3f}"
+        for col in ("mocap_file", "sensor_file"):
+            src = out / f"_{v}" / row[col].iloc[0]
+            rel = row[col].iloc[0].replace(TARGET, tid)
+            shutil.copy(src, out / rel)
+            row[col] = rel
+        rows.append(row)
+        shutil.rmtree(out / f"_{v}")
+    sheet = pd.concat(rows, ignore_index=True)
+    sheet.to_csv(out / "trials.csv", index=False)
+    return out / "trials.csv"

@@ -11,8 +11,9 @@ files say about each trial:
 
 * protocol, subject, speed, scenario, repetition and stick from the words of the file
   name (``tug_Y01_t1``, ``rollator_P01_straight_r1``, ``us_US01_slow``; words separated by
-  ``_``, ``-``, ``.`` or spaces), the subject from the C3D's ``SUBJECTS:NAMES`` when Vicon
-  wrote one, the protocol from the markers when the name has no protocol word (rollator
+  ``_``, ``-``, ``.`` or spaces); the subject from the C3D's ``SUBJECTS:NAMES`` only when
+  the name has no subject word (Vicon's names are often a session's, e.g. ``Treadmill``;
+  the summary says where each id came from); the protocol from the markers when the name has no protocol word (rollator
   markers ``RLT_*``; ultrasonic logs are ``treadmill`` trials unless named ``pendulum``);
 * the sensor height from the scan log's ``mounting_height_m``, the LaserScan topic of a
   bag when it has exactly one;
@@ -345,6 +346,7 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
     bag_detectors: dict[str, list[str]] = {}      # LegArray topic -> sensor bags with it
     trials: list[dict] = []
     ids: set[str] = set()
+    id_source: dict[str, list[str]] = {}          # where each trial's subject id came from
     for s in sensors:
         c3d = pairs.get(s.rel)
         f = {"labels": []}
@@ -356,8 +358,11 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
         if c3d:
             facts[c3d.rel] = f
         info = _trial_from_name(s.stem, s.kind, f["labels"])
-        if f.get("subject") and info.get("protocol") != "pendulum":
-            info["subject"] = f["subject"]
+        if info.get("subject"):
+            id_source.setdefault("the file name", []).append(s.stem)
+        elif f.get("subject") and info.get("protocol") != "pendulum":
+            info["subject"] = f["subject"]           # the name has no subject word
+            id_source.setdefault("the C3D's SUBJECTS:NAMES", []).append(s.stem)
         trial = _ID_BAD.sub("_", s.stem)
         if trial in ids:
             trial = _ID_BAD.sub("_", s.rel.rsplit(".", 2)[0].replace("/", "_"))
@@ -411,6 +416,10 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
             res.todo.append(f"trials.csv {trial}: stick (true/false; MTST Tables 1, 3 and 4 "
                             "group by it)")
         trials.append(row)
+    for src, stems in id_source.items():
+        res.notes.append(f"subject ids from {src}: {len(stems)} trial"
+                         f"{'s' * (len(stems) != 1)} ({', '.join(stems[:3])}"
+                         f"{', ...' if len(stems) > 3 else ''})")
     _number_repetitions(trials)
     trials.sort(key=lambda r: (r["trial"]))
 

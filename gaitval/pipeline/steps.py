@@ -703,6 +703,10 @@ def export_tracks_step(track_parquet, out, units: str = "m", topic: str | None =
     from gaitval.io.tracks import read_bag_tracks, track_to_exchange, write_tracks
 
     src_path = Path(track_parquet)
+    if not src_path.exists():
+        raise FileFormatError("file not found", path=src_path,
+                              hint="a track of gaitval's is results/<study>/track/<method>/"
+                                   "<trial>.parquet, made by the report run")
     if src_path.suffix == ".bag" or src_path.is_dir():
         rows, meta = read_bag_tracks(src_path, topic)
         if legs:                  # each leg a person: leg rows (docs/formats.md, Leg tracks)
@@ -1007,6 +1011,47 @@ def detection_topic_problems(sheet, entries: dict, source: str = "") -> None:
                                   f"{sorted(have)}", hint="name the topic (topic: ...)")
 
 
+def study_yaml_problems(sheet) -> list:
+    """The ``study.yaml`` beside a trial sheet against the config schema, as the run checks
+    it at start (``_check_study_files`` in workflow/rules/common.smk): a typo is one problem
+    naming the file, the key and the nearest valid one."""
+    from gaitval.configcheck import check_study_file
+
+    f = Path(sheet).parent / "study.yaml"
+    if not f.is_file():
+        return []
+    try:
+        with open(f, encoding="utf-8") as fh:
+            doc = yaml.safe_load(fh)
+        check_study_file({} if doc is None else doc, f)
+    except GaitvalError as exc:
+        return [exc]
+    except (OSError, yaml.YAMLError) as exc:
+        return [f"[file {f}] cannot be read: {exc}"]
+    return []
+
+
+#: Leg positions whose median lies farther than this from the origin of their frame (the
+#: laser or the mocap origin, metres) are no gait laboratory's: millimetres declared as metres.
+MAX_TRACK_DISTANCE_M = 100.0
+
+
+def _units_problem(rows: pd.DataFrame, meta: dict, path, trial: str) -> None:
+    """A track file whose positions cannot be in the units its header declares (checked
+    without the trial's registration, so against any room's size; the run checks them
+    against the laser's range once registered)."""
+    x = rows["x_m" if "x_m" in rows else "x"].to_numpy(float)
+    y = rows["y_m" if "y_m" in rows else "y"].to_numpy(float)
+    d = np.hypot(x, y)
+    d = d[np.isfinite(d)]
+    if d.size and np.median(d) > MAX_TRACK_DISTANCE_M:
+        raise FileFormatError(
+            f"the leg positions lie a median {np.median(d):,.0f} m from the origin of their "
+            f"frame ({meta.get('frame', 'sensor')!r}), beyond any room (header units "
+            f"{meta.get('units', 'm')!r})", path=path, trial=trial,
+            hint="positions in millimetres need 'units: mm' in the header")
+
+
 def external_problems(sheet, deep: bool = False) -> list[str]:
     """What ``gaitval validate`` reports of the study's own external methods and leg
     detectors (``external_methods:``, ``external_detections:`` of the study.yaml or
@@ -1060,7 +1105,8 @@ def external_problems(sheet, deep: bool = False) -> list[str]:
                         from gaitval.io.foot import read_foot
                         read_foot(path, trial=t)
                     elif key == "external_methods":
-                        read_external(path, entry, t)
+                        rows, meta = read_external(path, entry, t)
+                        _units_problem(rows, meta, path, t)
                     else:
                         read_external_detections(path, entry.get("topic"), t)
                 except GaitvalError as exc:

@@ -11,7 +11,7 @@ from snakemake.utils import update_config
 from gaitval.configcheck import (check_config, check_study_file, display_path,
                                  load_schema, raise_problems, retype_command_line,
                                  run_problems, with_sources)
-from gaitval.errors import ConfigError
+from gaitval.errors import ConfigError, GaitvalError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash, source_digest
 from gaitval.methods import METHODS, get_method, override_problems, set_params
@@ -414,7 +414,10 @@ def trials(study):
     """The validated trial sheet of a study (DataFrame indexed by trial id)."""
     path = sheet_path(study)
     if path not in _SHEETS:
-        _SHEETS[path] = load_trial_sheet(path, subjects_path(study))
+        try:
+            _SHEETS[path] = load_trial_sheet(path, subjects_path(study))
+        except GaitvalError as exc:   # a file gone since the start: one line, no traceback
+            sys.exit(f"gaitval: error: {exc}")
     return _SHEETS[path]
 
 

@@ -1,11 +1,12 @@
 # Worked example: gaitval's agreement statistics on a peer's published paired results
-# (config key peer_results; skipped when the file is absent, e.g. without ../shared).
+# (config key peer_results; skipped when the file is absent, e.g. without ../shared, and
+# in a run with a lab's own study: PEER_EXAMPLE in peer_common.smk).
 include: "peer_common.smk"
 
 
 rule peer_agreement:
     input:
-        config.get("peer_results", ""),
+        PEER_EXAMPLE,
     output:
         csv=report(
             f"{REPORTS}/tables/peer_agreement.csv",
@@ -30,9 +31,7 @@ rule peer_agreement:
 
 REPORT_ITEM_FUNCS.append(
     lambda study: (
-        [f"{REPORTS}/tables/peer_agreement.csv"]
-        if config.get("peer_results") and Path(config["peer_results"]).is_file()
-        else []
+        [f"{REPORTS}/tables/peer_agreement.csv"] if PEER_EXAMPLE else []
     )
 )
 

@@ -27,8 +27,7 @@ rule report_config:
             | {str(Path(f).resolve()) for f in workflow.configfiles if Path(f).is_file()}
             | {str(PRESETS / f"{study_cfg(s)['simulate']['preset']}.yaml")
                for s in config["run"] if is_simulated(s)}
-            | ({config["peer_results"]} if config.get("peer_results")
-               and Path(config["peer_results"]).is_file() else set())
+            | ({PEER_EXAMPLE} if PEER_EXAMPLE else set())
             | {str(Path(e["path"]).resolve()) for e in AGREEMENT_FILES.values()}
         ),
     output:
