@@ -21,7 +21,7 @@ from gaitval.pipeline.steps import register_step, trial_row
 
 #: variant -> words the refusal must contain (the probable cause named)
 CAUSES = {"mm": "millimetres", "rad": "radians", "swap": "x and y look exchanged",
-          "yaw180": "180 degrees", "other": f"same as trial {O.OTHER}",
+          "yaw180": "180 degrees", "other": "copied",
           "clock": "clock offset in the sheet"}
 
 

@@ -19,7 +19,7 @@ import own_study as O
 
 ROOT = Path(__file__).resolve().parents[1]
 CAUSES = {"mm": "millimetres", "rad": "radians", "swap": "x and y look exchanged",
-          "yaw180": "180 degrees", "other": f"same as trial {O.OTHER}",
+          "yaw180": "180 degrees", "other": "copied",
           "clock": "clock offset in the sheet"}
 
 

@@ -15,6 +15,7 @@ simulator (import contract ``analysis-not-simulate``): presets are read as YAML.
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -197,6 +198,12 @@ def paper_data(studies: list[StudyData], paper: str) -> str:
     return " + ".join(parts) if parts else "no study of the run has this protocol"
 
 
+def _without_where(reason: str) -> str:
+    """A refusal's message without its leading ``[file ..., trial ...]`` (the line names
+    the trial already)."""
+    return re.sub(r"^\[[^\]]*\]\s*", "", reason)
+
+
 def headline(studies: list[StudyData]) -> list[str]:
     """The lines at the top of the report: what the data are and what a verdict means."""
     if not studies:
@@ -205,11 +212,12 @@ def headline(studies: list[StudyData]) -> list[str]:
     for s in studies:
         if s.refused:
             n_an = s.n_trials - len(s.refused)
-            reasons = "; ".join(f"`{t}` ({proto}): {why}" for t, (proto, why)
-                                in sorted(s.refused.items()))
             out.append(f"**{s.name}: {n_an} of {s.n_trials} trials analysed; "
                        f"{len(s.refused)} refused at registration** and left out of every "
-                       f"table and verdict: {reasons}")
+                       "table and verdict (the registration table in the appendix has "
+                       "each one's files):")
+            out += [f"✗ `{t}` ({proto}): {_without_where(why)}"
+                    for t, (proto, why) in sorted(s.refused.items())]
     for s in studies:
         small = [paper for paper, protos in PAPER_PROTOCOLS.items()
                  if any(p in s.sizes for p in protos) and max(
