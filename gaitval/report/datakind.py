@@ -64,15 +64,16 @@ class StudyData:
     def analysed(self) -> dict[str, tuple[int, int]]:
         """protocol -> (subjects, trials) analysed: the sheet's less the refused trials
         (a subject all of whose trials were refused is not counted)."""
-        out = {}
-        for p, (n_subj, n_tr) in self.sizes.items():
-            gone = sum(1 for proto, _ in self.refused.values() if proto == p)
-            lost = self.lost_subjects.get(p, 0)
-            out[p] = (n_subj - lost, n_tr - gone)
+        if not self.refused or self.rows is None:
+            return dict(self.sizes)
+        left = self.rows[~self.rows["trial"].isin(list(self.refused))]
+        out = {p: (0, 0) for p in self.sizes}
+        out.update({p: (int(g["subject"].nunique()), int(g["trial"].nunique()))
+                    for p, g in left.groupby("protocol", sort=True)})
         return out
 
-    #: protocol -> subjects with no analysed trial left
-    lost_subjects: dict[str, int] = field(default_factory=dict)
+    #: the sheet's ``protocol, subject, trial`` columns (None when unreadable)
+    rows: pd.DataFrame | None = None
 
 
 def physics_checks(path: Path) -> dict | None:
@@ -99,34 +100,31 @@ def _load_yaml(path: Path) -> dict:
         return {}
 
 
-def refusals(reports_dir: Path, name: str) -> tuple[dict, dict]:
+def refusals(reports_dir: Path, name: str) -> dict:
     """Trials of study ``name`` refused at registration, from the study's registration
-    table in the report: (trial -> (protocol, reason), protocol -> subjects without any
-    registered trial)."""
+    table in the report: trial -> (protocol, reason)."""
     try:
         df = pd.read_csv(Path(reports_dir) / "tables" / f"study_registration_{name}.csv",
                          dtype=str, keep_default_na=False)
     except (OSError, ValueError):
-        return {}, {}
+        return {}
     if not {"trial", "status"} <= set(df.columns):
-        return {}, {}
+        return {}
     bad = df[df["status"] != "ok"]
-    refused = {str(r["trial"]): (str(r.get("protocol", "")), str(r.get("reason", "")))
-               for r in bad.to_dict("records")}
-    lost = {}
-    if "subject" in df.columns:
-        for proto, g in df.groupby("protocol"):
-            ok = set(g.loc[g["status"] == "ok", "subject"])
-            n = len(set(g["subject"]) - ok)
-            if n:
-                lost[str(proto)] = n
-    return refused, lost
+    return {str(r["trial"]): (str(r.get("protocol", "")), str(r.get("reason", "")))
+            for r in bad.to_dict("records")}
+
+
+def _rows(sheet: Path) -> pd.DataFrame | None:
+    try:
+        return pd.read_csv(sheet, usecols=["protocol", "subject", "trial"], dtype=str)
+    except (OSError, ValueError):
+        return None
 
 
 def _sizes(sheet: Path) -> dict[str, tuple[int, int]]:
-    try:
-        df = pd.read_csv(sheet, usecols=["protocol", "subject", "trial"], dtype=str)
-    except (OSError, ValueError):
+    df = _rows(sheet)
+    if df is None:
         return {}
     return {p: (int(g["subject"].nunique()), int(g["trial"].nunique()))
             for p, g in df.groupby("protocol", sort=True)}
@@ -167,8 +165,18 @@ def run_data(reports_dir: str | Path, study_names: list[str] | None,
                 for n in names]
     out = [study_data(n, config, base) for n in names]
     for s in out:
-        s.refused, s.lost_subjects = refusals(Path(reports_dir), s.name)
+        s.refused = refusals(Path(reports_dir), s.name)
+        if s.refused:
+            s.rows = _rows(_sheet_of(s.name, config, base))
     return out
+
+
+def _sheet_of(name: str, config: dict, base: Path) -> Path:
+    entry = (config.get("studies") or {}).get(name) or {}
+    if entry.get("simulate"):
+        return base / config.get("data_dir", "data") / name / "trials.csv"
+    sheet = Path(entry.get("trial_sheet") or "")
+    return sheet if sheet.is_absolute() else base / sheet
 
 
 def paper_data(studies: list[StudyData], paper: str) -> str:
