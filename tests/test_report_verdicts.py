@@ -153,7 +153,7 @@ def test_data_kind_from_the_resolved_config_and_the_trial_sheet(tmp_path):
     assert studies[0].label == "simulated replica (tiny, seed 7)"
     text = paper_data(studies, "tug")
     assert text == ("simulated replica (tiny, seed 7); smaller than the paper: 1 subject, "
-                    "2 trials (paper 7, 28)")
+                    "2 trials analysed (paper 7, 28)")
     assert paper_data(studies, "mtst") == "no study of the run has this protocol"
     # the replay preset is a replay of real mocap; a trial sheet is real recordings
     _provenance_config(rd, tmp_path / "data", preset="replay", seed=11)
