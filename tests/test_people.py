@@ -205,6 +205,7 @@ def test_a_walker_in_positive_1_is_found(realdata):
 
 
 @pytest.mark.realdata
+@pytest.mark.slow
 def test_empty_room_gives_no_track_for_any_method(realdata):
     """negative_2: a robot driving through a furnished room with nobody in it, three lasers
     with ~36 leg-like detections a scan.  Every method — the papers' (TUG, MTST, rollator KF
@@ -412,6 +413,7 @@ def test_leg_tracker_person_gate_equals_the_four_state_filter():
 
 
 @pytest.mark.realdata
+@pytest.mark.slow
 def test_leg_classifier_in_the_empty_room_each_laser_held_out(realdata):
     """leg_tracker's classifier (``kind__appearance: leg_forest``), each laser of
     negative_2 scored by the forest that did not see it (leave-one-topic-out,
