@@ -1,4 +1,4 @@
-# gaitval workflow.  The rules live in workflow/rules/*.smk; see ../shared/DESIGN.md and
+# gaitval workflow.  The rules live in workflow/rules/*.smk; see docs/architecture.md and
 # README.md.  Run:  snakemake --profile workflow/profiles/default
 from pathlib import Path
 

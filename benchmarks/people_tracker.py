@@ -42,7 +42,7 @@ def main() -> None:
     ap.add_argument("lasers", nargs="*", default=DEFAULT)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--method", default="people",
-                    help="people (online) or people_offline (both passes, v16-v17)")
+                    help="people (online) or people_offline (both passes)")
     args = ap.parse_args()
     from gaitval.detect.base import split_observations
     from gaitval.io.rosbag import read_rosbag_scans

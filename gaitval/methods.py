@@ -436,7 +436,7 @@ def track_trial(scans: ScanSeries, method: str | dict[str, Any], leg_width_m: fl
         return kind.track(scans, leg_width_m).to_frame()
     return kind.track(scans, leg_width_m, observations=observations).to_frame()
 
-# -- issue 36: a people tracker (several persons, two legs each, with a life cycle) -------
+# -- a people tracker (several persons, two legs each, with a life cycle) -------
 # Not a paper's method: the seed papers' leg model (seed 000's KF and χ² gate, Table 2;
 # seed 001's constant-velocity input and GNN assignment) inside a tracker that starts,
 # confirms, coasts and ends person hypotheses (gaitval/track/people.py, lifecycle.py;
@@ -457,9 +457,7 @@ METHODS["people"] = {
              "tentative_gate": {"name": "variable_region", "v_sw": 1.1, "v_st": 0.55},
              "birth": {"name": "unexplained_pairs", "max_pair_m": 0.8,
                        "min_leg_widths": 0.7},
-             # M of N scans with a leg pair that walks (docs/people.md; leg_tracker's own
-             # rule, `leg_travel`, confirms furniture in an empty room without its leg
-             # classifier)
+             # M of N scans with a leg pair that walks (docs/people.md)
              "confirmer": {"name": "m_of_n_moving", "window_s": 1.4, "m_fraction": 0.5,
                            "min_relative_travel_m": 0.5, "pass_leg_widths": 1.0,
                            "min_travel_m": 0.5, "evidence": "observations"},
@@ -478,16 +476,15 @@ METHODS["people"] = {
                             "max_turn_rps": 1.5},
              "static_map": {"name": "recent_hits", "cell_m": 0.1, "min_static_s": 1.4,
                             "tau_s": 5.0, "neighbourhood": 1},
-             # a person who walks in and stands is not confirmed by arrival in free space:
-             # `free_space` confirms furniture from a moving robot (docs/people.md,
-             # benchmarks/people_arrival.py); written out, not left to the default
+             # no confirmation by arrival in free space (it confirmed furniture from a
+             # moving robot; docs/history/people.md); written out, not left to the default
              "arrival": {"name": "none"},
              "init": None, "max_leg_separation_m": 0.8, "person_points_m": 0.13, "dt_s": None,
              "sides": "walking_direction"},
 }
 
-# The same tracker reading the recording forwards and backwards (issue 36, v16,
-# benchmarks/people_gate.py; gaitval/track/passes.py): an offline method, since the backward
+# The same tracker reading the recording forwards and backwards (docs/people.md, "Two
+# passes"; gaitval/track/passes.py): an offline method, since the backward
 # pass uses scans after the one it reports.  Not comparable with an online tracker
 # (leg_tracker); `people` stays the online one.
 METHODS["people_offline"] = copy.deepcopy(METHODS["people"])

@@ -88,6 +88,7 @@ def test_a_real_residual_goes_to_ezc3d(tmp_path):
 
 
 @pytest.mark.realdata
+@pytest.mark.slow
 def test_real_vicon_files_read_as_before(realdata):
     """The real files (analogs, real residuals, integer or DEC data) are read by ezc3d as
     a whole, as before; the answer is the same either way."""

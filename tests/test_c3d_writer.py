@@ -20,7 +20,8 @@ from gaitval.io.c3d import read_c3d
     (40000, 3, 1, None, False),     # POINT:FRAMES above 32,767 (an unsigned 16-bit count)
     (65536, 1, 1, "S1", False),     # POINT:FRAMES saturates
     (70000, 9, 1, None, True),      # the ultrasonic trials' size and more
-    (120000, 9, 1, None, False),    # ROTATION:DATA_START beyond int16: ezc3d writes it all
+    pytest.param(120000, 9, 1, None, False,   # ROTATION:DATA_START beyond int16: ezc3d
+                 marks=pytest.mark.slow),      # writes it all
 ])
 def test_fast_c3d_writer_gives_ezc3ds_bytes(tmp_path, monkeypatch, n_frames, n_markers,
                                              first_frame, prefix, with_events):

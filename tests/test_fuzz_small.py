@@ -20,6 +20,7 @@ BUDGET = {"c3d": 24, "bag": 4, "scanlog": 16, "ultrasonic": 16, "annotations": 1
 
 @pytest.mark.realdata
 @pytest.mark.parametrize("kind", H.KINDS)
+@pytest.mark.slow
 def test_mutants_load_or_name_the_file(kind, realdata, tmp_path):
     H.warm_up()
     results = [H.fuzz_one((kind, 20260, i, str(tmp_path))) for i in range(BUDGET[kind])]

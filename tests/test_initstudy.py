@@ -337,6 +337,7 @@ def test_external_tracks_named_by_trial_become_an_external_method(tiny_files, tm
     assert res.returncode == 1
 
 
+@pytest.mark.slow
 def test_init_study_external_methods_pass_validate(tiny_files, tmp_path):
     """Every trial with its track file: the study.yaml init-study writes declares the
     tracker, and `gaitval validate --deep` (schema, files, every file read) accepts it once

@@ -181,6 +181,7 @@ def test_annotated_pair_starts_on_the_annotated_person_not_the_closest_pair():
 
 # -- the steps on the real bag -----------------------------------------------------------------
 @pytest.mark.realdata
+@pytest.mark.slow
 def test_track_and_evaluate_the_outdoor_bag_from_its_first_annotation(outdoor, tmp_path):
     from gaitval.pipeline.legbench import legbench_evaluate_step, legbench_track_step
     path, (ann, _) = outdoor

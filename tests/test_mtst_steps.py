@@ -49,6 +49,7 @@ def _run(tiny, sheet, cj, reg, gt, name):
                               tiny / name / "eval").iloc[0]
 
 
+@pytest.mark.slow
 def test_the_steps_run_with_mocap_and_render_the_tables(tiny):
     s = _run(tiny, tiny / "tiny" / "trials.csv", tiny / "config.json",
              tiny / "register" / "registration.json", tiny / "register" / "groundtruth.parquet",

@@ -187,6 +187,7 @@ def _numpy_step(P, rng, X, Y, prev, dt, N=500):
     return est, cnt.max(axis=1) > 0, need.size
 
 
+@pytest.mark.slow
 def test_warm_up_compiles_what_a_track_then_uses(tmp_path):
     """gaitval.track.pf.warm_up (run by the fork server before it forks its workers, and by
     run.py after installing) gives the compiled loops a track calls the specialisation the

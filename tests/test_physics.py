@@ -33,6 +33,7 @@ def test_simulate_writes_the_physics_table(physics):
         "forward", "turning", "return"}
 
 
+@pytest.mark.slow
 def test_physics_rows_are_the_same_with_the_swing_statistics_on_a_pool(tiny):
     """generate_study maps the per-trial swing statistics over its worker processes
     (issue 13); the table is the serial one, row for row."""
@@ -154,6 +155,7 @@ def test_contact_statistics_see_overlapping_shanks(tmp_path):
     assert n_scans == 100 and 0 < n_close < 100
 
 
+@pytest.mark.slow
 def test_default_twin_gait_passes_the_step_and_cross_step_rows():
     """The rows that failed on the default study before the gait calibration (see
     docs/simulator.md, "Physical checks"): TUG cadence (141.5 > 140 /min), MTST step length

@@ -4,6 +4,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+import pytest
 
 from gaitval.registration import occupancy as occ
 from gaitval.registration.poledetect import nanmedian0, static_background
@@ -20,6 +21,7 @@ def _legs(rng, n, d_lo=0.1):
     return legs
 
 
+@pytest.mark.slow
 def test_windowed_occupancy_equals_every_beam_evaluated():
     rng = np.random.default_rng(7)
     windowed = 0

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from gaitval.report import stats_figures as sf
 
@@ -211,6 +212,7 @@ def test_rollator_figure_picks_a_successful_and_a_failed_trial():
     assert pick_trials(f[f["trial"] == "r_err"], "kf") == (None, "r_err")
 
 
+@pytest.mark.slow
 def test_rollator_figure_draws_both_trials(tmp_path, monkeypatch):
     from gaitval.report import rollator_figures as rf
     f = _rollator_frames({"r_str": ("straight", 0, 0), "r_err": ("straight", 3, 1)})

@@ -44,6 +44,7 @@ def report_job(out: str) -> tuple[str, str]:
     ('["default"]', "default"),
     ('["tiny","default"]', "tiny+default"),
 ])
+@pytest.mark.slow
 def test_report_rule_writes_into_the_run_folder(tmp_path, run, name):
     output, log = report_job(dry_run(tmp_path, run))
     outs = [o.strip() for o in output.split(",")]
@@ -52,6 +53,7 @@ def test_report_rule_writes_into_the_run_folder(tmp_path, run, name):
     assert log.strip() == f"logs/report/{name}.log"
 
 
+@pytest.mark.slow
 def test_switching_run_asks_for_another_report_not_the_stale_one(tmp_path):
     """A finished tiny report in the folder does not satisfy a default run."""
     done = tmp_path / "reports" / "tiny"
@@ -62,6 +64,7 @@ def test_switching_run_asks_for_another_report_not_the_stale_one(tmp_path):
     assert "reports/default/index.md" in output and "reports/tiny/" not in output
 
 
+@pytest.mark.slow
 def test_reports_dir_is_the_root_of_the_run_folders(tmp_path):
     output, _ = report_job(dry_run(tmp_path, '["tiny"]', f"reports_dir={tmp_path}/out"))
     assert f"{tmp_path}/out/tiny/index.md" in output

@@ -217,6 +217,7 @@ MTST_METHODS = ("mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed")
 
 
 @pytest.mark.realdata
+@pytest.mark.slow
 def test_empty_scene_bags_give_no_leg_track(realdata):
     """leg_tracker's recordings of empty rooms (a robot's three lasers, the robot moving at
     times): every TUG and MTST method reports no track on every topic.  (The rollator's KF

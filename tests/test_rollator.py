@@ -124,6 +124,7 @@ def test_facing_pair_keeps_the_start_of_a_walking_user():
     assert res.k_init == 0 and np.isfinite(res.x).all()
 
 
+@pytest.mark.slow
 def test_facing_pair_finds_nobody_when_no_pair_walks_with_the_sensor():
     """Two legs standing still in the window (amp 0: nobody walks), and two objects that
     pass each other while they sweep across the window (as negative_2.bag's right laser
@@ -185,6 +186,7 @@ def test_pf_recovers_both_legs_on_a_straight_walk(model):
     assert np.sqrt(np.mean(ev[1:] ** 2)) < 0.25
 
 
+@pytest.mark.slow
 def test_pf_is_deterministic_for_a_seed(model):
     scans, _ = walk(120, seed=8)
     a = ParticleFilterTracker(model=model, seed=42).track(scans, W)
@@ -323,6 +325,7 @@ def _people_on_rollator():
     return build_method("people", rollator_people_overrides())
 
 
+@pytest.mark.slow
 def test_people_on_the_rollator_follows_the_user_from_the_first_scan():
     """With the rollator's setup (the KF's window detector, facing_pair initialiser and
     births in the window) the people tracker reports the walking user from scan 0, on the

@@ -333,6 +333,7 @@ def _hashes(folder: Path) -> dict:
             for p in sorted(folder.rglob("*")) if p.is_file()}
 
 
+@pytest.mark.slow
 def test_same_preset_and_seed_give_byte_identical_files(tiny, tmp_path):
     # `tiny` was rendered by a pool of worker processes (one task per trial, ultrasonic
     # trials included); here every trial is rendered in this process, one after the other
@@ -341,6 +342,7 @@ def test_same_preset_and_seed_give_byte_identical_files(tiny, tmp_path):
     assert _hashes(tiny) == _hashes(tmp_path / "again")
 
 
+@pytest.mark.slow
 def test_seed_changes_the_study(tmp_path):
     cfg = load_preset("tiny")
     for k in ("mtst", "rollator", "ultrasonic"):
@@ -418,7 +420,8 @@ def _built_trials(preset):
         yield proto, build(S._rng(seed, 3, idx), *bargs)
 
 
-@pytest.mark.parametrize("preset", ["tiny", "default"])
+@pytest.mark.parametrize("preset", ["tiny",
+                                    pytest.param("default", marks=pytest.mark.slow)])
 def test_two_shanks_never_overlap(preset):
     """Issue 34: in every swing of every TUG, MTST and rollator trial the two shank
     centres at sensor height stay at least 0.95 leg widths apart (the old straight swings

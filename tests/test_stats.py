@@ -273,6 +273,7 @@ PEER_PAIRS = ["step_length", "step_time", "stride_length", "stride_time", "veloc
 
 
 @pytest.mark.parametrize("name", PEER_PAIRS)
+@pytest.mark.slow
 def test_agreement_on_peer_data_against_independent_routes(realdata, name):
     df = pd.read_parquet(realdata / "peer-results" / "gailo_results.parquet")
     out = agreement(df, f"gt_{name}", f"us_{name}").iloc[0]

@@ -549,6 +549,7 @@ def test_ultrasonic_table2_agreement_columns_come_from_the_stats_functions():
     assert "4 subjects, 32 strides" in note
 
 
+@pytest.mark.slow
 def test_ultrasonic_agreement_table_rows_and_figure(tmp_path):
     from gaitval.report.stats_figures import bland_altman_figure
     from gaitval.tables.ultrasonic_agreement import agreement_table

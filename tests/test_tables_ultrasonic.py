@@ -66,6 +66,7 @@ def test_table2_known_rmse_average_and_peak(gait_params):
     assert t.loc["S1", "ref_mean_m_published"] == 1.147
 
 
+@pytest.mark.slow
 def test_tables_3_to_6_cover_the_papers_parameters(gait_params):
     tabs = build_ultrasonic_tables(gait_params)
     assert "rmse_s" in tabs["table3"] and "rmse_mps" in tabs["table4"]
@@ -74,6 +75,7 @@ def test_tables_3_to_6_cover_the_papers_parameters(gait_params):
     assert tabs["table6"].iloc[-1]["rmse_published"] == 0.079        # Table 6 peak
 
 
+@pytest.mark.slow
 def test_table8_paired_tests_over_subjects():
     g = make_gait_params(seed=1, fast_error_factor=2.0)
     t = table8(g).set_index(["parameter", "quantity"])
@@ -122,6 +124,7 @@ def test_tableC1_is_anova_across_subjects(gait_params):
     assert by_k.loc["within", "SS_published"] == 0.23895
 
 
+@pytest.mark.slow
 def test_sample_strides_draws_the_papers_n_reproducibly(gait_params):
     from gaitval.tables.ultrasonic import sample_strides
 
@@ -152,6 +155,7 @@ def test_sample_strides_draws_the_papers_n_reproducibly(gait_params):
         sample_strides(gait_params, 0)
 
 
+@pytest.mark.slow
 def test_table8_gives_n_beside_ns_and_nv(gait_params):
     tabs = build_ultrasonic_tables(gait_params, 10)
     t8 = tabs["table8"].set_index(["parameter", "quantity"])
@@ -165,6 +169,7 @@ def test_table8_gives_n_beside_ns_and_nv(gait_params):
     assert cols.index("normal_std") + 1 == cols.index("normal_n")
 
 
+@pytest.mark.slow
 def test_table7_is_marked_not_comparable(gait_params):
     t = build_ultrasonic_tables(gait_params)["table7"]
     assert t["comparability"].str.startswith("not comparable: ").all()
@@ -184,6 +189,7 @@ def test_table7_normality_columns(gait_params):
     assert t.loc["stride_length", "mean_published"] == 1.147
 
 
+@pytest.mark.slow
 def test_write_tables_files_captions_and_determinism(gait_params, tmp_path):
     paths = write_ultrasonic_tables(gait_params, tmp_path / "a")
     names = sorted({p.stem for p in paths})
@@ -209,6 +215,7 @@ def test_bad_gait_parameter_tables_raise_one_clear_error(gait_params):
         table2(gait_params[gait_params.parameter != "stride_length"])
 
 
+@pytest.mark.slow
 def test_figures_are_written_and_deterministic(gait_params, tmp_path):
     from gaitval.report.stats_figures import bland_altman_figure, write_ultrasonic_figures
     paths = write_ultrasonic_figures(gait_params, tmp_path)

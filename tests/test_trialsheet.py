@@ -205,6 +205,7 @@ def _deep(tmp_path, rows, *extra):
 
 
 @pytest.mark.realdata
+@pytest.mark.slow
 def test_deep_validate_opens_real_files_and_names_each_that_does_not_load(tmp_path,
                                                                           realdata):
     c3d = realdata / "c3d" / "FunctionalWalk.c3d"

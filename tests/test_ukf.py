@@ -202,6 +202,7 @@ def test_ultrasonic_config_defaults_are_the_roles():
     assert build_tracker({"ultrasonic": {"ukf": {"alpha": 0.5}}}).alpha == 0.5
 
 
+@pytest.mark.slow
 def test_warm_up_compiles_what_a_track_then_uses(tmp_path):
     """gaitval.track.ukf.warm_up (the fork server's and run.py's) gives the UKF kernel the
     specialisation a track needs: a track of a 4-anchor log afterwards compiles nothing

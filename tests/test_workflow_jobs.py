@@ -49,6 +49,7 @@ def bad_ingest(tiny_data, tmp_path_factory):
     return work, res
 
 
+@pytest.mark.slow
 def test_a_failing_trial_names_file_trial_and_problem(bad_ingest):
     work, res = bad_ingest
     out = res.stdout + res.stderr
@@ -60,6 +61,7 @@ def test_a_failing_trial_names_file_trial_and_problem(bad_ingest):
     assert not (work / "results" / "tiny" / "ingest").exists()   # the job's output removed
 
 
+@pytest.mark.slow
 def test_the_log_gives_each_trials_command(tiny_data, tmp_path):
     """A batch's log holds, per trial, the command that runs the same step by hand; run
     by hand, it writes the same bytes."""
@@ -94,6 +96,7 @@ def _writes(path, text):
     Path(path).write_text(text)
 
 
+@pytest.mark.slow
 def test_run_batch_stops_at_the_first_failure_and_says_which(tmp_path):
     tasks = [Task("a", _writes, {"path": tmp_path / "a.txt", "text": "a"}),
              Task("b", _fails, {"label": "b"})]
@@ -103,6 +106,7 @@ def test_run_batch_stops_at_the_first_failure_and_says_which(tmp_path):
     assert "== b: FAILED: [file x.csv] trial b: broken" in log
 
 
+@pytest.mark.slow
 def test_run_batch_runs_every_task_and_logs_by_label(tmp_path):
     tasks = by_size([Task(f"t{i}", _writes, {"path": tmp_path / f"{i}.txt", "text": str(i)})
                      for i in range(5)], sizes=[1, 5, 3, 2, 4])
@@ -120,6 +124,7 @@ def test_a_usage_error_of_a_verb_fails_its_task(tmp_path):
         run_batch([Task("x", run_verbs, {"argvs": [argv]})], 1, tmp_path / "batch.log")
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_a_batch_job(tiny_data, tmp_path):
     """Ctrl-C (SIGINT to Snakemake's process group, as a terminal sends it) stops a batch
     job's workers too: nothing keeps running once Snakemake has exited."""

@@ -26,7 +26,7 @@ scans of one leg lasting at least ``min_false_s``; the rate is their number per 
 recording (scan span + one period).  Leg-level CLEAR-MOT needs leg annotations, which the
 leg_tracker bags do not have.
 
-Benchmark scoring (issue 36; ``../shared/specs/leg-tracker-benchmark.md``): besides full
+Benchmark scoring (Leigh et al. 2015, the leg_tracker benchmark's own scripts): besides full
 CLEAR-MOT, :func:`following_counts` gives the *following* reading the benchmark's authors
 use when only the followed person is annotated — false positives ignored, MOTA' = 1 −
 (FN + IDSW) / GT — and :func:`reference_id_switches` counts ID switches as their

@@ -50,8 +50,8 @@ def rollator_cfg(cfg: dict) -> dict:
 
 
 def rollator_people_overrides() -> dict:
-    """The people tracker's setup on the rollator (issue 36; docs/people.md, "In the
-    protocol tables"): the sensor is carried by the walker, so the user's place is known
+    """The people tracker's setup on the rollator (docs/people.md, "No phantom user on
+    the rollator"): the sensor is carried by the walker, so the user's place is known
     by construction — seed 002 §II's user window (x 0.10–1.00 m, y ±0.40 m behind the
     laser) — and the papers' KF starts on the leg pair it finds there at once.  The people
     tracker gets the same three things, all the built-in ``rollator_kf``'s (seed 002 §II):

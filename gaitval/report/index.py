@@ -34,7 +34,7 @@ from gaitval.report.datakind import PAPER_PROTOCOLS, headline, paper_data, run_d
 from gaitval.report.verdicts import VERDICT_COLUMNS, build_verdicts, summary_lines
 from gaitval.tables.numbers import format_value, to_display
 
-#: The paper tables gaitval renders (see ../shared/seeds/README.md), by protocol.
+#: The paper tables gaitval renders, by protocol.
 EXPECTED_TABLES = {
     "tug": ["tug_table2", "tug_table3", "tug_table4", "tug_table5"],
     "mtst": ["mtst_table1", "mtst_table3", "mtst_table4"],

@@ -41,7 +41,7 @@ tug_occlusion             per TUG phase, leg-scans with < 3 returning beams vs s
                           the note names what is on the line of sight (:func:`occluders`).
                           The forward and turning rows are the calibration targets of the
                           TUG sensor placement and the marker's section in the scan plane
-                          (``benchmarks/tug_scene_calibration.py``), so only the return
+                          (``experiments/tug_scene_calibration.py``), so only the return
                           row is an independent check; seed 000 counts the tracker's
                           unobservable steps, the twin the truth (docs/simulator.md)
 tug_turn_to_sit           seconds from the last return-line contact to the last contact

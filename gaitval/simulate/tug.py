@@ -30,7 +30,7 @@ TUG_MARKER_XY = (3.0, 0.0)
 #: the inner foot swings past it.  The path uses this radius; what the *laser* sees of the
 #: marker in its scan plane is the preset's ``tug.marker_scan_radius_m`` (default: this
 #: radius), a separate setting because seed 000 gives no marker at all beyond "turns
-#: around a marker" (docs/simulator.md, "The TUG scene calibrated").
+#: around a marker" (docs/simulator.md, "Calibrated settings").
 MARKER_RADIUS_M = 0.06
 MARKER_CLEARANCE_M = 0.05
 #: The chair's four legs (field frame, m; the front edge at x = 0) and their radius at

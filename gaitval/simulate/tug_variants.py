@@ -1,7 +1,7 @@
 """The default TUG trials re-rendered in memory with one free choice of the twin changed:
 a sensitivity check of the ``tug_phase_duration`` and ``tug_occlusion`` rows of
-:mod:`gaitval.simulate.physics` (docs/simulator.md, "Why the TUG turning occlusion and
-return rows failed").  Nothing is written; every trial keeps its random streams.
+:mod:`gaitval.simulate.physics` (docs/history/simulator.md, "Why the TUG turning occlusion
+and return rows failed").  Nothing is written; every trial keeps its random streams.
 """
 from __future__ import annotations
 
@@ -20,8 +20,8 @@ def tug_occlusion_variant(preset: str | dict = "default", marker_in_scan_plane: 
     changed, and their truth phase durations and occlusion (the ``tug_phase_duration`` and
     ``tug_occlusion`` rows' measures; nothing is written).
 
-    A sensitivity check of two free choices of the twin (docs/simulator.md, "Why the TUG
-    turning occlusion and return rows failed"): ``marker_in_scan_plane=False`` leaves the
+    A sensitivity check of two free choices of the twin (docs/history/simulator.md, "Why
+    the TUG turning occlusion and return rows failed"): ``marker_in_scan_plane=False`` leaves the
     turn marker out of the laser's scene (a marker lower than the scan plane; the walker's
     path still goes around its base), ``turn_step_factor`` replaces the walkers'
     ``GaitParams.turn_step_factor``, ``marker_scan_radius_m`` the marker's section in the

@@ -1,7 +1,7 @@
 """Published values of seed 002 (Chalvatzaki et al., ICRA 2017), transcribed from the seed text.
 
-Transcribed from ``../shared/seeds/002_3a7e136c0c9bbb56.txt`` (and checked against the
-checklist ``../shared/specs/seed002-rollator.md``).  Units as printed: cm and cm/s.
+Transcribed from the paper's text (and checked against a checklist of it).  Units as
+printed: cm and cm/s.
 
 Table I, Scenario 1 is legible.  The PF-MAD column prints several values with one decimal
 where two are expected (``ONE_DECIMAL``: compare them at ±0.1).  Table I, Scenario 2 is

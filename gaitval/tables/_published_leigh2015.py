@@ -1,7 +1,6 @@
 """Published values of the leg_tracker benchmark (Leigh et al., ICRA 2015, Tables II–III).
 
-Transcribed from ``../shared/specs/leg-tracker-benchmark.md`` (the paper's Table III;
-valid = matched).  ``n/a``: the paper does not count false positives on the following
+Transcribed from the paper's Table III (valid = matched).  ``n/a``: the paper does not count false positives on the following
 sets (only the followed person is annotated).
 
 Reference: A. Leigh, J. Pineau, N. Olmedo, H. Zhang, "Person Tracking and Following with 2D

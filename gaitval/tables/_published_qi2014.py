@@ -1,6 +1,6 @@
 """Published values of seed 003 (Qi et al., Sensors 2014), transcribed from the seed text.
 
-Transcribed from ``/work/shared/seeds/003_d657a7031a2bc1de.txt``.  The PDF extraction
+Transcribed from the paper's text.  The PDF extraction
 garbled the row labels of Tables 2–6 ("Dof", "Rei", "Duo", "rro" for Ref/Pro) and of
 Table 8 ("(ጠ)", "(8)", "()" for the unit lines) but not the numbers; the order of the
 rows (Ref mean, Ref std, Pro mean, Pro std, RMSE) is the one the captions describe.

@@ -1,10 +1,9 @@
 """Published values of seed 001 (Yorozu et al., Sensors 2015, 15, 11151–11168), Tables 1, 3, 4.
 
-Transcribed from ``../shared/seeds/001_8b8739c5501e2bab.txt`` (checked against that text by
+Transcribed from the paper's text (checked against that text by
 ``tests/test_mtst_tables.py``).  The text's Table 3 is garbled in one cell: Method 3's
 success is printed "64.6% (31/44)"; 31/44 would be 70.5 %, and 48 − (14 + 0 + 1 + 2) = 31
-with 31/48 = 64.6 %, so the denominator is 48 (as ``../shared/specs/seed001-mtst.md``
-reads it).  gaitval shows the printed text and uses 31/48.
+with 31/48 = 64.6 %, so the denominator is 48 (as a checklist of the paper reads it).  gaitval shows the printed text and uses 31/48.
 """
 from __future__ import annotations
 

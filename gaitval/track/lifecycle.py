@@ -1,7 +1,7 @@
 """A person hypothesis's life: birth, confirmation, coasting and end, each a role.
 
 A people tracker (:mod:`gaitval.track.people`) calls these roles once per scan; its loop
-holds none of their rules (Stone Soup's initiator/deleter split, docs/STYLE §13):
+holds none of their rules (Stone Soup's initiator/deleter split):
 
 ``birth`` (:data:`BIRTHS`)
     ``propose(obs, free, leg_width_m) -> [(i, j)]``: pairs of observations that no person
@@ -33,10 +33,6 @@ holds none of their rules (Stone Soup's initiator/deleter split, docs/STYLE §13
     leg to travel ``dist_travelled_together_to_initiate_leg_pair`` = 0.5 m in the odometry
     frame; gaitval has no odometry, so the same 0.5 m is asked of the vector between the
     legs.
-    ``leg_travel``: leg_tracker's own rule — each leg's filtered path since the pair formed
-    exceeds 0.5 m (steps > 1 cm of leg_tracker's leg filter), both legs seen
-    (:class:`LegTravel`); without leg_tracker's leg classifier it confirms furniture in an
-    empty room, so the ``people`` method does not use it (docs/people.md).
 ``refind`` (:data:`REFINDS`)
     ``remember(pid, t_last_seen, centre)`` when a reported person ends; ``match(tentative
     persons, t_k)`` → [(person, pid)]: tentative hypotheses that are a recently ended person
@@ -56,7 +52,8 @@ person without a leg observation on the current scan is *coasting* (its legs pre
 an ended person found again by the ``refind`` role is confirmed again, with its id.
 
 Measurement areas (:data:`AREAS`): ``field_of_view`` (the scan's bearings and range limits,
-less a margin) and ``rectangle`` (x, y bounds in the sensor frame: the mat, the walkway).
+less a margin) and ``rectangle`` (x, y bounds in the sensor frame: the rollator's user
+window, a mat, a walkway).
 
 References
 ----------
@@ -235,12 +232,13 @@ class MOfNMoving(Confirmer):
     evidence : {"estimates", "observations"}
         r and the body centre from the legs' filtered positions (default) or from the
         observations assigned to them: with ``observations`` the tests see only what the
-        scan saw, whatever the motion model predicts (benchmarks/people_gate.py, v12).
+        scan saw, whatever the motion model predicts (experiments/people_gate.py).
     walk_suffices : bool
         Where the world frame is known over the window and ``min_travel_m`` > 0, the body's
         steady walk (with the gap test) alone confirms, without the two gait tests (the
         legs pass, r spans d_c); where it is not known, the gait tests alone decide, as
-        before.  False (default): every test is asked (benchmarks/people_gate.py, v14).
+        before.  False (default): every test is asked; True confirms furniture in the
+        empty room (experiments/people_gate.py).
     """
 
     def __init__(self, window_s: float = 1.4, m_fraction: float = 0.5,
@@ -347,134 +345,6 @@ class MOfNMoving(Confirmer):
             return False
         # fewer than M of the last N scans saw both legs: not a person (yet)
         return sum(1 for r in mem["win"] if r is not None) < self.m
-
-
-@CONFIRMERS.register("leg_travel")
-class LegTravel(Confirmer):
-    """leg_tracker's confirmation: each leg has travelled a stated path since the pair was
-    formed, both legs are observed on the scan (module notes, ``leg_travel``).
-
-    leg_tracker (``joint_leg_tracker.py``) keeps one constant-velocity Kalman filter per
-    leg (process std ``0.5·Δt`` on position and velocity per step, observation std 0.1 m,
-    P₀ = 0.5·I) and adds to the leg's ``dist_travelled`` every filter step longer than
-    ``min_step_m`` = 0.01 m ("small distance changes ... likely caused by changes in
-    observation angle"); a potential leg pair becomes a person when both legs are matched
-    on the current scan and each has travelled more than
-    ``dist_travelled_together_to_initiate_leg_pair`` = 0.5 m since the pair was formed
-    (and a leg is in free space: the tracker's static-map test, :func:`gaitval.track.
-    people._on_static`).  Here each tentative person carries that filter for each leg,
-    fed with the leg's observation (``person.z``), and the pair is formed at the person's
-    birth::
-
-        s_f ← Σ_{k'} |p̂_f(k') − T_{k'}(p̂_f(k'−1))| · [> 0.01 m]      (f = L, R)
-        confirmed  ⇔  both legs observed on k  ∧  min(s_L, s_R) > 0.5 m
-
-    T_k carries the previous filter state into the current sensor frame with the sensor's
-    own motion from the ``ego_motion`` role (:meth:`scan`; leg_tracker filters in its
-    ``fixed_frame``, the odometry frame on its general benchmarks).  Where that motion is
-    unknown (a new ego-motion segment) T is the identity: the step is measured in the
-    sensor frame, which is leg_tracker's own setting on its following benchmarks
-    (``fixed_frame`` = ``base_laser_link``, ``person_following_outdoor_1_joint_leg.launch``
-    of angusleigh/leg_tracker_benchmarks), since no odometry is known there either.
-
-    Parameters
-    ----------
-    min_travel_m : float
-        leg_tracker's ``dist_travelled_together_to_initiate_leg_pair`` (0.5 m).
-    min_step_m : float
-        leg_tracker's 0.01 m below which a filter step is not counted.
-    std_obs_m, p0, process_std_per_s : float
-        leg_tracker's leg filter (0.1 m, 0.5, 0.5 m/s · Δt: its 0.05 at 10 Hz, 0.0667 at
-        7.5 Hz, 0.0333 at 15 Hz).
-    percentile, assoc_extra_m : float
-        leg_tracker's leg gate: an observation at Mahalanobis distance ≥ z =
-        Φ⁻¹(1 − (1 − 0.90)/2) = 1.645 with cov = P_xx + (σ_o + 0.4)² is not this leg's; it
-        would start a new leg track, so both legs' paths restart from zero (a new pair).
-    """
-
-    def __init__(self, min_travel_m: float = 0.5, min_step_m: float = 0.01,
-                 std_obs_m: float = 0.1, p0: float = 0.5, process_std_per_s: float = 0.5,
-                 percentile: float = 0.90, assoc_extra_m: float = 0.4):
-        self.percentile = percentile
-        self.assoc_extra_m = assoc_extra_m
-        # scipy here, not at the top: the Snakefile imports this module (the role registries)
-        from scipy.stats import norm
-
-        self.gate2 = float(norm.ppf(1.0 - (1.0 - percentile) / 2.0)) ** 2     # 1.645²
-        self.var_assoc = (std_obs_m + assoc_extra_m) ** 2
-        self.min_travel_m = min_travel_m
-        self.min_step_m = min_step_m
-        self.std_obs_m = std_obs_m
-        self.p0 = p0
-        self.process_std_per_s = process_std_per_s
-        self.dt = 0.1
-        self._motion = None
-
-    def bind(self, dt, leg_width_m: float = 0.10):
-        out = LegTravel(self.min_travel_m, self.min_step_m, self.std_obs_m, self.p0,
-                        self.process_std_per_s, self.percentile, self.assoc_extra_m)
-        out.dt = float(dt)
-        return out
-
-    def scan(self, k: int, motion) -> None:
-        """The sensor's motion from scan k−1 to k: (dx, dy, dθ) of its pose at k in its
-        frame at k−1, or None when unknown (module notes)."""
-        self._motion = motion
-
-    def new_memory(self):
-        # per leg: leg_tracker's filter state [x, y, vx, vy], its per-axis 2×2 covariance
-        # (the same for x and y: isotropic P₀, Q and R), and the path travelled
-        return {"kf": [None, None], "path": [0.0, 0.0]}
-
-    def _carry(self, st):
-        """A filter state of the previous scan in the current sensor frame."""
-        m = self._motion
-        if m is None:
-            return st
-        dx, dy, dth = m
-        c, s = math.cos(dth), math.sin(dth)
-        x, y, vx, vy = st
-        x, y = x - dx, y - dy
-        return [c * x + s * y, -s * x + c * y, c * vx + s * vy, -s * vx + c * vy]
-
-    def step(self, person, k):
-        mem = person.confirm_memory
-        dt = self.dt
-        q = (self.process_std_per_s * dt) ** 2
-        r = self.std_obs_m ** 2
-        for f in (0, 1):
-            z = person.z[f]
-            kf = mem["kf"][f]
-            if kf is None:
-                if z is not None:
-                    mem["kf"][f] = ([z[0], z[1], 0.0, 0.0], (self.p0, 0.0, self.p0))
-                continue
-            st, (pxx, pxv, pvv) = kf
-            old = self._carry(st)
-            # predict (constant velocity, F = [[1, Δt], [0, 1]] per axis, Q = q·I)
-            x, y, vx, vy = old[0] + dt * old[2], old[1] + dt * old[3], old[2], old[3]
-            pxx, pxv, pvv = (pxx + 2 * dt * pxv + dt * dt * pvv + q, pxv + dt * pvv,
-                             pvv + q)
-            if z is not None and ((z[0] - x) ** 2 + (z[1] - y) ** 2
-                                  >= self.gate2 * (pxx + self.var_assoc)):
-                # outside leg_tracker's leg gate: leg_tracker would start a new leg track
-                # here, and a new potential pair whose path starts at zero
-                mem["kf"][f] = ([z[0], z[1], 0.0, 0.0], (self.p0, 0.0, self.p0))
-                mem["path"] = [0.0, 0.0]
-                continue
-            if z is not None:                                   # correct, per axis
-                s_ = pxx + r
-                kx, kv = pxx / s_, pxv / s_
-                ex, ey = z[0] - x, z[1] - y
-                x, y, vx, vy = x + kx * ex, y + kx * ey, vx + kv * ex, vy + kv * ey
-                pxx, pxv, pvv = (1 - kx) * pxx, (1 - kx) * pxv, pvv - kv * pxv
-            d = math.hypot(x - old[0], y - old[1])
-            if d > self.min_step_m:
-                mem["path"][f] += d
-            mem["kf"][f] = ([x, y, vx, vy], (pxx, pxv, pvv))
-        if not (person.seen[0] and person.seen[1]):
-            return False
-        return min(mem["path"]) > self.min_travel_m
 
 
 # -- re-finding ----------------------------------------------------------------------------

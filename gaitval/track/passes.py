@@ -1,7 +1,7 @@
 """How many times the people tracker reads a recording: online, or forwards and backwards.
 
-Role ``passes`` of the ``people`` kind (issue 36, v16; ``benchmarks/people_gate.py`` has
-the change and its criteria, docs/people.md the measured result).
+Role ``passes`` of the ``people`` kind (docs/people.md, "Two passes";
+``experiments/people_gate.py`` has the criteria it was judged by).
 
 ``forward`` (the default)
     The tracker reads the scans once, in time order: what a robot can do, and what
@@ -18,8 +18,8 @@ the change and its criteria, docs/people.md the measured result).
 
 With ``extend_only`` a backward person that joins no forward person is dropped: the
 backward pass only extends the persons the forward (online) pass confirmed, back to their
-first appearance and across their gaps (issue 36, v17: on the reversed empty room the
-backward pass confirms furniture the forward pass does not, v16).
+first appearance and across their gaps (on the reversed empty room the backward pass
+alone confirms furniture the forward pass does not).
 
 The join (per pair of persons, forward f and backward b, reported on common scans)::
 
@@ -34,7 +34,7 @@ gets an id after every forward id); on each scan it takes the forward pass's row
 forward member is reported, otherwise the backward pass's (the member with more legs
 observed on that scan, then the smaller id).  A backward member's left/right labels are
 swapped when that brings its legs nearer to the forward members' on the scans both
-report (summed distance).  Since v18 the subject (the person the studies evaluate) and its
+report (summed distance).  The subject (the person the studies evaluate) and its
 left/right labels are the forward pass's: the group holding the forward pass's subject,
 labelled as the forward pass labelled it (``PeopleTracker.run``).
 """
@@ -119,7 +119,7 @@ def join_passes(fwd: pd.DataFrame, bwd: pd.DataFrame, gate_m: float,
     forward time, :func:`reverse_rows`) into one table of persons (module notes), and the
     id each forward person is reported with.  ``extend_only``: a backward person that joins
     no forward person is dropped.  ``splice_scans``: align each run of backward rows by the
-    scans within this many of it (None: by the whole overlap, v16)."""
+    scans within this many of it (None: by the whole overlap)."""
     cols = list(fwd.columns) if len(fwd.columns) else list(bwd.columns)
     if bwd.empty:
         return fwd, {}
@@ -199,8 +199,8 @@ def _align_sides(rows: pd.DataFrame, fwd: pd.DataFrame, bwd_all: pd.DataFrame,
                  splice_scans: int | None = None) -> pd.DataFrame:
     """Swap backward rows' L/R labels when that brings the backward member's legs nearer to
     the forward members' (summed distance): per run of consecutive scans of one member, on
-    the scans both report within ``splice_scans`` before and after the run (v19); a run with
-    none such, or ``splice_scans`` None, by every scan both report (v16)."""
+    the scans both report within ``splice_scans`` before and after the run; a run with
+    none such, or ``splice_scans`` None, by every scan both report."""
     fl = fwd.pivot_table(index="k", columns="side", values=["x_m", "y_m"], aggfunc="first")
     parts = []
     for pid, g in rows.groupby("person_id", sort=True):

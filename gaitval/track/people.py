@@ -146,7 +146,7 @@ class PeopleTracker(TrackerKind):
         The gate of tentative persons' legs (None: ``gate``).
     tentative_motion : spec or None
         The motion input of tentative persons' legs (None: ``motion``): a hypothesis that
-        is not yet a person has no gait to model (benchmarks/people_gate.py, v13).
+        is not yet a person has no gait to model (experiments/people_gate.py).
     birth, confirmer, deleter, area, refind : spec
         The life-cycle roles (:mod:`gaitval.track.lifecycle`); ``refind`` (default
         ``leg_tracker_gate``; ``none``: an ended person stays ended) gives a recently ended
@@ -230,7 +230,7 @@ class PeopleTracker(TrackerKind):
         ``scan_hypotheses`` (per scan: time spent, person hypotheses alive; both passes
         summed) as attributes of the result (benchmarks/people_tracker.py), and
         ``scan_static`` (per scan: for each observation, whether it lay on a static cell of
-        the forward pass's map; benchmarks/people_misses.py).
+        the forward pass's map; experiments/people_misses.py).
 
         With ``passes: forward_backward`` the same loop also reads the scans in reverse
         order and the two passes are joined (:mod:`gaitval.track.passes`)."""
@@ -249,7 +249,7 @@ class PeopleTracker(TrackerKind):
                 rscans, list(xy)[::-1], list(pats)[::-1], leg_width_m, profile, None)
             back = reverse_rows(_people_frame(brows), t)
             dt0 = float(step_durations(t, self.dt_s)[0]) if n > 1 else float(self.dt_s or 0.1)
-            # the subject and its labels are the forward (online) pass's (v18)
+            # the subject and its labels are the forward (online) pass's
             ahead = self._result(t, people, n_born, n_conf)
             people, ids = self.passes.join(people, back, dt0)
             if ahead.subject_id >= 0:

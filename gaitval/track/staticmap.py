@@ -95,12 +95,12 @@ class ScanMatching(EgoMotion):
     fallback_every_beam : bool
         A step that fails on every ``beam_step``-th beam is tried once more with every beam
         before the motion is called unknown (sparse scans, e.g. outdoors with most beams
-        returning nothing: benchmarks/scan_matching_fallback.py).  A step that succeeds on
+        returning nothing: experiments/scan_matching_fallback.py).  A step that succeeds on
         the subsampled beams is unchanged.
     max_speed_mps, max_turn_rps : float or None
         A step that moves the sensor faster than this (translation / Δt, |turn| / Δt) is an
         unknown step: ICP aligned something that is not the static scene (outdoors, the
-        followed person gives half the returns; benchmarks/scan_matching_fallback.py).
+        followed person gives half the returns; experiments/scan_matching_fallback.py).
         2 m/s and 1.5 rad/s: the motion ``max_pair_m`` already assumes.  None: no bound.
     """
 
@@ -286,7 +286,9 @@ ARRIVALS = Registry("arrival")
 class Arrival:
     """Role base: ``start(scans, poses)`` (a new world frame), per scan ``update(k, pose)``
     after the scan's observations were used, and ``confirms(person, pose, t)``: does
-    a tentative person stand where the scan saw free space a moment ago."""
+    a tentative person stand where the scan saw free space a moment ago.  ``none`` (the
+    only one) confirms nobody: arrival in free space (``free_space``) confirmed furniture
+    from a moving robot and was removed (docs/history/people.md)."""
 
     def start(self, scans, poses) -> "Arrival":
         return self
@@ -304,110 +306,3 @@ class Arrival:
 @ARRIVALS.register("none")
 class NoArrival(Arrival):
     pass
-
-
-@ARRIVALS.register("free_space")
-class FreeSpaceArrival(Arrival):
-    """A person who walked in: both legs stand where the scan saw through a moment ago.
-
-    A grid of *last-free* times in the ego-motion role's world frame (a new grid where that
-    frame restarts).  On every scan, each cell that a beam traverses up to ``margin_m``
-    before its return, and that holds no return of that scan, gets the scan's time t_k::
-
-        f_c ← t_k     for c on the ray of a beam to r_b − margin, c ∉ hits_k
-
-    A tentative person is confirmed by arrival on scan k when both legs are observed on k,
-    both were observed on at least ``min_support_s`` worth of scans since its birth, and
-    for each leg every cell c of the (2n+1)² block around the observation has
-    f_c ≥ t_k − ``memory_s``.  A chair leg's cell is hit on every scan that sees the chair
-    and never seen through, a standing person's was seen through before they came (change
-    detection on an occupancy grid: Wang, Thorpe, Thrun et al., IJRR 2007; leg_tracker's
-    "in free space" asks the same of one leg).  benchmarks/people_arrival.py states the
-    values and the criteria this role was judged by.
-
-    Parameters
-    ----------
-    cell_m : float
-        Cell size (0.1 m: the static map's, a leg's width).
-    neighbourhood : int
-        n: the (2n+1)² block around each leg (1: the static map's ±0.15 m).
-    memory_s : float
-        How recently the block must have been seen free (5 s: the static map's τ).
-    margin_m : float
-        A beam marks free only up to this before its return (0.2 m: the return's own cell
-        and one cell for range noise and discretisation).
-    min_support_s : float
-        Scans with both legs observed since the birth, as time (0.7 s: the confirmation
-        window's M = ⌈N/2⌉ of 1.4 s).
-    """
-
-    def __init__(self, cell_m: float = 0.1, neighbourhood: int = 1, memory_s: float = 5.0,
-                 margin_m: float = 0.2, min_support_s: float = 0.7):
-        self.cell_m = cell_m
-        self.neighbourhood = neighbourhood
-        self.memory_s = memory_s
-        self.margin_m = margin_m
-        self.min_support_s = min_support_s
-
-    def start(self, scans, poses):
-        out = FreeSpaceArrival(self.cell_m, self.neighbourhood, self.memory_s, self.margin_m,
-                               self.min_support_s)
-        d = np.diff(scans.t)
-        dt = float(np.median(d[d > 0])) if np.any(d > 0) else 0.1
-        out._support = max(1, math.ceil(self.min_support_s / dt - 1e-9))
-        out._scans = scans
-        out._t = np.asarray(scans.t, dtype=float)
-        r = scans.ranges
-        r_max = float(np.nanmax(r)) if np.isfinite(r).any() else 0.0
-        pad = r_max + 2 * self.cell_m * (self.neighbourhood + 1)
-        lo = poses[:, :2].min(axis=0) - pad
-        hi = poses[:, :2].max(axis=0) + pad
-        out._lo = np.floor(lo / self.cell_m).astype(np.int64)
-        shape = tuple((np.floor(hi / self.cell_m).astype(np.int64) - out._lo + 1).tolist())
-        out._free = np.full(shape, -np.inf)
-        a = scans.angle_min + scans.angle_increment * np.arange(r.shape[1])
-        out._cos, out._sin = np.cos(a), np.sin(a)
-        # sample distances along a ray: half a cell apart, so that no traversed cell is
-        # skipped by more than a corner
-        out._s = np.arange(0.0, max(r_max - self.margin_m, 0.0), 0.5 * self.cell_m)
-        return out
-
-    def update(self, k, pose):
-        r = self._scans.ranges[k]
-        ok = np.isfinite(r)
-        if not ok.any():
-            return
-        x, y, th = pose
-        c, s = math.cos(th), math.sin(th)
-        ux, uy = self._cos[ok], self._sin[ok]
-        wx, wy = c * ux - s * uy, s * ux + c * uy           # beam directions, world frame
-        rk = r[ok]
-        cm = self.cell_m
-        # the returns' cells: hit on this scan, not free
-        hit = np.floor(np.column_stack([x + rk * wx, y + rk * wy]) / cm).astype(np.int64) \
-            - self._lo
-        # points along each ray up to r - margin
-        ss = self._s
-        keep = ss[None, :] <= (rk - self.margin_m)[:, None]
-        px = (x + ss[None, :] * wx[:, None])[keep]
-        py = (y + ss[None, :] * wy[:, None])[keep]
-        ij = np.floor(np.column_stack([px, py]) / cm).astype(np.int64) - self._lo
-        nx, ny = self._free.shape
-        key = np.unique(ij[:, 0] * ny + ij[:, 1])
-        hkey = np.unique(hit[:, 0] * ny + hit[:, 1])
-        key = key[~np.isin(key, hkey, assume_unique=True)]
-        self._free.ravel()[key] = self._t[k]
-
-    def confirms(self, person, pose, t):
-        if not (person.seen[0] and person.seen[1]) or person.n_both < self._support:
-            return False
-        n, cm, since = self.neighbourhood, self.cell_m, t - self.memory_s
-        for wx, wy in to_world(pose, np.array(person.z)).tolist():
-            i = int(math.floor(wx / cm)) - int(self._lo[0])
-            j = int(math.floor(wy / cm)) - int(self._lo[1])
-            if i - n < 0 or j - n < 0 or i + n >= self._free.shape[0] \
-                    or j + n >= self._free.shape[1]:
-                return False
-            if float(self._free[i - n:i + n + 1, j - n:j + n + 1].min()) < since:
-                return False
-        return True

@@ -5,7 +5,7 @@ import shlex
 import sys
 from pathlib import Path
 
-from snakemake.common.configfile import load_configfile
+import yaml
 from snakemake.utils import update_config
 
 from gaitval.configcheck import (check_config, check_study_file, display_path,
@@ -21,22 +21,42 @@ from gaitval.pipeline.steps import (ALL_SCOPE, ANALYSIS_SECTIONS, EXTERNAL_PROTO
 from gaitval.tables.tug_evidence import method_reading
 
 
+def _load_config_file(path):
+    """A YAML (or JSON) config file as a dict; a file that is no mapping is refused."""
+    with open(path, encoding="utf-8") as fh:
+        doc = yaml.safe_load(fh)
+    if doc is None:
+        return {}
+    if not isinstance(doc, dict):
+        raise ConfigError(f"[file {display_path(Path(path))}] a config file holds keys at "
+                          f"its top level, not a {type(doc).__name__}")
+    return doc
+
+
+def _cli_configfiles():
+    """The --configfile paths as Snakemake holds them (absolute; its ConfigSettings)."""
+    return list(workflow.config_settings.configfiles)
+
+
+def _cli_config():
+    """--config as Snakemake parsed it (Snakemake's ConfigSettings.config)."""
+    return dict(workflow.config_settings.config or {})
+
+
 def _config_layers():
     """(name, dict) of every config source, lowest precedence first: the Snakefile's
     configfile, each --configfile, then --config (so a problem names where its key is)."""
-    settings = getattr(workflow, "config_settings", None)
-    cli = [Path(f).resolve() for f in getattr(settings, "configfiles", ())]
-    files = [Path(f).resolve() for f in getattr(workflow, "configfiles", ())]
+    cli = [Path(f).resolve() for f in _cli_configfiles()]
+    files = [Path(f).resolve() for f in workflow.configfiles]
     files = [f for f in files if f not in cli] + cli
-    layers = [(display_path(f), load_configfile(str(f))) for f in files if f.is_file()]
+    layers = [(display_path(f), _load_config_file(f)) for f in files if f.is_file()]
     return layers + [("--config", _command_line_config())]
 
 
 def _command_line_config():
     """--config as Snakemake parsed it, its nested scalars typed as in a config file
     (gaitval.configcheck.retype_command_line: {"pf_seed": "2018"} -> {"pf_seed": 2018})."""
-    settings = getattr(workflow, "config_settings", None)
-    return retype_command_line(dict(getattr(settings, "config", None) or {}))
+    return retype_command_line(_cli_config())
 
 
 def _method_definitions(cfg):
@@ -62,7 +82,7 @@ def _check_study_files(schema):
         from gaitval.pipeline.steps import study_side_problems
         study_side_problems(sheet, schema=schema)
         if cal.is_file():
-            own = load_configfile(str(cal))
+            own = _load_config_file(cal)
             check_study_file(own, cal, schema=schema)
             merged = {k: {**(config.get(k) or {}), **((own or {}).get(k) or {})}
                       for k in ("tracking", "tug")}
@@ -102,7 +122,7 @@ def _check_external(cfg):
     sheets = {study: _sheet_of(cfg, study) for study in cfg["run"]}
     for study, sheet in sheets.items():
         cal = sheet.parent / "study.yaml"
-        if cal.is_file() and ((load_configfile(str(cal)) or {}).get("tracking") or {}).get(
+        if cal.is_file() and ((_load_config_file(cal) or {}).get("tracking") or {}).get(
                 "external"):
             raise ConfigError(f"[file {display_path(cal)}] tracking.external: a study "
                               "declares its external methods under external_methods: "

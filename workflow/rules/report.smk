@@ -40,8 +40,8 @@ rule report_config:
         # the whole resolved config (paths and `run` too), so any change rewrites it
         chash=config_hash(config),
         command=rebuild_command(
-            list(getattr(workflow.config_settings, "configfiles", None) or ()),
-            dict(getattr(workflow.config_settings, "config", None) or {}),
+            _cli_configfiles(),
+            _cli_config(),
             Path.cwd(),
         ),
     run:

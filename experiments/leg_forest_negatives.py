@@ -48,7 +48,7 @@ laser of negative_2; (b) with leg_tracker's rule it confirms fewer persons there
 The outdoor bag (``--outdoor``) is run once afterwards for the record; its score decides
 nothing.
 
-    .venv/bin/python benchmarks/leg_forest_negatives.py LEG_TRACKER_CHECKOUT [--outdoor]
+    .venv/bin/python experiments/leg_forest_negatives.py LEG_TRACKER_CHECKOUT [--outdoor]
 
 LEG_TRACKER_CHECKOUT: a directory with ``rosbags/training_scans_res=0.33/`` of
 angusleigh/leg_tracker (the positive bags and negative_2.bag).

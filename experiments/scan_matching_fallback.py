@@ -8,7 +8,7 @@ speed, ``beam_step`` 2) declares the sensor's motion *unknown* when fewer than
 map, no steady-walk test across the break, no free-space history.  On the outdoor
 benchmark bag (``person_following_outdoor_1``, 245 beams, 78 % of them without a return)
 that happens on 4,226 of 7,169 steps, so the median "world frame" lasts **one scan**
-(measured while diagnosing the arrival role, benchmarks/people_arrival.py).  With every
+(measured while diagnosing the arrival role, experiments/people_arrival.py).  With every
 beam the same bag breaks into 594 frames.  Halving the beams was a speed choice made on
 dense indoor scans; where it leaves too few points, the role should use the points it has
 before it calls the motion unknown.
@@ -31,7 +31,7 @@ Criteria, stated before the first run.  The fallback is kept only if
 The outdoor benchmark score (``--outdoor``) is measured once, after (a)–(c), for the record;
 it decides nothing.
 
-    .venv/bin/python benchmarks/scan_matching_fallback.py [--outdoor]
+    .venv/bin/python experiments/scan_matching_fallback.py [--outdoor]
 
 Second change (v8), written with its criteria before it was run, after v7 had been scored
 (4,262 matched, against v6's 5,077; that score is known and is said here).

@@ -50,7 +50,7 @@ Criteria, stated before the first run.  ``arrival: free_space`` becomes part of
 The outdoor benchmark (``--outdoor``) is scored once, afterwards, for the record: it
 decides nothing, and no value above is changed because of it.
 
-    .venv/bin/python benchmarks/people_arrival.py [--outdoor]
+    .venv/bin/python experiments/people_arrival.py [--outdoor]
 
 References: Wang, C.-C.; Thorpe, C.; Thrun, S.; Hebert, M.; Durrant-Whyte, H.
 Simultaneous localization, mapping and moving object tracking. IJRR 2007, 26, 889–916.

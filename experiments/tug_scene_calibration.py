@@ -1,6 +1,6 @@
 """Calibrate the twin's two unsourced TUG scene settings on seed 000's observation
-statistics, by criteria fixed before the sweep (issue 34; docs/simulator.md, "The TUG
-scene: sensor placement and the turn marker").
+statistics, by criteria fixed before the sweep (issue 34; docs/simulator.md, "Calibrated
+settings"; docs/history/simulator.md, "The TUG scene calibrated").
 
 Seed 000 gives neither where beside the course its LRS stands ("a participant walks three
 meters from the LRS", §6.4) nor what its marker is ("turns around a marker", §1).  The
@@ -29,7 +29,7 @@ Criteria, written down before this script was first run:
 
 Nothing here looks at a tracker.  Usage::
 
-    .venv/bin/python benchmarks/tug_scene_calibration.py [--preset default] [--workers 2]
+    .venv/bin/python experiments/tug_scene_calibration.py [--preset default] [--workers 2]
 
 Prints both sweeps (forward / turning / return occlusion and the phase durations) and the
 two chosen values; writes nothing.

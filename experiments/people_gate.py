@@ -7,7 +7,7 @@ validation region (Table 1) but a *confirmed* person's legs with seed 000's χ²
 (G = 13.82 on the leg filter's innovation covariance, q = 15 m/s²).  With q that large the
 χ² gate admits an observation 0.4 m from a leg that stands still, one scan after it was
 last seen.  A per-step trace of the people tracker on ``person_following_outdoor_1``
-(``benchmarks/people_misses.py``'s tracker, watching the confirmed person's legs) shows
+(``experiments/people_misses.py``'s tracker, watching the confirmed person's legs) shows
 what follows:
 
 * scan 4738: the standing leg of the followed person (prior (1.53, 0.48) m, speed
@@ -49,9 +49,9 @@ Criteria, stated before the first run.  The change is kept only if
 The outdoor benchmark score (``--outdoor``) is measured once, after (a)–(d), for the record;
 it decides nothing.
 
-    .venv/bin/python benchmarks/people_gate.py                    # (a)
-    .venv/bin/python benchmarks/people_gate.py --compare OLD NEW  # (b), (c)
-    .venv/bin/python benchmarks/people_gate.py --outdoor          # the record
+    .venv/bin/python experiments/people_gate.py                    # (a)
+    .venv/bin/python experiments/people_gate.py --compare OLD NEW  # (b), (c)
+    .venv/bin/python experiments/people_gate.py --outdoor          # the record
 
 Result (v9, measured after the criteria above were committed): **not adopted.**
 (a) met: 0+0 on each laser.  (b) not met: TUG successes 22 → 17 of 28, MTST (mocap)
@@ -219,7 +219,7 @@ Seventh change (v14), written with its criteria before it was first run, after v
 results above were known.
 
 Why.  Of v13's 947 outdoor misses, 694 have a tentative hypothesis near the person that
-fails "the legs pass each other" (``benchmarks/people_misses.py``).  Two runs show what
+fails "the legs pass each other" (``experiments/people_misses.py``).  Two runs show what
 that test cannot see: scans 2703–2719, a person steps 0.5 m in from the edge of the view
 with the legs side by side and stands; scans 3871–3897, a person crosses 1.1 m in front
 of the robot at 0.44 m/s with one leg leading throughout (a side-step or a turn).  The

@@ -2,11 +2,11 @@
 Table 4) and the twin's (the truth: fewer than 3 beams on the leg, ``physics.csv``), on a
 method's success trials of a built report; and, for the leg-steps the tracker calls
 unobservable while the leg still returns 3 or more beams, how many beams and what the
-other leg's observed pattern was (docs/simulator.md, "The TUG scene calibrated").
+other leg's observed pattern was (docs/simulator.md, "Calibrated settings").
 
 Usage::
 
-    .venv/bin/python benchmarks/tug_unobservable_vs_truth.py [--study default] [--method tug_m2]
+    .venv/bin/python experiments/tug_unobservable_vs_truth.py [--study default] [--method tug_m2]
 
 Reads ``results/<study>/evaluate/<method>/<trial>/{summary,frames}.parquet`` and
 ``data/<study>/truth/<trial>/scans_legs.parquet``; prints one line per phase.

@@ -1,13 +1,13 @@
 """Scan-by-scan diagnosis of the people tracker on a rollator trial (issue 36).
 
-    python benchmarks/people_rollator_diag.py TRIAL {default|window|window_nomap} [OVERRIDES_JSON]
+    python experiments/people_rollator_diag.py TRIAL {default|window|window_nomap} [OVERRIDES_JSON]
 
 Reads $GAITVAL_RESULTS/ingest/TRIAL/sensor.parquet and $GAITVAL_DATA/subjects.csv (default
 results/default, data/default).  ``default``: the people method as configured; ``window``:
 births limited to seed 002's user window; ``window_nomap``: also no ego motion, no static
 map.  Prints the observations in the window, births, confirmations and, for every
 tentative hypothesis on every scan, the first ``m_of_n_moving`` condition that fails
-(docs/people.md, "In the protocol tables")."""
+(docs/history/people.md, "In the protocol tables")."""
 import os, sys, math, collections, json
 import numpy as np, pandas as pd
 from gaitval.io.scanlog import read_scanlog

@@ -2,7 +2,7 @@
 
 Usage::
 
-    .venv/bin/python benchmarks/people_misses.py BAG TOPIC FRAMES [--refind none]
+    .venv/bin/python experiments/people_misses.py BAG TOPIC FRAMES [--refind none]
 
 ``FRAMES``: the ``frames.parquet`` that ``gaitval legbench-evaluate`` wrote for a ``people``
 track of the same bag and topic (one row per scan: the annotated position ``gt_x_m,
@@ -25,7 +25,7 @@ counts as a miss is put in one class, the first that applies:
 
 For the misses whose first failed test is "legs do not pass", whether the hypothesis near
 also fails the world-frame walk, has no known world frame over its window, or walks (the
-test that v14 of benchmarks/people_gate.py let confirm alone): the first failed test is
+test that v14 of experiments/people_gate.py let confirm alone): the first failed test is
 not the only one.
 
 Then every confirmed person that ended: the scan, why (``left the area`` / ``unsupported``),
