@@ -75,9 +75,13 @@ tug_turn_to_sit_cross     cross steps among the turn-to-sit steps (people pivot 
 mtst_cross_steps          cross steps per 100 steps from the twin's truth footfalls vs seed 001
                           Table 4 (19 of 414 = 4.6); pass: inside the exact 95 % Poisson
                           interval of 19 counts (2.8–7.2 per 100)
-treadmill_stride_sd       stride-to-stride SD of the reference stride length per trial vs
+treadmill_stride_sd       stride-to-stride SD of the reference stride length per trial (eq.
+                          (17) on the true heel path, as the paper's reference system) vs
                           seed 003 Table 2 (Ref std, 0.019–0.056 m over subjects); pass: the
                           twin's mean inside that range
+treadmill_eq17_stride_    per belt speed: mean stride length by seed 003 eq. (17) on the
+  length                  twin's true heel path vs Table 8's reference mean (0.884, 1.169,
+                          1.410 m); pass: within 3 % (:data:`TREADMILL_EQ17_REL`)
 ========================  ==============================================================
 
 References
@@ -143,6 +147,12 @@ SIT_SEPARATION_TOL_M = 0.05
 MTST_CROSS = (19, 414)
 #: seed 003 Table 2, reference system: per-subject stride-length SD range (m).
 TREADMILL_STRIDE_SD_M = (0.019, 0.056)
+#: seed 003 Table 8, reference system: mean stride length by eq. (17) per belt speed (m).
+#: The paper's stride velocity is eq. (20), V = S/T, so these (not a belt speed) are what
+#: the paper observed of its subjects' strides.
+TREADMILL_EQ17_S_M = {"slow": 0.884, "normal": 1.169, "fast": 1.410}
+#: Tolerance of the twin's eq. (17) mean against them, stated before the twin was changed.
+TREADMILL_EQ17_REL = 0.03
 #: Published step length (/ body height) and cadence (steps/min) ranges per walker group.
 #: young: TUG at maximum speed — from seed 003's fast treadmill walking (stride
 #: 1.410 ± 0.090 m at 1.714 m height, mean ± 2 SD; cadence 0.993 strides/s = 119 /min)
@@ -670,18 +680,45 @@ def _mtst_rows(study_dir: Path, trials: pd.DataFrame) -> list[dict]:
                             for t in trials["trial"]])]
 
 
+def _eq17_strides(study_dir: Path, trial: str) -> pd.DataFrame | None:
+    """seed003 eq. (17)-(20) on the twin's true transmitter path along the belt (what the
+    paper's reference system measured: the heel marker's horizontal displacement)."""
+    from gaitval.gait.strides import stride_table
+
+    f = study_dir / "truth" / trial / "tx.parquet"
+    if not f.is_file():
+        return None
+    d = pd.read_parquet(f, columns=["t_s", "x_m"])
+    fs = 1.0 / float(np.median(np.diff(d["t_s"].to_numpy(float))))
+    return stride_table(d["x_m"].to_numpy(float), fs)
+
+
 def _treadmill_rows(study_dir: Path) -> list[dict]:
     tr = pd.read_csv(study_dir / "trials.csv")
-    tr = tr[(tr["protocol"] == "treadmill") & (tr["speed"] == "normal")]
-    sds = [float(pd.read_csv(f)["length_m"].std()) for t in tr["trial"]
-           if (f := study_dir / "truth" / t / "strides.csv").is_file()]
-    if not sds:
-        return []
-    lo, hi = TREADMILL_STRIDE_SD_M
-    return [_row("treadmill_stride_sd", "treadmill", float(np.mean(sds)), 0.039, lo, hi, "m",
-                 "mean inside the per-subject range", "seed 003 Table 2 (Ref std, normal "
-                 "speed; average 0.039 m)", group="adult",
-                 note=f"{len(sds)} normal-speed trials, reference-system stride lengths")]
+    tr = tr[tr["protocol"] == "treadmill"]
+    by_speed = {sp: [st for t in g["trial"] if (st := _eq17_strides(study_dir, t)) is not None]
+                for sp, g in tr.groupby("speed")}
+    rows = []
+    normal = by_speed.get("normal") or []
+    if normal:
+        sds = [float(st["stride_length"].std()) for st in normal]
+        lo, hi = TREADMILL_STRIDE_SD_M
+        rows.append(_row("treadmill_stride_sd", "treadmill", float(np.mean(sds)), 0.039, lo,
+                         hi, "m", "mean inside the per-subject range", "seed 003 Table 2 "
+                         "(Ref std, normal speed; average 0.039 m)", group="adult",
+                         note=f"{len(sds)} normal-speed trials, eq. (17) on the true heel "
+                              "path"))
+    for sp, ref in TREADMILL_EQ17_S_M.items():
+        if not by_speed.get(sp):
+            continue
+        val = float(np.mean([st["stride_length"].mean() for st in by_speed[sp]]))
+        rows.append(_row("treadmill_eq17_stride_length", "treadmill", val, ref,
+                         ref * (1 - TREADMILL_EQ17_REL), ref * (1 + TREADMILL_EQ17_REL), "m",
+                         f"within {TREADMILL_EQ17_REL:.0%} of the paper's reference mean",
+                         "seed 003 Table 8 (Ref S, eq. 17 on the reference heel marker)",
+                         group="adult", phase=sp,
+                         note=f"{len(by_speed[sp])} trials; eq. (17) on the true heel path"))
+    return rows
 
 
 def physics_table(study_dir: str | Path, walkers: list | None = None,
