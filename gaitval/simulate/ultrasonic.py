@@ -255,7 +255,7 @@ def simulate_ultrasonic_trial(out_dir: Path, plan: UltrasonicPlan, task: tuple
                                    cfg["mocap_rate_hz"], log, truth_tx, meta, strides)
     if kind == "treadmill":
         row = _trial_row(cfg, "treadmill", sub["subject"], trial, c3d_rel, us_rel,
-                         extra["speed"], v)
+                         extra["speed"], meta["speed_mps"])          # the belt's speed
     else:
         row = _trial_row(cfg, "pendulum", "pendulum", trial, c3d_rel, us_rel,
                          repetition=extra["repetition"])

@@ -221,13 +221,51 @@ def _burst_amplitudes(tx: np.ndarray, pitch: np.ndarray, anchors_f: np.ndarray,
     return received_amplitude(dist, cos_tx, cos_rx)
 
 
+#: The heel model's mean stride shape (:func:`stride_plan`'s draws' centres), for
+#: :func:`belt_speed`.
+_MEAN_SHAPE = {"u_ho": 0.34, "u_to": 0.61, "theta_to": 0.85, "z_h": 0.045, "L_h": 0.18,
+               "L_f": 0.20, "theta_hs": -0.30}
+
+
+def eq17_ratio(v: float, T: float) -> float:
+    """seed003 eq. (17) on the heel model's steady stride (mean shape) over its belt
+    stride ``v T``: 2 (max x - min x) / (v T).  Above 1: the heel keeps riding backwards
+    with the belt through heel rise (its forward swing about the metatarsal heads is
+    slower than the belt) and is rearmost just after toe-off, so its excursion is more
+    than half the stride."""
+    n = 4
+    t_hs = np.arange(n + 1) * T
+    plan = {"t_hs": t_hs, "x_hs": np.zeros(n + 1), "v": v,
+            **{k: (np.full(n, val) if k in ("u_ho", "u_to", "theta_to") else val)
+               for k, val in _MEAN_SHAPE.items()}}
+    t = np.linspace(t_hs[1], t_hs[2], 2001)
+    x, _, _ = heel_path(t, plan)
+    return float(2.0 * (x.max() - x.min()) / (v * T))
+
+
+def belt_speed(stride_velocity: float, T: float) -> float:
+    """The belt speed at which eq. (17)-(20) on the heel give ``stride_velocity`` (the
+    paper's V = S/T, Table 8: what its reference system measured, not its belt's speed)
+    for strides of duration ``T``: ``v = V / eq17_ratio(v, T)``, by fixed-point iteration
+    (the ratio changes little with v)."""
+    v = stride_velocity
+    for _ in range(6):
+        v = stride_velocity / eq17_ratio(v, T)
+    return float(v)
+
+
 def simulate_treadmill_trial(rng: np.random.Generator, cfg: dict, subject: dict,
                              speed_mps: float, R: np.ndarray, o: np.ndarray):
-    """One treadmill trial in memory: mocap (labels, xyz), log, truth tables."""
+    """One treadmill trial in memory: mocap (labels, xyz), log, truth tables.
+
+    ``speed_mps`` is the trial's stride velocity as the paper reports it (seed003 eq. (20),
+    V = S/T with S by eq. (17)); the belt runs at :func:`belt_speed` of it, which the
+    trial sheet records (``meta["speed_mps"]``)."""
     dur, rate, us_rate = cfg["duration_s"], cfg["mocap_rate_hz"], cfg["us_rate_hz"]
     T_pop = float(np.interp(speed_mps, *_T_OF_SPEED))
     T_mean = T_pop * np.sqrt(subject["leg_length_m"] / (0.53 * 1.714)) * subject["_t_factor"]
     cv = cfg["stride_cv"] * (1.3 if speed_mps < 0.7 else 1.0)
+    speed_mps = round(belt_speed(speed_mps, T_mean), 3)            # the belt's
     t0 = rng.uniform(0.0, T_mean)
     plan_r = stride_plan(rng, dur, T_mean, speed_mps, cv, t0=t0)
     plan_l = stride_plan(rng, dur, T_mean, speed_mps, cv, t0=t0 + 0.5 * T_mean)
