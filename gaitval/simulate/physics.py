@@ -79,6 +79,9 @@ treadmill_stride_sd       stride-to-stride SD of the reference stride length per
                           (17) on the true heel path, as the paper's reference system) vs
                           seed 003 Table 2 (Ref std, 0.019–0.056 m over subjects); pass: the
                           twin's mean inside that range
+treadmill_subject_sd_     per belt speed: SD over subjects of their mean eq. (17) stride
+  stride_length           length vs Table 8's reference SD (0.095, 0.112, 0.091 m); pass:
+                          inside the 95 % chi-square interval of an SD of 10 subjects
 treadmill_eq17_stride_    per belt speed: mean stride length by seed 003 eq. (17) on the
   length                  twin's true heel path vs Table 8's reference mean (0.884, 1.169,
                           1.410 m); pass: within 3 % (:data:`TREADMILL_EQ17_REL`)
@@ -151,6 +154,8 @@ TREADMILL_STRIDE_SD_M = (0.019, 0.056)
 #: The paper's stride velocity is eq. (20), V = S/T, so these (not a belt speed) are what
 #: the paper observed of its subjects' strides.
 TREADMILL_EQ17_S_M = {"slow": 0.884, "normal": 1.169, "fast": 1.410}
+#: seed 003 Table 8, reference system: SD over the ten subjects of their stride length (m).
+TREADMILL_SUBJECT_SD_S_M = {"slow": 0.095, "normal": 0.112, "fast": 0.091}
 #: Tolerance of the twin's eq. (17) mean against them, stated before the twin was changed.
 TREADMILL_EQ17_REL = 0.03
 #: Published step length (/ body height) and cadence (steps/min) ranges per walker group.
@@ -708,6 +713,21 @@ def _treadmill_rows(study_dir: Path) -> list[dict]:
                          "(Ref std, normal speed; average 0.039 m)", group="adult",
                          note=f"{len(sds)} normal-speed trials, eq. (17) on the true heel "
                               "path"))
+    n_paper = 10                                       # seed 003: ten subjects
+    for sp, ref in TREADMILL_SUBJECT_SD_S_M.items():
+        g = tr[tr["speed"] == sp]
+        if g.empty or g["subject"].nunique() < 2:
+            continue
+        means = [st["stride_length"].mean() for t in g["trial"]
+                 if (st := _eq17_strides(study_dir, t)) is not None]
+        lo = ref * np.sqrt((n_paper - 1) / stats.chi2.ppf(0.975, n_paper - 1))
+        hi = ref * np.sqrt((n_paper - 1) / stats.chi2.ppf(0.025, n_paper - 1))
+        rows.append(_row("treadmill_subject_sd_stride_length", "treadmill",
+                         float(np.std(means, ddof=1)), ref, lo, hi, "m",
+                         "inside the 95 % interval of an SD of 10 subjects",
+                         "seed 003 Table 8 (Ref std of S over subjects)", group="adult",
+                         phase=sp, note=f"{len(means)} subjects' mean eq. (17) stride "
+                                        "length"))
     for sp, ref in TREADMILL_EQ17_S_M.items():
         if not by_speed.get(sp):
             continue
