@@ -26,7 +26,8 @@ What the paper leaves open is made explicit here:
   the ranges fit both equally.  After an abrupt manoeuvre the linearised update can carry
   the state through the plane, and it then tracks the mirror image.  When the anchors are
   coplanar, the side of ``init_guess`` is taken as the physical side (the transmitter faces
-  the receivers) and a state that ends an update on the other side is reflected back
+  the receivers) and a state that ends a sample on the other side (after an update, or coasting on
+  its prediction alone) is reflected back
   (position and velocity); this is counted in ``reflected``.
 * **Checked (re-)initialisation.**  The paper's filter starts from a known position;
   gaitval starts (and restarts a lost filter) from a trilateration of one sample's ranges.

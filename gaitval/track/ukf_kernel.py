@@ -156,10 +156,12 @@ def ukf_steps(k0, force, t, d, n_finite, model, x, P, starved, out):
                     xn, P, ok = _update(x, P, nu, Pyy, Pxy, np.flatnonzero(used[k]))
                     x[:] = xn
                 P = 0.5 * (P + P.T)
-                if normal.size:
-                    reflected[k] = _reflect(x, normal, centre)
             lost = not ok
             starved[0] = starved[0] + 1 if (n_ok < min_anchors or mismatch) else 0
+        # after an update, and after a prediction alone (no range, or none usable): a
+        # state that coasts across the receiver plane is the mirror image too
+        if normal.size and np.isfinite(x[0]):
+            reflected[k] = _reflect(x, normal, centre)
         if lost or np.isnan(P[0, 0]) or abs(x[0]) > 1e3:  # numerically lost
             starved[0] = reinit_after
         out_x[k] = x
