@@ -265,6 +265,29 @@ def test_subject_from_the_c3d_and_the_mtst_study_yaml(tiny_files, tmp_path):
     subj = pd.read_csv(lab / "subjects.csv", dtype=str, keep_default_na=False).iloc[0]
     assert (subj["height_m"], subj["leg_width_m"], subj["stick"]) == (FILL_IN,) * 3
     assert any("height_m" in t for t in res.todo)
+    assert any("subject ids from the C3D's SUBJECTS:NAMES: 1 trial" in n for n in res.notes)
+
+
+def test_the_file_name_names_the_subject_before_the_c3d(tiny_files, tmp_path):
+    """As the README says, ids come from the file names; Vicon's SUBJECTS:NAMES (often a
+    session's, "Treadmill") only where the name has no subject word; the summary says
+    which."""
+    from gaitval.io.c3d_read import read_c3d
+    from gaitval.io.c3d_write import write_c3d
+
+    lab = tmp_path / "lab"
+    lab.mkdir()
+    m = read_c3d(tiny_files / "mocap" / "mtst_E01_t1.c3d")
+    write_c3d(lab / "mtst_E07_stick_3.c3d", m.labels, m.xyz, m.rate_hz,
+              subject_prefix="Treadmill")
+    shutil.copy(tiny_files / "lrs" / "mtst_E01_t1.scan.parquet",
+                lab / "mtst_E07_stick_3.scan.parquet")
+    res = init_study(lab)
+    row = pd.read_csv(lab / "trials.csv", dtype=str, keep_default_na=False).iloc[0]
+    assert row["subject"] == "E07"
+    assert any("subject ids from the file name: 1 trial (mtst_E07_stick_3)" in n
+               for n in res.notes), res.notes
+    assert "subject ids from the file name" in res.text()
 
 
 def test_plug_in_gait_anthropometrics_are_read_from_the_c3d(realdata, tiny_files, tmp_path):
