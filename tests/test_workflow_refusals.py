@@ -60,3 +60,16 @@ def test_refused_trials_are_loud(realdata, tmp_path):
     again = run_report(tmp_path, sheet, "--accept-refusals")
     assert again.returncode == 0, (again.stdout + again.stderr)[-3000:]
     assert f"analysed 3 of {n} trials" in again.stdout
+
+
+@pytest.mark.slow
+def test_the_correct_study_exits_0_with_every_trial_analysed(realdata, tmp_path):
+    sim = O.replay_study(tmp_path / "replay")
+    sheet = O.build(sim, tmp_path / "data" / O.STUDY, None)
+    res = run_report(tmp_path, sheet)
+    assert res.returncode == 0, (res.stdout + res.stderr)[-4000:]
+    assert "analysed 3 of 3 trials" in res.stdout
+    rec = json.loads((tmp_path / "reports" / O.STUDY / "analysed.json").read_text())
+    assert rec[O.STUDY] == {"trials": 3, "analysed": 3, "refused": {}}
+    top = (tmp_path / "reports" / O.STUDY / "index.md").read_text().split("## Verdicts")[0]
+    assert "refused" not in top
