@@ -1,0 +1,172 @@
+"""The papers' example figures (verb ``paper-figures``): one protocol's figures from the
+run's per-trial results, read by their place in the results folder.
+
+Per protocol, from the first of the given ``results/<study>`` folders that has its results:
+
+========== ============================================== =================================
+protocol   reads                                          writes (figures/)
+========== ============================================== =================================
+tug        ``evaluate/<m>/<trial>/{frames,events,summary}`` ``tug_fig12.png``,
+           for ``tug_m1..3``, ``ingest/<trial>/sensor``    ``tug_fig13.png``
+mtst       ``mtst_eval/<m>/<trial>/*``,                    ``mtst_fig6a.png``,
+           ``mtst_track/<m>/<trial>``, ingest, register    ``mtst_fig8.png``, ``mtst_fig9.png``
+rollator   ``rollator/<kf|pf>/<trial>/frames``, its         ``rollator_fig5.png``
+           ``.track.parquet``, ingest
+ultrasonic ``ultrasonic/{track,gait}/<trial>.parquet``     ``ultrasonic_fig2..4.png``
+========== ============================================== =================================
+
+A figure the run's data cannot give (no trial of a kind) is left out; the step writes the
+figures it made and stamps them (``provenance/<protocol>_paper_figures.json``).
+"""
+from __future__ import annotations
+
+import argparse
+import functools
+from pathlib import Path
+
+import pandas as pd
+
+from gaitval.errors import GaitvalError
+from gaitval.io.parquet import read_parquet
+
+PROTOCOLS = ("tug", "mtst", "rollator", "ultrasonic")
+#: The figures each protocol's step can write (the workflow's declared outputs).
+FIGURES = {"tug": ["tug_fig12", "tug_fig13"],
+           "mtst": ["mtst_fig6a", "mtst_fig8", "mtst_fig9"],
+           "rollator": ["rollator_fig5"],
+           "ultrasonic": ["ultrasonic_fig2", "ultrasonic_fig3", "ultrasonic_fig4"]}
+
+
+def _concat(paths) -> pd.DataFrame:
+    dfs = [d for d in (read_parquet(p) for p in paths) if len(d)]
+    return pd.concat(dfs, ignore_index=True) if dfs else pd.DataFrame()
+
+
+@functools.lru_cache(maxsize=8)
+def _scans(path: str):
+    from gaitval.io.scanlog import read_scanlog
+    return read_scanlog(path)
+
+
+def _scans_of(study_dir: Path):
+    def get(trial: str):
+        p = study_dir / "ingest" / str(trial) / "sensor.parquet"
+        return _scans(str(p)) if p.is_file() else None
+    return get
+
+
+def _truth_of(study_dir: Path):
+    def get(trial: str):
+        hits = sorted((study_dir / "register").glob(f"*/{trial}/groundtruth.parquet"))
+        if not hits:
+            return None
+        g = read_parquet(hits[0])
+        return g[g["valid"].astype(bool)] if "valid" in g else g
+    return get
+
+
+def tug_figures(study_dir: Path, out: Path, methods=("tug_m1", "tug_m2", "tug_m3")):
+    from gaitval.report.paper_figures_tug import write_tug_paper_figures
+
+    dirs = [d for m in methods for d in sorted((study_dir / "evaluate" / m).glob("*/"))]
+    if not dirs:
+        return None
+    frames, events, summary = (_concat(d / f"{n}.parquet" for d in dirs
+                                       if (d / f"{n}.parquet").is_file())
+                               for n in ("frames", "events", "summary"))
+    if len(summary) and "category" in summary:
+        summary = summary[summary["category"].astype(str) != "not_registered"]
+    if frames.empty:
+        return []
+    return write_tug_paper_figures(frames, events, summary, _scans_of(study_dir), out)
+
+
+def mtst_figures(study_dir: Path, out: Path, config_json=None,
+                 methods=("mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed")):
+    from gaitval.evaluate.mtst_trial import settings
+    from gaitval.report.paper_figures_mtst import write_mtst_paper_figures
+
+    dirs = [d for m in methods for d in sorted((study_dir / "mtst_eval" / m).glob("*/"))]
+    if not dirs:
+        return None
+    data = {n: _concat(d / f"{n}.parquet" for d in dirs if (d / f"{n}.parquet").is_file())
+            for n in ("contacts", "targets", "events", "summary", "gates")}
+    tracks = _concat(p for m in methods
+                     for p in sorted((study_dir / "mtst_track" / m).glob("*.parquet")))
+    from gaitval.pipeline.steps import load_json
+    s = settings(load_json(config_json) if config_json else {})
+    return write_mtst_paper_figures(data, tracks, _scans_of(study_dir),
+                                    _truth_of(study_dir), out, s)
+
+
+def rollator_figures(study_dir: Path, out: Path, kf="rollator_kf", pf="rollator_pf"):
+    from gaitval.report.paper_figures_rollator import write_rollator_paper_figures
+
+    dirs = [d for m in (kf, pf) for d in sorted((study_dir / "rollator" / m).glob("*/"))]
+    if not dirs:
+        return None
+    frames = _concat(d / "frames.parquet" for d in dirs if (d / "frames.parquet").is_file())
+    tracks = _concat(p for m in (kf, pf)
+                     for p in sorted((study_dir / "rollator" / m).glob("*.track.parquet")))
+    if frames.empty:
+        return []
+    return write_rollator_paper_figures(frames, tracks, _scans_of(study_dir), out, kf, pf)
+
+
+def ultrasonic_figures(study_dir: Path, out: Path, config_json=None):
+    from gaitval.pipeline.steps import load_json
+    from gaitval.report.paper_figures_ultrasonic import write_ultrasonic_paper_figures
+
+    gait = sorted((study_dir / "ultrasonic" / "gait").glob("*.parquet"))
+    if not gait:
+        return None
+    tracks = {p.stem: read_parquet(p)
+              for p in sorted((study_dir / "ultrasonic" / "track").glob("*.parquet"))}
+    cfg = (load_json(config_json).get("ultrasonic") or {}) if config_json else {}
+    return write_ultrasonic_paper_figures(tracks, _concat(gait), out, cfg)
+
+
+def paper_figures_step(protocol: str, results_dirs, figures_dir, reports_dir,
+                       config_hash: str = "", config_json=None) -> list[Path]:
+    """One protocol's figures (module table) from the first results folder with its
+    results; stamps what it wrote.  Raises when no folder has the protocol's results."""
+    from gaitval.report.provenance import stamp
+
+    if protocol not in PROTOCOLS:
+        raise GaitvalError(f"paper-figures: unknown protocol {protocol!r}; known: "
+                           f"{', '.join(PROTOCOLS)}")
+    out = Path(figures_dir)
+    make = {"tug": lambda d: tug_figures(d, out),
+            "mtst": lambda d: mtst_figures(d, out, config_json),
+            "rollator": lambda d: rollator_figures(d, out),
+            "ultrasonic": lambda d: ultrasonic_figures(d, out, config_json)}[protocol]
+    for d in map(Path, results_dirs):
+        paths = make(d)
+        if paths is not None:
+            stamp(f"{protocol}_paper_figures", paths, reports_dir, config_hash_=config_hash)
+            return paths
+    raise GaitvalError(f"paper-figures: no {protocol} results under "
+                       f"{', '.join(map(str, results_dirs))}")
+
+
+def add_paper_figure_verbs(sub) -> None:
+    """``paper-figures`` (for gaitval.cli)."""
+    def run(a: argparse.Namespace) -> int:
+        paper_figures_step(a.protocol, a.results, a.figures_dir, a.reports_dir,
+                           a.config_hash, a.config)
+        return 0
+
+    s = sub.add_parser("paper-figures", help="the papers' example figures of one protocol "
+                       "(seed 000 Figs. 12-13, seed 001 Figs. 6a, 8, 9, seed 002 Fig. 5, "
+                       "seed 003 Figs. 2-4) from a run's results")
+    s.add_argument("protocol", choices=PROTOCOLS)
+    s.add_argument("--results", nargs="+", required=True, metavar="DIR",
+                   help="results/<study> folders; the first with the protocol's results "
+                   "is drawn")
+    s.add_argument("--config", default=None,
+                   help="a study config view (mtst: the mtst section; ultrasonic: its "
+                   "strides and symmetry window)")
+    s.add_argument("--figures-dir", required=True, help="where the PNGs go")
+    s.add_argument("--reports-dir", default="reports", help="the report folder (provenance)")
+    s.add_argument("--config-hash", default="", help="recorded in the provenance")
+    s.set_defaults(func=run)
