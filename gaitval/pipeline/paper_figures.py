@@ -15,8 +15,9 @@ rollator   ``rollator/<kf|pf>/<trial>/frames``, its         ``rollator_fig5.png`
 ultrasonic ``ultrasonic/{track,gait}/<trial>.parquet``     ``ultrasonic_fig2..4.png``
 ========== ============================================== =================================
 
-A figure the run's data cannot give (no trial of a kind) is left out; the step writes the
-figures it made and stamps them (``provenance/<protocol>_paper_figures.json``).
+A figure the run's data cannot give (no tracked trial of the methods it compares) is
+written as a PNG that says so (:func:`not_produced`: the workflow declares every figure);
+the step stamps what it wrote (``provenance/<protocol>_paper_figures.json``).
 """
 from __future__ import annotations
 
@@ -143,10 +144,26 @@ def paper_figures_step(protocol: str, results_dirs, figures_dir, reports_dir,
     for d in map(Path, results_dirs):
         paths = make(d)
         if paths is not None:
+            made = {p.stem for p in paths}
+            paths += [not_produced(out / f"{stem}.png", stem, d.name)
+                      for stem in FIGURES[protocol] if stem not in made]
             stamp(f"{protocol}_paper_figures", paths, reports_dir, config_hash_=config_hash)
             return paths
     raise GaitvalError(f"paper-figures: no {protocol} results under "
                        f"{', '.join(map(str, results_dirs))}")
+
+
+def not_produced(path: Path, stem: str, study: str) -> Path:
+    """A PNG that says the figure could not be drawn from this run (the workflow declares
+    every figure, so one the data cannot give is a statement, not a missing file)."""
+    from gaitval.report.figures import plt, save_figure
+
+    fig, ax = plt.subplots(figsize=(6, 1.6))
+    ax.axis("off")
+    ax.text(0.5, 0.5, f"{stem}: not drawn — study {study} has no trial showing the "
+            "situation\n(no tracked trial of the methods it compares, or no contact near a "
+            "target)", ha="center", va="center", fontsize=9, wrap=True)
+    return save_figure(fig, path)
 
 
 def add_paper_figure_verbs(sub) -> None:
