@@ -66,7 +66,33 @@ def _truth_of(study_dir: Path):
     return get
 
 
-def tug_figures(study_dir: Path, out: Path, methods=("tug_m1", "tug_m2", "tug_m3")):
+def _obs_of(study_dir: Path, family: str, scans_of, sheet, subjects):
+    """``(trial, method) -> observations``: the method's detector (its config view's
+    definition, :func:`gaitval.pipeline.detections.method_detector`) run on the trial's
+    scans with the leg width its track step uses; None for a method that detects scan by
+    scan, or without the trial sheet and subject table."""
+    if not sheet or not subjects:
+        return None
+    from gaitval.detect import DETECTORS
+    from gaitval.pipeline.detections import method_detector
+    from gaitval.pipeline.steps import load_json, trial_and_subject, tug_leg_width
+
+    def get(trial: str, method: str):
+        view = study_dir / "config_views" / family / f"{method}.json"
+        cfg = load_json(view if view.is_file() else study_dir / "config.json")
+        spec = method_detector(cfg, method)
+        scans = scans_of(trial)
+        if spec is None or scans is None:
+            return None
+        _, subj = trial_and_subject(sheet, subjects, trial)
+        width = (tug_leg_width(subj, cfg) if family == "tug"
+                 else float(subj["leg_width_m"]))
+        return DETECTORS.build(spec).detect(scans, float(width))
+    return get
+
+
+def tug_figures(study_dir: Path, out: Path, methods=("tug_m1", "tug_m2", "tug_m3"),
+                sheet=None, subjects=None):
     from gaitval.report.paper_figures_tug import write_tug_paper_figures
 
     dirs = [d for m in methods for d in sorted((study_dir / "evaluate" / m).glob("*/"))]
@@ -79,11 +105,14 @@ def tug_figures(study_dir: Path, out: Path, methods=("tug_m1", "tug_m2", "tug_m3
         summary = summary[summary["category"].astype(str) != "not_registered"]
     if frames.empty:
         return []
-    return write_tug_paper_figures(frames, events, summary, _scans_of(study_dir), out)
+    scans_of = _scans_of(study_dir)
+    return write_tug_paper_figures(frames, events, summary, scans_of, out,
+                                   _obs_of(study_dir, "tug", scans_of, sheet, subjects))
 
 
 def mtst_figures(study_dir: Path, out: Path, config_json=None,
-                 methods=("mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed")):
+                 methods=("mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed"), sheet=None,
+                 subjects=None):
     from gaitval.evaluate.mtst_trial import settings
     from gaitval.report.paper_figures_mtst import write_mtst_paper_figures
 
@@ -96,8 +125,18 @@ def mtst_figures(study_dir: Path, out: Path, config_json=None,
                      for p in sorted((study_dir / "mtst_track" / m).glob("*.parquet")))
     from gaitval.pipeline.steps import load_json
     s = settings(load_json(config_json) if config_json else {})
-    return write_mtst_paper_figures(data, tracks, _scans_of(study_dir),
-                                    _truth_of(study_dir), out, s)
+    full = _scans_of(study_dir)
+    kept: dict[str, object] = {}
+
+    def scans_of(trial: str):           # the scans the MTST methods track (mtst.scan_period_s)
+        from gaitval.pipeline.mtst import keep_every
+        if trial not in kept:
+            sc = full(trial)
+            kept[trial] = (keep_every(sc, float(s["scan_period_s"]), trial=trial)
+                           if sc is not None else None)
+        return kept[trial]
+    return write_mtst_paper_figures(data, tracks, scans_of, _truth_of(study_dir), out, s,
+                                    _obs_of(study_dir, "mtst", scans_of, sheet, subjects))
 
 
 def rollator_figures(study_dir: Path, out: Path, kf="rollator_kf", pf="rollator_pf"):
@@ -128,17 +167,22 @@ def ultrasonic_figures(study_dir: Path, out: Path, config_json=None):
 
 
 def paper_figures_step(protocol: str, results_dirs, figures_dir, reports_dir,
-                       config_hash: str = "", config_json=None) -> list[Path]:
+                       config_hash: str = "", config_json=None, sheet=None,
+                       subjects=None) -> list[Path]:
     """One protocol's figures (module table) from the first results folder with its
-    results; stamps what it wrote.  Raises when no folder has the protocol's results."""
+    results; stamps what it wrote.  ``sheet`` and ``subjects`` (that study's trial sheet
+    and subject table) give the leg widths the TUG and MTST detectors ran with, so the
+    snapshots show the methods' observations; without them they are left out.  Raises
+    when no folder has the protocol's results."""
     from gaitval.report.provenance import stamp
 
     if protocol not in PROTOCOLS:
         raise GaitvalError(f"paper-figures: unknown protocol {protocol!r}; known: "
                            f"{', '.join(PROTOCOLS)}")
     out = Path(figures_dir)
-    make = {"tug": lambda d: tug_figures(d, out),
-            "mtst": lambda d: mtst_figures(d, out, config_json),
+    make = {"tug": lambda d: tug_figures(d, out, sheet=sheet, subjects=subjects),
+            "mtst": lambda d: mtst_figures(d, out, config_json, sheet=sheet,
+                                           subjects=subjects),
             "rollator": lambda d: rollator_figures(d, out),
             "ultrasonic": lambda d: ultrasonic_figures(d, out, config_json)}[protocol]
     for d in map(Path, results_dirs):
@@ -170,19 +214,23 @@ def add_paper_figure_verbs(sub) -> None:
     """``paper-figures`` (for gaitval.cli)."""
     def run(a: argparse.Namespace) -> int:
         paper_figures_step(a.protocol, a.results, a.figures_dir, a.reports_dir,
-                           a.config_hash, a.config)
+                           a.config_hash, a.config, a.sheet, a.subjects)
         return 0
 
     s = sub.add_parser("paper-figures", help="the papers' example figures of one protocol "
                        "(seed 000 Figs. 12-13, seed 001 Figs. 6a, 8, 9, seed 002 Fig. 5, "
                        "seed 003 Figs. 2-4) from a run's results")
-    s.add_argument("protocol", choices=PROTOCOLS)
+    s.add_argument("protocol", choices=PROTOCOLS, help="which paper's figures: "
+                   + ", ".join(PROTOCOLS))
     s.add_argument("--results", nargs="+", required=True, metavar="DIR",
                    help="results/<study> folders; the first with the protocol's results "
                    "is drawn")
     s.add_argument("--config", default=None,
                    help="a study config view (mtst: the mtst section; ultrasonic: its "
                    "strides and symmetry window)")
+    s.add_argument("--sheet", default=None, help="the study's trial sheet (with --subjects: "
+                   "the leg widths of the TUG and MTST snapshots' observations)")
+    s.add_argument("--subjects", default=None, help="the study's subject table")
     s.add_argument("--figures-dir", required=True, help="where the PNGs go")
     s.add_argument("--reports-dir", default="reports", help="the report folder (provenance)")
     s.add_argument("--config-hash", default="", help="recorded in the provenance")

@@ -17,7 +17,9 @@ run's MTST evaluations and scans.
   evaluation's ``gates`` table), Method 2's radius is fixed (1.5 w_l).
 
 Where the run has no such failure the snapshot falls back to the method's longest
-occlusion, else to the scan where the true legs were closest, and its title says so.  Gates are not drawn as circles: the track keeps no
+occlusion, else to the scan where the true legs were closest, and its title says so.
+Each method's observations (its detector run again on the trial, with or without FS_U)
+are drawn with their patterns.  Gates are not drawn as circles: the track keeps no
 predicted position to centre them on (:mod:`gaitval.report.paper_figures_scans`).
 """
 from __future__ import annotations
@@ -91,7 +93,7 @@ def _closest_legs(tracks: pd.DataFrame, method: str, truth_of
 
 
 def _snapshots(tracks, events, summary, scans_of, truth_of, path, m_a, m_b, kinds,
-               situation, fig_no, notes=None) -> Path | None:
+               situation, fig_no, notes=None, obs_of=None) -> Path | None:
     ev = pick_event(events, summary, m_a, m_b, kinds)
     if ev is not None:
         trial, t0 = str(ev["trial"]), float(ev["t_start_s"])
@@ -118,22 +120,25 @@ def _snapshots(tracks, events, summary, scans_of, truth_of, path, m_a, m_b, kind
     dt = float(np.median(np.diff(np.unique(rows[0][1]["t_sensor_s"])))) if rows else 0.05
     times = [t0 + i * dt for i in (-6, -3, -1, 0, 3)]
     title = (f"MTST trial {trial}, {situation}: {what} — rows {', '.join(m for m, _ in rows)} "
-             f"(cf. Yorozu et al. 2015, MTST, Fig. {fig_no})\nvalidation regions and "
-             "observed leg positions not drawn: the track files do not keep them")
+             f"(cf. Yorozu et al. 2015, MTST, Fig. {fig_no})\nvalidation regions not "
+             "drawn: the track files do not keep them")
+    obs = {m: obs_of(trial, m) for m, _ in rows} if obs_of is not None else {}
     return snapshot_figure(scans, rows, times, path, title=title, truth=truth_of(trial),
-                           notes=notes)
+                           notes=notes,
+                           observations={m: o for m, o in obs.items() if o is not None})
 
 
 def figure8(tracks, events, summary, scans_of, truth_of, path, m_a: str = "mtst_m1",
-            m_b: str = "mtst_m2") -> Path | None:
+            m_b: str = "mtst_m2", obs_of=None) -> Path | None:
     """Scan snapshots of ``m_a`` (no FS_U) and ``m_b`` around ``m_a``'s first tracking
     failure (lost, or a false track other than a switch) in a trial ``m_b`` tracked."""
     return _snapshots(tracks, events, summary, scans_of, truth_of, path, m_a, m_b,
-                      ("lost", "false_other"), "a leg temporarily hidden", "8")
+                      ("lost", "false_other"), "a leg temporarily hidden", "8",
+                      obs_of=obs_of)
 
 
 def figure9(tracks, events, summary, scans_of, truth_of, gates, path, m_a: str = "mtst_m2",
-            m_b: str = PROPOSED) -> Path | None:
+            m_b: str = PROPOSED, obs_of=None) -> Path | None:
     """Scan snapshots of ``m_a`` (large fixed region) and ``m_b`` (variable region)
     around ``m_a``'s first false tracking by switching the legs in a trial ``m_b``
     tracked; ``m_b``'s panels give its gate radii (``gates``: ``trial, method, k, side,
@@ -147,7 +152,8 @@ def figure9(tracks, events, summary, scans_of, truth_of, gates, path, m_a: str =
         return "gate r: " + ", ".join(f"{s} {100 * float(v):.1f} cm" for s, v in
                                       zip(r["side"].astype(str), r["radius_m"]))
     return _snapshots(tracks, events, summary, scans_of, truth_of, path, m_a, m_b,
-                      ("false_swap",), "both legs close together", "9", notes=notes)
+                      ("false_swap",), "both legs close together", "9", notes=notes,
+                      obs_of=obs_of)
 
 
 def figure6a(contacts: pd.DataFrame, targets: pd.DataFrame, path: str | Path, s: dict,
@@ -216,19 +222,21 @@ def figure6a(contacts: pd.DataFrame, targets: pd.DataFrame, path: str | Path, s:
 
 
 def write_mtst_paper_figures(data: dict[str, pd.DataFrame], tracks: pd.DataFrame, scans_of,
-                             truth_of, out_dir, s: dict) -> list[Path]:
+                             truth_of, out_dir, s: dict, obs_of=None) -> list[Path]:
     """``mtst_fig6a.png``, ``mtst_fig8.png`` and ``mtst_fig9.png`` (those the run allows).
 
     ``data``: the pooled evaluation tables (``contacts``, ``targets``, ``events``,
     ``summary``, ``gates``); ``tracks``: the MTST tracks (sensor frame) of the trials with
     mocap; ``scans_of(trial)`` its scans (None when not ingested) and ``truth_of(trial)``
-    its ground truth (``t_sensor_s, side, xs_m, ys_m``)."""
+    its ground truth (``t_sensor_s, side, xs_m, ys_m``); ``obs_of(trial, method)`` the
+    method's detector's observations (None: not drawn)."""
     out = Path(out_dir)
     e = pd.DataFrame()
     ev, summ = data.get("events", e), data.get("summary", e)
     paths = [figure6a(data.get("contacts", e), data.get("targets", e),
                       out / "mtst_fig6a.png", s),
-             figure8(tracks, ev, summ, scans_of, truth_of, out / "mtst_fig8.png"),
+             figure8(tracks, ev, summ, scans_of, truth_of, out / "mtst_fig8.png",
+                     obs_of=obs_of),
              figure9(tracks, ev, summ, scans_of, truth_of, data.get("gates"),
-                     out / "mtst_fig9.png")]
+                     out / "mtst_fig9.png", obs_of=obs_of)]
     return [p for p in paths if p is not None]

@@ -3,10 +3,11 @@ legs, one row per method and one column per scan — what the papers' example fi
 tracking situation show (seed 000 Fig. 12, seed 001 Figs. 8 and 9, seed 002 Fig. 5).
 
 What a snapshot can show is what the run keeps: the raw scan (the ingested scan log), each
-method's estimate per scan and leg with its pattern (``UO``: no observation associated)
-and the ground truth at the scan.  The trackers' gates (validation regions), their
-observations before association and a particle filter's particles are not written by the
-tracking step, so no snapshot draws them; the callers' titles say so.
+method's estimate per scan and leg with its pattern (``UO``: no observation associated),
+the ground truth at the scan, and the observations of the method's detector (run again on
+the trial's scans by :mod:`gaitval.pipeline.paper_figures`, as the track step ran it).
+The trackers' gates (validation regions) and a particle filter's particles are not
+written by the tracking step, so no snapshot draws them; the callers' titles say so.
 """
 from __future__ import annotations
 
@@ -35,7 +36,8 @@ def snapshot_figure(scans, rows: list[tuple[str, pd.DataFrame]], times: list[flo
                     path: str | Path, *, title: str, truth: pd.DataFrame | None = None,
                     x: str = "x_m", y: str = "y_m", xt: str = "xs_m", yt: str = "ys_m",
                     half_m: float = 0.55, trail: int = 8, notes=None,
-                    column_titles: list[str] | None = None) -> Path:
+                    column_titles: list[str] | None = None,
+                    observations: dict | None = None) -> Path:
     """One row per ``(label, track)`` and one column per time of ``times`` (sensor clock).
 
     Each ``track`` has ``k, t_sensor_s, side`` and the position columns ``x, y`` (sensor
@@ -48,6 +50,9 @@ def snapshot_figure(scans, rows: list[tuple[str, pd.DataFrame]], times: list[flo
     ``notes(label, k)`` adds a line to a panel's title (e.g. the gate radii at scan k);
     ``column_titles`` head each column.  ``scans``, ``truth`` and each row's track may
     be lists, one per column (snapshots of different trials side by side).
+    ``observations``: per row label, the method's detector's observation table
+    (``t_sensor_s, x_m, y_m, pattern``; :mod:`gaitval.detect.base`) of the trial, drawn as
+    green diamonds labelled with their pattern (the observations y_k^j before association).
     """
     ncol = len(times)
     fig, axes = plt.subplots(len(rows), ncol, figsize=(max(2.9 * ncol, 8.0),
@@ -58,7 +63,9 @@ def snapshot_figure(scans, rows: list[tuple[str, pd.DataFrame]], times: list[flo
             ax = axes[r][c]
             tr = _at(tracks, c)
             tru = _at(truth, c) if truth is not None else tr
-            k = _panel(ax, _at(scans, c), tr, tru, float(t0), x, y, xt, yt, half_m, trail)
+            obs = (observations or {}).get(label)
+            k = _panel(ax, _at(scans, c), tr, tru, float(t0), x, y, xt, yt, half_m, trail,
+                       _at(obs, c) if obs is not None else None)
             extra = notes(label, k) if notes is not None and k is not None else ""
             head = f"{column_titles[c]}\n" if column_titles else ""
             ax.set_title(f"{head}{label}, t = {float(t0):.3f} s"
@@ -75,6 +82,9 @@ def snapshot_figure(scans, rows: list[tuple[str, pd.DataFrame]], times: list[flo
                                   label=f"{side} leg estimate (line: last {trail} scans)"))
     handles.append(plt.Line2D([], [], ls="none", marker="s", mfc="none", color="0.2",
                               label="estimate with no observation (UO)"))
+    if observations:
+        handles.append(plt.Line2D([], [], ls="none", marker="D", mfc="none",
+                                  color="tab:green", label="observed leg position (pattern)"))
     fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=7.5, frameon=False)
     fig.suptitle(title, fontsize=9)
     fig.tight_layout(rect=(0, 0.08, 1, 0.95))
@@ -96,7 +106,7 @@ def _nearest_rows(df: pd.DataFrame, t0: float, tol: float = 0.06) -> pd.DataFram
     return d.sort_values("_dt", kind="stable").drop_duplicates("side").drop(columns="_dt")
 
 
-def _panel(ax, scans, tr, truth, t0, x, y, xt, yt, half, trail):
+def _panel(ax, scans, tr, truth, t0, x, y, xt, yt, half, trail, obs=None):
     """Draw one panel; return the track's scan index k nearest ``t0`` (None: no track)."""
     now = _nearest_rows(tr, t0)
     k = int(now["k"].iloc[0]) if len(now) else None
@@ -114,6 +124,14 @@ def _panel(ax, scans, tr, truth, t0, x, y, xt, yt, half, trail):
     for row in tk.itertuples(index=False):
         ax.plot(getattr(row, xt), getattr(row, yt), "o", ms=14, mfc="0.85", mec="0.5",
                 zorder=1)
+    if obs is not None and len(obs):
+        ts = float(scans.t[nearest_scan(scans.t, t0)])
+        o = obs[(obs["t_sensor_s"] - ts).abs() < 1e-6]
+        ax.plot(o["x_m"], o["y_m"], "D", ms=6, mfc="none", mec="tab:green", mew=1.3,
+                zorder=6)
+        for r in o.itertuples(index=False):
+            ax.annotate(str(r.pattern), (r.x_m, r.y_m), textcoords="offset points",
+                        xytext=(5, -9), fontsize=6, color="tab:green", zorder=7)
     for side in ("L", "R"):
         if k is None:
             break

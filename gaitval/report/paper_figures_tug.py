@@ -10,8 +10,9 @@ Figs. 12 and 13) from the run's TUG evaluations and scans.
   the turning phase (:func:`pick_occlusion`), tracked against mocap, top view per method,
   and its position error over time.
 
-The paper's panels also draw the gates and the observed leg positions y_k^j; the track
-files do not keep them (:mod:`gaitval.report.paper_figures_scans`).
+The paper's panels also draw the gates; the track files do not keep them
+(:mod:`gaitval.report.paper_figures_scans`).  The observed leg positions y_k^j are drawn
+when ``obs_of`` gives them.
 """
 from __future__ import annotations
 
@@ -89,7 +90,7 @@ def pick_occlusion(frames: pd.DataFrame, method: str = M2) -> pd.Series | None:
 
 
 def figure12(frames: pd.DataFrame, events: pd.DataFrame, summaries: pd.DataFrame, scans_of,
-             path: str | Path, m_a: str = M1, m_b: str = M2) -> Path | None:
+             path: str | Path, m_a: str = M1, m_b: str = M2, obs_of=None) -> Path | None:
     """Scan snapshots of ``m_a`` and ``m_b`` around :func:`pick_fig12_event`, or, when
     ``m_a`` never tracked falsely, around ``m_b``'s first false tracking, else around
     ``m_a``'s longest occlusion in the turn (the title says which).  ``scans_of(trial)`` returns the trial's ScanSeries.  None when
@@ -119,9 +120,12 @@ def figure12(frames: pd.DataFrame, events: pd.DataFrame, summaries: pd.DataFrame
     rows = [(m, f[f["method"].astype(str) == m]) for m in (m_a, m_b)
             if (f["method"].astype(str) == m).any()]
     title = (f"TUG trial {trial}: {what} — rows {', '.join(m for m, _ in rows)} "
-             "(cf. Yorozu et al. 2015 Fig. 12)\ngates and observed leg positions not drawn: "
-             "the track files do not keep them")
-    return snapshot_figure(scans, rows, times, path, title=title)
+             "(cf. Yorozu et al. 2015 Fig. 12)\ngates not drawn: the track files do not "
+             "keep them")
+    obs = {m: obs_of(trial, m) for m, _ in rows} if obs_of is not None else None
+    return snapshot_figure(scans, rows, times, path, title=title,
+                           observations={m: o for m, o in (obs or {}).items()
+                                         if o is not None})
 
 
 def figure13(frames: pd.DataFrame, path: str | Path, m_a: str = M2, m_b: str = M3,
@@ -180,9 +184,11 @@ def figure13(frames: pd.DataFrame, path: str | Path, m_a: str = M2, m_b: str = M
 
 
 def write_tug_paper_figures(frames: pd.DataFrame, events: pd.DataFrame,
-                            summaries: pd.DataFrame, scans_of, out_dir) -> list[Path]:
+                            summaries: pd.DataFrame, scans_of, out_dir, obs_of=None
+                            ) -> list[Path]:
     """``tug_fig12.png`` and ``tug_fig13.png`` (those the run's methods allow)."""
     out = Path(out_dir)
-    paths = [figure12(frames, events, summaries, scans_of, out / "tug_fig12.png"),
+    paths = [figure12(frames, events, summaries, scans_of, out / "tug_fig12.png",
+                      obs_of=obs_of),
              figure13(frames, out / "tug_fig13.png")]
     return [p for p in paths if p is not None]

@@ -12,7 +12,8 @@ own ultrasonic tracks.
 Figure 3 is the paper's normal gait, Figure 4 an abnormal (asymmetric) gait.  The twin
 simulates healthy walkers only, so :func:`write_ultrasonic_paper_figures` draws for
 Figure 4 the run's *least symmetric* normal-speed trial (the largest mean |1 − hS| of the
-system in the gait table) and its title says that it is not an abnormal gait.
+system in the gait table) and its title says that it is not an abnormal gait; Figures 2
+and 3 show the most symmetric one (:func:`symmetry_order`).
 
 The signal is the system's (UKF) heel track in the ultrasonic frame (X progression, Y
 vertical), mean removed, at the log's own rate; the tables' hS and vS are computed on the
@@ -141,32 +142,23 @@ def figure_symmetry_autocorrelation(track: pd.DataFrame, trial: str, path: str |
     return save_figure(fig, path)
 
 
-def least_symmetric_trial(gait_params: pd.DataFrame, speed: str = "normal") -> str | None:
-    """The trial at ``speed`` whose system hS is farthest from 1 on average (|1 − hS|);
-    None without an hS row."""
+def symmetry_order(gait_params: pd.DataFrame, speed: str = "normal") -> list[str]:
+    """The trials at ``speed`` from the most to the least symmetric: by the mean |1 − hS|
+    of the system over the trial's windows (ties by id); [] without an hS row."""
     g = gait_params[(gait_params["parameter"] == "h_symmetry")
                     & (gait_params["speed"].astype(str) == speed)]
     g = g[np.isfinite(pd.to_numeric(g["system"], errors="coerce"))]
     if g.empty:
-        return None
+        return []
     dev = (1.0 - g["system"].astype(float)).abs().groupby(g["trial"].astype(str)).mean()
-    return str(sorted(dev.index, key=lambda tr: (-dev[tr], tr))[0])
-
-
-def normal_trial(gait_params: pd.DataFrame, speed: str = "normal") -> str | None:
-    """The first trial (by subject, then id) at ``speed``: the figures' normal gait."""
-    g = gait_params[gait_params["speed"].astype(str) == speed]
-    if g.empty:
-        return None
-    first = g.sort_values(["subject", "trial"], kind="stable").iloc[0]
-    return str(first["trial"])
+    return sorted(dev.index, key=lambda tr: (dev[tr], tr))
 
 
 def write_ultrasonic_paper_figures(tracks: dict[str, pd.DataFrame],
                                    gait_params: pd.DataFrame, out_dir: str | Path,
                                    cfg: dict | None = None) -> list[Path]:
-    """``ultrasonic_fig2.png``, ``ultrasonic_fig3.png`` (the first normal-speed trial) and
-    ``ultrasonic_fig4.png`` (the least symmetric normal-speed trial, module notes);
+    """``ultrasonic_fig2.png``, ``ultrasonic_fig3.png`` (the most symmetric normal-speed
+    trial) and ``ultrasonic_fig4.png`` (the least symmetric one, module notes);
     ``tracks``: trial → UKF track; ``cfg``: the ``ultrasonic`` section (strides' period
     limits, ``symmetry.window_strides``).  [] without a normal-speed trial."""
     from gaitval.evaluate.ultrasonic_config import resolve_cfg
@@ -176,19 +168,22 @@ def write_ultrasonic_paper_figures(tracks: dict[str, pd.DataFrame],
           "max_period_s": float(c["strides"]["max_period_s"])}
     K = int(c["symmetry"]["window_strides"])
     out = Path(out_dir)
-    normal = normal_trial(gait_params)
-    if normal is None or normal not in tracks:
+    order = [t for t in symmetry_order(gait_params) if t in tracks]
+    if not order:
         return []
-    worst = least_symmetric_trial(gait_params) or normal
-    hs = gait_params[(gait_params["parameter"] == "h_symmetry")
-                     & (gait_params["trial"].astype(str) == worst)]["system"].astype(float)
-    hs_txt = f"mean system hS {hs.mean():.3f}" if len(hs) else "no hS"
+    normal, worst = order[0], order[-1]
+
+    def hs(trial):
+        v = gait_params[(gait_params["parameter"] == "h_symmetry")
+                        & (gait_params["trial"].astype(str) == trial)]["system"].astype(float)
+        return f"mean system hS {v.mean():.3f}"
     return [figure2_autocorrelation(tracks[normal], normal, out / "ultrasonic_fig2.png",
                                     **kw),
-            figure_symmetry_autocorrelation(tracks[normal], normal,
-                                            out / "ultrasonic_fig3.png", figure="3",
-                                            what="normal gait", n_strides=K, **kw),
+            figure_symmetry_autocorrelation(
+                tracks[normal], normal, out / "ultrasonic_fig3.png", figure="3",
+                what=f"normal gait, the run's most symmetric normal-speed trial ({hs(normal)})",
+                n_strides=K, **kw),
             figure_symmetry_autocorrelation(
                 tracks[worst], worst, out / "ultrasonic_fig4.png", figure="4",
-                what=f"the run's least symmetric normal-speed trial, {hs_txt}; "
-                     "no abnormal gait simulated", n_strides=K, **kw)]
+                what=f"the run's least symmetric normal-speed trial ({hs(worst)}); no "
+                     "abnormal gait simulated", n_strides=K, **kw)]

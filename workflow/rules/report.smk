@@ -89,13 +89,15 @@ def paper_figure_inputs(protocol):
     r = f"{RESULTS}/{s}"
     if protocol == "tug":
         ms = [m for m in ("tug_m1", "tug_m2", "tug_m3") if m in tug_runs()]
-        return ([f"{r}/ingest"] + [f"{r}/evaluate/{m}" for m in ms])
+        return ([f"{r}/ingest"] + [f"{r}/evaluate/{m}" for m in ms]
+                + [f"{r}/config_views/tug/{m}.json" for m in ms])
     if protocol == "mtst":
         ms = [m for m in ("mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed")
               if m in mtst_methods()]
         return ([f"{r}/ingest", f"{r}/config_views/mtst/{STUDY_VIEW}.json"]
                 + register_dirs(s) + [f"{r}/mtst_eval/{m}" for m in ms]
-                + [f"{r}/mtst_track/{m}" for m in ms])
+                + [f"{r}/mtst_track/{m}" for m in ms]
+                + [f"{r}/config_views/mtst/{m}.json" for m in ms])
     if protocol == "rollator":
         rc = rollator_cfg()
         return [f"{r}/ingest"] + [f"{r}/rollator/{m}" for m in (rc["kf_method"],
@@ -120,6 +122,8 @@ rule tug_paper_figures:
         run_verb_job(verb("paper-figures", "tug", "--results",
                           f"{RESULTS}/{params.study}",
                           *(["--config", params.config[0]] if params.config else []),
+                          "--sheet", sheet_path(params.study),
+                          "--subjects", subjects_path(params.study),
                           "--figures-dir", str(Path(output[0]).parent),
                           "--reports-dir", str(Path(output[0]).parents[1]),
                           "--config-hash", params.chash), log[0])
@@ -148,6 +152,8 @@ rule mtst_paper_figures:
         run_verb_job(verb("paper-figures", "mtst", "--results",
                           f"{RESULTS}/{params.study}",
                           *(["--config", params.config[0]] if params.config else []),
+                          "--sheet", sheet_path(params.study),
+                          "--subjects", subjects_path(params.study),
                           "--figures-dir", str(Path(output[0]).parent),
                           "--reports-dir", str(Path(output[0]).parents[1]),
                           "--config-hash", params.chash), log[0])
@@ -176,6 +182,8 @@ rule rollator_paper_figures:
         run_verb_job(verb("paper-figures", "rollator", "--results",
                           f"{RESULTS}/{params.study}",
                           *(["--config", params.config[0]] if params.config else []),
+                          "--sheet", sheet_path(params.study),
+                          "--subjects", subjects_path(params.study),
                           "--figures-dir", str(Path(output[0]).parent),
                           "--reports-dir", str(Path(output[0]).parents[1]),
                           "--config-hash", params.chash), log[0])
@@ -204,6 +212,8 @@ rule ultrasonic_paper_figures:
         run_verb_job(verb("paper-figures", "ultrasonic", "--results",
                           f"{RESULTS}/{params.study}",
                           *(["--config", params.config[0]] if params.config else []),
+                          "--sheet", sheet_path(params.study),
+                          "--subjects", subjects_path(params.study),
                           "--figures-dir", str(Path(output[0]).parent),
                           "--reports-dir", str(Path(output[0]).parents[1]),
                           "--config-hash", params.chash), log[0])
