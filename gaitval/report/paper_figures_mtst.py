@@ -124,7 +124,7 @@ def _snapshots(tracks, events, summary, scans_of, truth_of, path, m_a, m_b, kind
              "drawn: the track files do not keep them")
     obs = {m: obs_of(trial, m) for m, _ in rows} if obs_of is not None else {}
     return snapshot_figure(scans, rows, times, path, title=title, truth=truth_of(trial),
-                           notes=notes,
+                           notes=(lambda label, k: notes(label, k, trial)) if notes else None,
                            observations={m: o for m, o in obs.items() if o is not None})
 
 
@@ -141,12 +141,14 @@ def figure9(tracks, events, summary, scans_of, truth_of, gates, path, m_a: str =
             m_b: str = PROPOSED, obs_of=None) -> Path | None:
     """Scan snapshots of ``m_a`` (large fixed region) and ``m_b`` (variable region)
     around ``m_a``'s first false tracking by switching the legs in a trial ``m_b``
-    tracked; ``m_b``'s panels give its gate radii (``gates``: ``trial, method, k, side,
-    radius_m``)."""
-    g = gates if gates is not None else pd.DataFrame(columns=["method", "k", "side"])
+    tracked; ``m_b``'s panels give its gate radii at the scan (``gates``: ``trial, method,
+    k, side, radius_m``)."""
+    g = gates if gates is not None and len(gates) else pd.DataFrame(
+        columns=["trial", "method", "k", "side", "radius_m"])
 
-    def notes(label, k):
-        r = g[(g["method"].astype(str) == label) & (g["k"] == k)]
+    def notes(label, k, trial):
+        r = g[(g["trial"].astype(str) == trial) & (g["method"].astype(str) == label)
+              & (g["k"] == k)].drop_duplicates("side").sort_values("side")
         if r.empty:
             return ""
         return "gate r: " + ", ".join(f"{s} {100 * float(v):.1f} cm" for s, v in

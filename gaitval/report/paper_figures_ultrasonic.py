@@ -176,7 +176,7 @@ def write_ultrasonic_paper_figures(tracks: dict[str, pd.DataFrame],
     def hs(trial):
         v = gait_params[(gait_params["parameter"] == "h_symmetry")
                         & (gait_params["trial"].astype(str) == trial)]["system"].astype(float)
-        return f"mean system hS {v.mean():.3f}"
+        return f"system's mean |1 − hS| {(1.0 - v).abs().mean():.3f} over {len(v)} windows"
     return [figure2_autocorrelation(tracks[normal], normal, out / "ultrasonic_fig2.png",
                                     **kw),
             figure_symmetry_autocorrelation(
