@@ -103,13 +103,18 @@ def test_the_tiny_report_draws_every_data_figure(tiny_run):
 
 
 def test_paper_figures_are_deterministic(tiny_run, tmp_path):
-    """The same results give the same PNG bytes (no time stamps in the files)."""
+    """The same results give the same PNG bytes (no time stamps in the files), and the
+    report's: the workflow's job is the step."""
     from gaitval.pipeline.paper_figures import PROTOCOLS, paper_figures_step
 
     results = tiny_run / "results" / "tiny"
+    data = tiny_run / "data" / "tiny"
     for proto in PROTOCOLS:
-        a = paper_figures_step(proto, [results], tmp_path / "a", tmp_path / "ra")
-        b = paper_figures_step(proto, [results], tmp_path / "b", tmp_path / "rb")
+        view = results / "config_views" / proto / "study.json"
+        kw = {"config_json": view if view.is_file() else None,
+              "sheet": data / "trials.csv", "subjects": data / "subjects.csv"}
+        a = paper_figures_step(proto, [results], tmp_path / "a", tmp_path / "ra", **kw)
+        b = paper_figures_step(proto, [results], tmp_path / "b", tmp_path / "rb", **kw)
         assert [p.name for p in a] == [p.name for p in b]
         for pa, pb in zip(a, b):
             assert pa.read_bytes() == pb.read_bytes(), pa.name
