@@ -837,6 +837,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_rollator_verbs(sub)
     from gaitval.pipeline.legbench import add_legbench_verbs
     add_legbench_verbs(sub)              # annotated recordings without mocap (issue 18)
+    from gaitval.pipeline.paper_figures import add_paper_figure_verbs
+    add_paper_figure_verbs(sub)          # the papers' example figures
 
     s = sub.add_parser("report", help="write reports/<run>/index.md, index.html and the "
                        "verdict table from the report folder's tables and figures")

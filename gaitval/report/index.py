@@ -54,6 +54,40 @@ SECTION_TITLES = {
                    "(python3 run.py sensitivity)",
     "study": "Appendix: study, ingest and registration",
 }
+#: Captions of the papers' example figures (gaitval.pipeline.paper_figures); what the
+#: run cannot show is said, never drawn.
+PAPER_FIGURE_CAPTIONS = {
+    "tug_fig12": "TUG: scan snapshots (laser points, true legs, each method's observed "
+    "leg positions with their patterns, each leg's estimate and last scans) of Methods 1 "
+    "and 2 around Method 1's first false tracking, in the turn where there is one (the "
+    "title says which situation the run gave); the gates are not drawn, the track files "
+    "do not keep them (cf. seed 000 Fig. 12).",
+    "tug_fig13": "TUG: the hidden leg during Method 2's longest occlusion in the turn, "
+    "tracked by Method 2 (no interpolation) and Method 3 (Catmull–Rom) against VICON, and "
+    "its position error over time (cf. seed 000 Fig. 13).",
+    "mtst_fig6a": "MTST: foot contacts of the proposed method near an assigned target, "
+    "relative to the target's centre, with the target and the judgement region of a "
+    "participant of the default height (cf. seed 001 Fig. 6a).",
+    "mtst_fig8": "MTST: scan snapshots of Method 1 (no FS_U) and Method 2 (FS_U) around "
+    "Method 1's first lost track, each method's observations with their patterns; the "
+    "validation regions are not drawn (cf. seed 001 Fig. 8).",
+    "mtst_fig9": "MTST: scan snapshots of Method 2 (large fixed region) and the proposed "
+    "method (variable region, its radii per panel) where the legs were close together "
+    "(Method 2's first switch, else the legs' closest approach), each method's "
+    "observations with their patterns (cf. seed 001 Fig. 9).",
+    "rollator_fig5": "Rollator: KF and PF estimates on the laser scan where the KF's "
+    "error began with clutter and with a hidden leg; the KF's detections and the PF's "
+    "particles are not drawn, the track files do not keep them (cf. seed 002 Fig. 5).",
+    "ultrasonic_fig2": "Ultrasonic: the heel's horizontal displacement of the most "
+    "symmetric normal-speed trial and its biased and unbiased autocorrelation (cf. seed "
+    "003 Fig. 2).",
+    "ultrasonic_fig3": "Ultrasonic: horizontal and vertical unbiased autocorrelation of the "
+    "most symmetric normal-speed trial over one symmetry window, R1 and R2 marked (cf. "
+    "seed 003 Fig. 3).",
+    "ultrasonic_fig4": "Ultrasonic: as Fig. 3 for the run's least symmetric trial; the "
+    "paper shows an abnormal gait, the twin simulates none, so this is not one (cf. seed "
+    "003 Fig. 4).",
+}
 #: Captions of the figures, by stem (``{p}``: the parameter of a per-parameter figure).
 FIGURE_CAPTIONS = {
     "tug_trajectories": "TUG: tracked (thin) and true (thick) leg trajectories of a "
@@ -81,6 +115,7 @@ FIGURE_CAPTIONS = {
     "difference (green, dash-dot) where it gives one; the legend is below the plot.",
     "legbench_tracks": "Annotated recordings: tracked person (leg midpoint) against the "
     "hand-annotated person over time, one row per method; misses marked below.",
+    **PAPER_FIGURE_CAPTIONS,
 }
 def figure_caption(stem: str) -> str:
     """The caption of figure ``stem`` (:data:`FIGURE_CAPTIONS`; a generic one otherwise)."""
