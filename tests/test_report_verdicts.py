@@ -185,8 +185,8 @@ def test_html_top_says_what_the_data_are_then_verdicts_with_reasons(tmp_path):
     assert (rd / "verdicts.csv").is_file()
     header, rows = display_table(pd.read_csv(rd / "tables" / "tug_table3.csv"), "tug_table3")
     names = [c for c, _ in header]
-    assert names.index("success_pct_published") == names.index("success_pct") + 1
-    assert rows[0][names.index("success_pct")] == "25.0"            # a rate in per cent
+    assert names.index("Success (%), published") == names.index("Success (%)") + 1
+    assert rows[0][names.index("Success (%)")] == "25.0"            # a rate in per cent
 
 
 def test_table_c1_primary_reading_is_the_papers_words_and_stride_index_stands_beside():

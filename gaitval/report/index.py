@@ -31,6 +31,7 @@ from gaitval.io.atomic import write_text
 from gaitval.report.provenance import load_all, relative_path
 from gaitval.report.datakind import PAPER_PROTOCOLS, headline, paper_data, run_data
 from gaitval.report.verdicts import VERDICT_COLUMNS, build_verdicts, summary_lines
+from gaitval.tables.labels import base_of, is_published, label
 from gaitval.tables.numbers import format_value, to_display
 
 #: The paper tables gaitval renders (see ../shared/seeds/README.md), by protocol.
@@ -191,21 +192,23 @@ def _md_cells(md_path: Path) -> tuple[list[str], list[list[str]]] | None:
 
 def _published_beside(header: list[str], rows: list[list[str]]
                       ) -> tuple[list[tuple[str, bool]], list[list[str]]]:
-    """Each ``<q>_published`` column moved right after ``<q>``."""
-    cols = [c for c in header if not c.endswith("_published") or c[:-10] not in header]
+    """Each published column (header ``<label>, published``, :mod:`gaitval.tables.labels`)
+    moved right after its quantity's."""
+    published = {base_of(c): c for c in header if is_published(c) and base_of(c) in header}
+    cols = [c for c in header if c not in published.values()]
     order = []
     for c in cols:
         order.append(c)
-        if f"{c}_published" in header:
-            order.append(f"{c}_published")
+        if c in published:
+            order.append(published[c])
     idx = [header.index(c) for c in order]
-    return ([(c, c.endswith("_published")) for c in order],
+    return ([(c, is_published(c)) for c in order],
             [[r[i] if i < len(r) else "" for i in idx] for r in rows])
 
 
 def display_table(df: pd.DataFrame, table: str | None = None
                   ) -> tuple[list[tuple[str, bool]], list[list[str]]]:
-    """Header ``(name, is_published)`` and formatted rows for the HTML report.
+    """Header ``(label, is_published)`` and formatted rows for the HTML report.
 
     The table in its display units (:func:`gaitval.tables.numbers.to_display`), each
     ``<q>_published`` column right after ``<q>``, every cell by
@@ -220,7 +223,7 @@ def display_table(df: pd.DataFrame, table: str | None = None
         if f"{c}_published" in d.columns:
             order.append(f"{c}_published")
     rows = [[format_value(d[c].iloc[i], c, table) for c in order] for i in range(len(d))]
-    return [(c, c.endswith("_published")) for c in order], rows
+    return [(label(c), c.endswith("_published")) for c in order], rows
 
 
 _MD_INLINE = [(re.compile(r"`([^`]+)`"), r"<code>\1</code>"),

@@ -1,7 +1,8 @@
 """Render one tidy table as ``<stem>.csv``, ``<stem>.md`` and ``<stem>.tex``.
 
 Every paper table goes through :func:`write_table`, so all three files always say the same
-thing: the CSV is the tidy source (units in column names), the Markdown carries the caption
+thing: the CSV is the tidy source (units in column names), the Markdown and the LaTeX
+print each column's label with its unit (:mod:`gaitval.tables.labels`); the Markdown carries the caption
 and notes for the report, the LaTeX (:mod:`gaitval.tables.latex`, pandas' Styler with
 booktabs) is ready for a manuscript.  The Markdown and the LaTeX get the table in its
 display units (:func:`gaitval.tables.numbers.to_display`: per cent for rates, mm for
@@ -17,14 +18,17 @@ from pathlib import Path
 import pandas as pd
 
 from gaitval.io.atomic import write_text
+from gaitval.tables.labels import label
 from gaitval.tables.numbers import format_value, to_display
 
 
 def to_markdown(df: pd.DataFrame, table: str | None = None) -> str:
     """``df`` (in display units, :func:`gaitval.tables.numbers.to_display`) as a Markdown
-    table, each cell by :func:`gaitval.tables.numbers.format_value`."""
+    table, each header the column's label (:func:`gaitval.tables.labels.label`), each
+    cell by :func:`gaitval.tables.numbers.format_value`."""
     cols = [str(c) for c in df.columns]
-    lines = ["| " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
+    heads = [label(c) for c in cols]
+    lines = ["| " + " | ".join(heads) + " |", "|" + "|".join("---" for _ in cols) + "|"]
     for row in df.itertuples(index=False, name=None):
         lines.append("| " + " | ".join(format_value(v, c, table).replace("|", "\\|")
                                        for c, v in zip(cols, row)) + " |")
