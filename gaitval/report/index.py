@@ -42,15 +42,15 @@ EXPECTED_TABLES = {
     "ultrasonic": [f"ultrasonic_table{i}" for i in range(1, 9)] + ["ultrasonic_tableC1"],
 }
 SECTION_TITLES = {
-    "tug": "TUG leg tracking (Yorozu et al., Sensors 2015, seed 000)",
-    "mtst": "Multi-target stepping task (Yorozu et al., Sensors 2015, seed 001)",
-    "rollator": "Robotic rollator, KF vs PF (Chalvatzaki et al., 2017, seed 002)",
-    "ultrasonic": "Ultrasonic foot tracking (Qi et al., Sensors 2014, seed 003)",
+    "tug": "TUG leg tracking (Yorozu et al. 2015a)",
+    "mtst": "Multi-target stepping task (Yorozu et al. 2015b)",
+    "rollator": "Robotic rollator, KF vs PF (Chalvatzaki et al. 2017)",
+    "ultrasonic": "Ultrasonic foot tracking (Qi et al. 2014)",
     "legbench": "Annotated recordings without mocap: CLEAR-MOT (Leigh et al., ICRA 2015)",
     "detections": "External leg detectors (no identity): detection rate, RMSE and false "
                   "detections against the mocap legs",
     "peer": "Worked example: agreement statistics on a peer's published data",
-    "sensitivity": "Sensitivity: the verdicts under the twin's alternative free choices "
+    "sensitivity": "Sensitivity: the verdicts under the simulated replica's alternative free choices "
                    "(python3 run.py sensitivity)",
     "study": "Appendix: study, ingest and registration",
 }
@@ -58,22 +58,22 @@ SECTION_TITLES = {
 FIGURE_CAPTIONS = {
     "tug_trajectories": "TUG: tracked (thin) and true (thick) leg trajectories of a "
     "successful and a failed trial (rows), one column per method, each panel saying "
-    "success or FAILED (cf. seed 000 Fig. 14).",
+    "success or FAILED (cf. Yorozu et al. 2015a Fig. 14).",
     "tug_false_tracking": "TUG: the first false tracking of a failed trial — both legs' "
     "tracks and truth around the moment a track jumped to the other leg or was lost "
-    "(cf. seed 000 Fig. 11).",
+    "(cf. Yorozu et al. 2015a Fig. 11).",
     "mtst_trial": "MTST: a successful and a failed trial on the mat (rows): tracked legs "
     "(thin) against the mocap legs (thick), foot contacts, targets, target steps judged (O) "
-    "and cross steps detected (+) (cf. seed 001 Fig. 10).",
+    "and cross steps detected (+) (cf. Yorozu et al. 2015b Fig. 10).",
     "rollator_turning_trial": "Rollator: lateral and forward position of each leg over "
     "time in a successful and a failed trial; truth red, KF black, PF blue; grey bands: "
-    "KF error frames, dotted lines: KF re-initialisations (cf. seed 002 Fig. 4).",
+    "KF error frames, dotted lines: KF re-initialisations (cf. Chalvatzaki et al. 2017 Fig. 4).",
     "ultrasonic_figA1": "Ultrasonic: histograms of the stride-parameter differences system "
-    "− reference at normal speed (cf. seed 003 Fig. A1).",
+    "− reference at normal speed (cf. Qi et al. 2014 Fig. A1).",
     "ultrasonic_figB1": "Ultrasonic: per-subject boxplots of the system's stride "
-    "parameters at normal speed (cf. seed 003 Fig. B1).",
+    "parameters at normal speed (cf. Qi et al. 2014 Fig. B1).",
     "ultrasonic_fig5": "Ultrasonic: mean ± SD of reference and system per walking speed; "
-    "* p < 0.05 against normal speed (paired t-test, Table 8; cf. seed 003 Fig. 5).",
+    "* p < 0.05 against normal speed (paired t-test, Table 8; cf. Qi et al. 2014 Fig. 5).",
     "ultrasonic_bland_altman_{p}": "Ultrasonic: Bland–Altman plot of {p} at normal speed, "
     "system − reference against their mean, in the quantity's display unit; points "
     "coloured by subject; pooled bias and limits of agreement (grey, dashed, 95 % CIs as "

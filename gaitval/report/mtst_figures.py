@@ -1,12 +1,12 @@
-"""MTST figure (seed 001 Fig. 10 style): a successful and a failed trial on the mat, one
+"""MTST figure (Yorozu et al. 2015b Fig. 10 style): a successful and a failed trial on the mat, one
 row each — both tracked legs (thin) against the mocap legs (thick, where the study has
 mocap), the foot contacts, the targets, the target steps judged ("O") and the cross steps
-detected ("+"); each row says its tracking verdict (seed 001 Table 3: success, lost,
+detected ("+"); each row says its tracking verdict (Yorozu et al. 2015b Table 3: success, lost,
 false_swap, false_other).
 
 References
 ----------
-Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (seed 001), Figure 10, Table 3.
+Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (Yorozu et al. 2015b), Figure 10, Table 3.
 """
 from __future__ import annotations
 

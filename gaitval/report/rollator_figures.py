@@ -1,4 +1,4 @@
-"""Seed 002 figure: a successful and a failed trial, both trackers' legs against the truth
+"""Chalvatzaki et al. 2017 figure: a successful and a failed trial, both trackers' legs against the truth
 (cf. its Fig. 4).
 
 Per trial the paper's Fig. 4 panels: lateral and forward position of the left and the

@@ -1,10 +1,10 @@
 """TUG leg-tracking figures: tracked vs true trajectories of a successful and a failed trial
-(seed 000 Fig. 14 style) and a false-tracking example (Fig. 11 style), from the evaluation
+(Yorozu et al. 2015a Fig. 14 style) and a false-tracking example (Fig. 11 style), from the evaluation
 frames.
 
 References
 ----------
-Yorozu, A.; Moriguchi, T.; Takahashi, M. Sensors 2015, 15, 22451–22472 (seed 000).
+Yorozu, A.; Moriguchi, T.; Takahashi, M. Sensors 2015, 15, 22451–22472 (Yorozu et al. 2015a).
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Published values of seed 002 (Chalvatzaki et al., ICRA 2017), transcribed from the seed text.
+"""Published values of Chalvatzaki et al. 2017 (Chalvatzaki et al., ICRA 2017), transcribed from the seed text.
 
 Transcribed from ``../shared/seeds/002_3a7e136c0c9bbb56.txt`` (and checked against the
 checklist ``../shared/specs/seed002-rollator.md``).  Units as printed: cm and cm/s.

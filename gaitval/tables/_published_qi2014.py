@@ -1,4 +1,4 @@
-"""Published values of seed 003 (Qi et al., Sensors 2014), transcribed from the seed text.
+"""Published values of Qi et al. 2014 (Qi et al., Sensors 2014), transcribed from the seed text.
 
 Transcribed from ``/work/shared/seeds/003_d657a7031a2bc1de.txt``.  The PDF extraction
 garbled the row labels of Tables 2–6 ("Dof", "Rei", "Duo", "rro" for Ref/Pro) and of

@@ -267,7 +267,7 @@ def _layout(groups, info, page) -> tuple[dict[str, str], bool]:
             continue
         # the paragraph columns leave FLEX_MARGIN_PT of the width unused: the widths of
         # the other columns are estimates (0.6 em a character), and a row of them 0.36 pt
-        # wider than estimated overfilled the line (tiny's tug_failures, issue 34)
+        # wider than estimated overfilled the line (tiny's tug_failures)
         share = (avail - FLEX_MARGIN_PT) / len(left)
         for c in left:
             w = max(share, info[c]["min"] * cw)

@@ -76,10 +76,10 @@ PAPER_TABLES = ("tug_table", "tug_failures", "mtst_table", "rollator_table", "ro
 #: Per-table formats of columns (the paper's precision where it differs from the rules).
 TABLE_COLUMNS: dict[str, dict[str, Format]] = {
     "rollator_table1": {c: Format("fixed", 2, 100.0) for c in (
-        "rmse_kf", "rmse_pf", "mad_kf", "mad_pf")},            # seed 002: cm, cm/s
+        "rmse_kf", "rmse_pf", "mad_kf", "mad_pf")},            # Chalvatzaki et al. 2017: cm, cm/s
     "rollator_table2": {"tracking_time_s": Format("fixed", 2)},
 }
-#: Per-table formats of columns by prefix: an external method's columns (issue 37) are
+#: Per-table formats of columns by prefix: an external method's columns are
 #: named after it (``rmse_<method>``), so they are matched by their statistic.
 TABLE_PREFIXES: dict[str, dict[tuple[str, ...], Format]] = {
     "rollator_table1": {("rmse_", "mad_"): Format("fixed", 2, 100.0)},
