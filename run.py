@@ -14,7 +14,7 @@ named at the start and the end); ``report -v`` (or ``GAITVAL_CONSOLE=raw``) show
 Snakemake's own console instead.
 Also: ``python3 run.py bench benchmarks/NAME.py`` (installs the benchmark-only extras), and
 ``python3 run.py sensitivity`` (the default report beside the same study under each
-alternative free choice of the twin: ``reports/default/tables/sensitivity.*``).
+alternative free choice of the simulated replica: ``reports/default/tables/sensitivity.*``).
 
 Resuming after a kill (power cut, killed cluster job): ``report`` finds Snakemake's lock
 left behind in ``.snakemake/locks``; when no live Snakemake works in this folder it

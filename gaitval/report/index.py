@@ -58,16 +58,21 @@ SECTION_TITLES = {
 FIGURE_CAPTIONS = {
     "tug_trajectories": "TUG: tracked (thin) and true (thick) leg trajectories of a "
     "successful and a failed trial (rows), one column per method, each panel saying "
-    "success or FAILED (cf. Yorozu et al. 2015a Fig. 14).",
+    "success or FAILED (cf. Yorozu et al. 2015a Fig. 14). The VICON legs set the axes; a "
+    "track that diverges beyond them is clipped at the edge and its panel says how far it went.",
     "tug_false_tracking": "TUG: the first false tracking of a failed trial — both legs' "
     "tracks and truth around the moment a track jumped to the other leg or was lost "
     "(cf. Yorozu et al. 2015a Fig. 11).",
     "mtst_trial": "MTST: a successful and a failed trial on the mat (rows): tracked legs "
     "(thin) against the mocap legs (thick), foot contacts, targets, target steps judged (O) "
-    "and cross steps detected (+) (cf. Yorozu et al. 2015b Fig. 10).",
+    "and cross steps detected (+) (cf. Yorozu et al. 2015b Fig. 10). The mocap legs and the "
+    "mat set the axes; a track that diverges beyond them is clipped at the edge and its panel "
+    "says how far it went.",
     "rollator_turning_trial": "Rollator: lateral and forward position of each leg over "
     "time in a successful and a failed trial; truth red, KF black, PF blue; grey bands: "
-    "KF error frames, dotted lines: KF re-initialisations (cf. Chalvatzaki et al. 2017 Fig. 4).",
+    "KF error frames, dotted lines: KF re-initialisations (cf. Chalvatzaki et al. 2017 Fig. 4). "
+    "The truth sets each panel's vertical axis; a track that diverges beyond it is clipped "
+    "and the panel says so.",
     "ultrasonic_figA1": "Ultrasonic: histograms of the stride-parameter differences system "
     "− reference at normal speed (cf. Qi et al. 2014 Fig. A1).",
     "ultrasonic_figB1": "Ultrasonic: per-subject boxplots of the system's stride "

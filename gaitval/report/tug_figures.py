@@ -16,7 +16,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from gaitval.report.figures import save_figure  # noqa: E402
+from gaitval.report.figures import clip_to_reference, save_figure  # noqa: E402
 
 COLORS = {"L": "tab:blue", "R": "tab:red"}
 
@@ -96,7 +96,10 @@ def _trial_row(axes, f: pd.DataFrame, trial: str, methods, summaries) -> None:
             ax.plot(uo["x_m"], uo["y_m"], "o", mfc="none", ms=3, color=COLORS[side])
         ax.set_title(f"{trial}, {m}{_outcome(summaries, trial, m)}", fontsize=9)
         ax.set_xlabel("x (sensor frame) [m]")
-        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_aspect("equal", adjustable="box")
+        # the VICON legs set the limits; a diverged track is clipped, and the panel says so
+        clip_to_reference(ax, [d["xs_m"]], [d["ys_m"]], [d["x_m"]], [d["y_m"]],
+                          what="LRS track")
         ax.grid(True, lw=0.3)
     axes[0].set_ylabel("y (sensor frame) [m]")
 
