@@ -138,6 +138,7 @@ class LogHandler(LogHandlerBase):
         self.finished: list[tuple[int, str]] = []      # (jobid, line) waiting for PROGRESS
         self.done = 0
         self.total: Optional[int] = None
+        self.shown_total: Optional[int] = None      # the total the last lines showed
         self.failed = 0
         self.refused = 0
         self.t0 = time.monotonic()
@@ -229,7 +230,7 @@ class LogHandler(LogHandlerBase):
         if self.started or total is None:
             return
         self.started = True
-        self.total = int(total)
+        self.total = self.shown_total = int(total)
         where = f"; Snakemake's full log: {self.logfile}" if self.logfile else ""
         self._print(f"[gaitval] {self.total} steps to run{where}")
 
@@ -263,9 +264,14 @@ class LogHandler(LogHandlerBase):
         first = done - len(self.finished) + 1
         for i, (_, line) in enumerate(self.finished):
             head, *rest = line.split("\n")
-            self._print(f"[{first + i}/{self.total}] {head}")
+            self._print(f"[{first + i}/{self.shown_total or self.total}] {head}")
             for r in rest:
                 self._print(r, "yellow")
+        if self.shown_total is not None and self.total != self.shown_total:
+            # a checkpoint (the simulation) wrote the trial sheet: its trials' steps
+            self._print(f"[gaitval] the run now has {self.total} steps (the trials the "
+                        "finished step made known)")
+        self.shown_total = self.total
         self.done = done
         self.finished = []
 

@@ -146,3 +146,21 @@ def test_snakemake_finds_the_plugin_by_its_package_name():
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
                          text=True, check=True, cwd="/")
     assert out.stdout.strip() == "True"
+
+
+def test_a_checkpoint_that_adds_steps_is_said_once(tmp_path):
+    h = _handler()
+    h.emit(_rec("Job stats", event=LogEvent.RUN_INFO, stats={"total": 5}))
+    h.emit(_rec(event=LogEvent.JOB_INFO, jobid=1, rule_name="simulate",
+                wildcards={"study": "default"}, log=[], output=[]))
+    h.emit(_rec(event=LogEvent.JOB_FINISHED, job_id=1))
+    h.emit(_rec(event=LogEvent.PROGRESS, done=1, total=62))
+    h.emit(_rec(event=LogEvent.JOB_INFO, jobid=2, rule_name="ingest",
+                wildcards={"study": "default"}, log=[], output=[]))
+    h.emit(_rec(event=LogEvent.JOB_FINISHED, job_id=2))
+    h.emit(_rec(event=LogEvent.PROGRESS, done=2, total=62))
+    lines = h.stream.getvalue().splitlines()
+    assert lines[1].startswith("[1/5] simulate default")
+    assert lines[2] == ("[gaitval] the run now has 62 steps (the trials the finished step "
+                        "made known)")
+    assert lines[3].startswith("[2/62] ingest default")
