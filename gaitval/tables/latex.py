@@ -246,7 +246,7 @@ def _layout(groups, info, page) -> tuple[dict[str, str], bool]:
         for c in g:
             specs[c] = "r" if info[c]["num"] else "l"
         if len(g) == 2:                           # a header over ours/paper: no break
-            head = (len(g[0]) + 3) * cw + pad
+            head = (len(label(g[0])) + 3) * cw + pad
         elif info[g[0]]["chars"] > max(info[g[0]]["cells"], info[g[0]]["head"]):
             # a long header over short entries breaks between its words
             w = max(info[g[0]]["cells"], info[g[0]]["head"] + 2, 5) * cw
