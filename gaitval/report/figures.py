@@ -29,7 +29,7 @@ def save_figure(fig, path: str | Path, dpi: int = 120) -> Path:
 #: How far beyond the reference (mocap truth, the mat) a figure shows, as a fraction of
 #: the reference's extent, at least this many metres: a track that diverges further is
 #: clipped at the edge and the panel says so (one diverged track must not squash the rest).
-CLIP_MARGIN = 0.25
+CLIP_MARGIN = 0.1
 CLIP_MIN_M = 0.3
 
 
