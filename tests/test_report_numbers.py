@@ -89,6 +89,8 @@ def problems(table: str, header: list[str], rows: list[list[str]],
             m = NUMBER.match(cell)
             if m and table != "verdicts":
                 f = column_format((names or {}).get(h, h), table)
+                if f.kind == "sig":                        # significant figures
+                    continue
                 allowed = {"p": 3, "int": 1, "fixed": f.decimals}.get(f.kind, 3)
                 small = 0 < abs(float(cell.replace("−", "-"))) < 10 ** -allowed \
                     and len(m.group(2) or "") <= allowed + 12
@@ -134,6 +136,8 @@ def test_a_non_zero_value_is_never_printed_as_zero():
     assert format_value(-0.0004, "bias", None) == "-0.00040"
     assert format_value(0.000246, "mean", "ultrasonic_table8") == "0.00025"
     assert format_value(0.0031, "SS", "ultrasonic_tableC1") == "0.0031"
+    assert format_value(0.0134, "SS", "ultrasonic_tableC1") == "0.013"   # significant figures
+    assert format_value(1.3, "SS_published", "ultrasonic_tableC1") == "1.3"
     assert format_value(0.04, "n", None) == "0.040"                 # a count's mean
     assert format_value(0.0123, "mean", "ultrasonic_table8") == "0.012"   # unchanged
     assert format_value(float("inf"), "x") == "∞"

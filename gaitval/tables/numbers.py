@@ -51,8 +51,8 @@ import pandas as pd
 class Format:
     """How a column is printed.
 
-    ``kind``: ``"p"`` (p-value), ``"int"`` (count), ``"fixed"`` (``decimals`` decimals) or
-    ``"text"`` (as written); ``scale``: factor from the CSV's unit to the display unit;
+    ``kind``: ``"p"`` (p-value), ``"int"`` (count), ``"fixed"`` (``decimals`` decimals),
+    ``"sig"`` (``decimals`` significant figures) or ``"text"`` (as written); ``scale``: factor from the CSV's unit to the display unit;
     ``rename``: ``(old suffix, new suffix)`` of the header, or None.
     """
     kind: str
@@ -78,6 +78,9 @@ TABLE_COLUMNS: dict[str, dict[str, Format]] = {
     "rollator_table1": {c: Format("fixed", 2, 100.0) for c in (
         "rmse_kf", "rmse_pf", "mad_kf", "mad_pf")},            # Chalvatzaki et al. 2017: cm, cm/s
     "rollator_table2": {"tracking_time_s": Format("fixed", 2)},
+    # Qi et al. 2014 Table C1: sums and mean squares span four orders of magnitude
+    # (0.0017 to 1.3), so significant figures, not decimals
+    "ultrasonic_tableC1": {"SS": Format("sig", 2), "MS": Format("sig", 2)},
 }
 #: Per-table formats of columns by prefix: an external method's columns are
 #: named after it (``rmse_<method>``), so they are matched by their statistic.
@@ -205,6 +208,8 @@ def format_value(value, column: str, table: str | None = None) -> str:
     x = float(value)
     if f.kind == "p":
         return p_value(x)
+    if f.kind == "sig":
+        return number(x, f.decimals)
     integral = math.isfinite(x) and abs(x - round(x)) < 1e-9
     if f.kind == "int":
         return str(int(round(x))) if integral else not_zero(x, fixed(x, 1))
