@@ -3,8 +3,7 @@
 Every paper table goes through :func:`write_table`, so all three files always say the same
 thing: the CSV is the tidy source (units in column names), the Markdown and the LaTeX
 print each column's label with its unit (:mod:`gaitval.tables.labels`); the Markdown
-carries the caption
-and notes for the report, the LaTeX (:mod:`gaitval.tables.latex`, pandas' Styler with
+carries the caption and notes for the report, the LaTeX (:mod:`gaitval.tables.latex`, pandas' Styler with
 booktabs) is ready for a manuscript.  The Markdown and the LaTeX get the table in its
 display units (:func:`gaitval.tables.numbers.to_display`: per cent for rates, mm for
 registration residuals, cm for the rollator's Table I) and every Markdown cell is printed by
