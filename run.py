@@ -217,6 +217,13 @@ def sensitivity(rest: list[str], env: dict) -> int:
     return 0
 
 
+def _has_logger_plugins() -> bool:
+    """Whether the environment's Snakemake takes logger plugins (Snakemake 9; 8 has none,
+    and then its own console is the one there is)."""
+    return subprocess.call([str(PY), "-c", "import snakemake_interface_logger_plugins"],
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) == 0
+
+
 def console_args(rest: list[str], env: dict) -> tuple[list[str], list[str]]:
     """Snakemake's arguments without ``-v``/``--verbose``, and the logger to add.
 
@@ -228,7 +235,8 @@ def console_args(rest: list[str], env: dict) -> tuple[list[str], list[str]]:
     checkout goes on ``PYTHONPATH`` (``env``, changed in place)."""
     raw = {"-v", "--verbose"}
     if any(a in raw for a in rest) or os.environ.get("GAITVAL_CONSOLE", "") == "raw" \
-            or any(a == "--logger" or a.startswith("--logger=") for a in rest):
+            or any(a == "--logger" or a.startswith("--logger=") for a in rest) \
+            or not _has_logger_plugins():
         return [a for a in rest if a not in raw], []
     env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), env.get("PYTHONPATH", ""))
                                         if p)

@@ -164,3 +164,10 @@ def test_a_checkpoint_that_adds_steps_is_said_once(tmp_path):
     assert lines[2] == ("[gaitval] the run now has 62 steps (the trials the finished step "
                         "made known)")
     assert lines[3].startswith("[2/62] ingest default")
+
+
+def test_snakemake_without_logger_plugins_keeps_its_own_console(monkeypatch):
+    """Snakemake 8 (pyproject allows it) has no --logger: run.py then adds nothing."""
+    monkeypatch.delenv("GAITVAL_CONSOLE", raising=False)
+    monkeypatch.setattr(run_py, "_has_logger_plugins", lambda: False)
+    assert run_py.console_args(["-n"], {}) == (["-n"], [])
