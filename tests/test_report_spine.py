@@ -73,3 +73,17 @@ def test_cli_user_error_is_one_line_per_problem_and_exit_1(tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:
         main(["validate"])
     assert exc.value.code == 2
+
+
+def test_captions_and_notes_name_columns_by_their_headers(tmp_path):
+    """A caption or note that names a column by its machine name (bare or in backticks)
+    shows the header the reader sees instead; method names and other words are kept."""
+    df = pd.DataFrame({"method": ["tug_m1"], "ft_forward": [1], "diff_mean_m": [0.1]})
+    _, md, tex = write_table(df, tmp_path / "tug_table9",
+                             caption="Counts; ft_forward has no published counterpart.",
+                             notes=["`diff_mean_m` is system minus reference for tug_m1"])
+    text = md.read_text()
+    assert "_False tracking, forward_ has no published" in text
+    assert "- _Difference mean (m)_ is system minus reference for tug_m1" in text
+    assert "ft_forward" not in tex.read_text() and "diff" not in tex.read_text().lower() \
+        .replace("difference", "")

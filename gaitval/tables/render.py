@@ -35,6 +35,24 @@ def to_markdown(df: pd.DataFrame, table: str | None = None) -> str:
     return "\n".join(lines)
 
 
+def cite_columns(text: str, df: pd.DataFrame, shown: pd.DataFrame) -> str:
+    """``text`` (a caption or note) with each machine name of a column of the table
+    (``ft_forward``, `` `diff_mean` ``; the CSV's or the display one) replaced by the
+    header the reader sees, in italics (``_False tracking, forward_``)."""
+    import re
+
+    names = {}
+    for orig, disp in zip(df.columns, shown.columns):
+        for name in {str(orig), str(disp)}:
+            if "_" in name:
+                names[name] = label(disp)
+    for name in sorted(names, key=len, reverse=True):
+        n = re.escape(name)
+        text = re.sub(rf"`{n}`|(?<![\w`]){n}(?![\w`])",
+                      lambda m, n=name: f"_{names[n]}_", text)
+    return text
+
+
 def write_table(df: pd.DataFrame, stem: str | Path, *, caption: str,
                 notes: list[str] | None = None,
                 csv_float_format: str = "%.6g") -> list[Path]:
@@ -62,6 +80,8 @@ def write_table(df: pd.DataFrame, stem: str | Path, *, caption: str,
     stem = Path(stem)
     csv_text = df.to_csv(index=False, float_format=csv_float_format, lineterminator="\n")
     shown = to_display(df, stem.name)
+    caption, notes = cite_columns(caption, df, shown), [cite_columns(n, df, shown)
+                                                       for n in notes or []]
     md = [f"**{caption}**", "", to_markdown(shown, stem.name)]
     if notes:
         md += [""] + [f"- {n}" for n in notes]
