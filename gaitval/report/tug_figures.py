@@ -69,7 +69,7 @@ def plot_trial_trajectories(frames: pd.DataFrame, trial: str | list[str], path: 
     what = ("a successful and a failed trial" if len(rows) == 2 else f"trial {rows[0]}")
     fig.suptitle(f"Leg trajectories, tracked (LRS) vs true (VICON): {what} "
                  "(open circles: unobservable, UO)")
-    fig.tight_layout()
+    fig.tight_layout(h_pad=2.0)          # room for a row's x label above the next titles
     return save_figure(fig, path)
 
 
