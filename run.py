@@ -9,9 +9,12 @@ Each creates ``.venv`` and installs into it, on first use and again only when
 ``requirements.lock`` (hashed, ``pip install --require-hashes``; made with pip-tools, see
 the file's head) and then gaitval itself (``pip install --no-deps -e .``).  Extra arguments go to Snakemake
 (``report``) or pytest (``test``), e.g. ``python3 run.py report --config 'run=["tiny"]'``.
+``report`` prints one line per finished step (Snakemake's full output goes to its log file,
+named at the start and the end); ``report -v`` (or ``GAITVAL_CONSOLE=raw``) shows
+Snakemake's own console instead.
 Also: ``python3 run.py bench benchmarks/NAME.py`` (installs the benchmark-only extras), and
 ``python3 run.py sensitivity`` (the default report beside the same study under each
-alternative free choice of the twin: ``reports/default/tables/sensitivity.*``, issue 34).
+alternative free choice of the simulated replica: ``reports/default/tables/sensitivity.*``).
 
 Resuming after a kill (power cut, killed cluster job): ``report`` finds Snakemake's lock
 left behind in ``.snakemake/locks``; when no live Snakemake works in this folder it
@@ -190,8 +193,9 @@ def sensitivity(rest: list[str], env: dict) -> int:
     table of verdicts beside each other (reports/default/tables/sensitivity.*), then the
     default report's index again so it shows that table."""
     ensure_env("test")
+    rest, logger = console_args(rest, env)
     for name in ("default", *SENSITIVITY_STUDIES):
-        cmd = [str(BIN / "snakemake"), "--profile", "workflow/profiles/default",
+        cmd = [str(BIN / "snakemake"), "--profile", "workflow/profiles/default", *logger,
                "--config", f'run=["{name}"]', *rest]
         print("[run.py] " + " ".join(cmd), flush=True)
         if not clear_stale_lock(cmd, env, _workdir(rest)):
@@ -213,6 +217,32 @@ def sensitivity(rest: list[str], env: dict) -> int:
     return 0
 
 
+def _has_logger_plugins() -> bool:
+    """Whether the environment's Snakemake takes logger plugins (Snakemake 9; 8 has none,
+    and then its own console is the one there is)."""
+    return subprocess.call([str(PY), "-c", "import snakemake_interface_logger_plugins"],
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) == 0
+
+
+def console_args(rest: list[str], env: dict) -> tuple[list[str], list[str]]:
+    """Snakemake's arguments without ``-v``/``--verbose``, and the logger to add.
+
+    By default Snakemake's console is gaitval's (``--logger gaitval``,
+    ``snakemake_logger_plugin_gaitval``: one line per finished step, errors and refusals
+    highlighted; Snakemake's full output in its log file).  ``-v``/``--verbose`` or
+    ``GAITVAL_CONSOLE=raw`` give Snakemake's own console back.  Snakemake finds a logger
+    plugin by its top-level package name, which an editable install hides, so the
+    checkout goes on ``PYTHONPATH`` (``env``, changed in place)."""
+    raw = {"-v", "--verbose"}
+    if any(a in raw for a in rest) or os.environ.get("GAITVAL_CONSOLE", "") == "raw" \
+            or any(a == "--logger" or a.startswith("--logger=") for a in rest) \
+            or not _has_logger_plugins():
+        return [a for a in rest if a not in raw], []
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), env.get("PYTHONPATH", ""))
+                                        if p)
+    return rest, ["--logger", "gaitval"]
+
+
 def main(argv: list[str]) -> int:
     if not argv or argv[0] not in ("report", "test", "bench", "sensitivity"):
         print(__doc__)
@@ -226,7 +256,9 @@ def main(argv: list[str]) -> int:
         return sensitivity(rest, env)
     if verb == "report":
         ensure_env("test")
-        cmd = [str(BIN / "snakemake"), "--profile", "workflow/profiles/default", *rest]
+        rest, logger = console_args(rest, env)
+        cmd = [str(BIN / "snakemake"), "--profile", "workflow/profiles/default", *logger,
+               *rest]
         if not clear_stale_lock(cmd, env, _workdir(rest)):
             return 1
     elif verb == "test":

@@ -425,7 +425,7 @@ def _add_lrs_verbs(sub) -> None:
 
     s = sub.add_parser("evaluate-tug", help="evaluate one tracked TUG trial against its "
                        "mocap legs: per-frame errors, false tracking (swaps, lost legs), "
-                       "stance identification (seed 000 Tables 3-5)")
+                       "stance identification (Yorozu et al. 2015a Tables 3-5)")
     s.add_argument("--track", required=True, help="the trial's per-scan track "
                    "(results/<study>/track/<method>/<trial>.parquet: gaitval's own, or an "
                    "external method's from 'gaitval import-tracks'; sensor frame and clock)")
@@ -523,7 +523,7 @@ def _add_lrs_verbs(sub) -> None:
                    "rollator/<method>/<trial>.track.parquet)")
     s.set_defaults(func=cmd_import_tracks)
 
-    s = sub.add_parser("tug-tables", help="seed 000 Tables 2-5 and figures")
+    s = sub.add_parser("tug-tables", help="Yorozu et al. 2015a Tables 2-5 and figures")
     s.add_argument("inputs", nargs="+", metavar="EVAL_DIR",
                    help="per-(trial, method) evaluation folders of evaluate-tug "
                    "(results/<study>/evaluate/<method>/<trial>)")
@@ -586,11 +586,11 @@ def _add_ultrasonic_verbs(sub) -> None:
                    "(results/<study>/config_views/ultrasonic/study.json): its ultrasonic: "
                    "section")
     s.add_argument("--out", required=True, help="one row per stride, reference and system "
-                   "(seed 003 eq. 16-22), Parquet (results/<study>/ultrasonic/gait/"
+                   "(Qi et al. 2014 eq. 16-22), Parquet (results/<study>/ultrasonic/gait/"
                    "<trial>.parquet)")
     s.set_defaults(func=cmd_gait_parameters)
 
-    s = sub.add_parser("ultrasonic-tables", help="seed 003 Tables 2-8, C1 and figures")
+    s = sub.add_parser("ultrasonic-tables", help="Qi et al. 2014 Tables 2-8, C1 and figures")
     s.add_argument("inputs", nargs="+", metavar="GAIT_PARQUET",
                    help="per-trial gait parameter files of gait-parameters "
                    "(results/<study>/ultrasonic/gait/<trial>.parquet)")
@@ -722,7 +722,7 @@ def _add_mtst_verbs(sub) -> None:
            "<method>.json): the mtst: section (targets, mat, gates)",
            out="folder (results/<study>/mtst_eval/<method>/<trial>): contacts, steps, "
            "events, gates, track_field, summary, targets (.parquet)")
-    s = sub.add_parser("mtst-tables", help="seed 001 Tables 1, 3, 4 and the trial figure")
+    s = sub.add_parser("mtst-tables", help="Yorozu et al. 2015b Tables 1, 3, 4 and the trial figure")
     s.add_argument("inputs", nargs="+", metavar="EVAL_DIR",
                    help="per-(trial, method) evaluation folders of mtst-evaluate "
                    "(results/<study>/mtst_eval/<method>/<trial>)")
@@ -800,7 +800,7 @@ def _add_rollator_verbs(sub) -> None:
            method="the method's name (its label in the tables)", config=view,
            out="folder (results/<study>/rollator/<method>/<trial>): frames.parquet, "
            "summary.parquet")
-    s = sub.add_parser("rollator-tables", help="seed 002 Tables I, II and the figure")
+    s = sub.add_parser("rollator-tables", help="Chalvatzaki et al. 2017 Tables I, II and the figure")
     s.add_argument("inputs", nargs="+", metavar="EVAL_DIR",
                    help="per-(trial, method) evaluation folders of rollator-evaluate "
                    "(results/<study>/rollator/<method>/<trial>)")

@@ -14,7 +14,7 @@ import pytest
 from gaitval.report.index import build_index
 from gaitval.tables import write_table
 from gaitval.tables.numbers import (E_NOTATION, column_format, display_name, format_value,
-                                    number)
+                                    number, to_display)
 
 ROOT = Path(__file__).resolve().parents[1]
 NUMBER = re.compile(r"^-?\d+(\.(\d+))?$")
@@ -75,8 +75,11 @@ def html_tables(path: Path) -> list[tuple[str, list[str], list[list[str]]]]:
     return [(anchor, rows[0], rows[1:]) for anchor, rows in p.tables if rows]
 
 
-def problems(table: str, header: list[str], rows: list[list[str]]) -> list[str]:
-    """Cells with e-notation, ``nan``/``<NA>`` or more decimals than the column's format."""
+def problems(table: str, header: list[str], rows: list[list[str]],
+             names: dict[str, str] | None = None) -> list[str]:
+    """Cells with e-notation, ``nan``/``<NA>`` or more decimals than the column's format
+    (a value below its decimals is shown with two significant figures instead, never as
+    zero).  ``names``: rendered header (a label) -> the column's display name."""
     out = []
     for row in rows:
         for h, cell in zip(header, row):
@@ -85,11 +88,25 @@ def problems(table: str, header: list[str], rows: list[list[str]]) -> list[str]:
                 continue
             m = NUMBER.match(cell)
             if m and table != "verdicts":
-                f = column_format(h, table)
+                f = column_format((names or {}).get(h, h), table)
+                if f.kind == "sig":                        # significant figures
+                    continue
                 allowed = {"p": 3, "int": 1, "fixed": f.decimals}.get(f.kind, 3)
-                if len(m.group(2) or "") > allowed:
+                small = 0 < abs(float(cell.replace("−", "-"))) < 10 ** -allowed \
+                    and len(m.group(2) or "") <= allowed + 12
+                if len(m.group(2) or "") > allowed and not small:
                     out.append(f"{table}.{h}: {cell!r} has more than {allowed} decimals")
     return out
+
+
+def header_names(csv: Path) -> dict[str, str]:
+    """Rendered header (label) -> display name, of the table whose CSV is ``csv``."""
+    if not csv.is_file():
+        return {}
+    from gaitval.tables.labels import label
+
+    cols = to_display(pd.read_csv(csv), csv.stem).columns
+    return {label(c): c for c in cols}
 
 
 def scan_report(rd: Path) -> tuple[int, list[str]]:
@@ -98,18 +115,31 @@ def scan_report(rd: Path) -> tuple[int, list[str]]:
     for md in sorted((rd / "tables").glob("*.md")) + [rd / "verdicts.md"]:
         for header, rows in md_tables(md):
             n += sum(len(r) for r in rows)
-            bad += problems(md.stem, header, rows)
+            bad += problems(md.stem, header, rows, header_names(md.with_suffix(".csv")))
     for anchor, header, rows in html_tables(rd / "index.html"):
         n += sum(len(r) for r in rows)
-        bad += [f"html {p}" for p in problems(anchor, header, rows)]
+        names = header_names(rd / "tables" / f"{anchor}.csv")
+        bad += [f"html {p}" for p in problems(anchor, header, rows, names)]
     return n, bad
 
 
 # -- the format ---------------------------------------------------------------------------
 def test_float_noise_is_an_honest_zero_never_e_notation():
     assert format_value(-1.68e-18, "diff_mean_s", "ultrasonic_table3") == "0.000"
-    assert format_value(-7.91e-05, "diff_mean_m", "ultrasonic_table2") == "0.000"
-    assert format_value(-0.0004, "bias", None) == "0.000"            # never -0.000
+    assert format_value(0.0, "diff_mean_s", "ultrasonic_table3") == "0.000"
+
+
+def test_a_non_zero_value_is_never_printed_as_zero():
+    """Below its column's decimals a value gets two significant figures (Table 8's
+    0.000246, Table C1's small SS), never 0.000 nor -0.000 nor e-notation."""
+    assert format_value(-7.91e-05, "diff_mean_m", "ultrasonic_table2") == "-0.000079"
+    assert format_value(-0.0004, "bias", None) == "-0.00040"
+    assert format_value(0.000246, "mean", "ultrasonic_table8") == "0.00025"
+    assert format_value(0.0031, "SS", "ultrasonic_tableC1") == "0.0031"
+    assert format_value(0.0134, "SS", "ultrasonic_tableC1") == "0.013"   # significant figures
+    assert format_value(1.3, "SS_published", "ultrasonic_tableC1") == "1.3"
+    assert format_value(0.04, "n", None) == "0.040"                 # a count's mean
+    assert format_value(0.0123, "mean", "ultrasonic_table8") == "0.012"   # unchanged
     assert format_value(float("inf"), "x") == "∞"
     assert format_value(np.nan, "x") == "" and format_value(pd.NA, "x") == ""
 

@@ -37,7 +37,9 @@ def test_write_table_three_formats_agree_and_are_deterministic(tmp_path):
     assert back["rmse_x_m"].iloc[0] == pytest.approx(0.0512)
     md = a[1].read_text()
     assert "| Method 1 | 0.051 | 0.051 | 3 |" in md and "a note" in md
-    assert r"rmse\_\allowbreak{}x\_\allowbreak{}m" in a[2].read_text()  # escaped header
+    assert "| Method | RMSE x (m) | RMSE x (m), published | n |" in md      # labels
+    tex = a[2].read_text()
+    assert "RMSE x (m)" in tex and "rmse" not in tex.lower().replace("rmse x", "")
 
 
 def test_index_lists_items_with_provenance_and_missing_tables(tmp_path):
@@ -71,3 +73,17 @@ def test_cli_user_error_is_one_line_per_problem_and_exit_1(tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:
         main(["validate"])
     assert exc.value.code == 2
+
+
+def test_captions_and_notes_name_columns_by_their_headers(tmp_path):
+    """A caption or note that names a column by its machine name (bare or in backticks)
+    shows the header the reader sees instead; method names and other words are kept."""
+    df = pd.DataFrame({"method": ["tug_m1"], "ft_forward": [1], "diff_mean_m": [0.1]})
+    _, md, tex = write_table(df, tmp_path / "tug_table9",
+                             caption="Counts; ft_forward has no published counterpart.",
+                             notes=["`diff_mean_m` is system minus reference for tug_m1"])
+    text = md.read_text()
+    assert "_False tracking, forward_ has no published" in text
+    assert "- _Difference mean (m)_ is system minus reference for tug_m1" in text
+    assert "ft_forward" not in tex.read_text() and "diff" not in tex.read_text().lower() \
+        .replace("difference", "")

@@ -63,7 +63,7 @@ def test_the_other_reading_is_shown_beside_and_not_counted(tmp_path):
     assert len(tug) == 4                                # ranking + 3 methods, once each
     assert tug["comparison"].str.contains("reading swing_first").all()
     assert tug["alternative"].str.startswith("reading stance_first: ").all()
-    assert "TUG leg tracking (seed 000): 0 of 4 comparable" in summary_lines(v)[0]
+    assert "TUG leg tracking (Yorozu et al. 2015a): 0 of 4 comparable" in summary_lines(v)[0]
 
 
 def test_rows_the_table_calls_not_comparable_are_not_comparable(tmp_path):
@@ -107,7 +107,7 @@ def test_a_study_too_small_says_so_instead_of_scoring(tmp_path):
     tug = v[v["study"] == "tug"]
     assert (tug["outcome"] == "not comparable").all()
     assert tug["why"].str.startswith("too small").all()
-    assert "TUG leg tracking (seed 000): no comparison could be scored; 4 not " \
+    assert "TUG leg tracking (Yorozu et al. 2015a): no comparison could be scored; 4 not " \
            "comparable" in summary_lines(v)[0]
     # build_verdicts needs ultrasonic_table8 for the ultrasonic builder: C1 alone is not run
     from gaitval.report.verdicts import ultrasonic_verdicts
@@ -185,8 +185,8 @@ def test_html_top_says_what_the_data_are_then_verdicts_with_reasons(tmp_path):
     assert (rd / "verdicts.csv").is_file()
     header, rows = display_table(pd.read_csv(rd / "tables" / "tug_table3.csv"), "tug_table3")
     names = [c for c, _ in header]
-    assert names.index("success_pct_published") == names.index("success_pct") + 1
-    assert rows[0][names.index("success_pct")] == "25.0"            # a rate in per cent
+    assert names.index("Success (%), published") == names.index("Success (%)") + 1
+    assert rows[0][names.index("Success (%)")] == "25.0"            # a rate in per cent
 
 
 def test_table_c1_primary_reading_is_the_papers_words_and_stride_index_stands_beside():

@@ -238,7 +238,8 @@ def headline(studies: list[StudyData]) -> list[str]:
         c = s.checks
         if not c:
             continue
-        line = (f"**{s.name}**'s twin passes {c['passed']} of its {c['n']} physical checks "
+        line = (f"**{s.name}**'s simulated replica passes {c['passed']} of its {c['n']} "
+                f"physical checks "
                 f"(`{c['path']}`: gait and contact physics against real walks, the papers' "
                 f"occlusion rates, phase durations and step counts; docs/simulator.md, "
                 f"\"Physical checks\")")

@@ -32,6 +32,7 @@ from gaitval.io.atomic import write_text
 from gaitval.report.provenance import load_all, relative_path
 from gaitval.report.datakind import PAPER_PROTOCOLS, headline, paper_data, run_data
 from gaitval.report.verdicts import VERDICT_COLUMNS, build_verdicts, summary_lines
+from gaitval.tables.labels import base_of, is_published, label
 from gaitval.tables.numbers import format_value, to_display
 
 #: The paper tables gaitval renders, by protocol.
@@ -42,15 +43,15 @@ EXPECTED_TABLES = {
     "ultrasonic": [f"ultrasonic_table{i}" for i in range(1, 9)] + ["ultrasonic_tableC1"],
 }
 SECTION_TITLES = {
-    "tug": "TUG leg tracking (Yorozu et al., Sensors 2015, seed 000)",
-    "mtst": "Multi-target stepping task (Yorozu et al., Sensors 2015, seed 001)",
-    "rollator": "Robotic rollator, KF vs PF (Chalvatzaki et al., 2017, seed 002)",
-    "ultrasonic": "Ultrasonic foot tracking (Qi et al., Sensors 2014, seed 003)",
+    "tug": "TUG leg tracking (Yorozu et al. 2015a)",
+    "mtst": "Multi-target stepping task (Yorozu et al. 2015b)",
+    "rollator": "Robotic rollator, KF vs PF (Chalvatzaki et al. 2017)",
+    "ultrasonic": "Ultrasonic foot tracking (Qi et al. 2014)",
     "legbench": "Annotated recordings without mocap: CLEAR-MOT (Leigh et al., ICRA 2015)",
     "detections": "External leg detectors (no identity): detection rate, RMSE and false "
                   "detections against the mocap legs",
     "peer": "Worked example: agreement statistics on a peer's published data",
-    "sensitivity": "Sensitivity: the verdicts under the twin's alternative free choices "
+    "sensitivity": "Sensitivity: the verdicts under the simulated replica's alternative free choices "
                    "(python3 run.py sensitivity)",
     "study": "Appendix: study, ingest and registration",
 }
@@ -92,22 +93,27 @@ PAPER_FIGURE_CAPTIONS = {
 FIGURE_CAPTIONS = {
     "tug_trajectories": "TUG: tracked (thin) and true (thick) leg trajectories of a "
     "successful and a failed trial (rows), one column per method, each panel saying "
-    "success or FAILED (cf. seed 000 Fig. 14).",
+    "success or FAILED (cf. Yorozu et al. 2015a Fig. 14). The VICON legs set the axes; a "
+    "track that diverges beyond them is clipped at the edge and its panel says how far it went.",
     "tug_false_tracking": "TUG: the first false tracking of a failed trial — both legs' "
     "tracks and truth around the moment a track jumped to the other leg or was lost "
-    "(cf. seed 000 Fig. 11).",
+    "(cf. Yorozu et al. 2015a Fig. 11).",
     "mtst_trial": "MTST: a successful and a failed trial on the mat (rows): tracked legs "
     "(thin) against the mocap legs (thick), foot contacts, targets, target steps judged (O) "
-    "and cross steps detected (+) (cf. seed 001 Fig. 10).",
+    "and cross steps detected (+) (cf. Yorozu et al. 2015b Fig. 10). The mocap legs and the "
+    "mat set the axes; a track that diverges beyond them is clipped at the edge and its panel "
+    "says how far it went.",
     "rollator_turning_trial": "Rollator: lateral and forward position of each leg over "
     "time in a successful and a failed trial; truth red, KF black, PF blue; grey bands: "
-    "KF error frames, dotted lines: KF re-initialisations (cf. seed 002 Fig. 4).",
+    "KF error frames, dotted lines: KF re-initialisations (cf. Chalvatzaki et al. 2017 Fig. 4). "
+    "The truth sets each panel's vertical axis; a track that diverges beyond it is clipped "
+    "and the panel says so.",
     "ultrasonic_figA1": "Ultrasonic: histograms of the stride-parameter differences system "
-    "− reference at normal speed (cf. seed 003 Fig. A1).",
+    "− reference at normal speed (cf. Qi et al. 2014 Fig. A1).",
     "ultrasonic_figB1": "Ultrasonic: per-subject boxplots of the system's stride "
-    "parameters at normal speed (cf. seed 003 Fig. B1).",
+    "parameters at normal speed (cf. Qi et al. 2014 Fig. B1).",
     "ultrasonic_fig5": "Ultrasonic: mean ± SD of reference and system per walking speed; "
-    "* p < 0.05 against normal speed (paired t-test, Table 8; cf. seed 003 Fig. 5).",
+    "* p < 0.05 against normal speed (paired t-test, Table 8; cf. Qi et al. 2014 Fig. 5).",
     "ultrasonic_bland_altman_{p}": "Ultrasonic: Bland–Altman plot of {p} at normal speed, "
     "system − reference against their mean, in the quantity's display unit; points "
     "coloured by subject; pooled bias and limits of agreement (grey, dashed, 95 % CIs as "
@@ -227,21 +233,23 @@ def _md_cells(md_path: Path) -> tuple[list[str], list[list[str]]] | None:
 
 def _published_beside(header: list[str], rows: list[list[str]]
                       ) -> tuple[list[tuple[str, bool]], list[list[str]]]:
-    """Each ``<q>_published`` column moved right after ``<q>``."""
-    cols = [c for c in header if not c.endswith("_published") or c[:-10] not in header]
+    """Each published column (header ``<label>, published``, :mod:`gaitval.tables.labels`)
+    moved right after its quantity's."""
+    published = {base_of(c): c for c in header if is_published(c) and base_of(c) in header}
+    cols = [c for c in header if c not in published.values()]
     order = []
     for c in cols:
         order.append(c)
-        if f"{c}_published" in header:
-            order.append(f"{c}_published")
+        if c in published:
+            order.append(published[c])
     idx = [header.index(c) for c in order]
-    return ([(c, c.endswith("_published")) for c in order],
+    return ([(c, is_published(c)) for c in order],
             [[r[i] if i < len(r) else "" for i in idx] for r in rows])
 
 
 def display_table(df: pd.DataFrame, table: str | None = None
                   ) -> tuple[list[tuple[str, bool]], list[list[str]]]:
-    """Header ``(name, is_published)`` and formatted rows for the HTML report.
+    """Header ``(label, is_published)`` and formatted rows for the HTML report.
 
     The table in its display units (:func:`gaitval.tables.numbers.to_display`), each
     ``<q>_published`` column right after ``<q>``, every cell by
@@ -256,7 +264,7 @@ def display_table(df: pd.DataFrame, table: str | None = None
         if f"{c}_published" in d.columns:
             order.append(f"{c}_published")
     rows = [[format_value(d[c].iloc[i], c, table) for c in order] for i in range(len(d))]
-    return [(c, c.endswith("_published")) for c in order], rows
+    return [(label(c), c.endswith("_published")) for c in order], rows
 
 
 _MD_INLINE = [(re.compile(r"`([^`]+)`"), r"<code>\1</code>"),

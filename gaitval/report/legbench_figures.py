@@ -1,4 +1,4 @@
-"""Figure of annotated recordings: tracked vs annotated person over time (issue 18).
+"""Figure of annotated recordings: tracked vs annotated person over time.
 
 One row per method, two panels (x forward, y left of the laser, m): the hand-annotated
 person (black), and the tracker's person (leg midpoint) for each initialisation; scans

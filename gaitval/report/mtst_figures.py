@@ -1,12 +1,12 @@
-"""MTST figure (seed 001 Fig. 10 style): a successful and a failed trial on the mat, one
+"""MTST figure (Yorozu et al. 2015b Fig. 10 style): a successful and a failed trial on the mat, one
 row each — both tracked legs (thin) against the mocap legs (thick, where the study has
 mocap), the foot contacts, the targets, the target steps judged ("O") and the cross steps
-detected ("+"); each row says its tracking verdict (seed 001 Table 3: success, lost,
+detected ("+"); each row says its tracking verdict (Yorozu et al. 2015b Table 3: success, lost,
 false_swap, false_other).
 
 References
 ----------
-Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (seed 001), Figure 10, Table 3.
+Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (Yorozu et al. 2015b), Figure 10, Table 3.
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
-from gaitval.report.figures import save_figure  # noqa: E402
+from gaitval.report.figures import clip_to_reference, save_figure  # noqa: E402
 
 LEG_COLORS = {"L": "tab:blue", "R": "tab:red"}
 TARGET_COLORS = {"red": "#d62728", "blue": "#1f77b4", "white": "#ffffff"}
@@ -173,6 +173,14 @@ def _trial_panel(ax, data: dict[str, pd.DataFrame], trial: str, method: str,
                     label="cross step detected (+)" if side == "L" else None)
     ax.set_aspect("equal")
     ax.set_ylabel("y (m)")
+    # the mocap legs and the mat set the limits; a diverged track is clipped, and said so
+    ref_x = [tr["x_true_m"]] if has_truth else []
+    ref_y = [tr["y_true_m"]] if has_truth else []
+    if len(tg) and {"x_m", "y_m"} <= set(tg.columns):
+        ref_x.append(tg["x_m"])
+        ref_y.append(tg["y_m"])
+    if len(tr) and ref_x:
+        clip_to_reference(ax, ref_x, ref_y, [tr["x_m"]], [tr["y_m"]], what="tracked leg")
     note = "" if has_truth else " — no mocap"
     ax.set_title(f"{trial}, {method}: {outcome or 'no verdict'}{note}", fontsize=9,
                  color="tab:red" if outcome.startswith("FAILED") else "black")

@@ -1,4 +1,4 @@
-"""Seed 002 figure: a successful and a failed trial, both trackers' legs against the truth
+"""Chalvatzaki et al. 2017 figure: a successful and a failed trial, both trackers' legs against the truth
 (cf. its Fig. 4).
 
 Per trial the paper's Fig. 4 panels: lateral and forward position of the left and the
@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from gaitval.report.figures import plt, save_figure
+from gaitval.report.figures import clip_to_reference, plt, save_figure
 
 COLOURS = {"truth": "tab:red", "kf": "black", "pf": "tab:blue"}
 
@@ -125,6 +125,9 @@ def _trial_rows(axes, f: pd.DataFrame, tid: str, kf: str, pf: str, mount, verdic
             for k in np.flatnonzero(kf_f["restart"].to_numpy(bool)):
                 ax.axvline(t[k], color="black", lw=0.4, ls=":")
             ax.set_ylabel(name)
+            # the ground truth sets the limits; a diverged KF/PF track is clipped (said so)
+            clip_to_reference(ax, None, [curves["truth"][axis]], None,
+                              [curves["kf"][axis], curves["pf"][axis]], what="track")
             title = f"{'left' if side == 'L' else 'right'} leg, {name.split()[0]}"
             if i == 0:
                 title = f"{tid}: {verdict}\n{title}" if verdict else f"{tid}\n{title}"

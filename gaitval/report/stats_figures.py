@@ -1,4 +1,4 @@
-"""Statistics figures of seed 003 (Qi et al., Sensors 2014) and Bland–Altman plots.
+"""Statistics figures of Qi et al. 2014 (Qi et al., Sensors 2014) and Bland–Altman plots.
 
 - :func:`figure_a1_histograms` — like Figure A1: histograms (here of the differences
   system − reference, per parameter).

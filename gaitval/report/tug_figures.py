@@ -1,10 +1,10 @@
 """TUG leg-tracking figures: tracked vs true trajectories of a successful and a failed trial
-(seed 000 Fig. 14 style) and a false-tracking example (Fig. 11 style), from the evaluation
+(Yorozu et al. 2015a Fig. 14 style) and a false-tracking example (Fig. 11 style), from the evaluation
 frames.
 
 References
 ----------
-Yorozu, A.; Moriguchi, T.; Takahashi, M. Sensors 2015, 15, 22451–22472 (seed 000).
+Yorozu, A.; Moriguchi, T.; Takahashi, M. Sensors 2015, 15, 22451–22472 (Yorozu et al. 2015a).
 """
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from gaitval.report.figures import save_figure  # noqa: E402
+from gaitval.report.figures import clip_to_reference, save_figure  # noqa: E402
 
 COLORS = {"L": "tab:blue", "R": "tab:red"}
 
@@ -69,7 +69,7 @@ def plot_trial_trajectories(frames: pd.DataFrame, trial: str | list[str], path: 
     what = ("a successful and a failed trial" if len(rows) == 2 else f"trial {rows[0]}")
     fig.suptitle(f"Leg trajectories, tracked (LRS) vs true (VICON): {what} "
                  "(open circles: unobservable, UO)")
-    fig.tight_layout()
+    fig.tight_layout(h_pad=2.0)          # room for a row's x label above the next titles
     return save_figure(fig, path)
 
 
@@ -96,7 +96,10 @@ def _trial_row(axes, f: pd.DataFrame, trial: str, methods, summaries) -> None:
             ax.plot(uo["x_m"], uo["y_m"], "o", mfc="none", ms=3, color=COLORS[side])
         ax.set_title(f"{trial}, {m}{_outcome(summaries, trial, m)}", fontsize=9)
         ax.set_xlabel("x (sensor frame) [m]")
-        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_aspect("equal", adjustable="box")
+        # the VICON legs set the limits; a diverged track is clipped, and the panel says so
+        clip_to_reference(ax, [d["xs_m"]], [d["ys_m"]], [d["x_m"]], [d["y_m"]],
+                          what="LRS track")
         ax.grid(True, lw=0.3)
     axes[0].set_ylabel("y (sensor frame) [m]")
 

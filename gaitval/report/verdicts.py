@@ -20,7 +20,7 @@ Outcomes (column ``outcome``):
   the range: too wide to test a published value with);
 * ``not run`` — the run has no study with the paper's protocol.
 
-One primary reading per comparison.  TUG's Methods run under two readings of seed 000
+One primary reading per comparison.  TUG's Methods run under two readings of Yorozu et al. 2015a
 eq. (3)–(4) (:mod:`gaitval.gait.phases`); the primary one is gaitval's default
 (``swing_first``: the reading that gives Table 2's v_sw_th and the "unlikely" Phase 5 of
 the paper's text a role, docs/tracking.md); the other is shown beside it in
@@ -32,10 +32,10 @@ the reproduced 95% CI (Wilson) — for a proportion; value inside published mean
 
 References
 ----------
-Yorozu, A.; Moriguchi, T.; Takahashi, M. Sensors 2015, 15, 22451–22472 (seed 000, TUG).
-Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (seed 001, MTST).
-Chalvatzaki, G. et al. ICRA 2017 (seed 002, robotic rollator).
-Qi, Y. et al. Sensors 2014, 14(8), 15434–15457 (seed 003, ultrasonic).
+Yorozu, A.; Moriguchi, T.; Takahashi, M. Sensors 2015, 15, 22451–22472 (Yorozu et al. 2015a, TUG).
+Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (Yorozu et al. 2015b, MTST).
+Chalvatzaki, G. et al. ICRA 2017 (Chalvatzaki et al. 2017, robotic rollator).
+Qi, Y. et al. Sensors 2014, 14(8), 15434–15457 (Qi et al. 2014, ultrasonic).
 """
 from __future__ import annotations
 
@@ -51,8 +51,8 @@ from gaitval.tables.numbers import number, p_value
 VERDICT_COLUMNS = ("study", "data", "comparison", "source", "table", "published",
                    "reproduced", "criterion", "outcome", "why", "alternative")
 OUTCOMES = ("reproduced", "not reproduced", "not comparable", "not run")
-STUDIES = {"tug": "TUG leg tracking (seed 000)", "mtst": "MTST (seed 001)",
-           "rollator": "Robotic rollator (seed 002)", "ultrasonic": "Ultrasonic (seed 003)"}
+STUDIES = {"tug": "TUG leg tracking (Yorozu et al. 2015a)", "mtst": "MTST (Yorozu et al. 2015b)",
+           "rollator": "Robotic rollator (Chalvatzaki et al. 2017)", "ultrasonic": "Ultrasonic (Qi et al. 2014)"}
 #: The table each study's verdicts need; absent → one ``not run`` row.
 REQUIRED = {"tug": "tug_table3", "mtst": "mtst_table3", "rollator": "rollator_table1",
             "ultrasonic": "ultrasonic_table8"}
@@ -162,7 +162,7 @@ def _broken_pairs(pub: dict[str, float], rep: dict[str, float], fmt) -> str:
     return "; ".join(out)
 
 
-# -- TUG (seed 000) ------------------------------------------------------------------------
+# -- TUG (Yorozu et al. 2015a) ------------------------------------------------------------------------
 _TUG_FAIL = (("ft_turning", "false tracking in turning"), ("ft_return",
              "false tracking on return"), ("ft_forward", "false tracking forward"),
              ("sf_turning", "stance failures in turning"), ("sf_other", "other stance failures"))
@@ -219,7 +219,7 @@ def _tug_reading_rows(g: pd.DataFrame) -> dict[str, dict]:
 
 
 def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
-    """Seed 000: success ranking and per-method success (Table 3; primary reading of
+    """Yorozu et al. 2015a: success ranking and per-method success (Table 3; primary reading of
     eq. (3)–(4), the other beside); Method 3 below Method 2 in turning-phase (Table 4) and
     unobservable (Table 5) RMSE."""
     st = "tug"
@@ -288,7 +288,7 @@ def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[
     return rows
 
 
-# -- MTST (seed 001) -----------------------------------------------------------------------
+# -- MTST (Yorozu et al. 2015b) -----------------------------------------------------------------------
 def _k_n(s: str) -> tuple[float, float] | None:
     """``(k, n)`` of a ``"x% (k/n)"`` string."""
     try:
@@ -316,7 +316,7 @@ def _mtst_failures(r) -> str:
 
 
 def mtst_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
-    """Seed 001: success ranking of Methods 1-3 and the proposed method (Table 3, mocap
+    """Yorozu et al. 2015b: success ranking of Methods 1-3 and the proposed method (Table 3, mocap
     reference; the rater events' where no trial has mocap), each method's success and
     target-step judgement success (Table 4), each with its 95 % interval."""
     st = "mtst"
@@ -384,9 +384,9 @@ def mtst_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list
     return rows
 
 
-# -- Rollator (seed 002) -------------------------------------------------------------------
+# -- Rollator (Chalvatzaki et al. 2017) -------------------------------------------------------------------
 def rollator_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
-    """Seed 002: the PF beats the KF — lower RMSE and MAD per quantity in most subject ×
+    """Chalvatzaki et al. 2017: the PF beats the KF — lower RMSE and MAD per quantity in most subject ×
     scenario cells (Table I, in the paper's cm and cm/s) and fewer error frames
     (Table II)."""
     st = "rollator"
@@ -442,7 +442,7 @@ def rollator_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> 
     return rows
 
 
-# -- Ultrasonic (seed 003) -----------------------------------------------------------------
+# -- Ultrasonic (Qi et al. 2014) -----------------------------------------------------------------
 _SPEED_ORDER = ("slow", "normal", "fast")
 
 
@@ -479,7 +479,7 @@ def _ns_nv_reason(t8: pd.DataFrame, sym: str) -> str:
 
 
 def ultrasonic_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
-    """Seed 003: pendulum bias within its spread (Table 1); the system's stride parameters
+    """Qi et al. 2014: pendulum bias within its spread (Table 1); the system's stride parameters
     at normal speed within the published mean ± SD (Table 8); the direction of the speed
     effects (Table 8); normality (Table 7) and no subject effect (Table C1)."""
     st = "ultrasonic"

@@ -1,4 +1,4 @@
-"""Published values of seed 002 (Chalvatzaki et al., ICRA 2017), transcribed from the seed text.
+"""Published values of Chalvatzaki et al. 2017 (Chalvatzaki et al., ICRA 2017), transcribed from the seed text.
 
 Transcribed from the paper's text (and checked against a checklist of it).  Units as
 printed: cm and cm/s.

@@ -1,4 +1,4 @@
-"""Published values of seed 003 (Qi et al., Sensors 2014), transcribed from the seed text.
+"""Published values of Qi et al. 2014 (Qi et al., Sensors 2014), transcribed from the seed text.
 
 Transcribed from the paper's text.  The PDF extraction
 garbled the row labels of Tables 2–6 ("Dof", "Rei", "Duo", "rro" for Ref/Pro) and of

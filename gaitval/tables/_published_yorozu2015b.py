@@ -1,4 +1,4 @@
-"""Published values of seed 001 (Yorozu et al., Sensors 2015, 15, 11151–11168), Tables 1, 3, 4.
+"""Published values of Yorozu et al. 2015b (Yorozu et al., Sensors 2015, 15, 11151–11168), Tables 1, 3, 4.
 
 Transcribed from the paper's text (checked against that text by
 ``tests/test_mtst_tables.py``).  The text's Table 3 is garbled in one cell: Method 3's

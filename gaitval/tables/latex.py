@@ -5,6 +5,8 @@ Every ``.tex`` gaitval writes compiles with pdflatex inside :data:`PREAMBLE` (th
 texlive-latex-base, texlive-latex-recommended, texlive-latex-extra).  What the renderer
 does so that it does:
 
+* **Headers.** Each column's label with its unit (:mod:`gaitval.tables.labels`), never
+  its machine name (the CSV keeps those).
 * **Escaping.** Every header, cell, caption and note goes through :func:`latex_text`: the
   ten LaTeX specials (``\\ & % $ # _ { } ~ ^``) become their text commands and Unicode the
   tables use (Δ ≥ ≤ ± ∓ − × → · √ σ ² – — … §, any Greek letter) becomes a LaTeX command
@@ -22,7 +24,7 @@ does so that it does:
   ``\\footnotesize``; a wider one in landscape (``pdflscape``) in ``\\scriptsize``.  Long
   text columns share the width left by the others as ragged-right ``p{..}`` paragraphs
   (a justified narrow column is all underfull lines); a long header over short entries
-  breaks after its underscores.  A table that still does not fit is split into parts
+  breaks between its words.  A table that still does not fit is split into parts
   that each repeat its *key columns* (:func:`key_columns`: the leading columns that tell
   the rows apart, e.g. ``method`` and ``tug_phase``), results first and descriptive text
   last.  A text column of sentences (entries over :data:`PROSE_CHARS` characters) is a
@@ -45,6 +47,8 @@ import unicodedata
 
 import numpy as np
 import pandas as pd
+
+from gaitval.tables.labels import label
 
 #: What a document needs to \input any gaitval table (tests/test_latex_compile.py uses it).
 PREAMBLE = "\n".join([
@@ -211,10 +215,11 @@ def _col_info(df: pd.DataFrame, col: str, table: str | None) -> dict:
     cells = max([_plain_len(v, col, table) for v in df[col]] + [0])
     num = _numeric(df[col])
     words = [len(w) for v in df[col] if isinstance(v, str) for w in v.split()]
-    return {"num": num, "chars": max(cells, len(col)), "cells": cells,
+    head = label(col)
+    return {"num": num, "chars": max(cells, len(head)), "cells": cells,
             "min": max([8, min(max(words + [0]), 17)]
-                       + [len(w) for w in re.split(r"[_ ]", col)]),
-            "head": max(len(w) for w in re.split(r"(?<=_)", col)),
+                       + [len(w) for w in re.split(r"[_ ]", head)]),
+            "head": max(len(w) for w in re.split(r"(?<=[_ ])", head)),
             "shrink": not num and cells > 12}
 
 
@@ -241,9 +246,9 @@ def _layout(groups, info, page) -> tuple[dict[str, str], bool]:
         for c in g:
             specs[c] = "r" if info[c]["num"] else "l"
         if len(g) == 2:                           # a header over ours/paper: no break
-            head = (len(g[0]) + 3) * cw + pad
+            head = (len(label(g[0])) + 3) * cw + pad
         elif info[g[0]]["chars"] > max(info[g[0]]["cells"], info[g[0]]["head"]):
-            # a long header over short entries breaks after its underscores
+            # a long header over short entries breaks between its words
             w = max(info[g[0]]["cells"], info[g[0]]["head"] + 2, 5) * cw
             align = r"\raggedleft" if info[g[0]]["num"] else r"\raggedright"
             specs[g[0]] = rf">{{{align}\arraybackslash}}p{{{w:.1f}pt}}"
@@ -262,7 +267,7 @@ def _layout(groups, info, page) -> tuple[dict[str, str], bool]:
             continue
         # the paragraph columns leave FLEX_MARGIN_PT of the width unused: the widths of
         # the other columns are estimates (0.6 em a character), and a row of them 0.36 pt
-        # wider than estimated overfilled the line (tiny's tug_failures, issue 34)
+        # wider than estimated overfilled the line (tiny's tug_failures)
         share = (avail - FLEX_MARGIN_PT) / len(left)
         for c in left:
             w = max(share, info[c]["min"] * cw)
@@ -330,8 +335,8 @@ def _split(keys, rest, info, page) -> list[list[list[str]]]:
 
 
 def _head(name: str) -> str:
-    """A column header; it may break after an underscore in a paragraph column."""
-    return latex_text(name).replace(r"\_", r"\_\allowbreak{}")
+    """A column header: the column's label with its unit (:mod:`gaitval.tables.labels`)."""
+    return latex_text(label(name))
 
 
 def _col_width_pt(spec: str, info: dict, page: dict) -> float:
@@ -355,7 +360,7 @@ def _height_pt(df: pd.DataFrame, groups, specs, info, page, *, table: str | None
     for _, row in df[cols].iterrows():
         n = max([lines(_plain_len(row[c], c, table), widths[c]) for c in para] + [1])
         rows += n * line
-    head = max([lines(len(c), widths[c]) for c in para] + [1]) * line
+    head = max([lines(len(label(c)), widths[c]) for c in para] + [1]) * line
     head += line if any(len(g) == 2 for g in groups) else 0
     text_w = page["width_pt"]
     cap = math.ceil(1.15 * (len(caption) + 12) * 5.0 / text_w) * 12.0 + 10

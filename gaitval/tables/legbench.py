@@ -1,4 +1,4 @@
-"""The CLEAR-MOT table of annotated recordings (issue 18; docs/legbench.md).
+"""The CLEAR-MOT table of annotated recordings (docs/legbench.md).
 
 One row per (trial, method, initialisation): MOTA, MOTP (m), ID switches, IDF1 and the
 counts behind them (Bernardin & Stiefelhagen 2008, through py-motmetrics), at the
@@ -86,7 +86,7 @@ BENCH_COLUMNS = ["benchmark_set", "tracker", "source", "online", "annotations", 
 def benchmark_table(summary: pd.DataFrame, methods=None, inits=None, offline=()
                     ) -> pd.DataFrame:
     """The published rows of each benchmark set beside gaitval's, counted the way the
-    set's authors count (issue 36; spec ``leg-tracker-benchmark.md``).
+    set's authors count (spec ``leg-tracker-benchmark.md``).
 
     Per set: the paper's trackers (matched, ID switches, misses, FP, MOTA, MOTP), then
     every gaitval (method, init) summed over the set's recordings.  Following sets ignore

@@ -1,12 +1,12 @@
 """Agreement with the camera reference, one row per system: gaitval's UKF and external ones.
 
-Issue 37.  Seed 003's Tables 2–6 describe one system, the ultrasonic UKF.  A study team
+Issue 37.  Qi et al. 2014's Tables 2–6 describe one system, the ultrasonic UKF.  A study team
 validating its own foot-tracking system (a ``*.foot.csv`` per treadmill trial,
 :mod:`gaitval.io.foot`) wants the same statistics for it, beside gaitval's: this table
 stacks, per system, the pooled and repeated-measures agreement of every parameter at every
 speed (:func:`gaitval.tables.ultrasonic_agreement.agreement_table`: bias and Bland–Altman
 limits with their confidence intervals, ICC(A,1); the mixed-model bias, limits and ICC with
-subjects as a random effect; proportional bias), each on the strides that seed 003's tables
+subjects as a random effect; proportional bias), each on the strides that Qi et al. 2014's tables
 use (:func:`gaitval.tables.ultrasonic_params.sample_strides`: ``ultrasonic.tables``, by
 default 10 per subject and speed, drawn with the same seed from that system's matched
 strides).  Differences are system − reference.  No paper gives these rows: no verdicts.
@@ -67,12 +67,12 @@ def write_method_agreement(gait_by_method: dict[str, pd.DataFrame], out_stem: st
     table = method_agreement_table(gait_by_method, cfg)
     k, seed = table_settings(cfg)
     caption = ("Agreement of each foot-tracking system with the camera reference on the "
-               "treadmill trials: gaitval's ultrasonic UKF (seed 003) and the external "
-               "systems declared for the study (issue 37), one block of rows per system; "
+               "treadmill trials: gaitval's ultrasonic UKF (Qi et al. 2014) and the external "
+               "systems declared for the study, one block of rows per system; "
                "differences system − reference.")
     notes = [
         f"Strides: {k} per subject and speed (ultrasonic.tables), drawn with seed {seed} "
-        "from each system's own matched strides, as seed 003's Tables 2–6 are; a system "
+        "from each system's own matched strides, as Qi et al. 2014's Tables 2–6 are; a system "
         "that matches other strides is compared on other strides.",
         "Pooled columns treat every stride as independent (Bland & Altman 1999); *_rm "
         "columns take subjects as a random effect (Bland & Altman 2007; Zou 2013); ICC(A,1) "

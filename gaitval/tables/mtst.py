@@ -1,4 +1,4 @@
-"""Seed 001 (MTST) Tables 1, 3 and 4, published values beside the reproduced ones.
+"""Yorozu et al. 2015b (MTST) Tables 1, 3 and 4, published values beside the reproduced ones.
 
 Inputs are the per-(trial, method) tables of :mod:`gaitval.pipeline.mtst` concatenated
 (``summary``, ``gates``), so this module only counts and renders.
@@ -18,7 +18,7 @@ References
 ----------
 Yorozu, A.; Nishiguchi, S.; Yamada, M.; Aoyama, T.; Moriguchi, T.; Takahashi, M. Gait
 Measurement System for the Multi-Target Stepping Task Using a Laser Range Sensor. Sensors
-2015, 15, 11151–11168 (seed 001).
+2015, 15, 11151–11168 (Yorozu et al. 2015b).
 """
 from __future__ import annotations
 
@@ -139,7 +139,7 @@ def table3(summary: pd.DataFrame, methods: list[str]) -> pd.DataFrame:
 def judging_rules_note(t3: pd.DataFrame) -> str:
     """The note that names Table 3's two judging rules, with the success of each method
     under both (mocap rows)."""
-    text = ("Two judging rules side by side, fixed before the results (issue 34): the "
+    text = ("Two judging rules side by side, fixed before the results: the "
             "columns without suffix use the paper's rule (any swap or lost track of >= "
             "0.20 s against the mocap truth, or two consecutive rater contacts; primary, "
             "compared with the published values); the *_persistent_swap columns count a "
@@ -220,7 +220,7 @@ def mocap_notes(summary: pd.DataFrame) -> list[str]:
 def table4_external(summary: pd.DataFrame, t4: pd.DataFrame, external: list[str]
                     ) -> pd.DataFrame:
     """Table 4 with a ``method`` column: the proposed method's rows, then each external
-    method's (tracking.external, issue 37) on the trials *it* tracked successfully, without
+    method's (tracking.external) on the trials *it* tracked successfully, without
     published values (they are the proposed method's)."""
     out = [t4.assign(method="mtst_proposed")]
     for m in external:
@@ -240,7 +240,7 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
     """Write ``mtst_table1``, ``mtst_table3``, ``mtst_table4`` (csv, md, tex) from the
     concatenated per-trial tables ``data`` (``summary``, ``gates``).  ``shown``: method ->
     the name the tables print (a method run with overrides,
-    :func:`gaitval.methods.display_name`).  ``external``: external methods (issue 37),
+    :func:`gaitval.methods.display_name`).  ``external``: external methods,
     which get rows in Tables 3 and 4 (Table 4 then has a ``method`` column).
     ``left_out``: trial -> why it is not in the tables (a refused registration with
     nothing else to place it); Tables 3 and 4 say so in a note."""
@@ -264,7 +264,7 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
         t1, t3 = (t.assign(method=t["method"].map(lambda m: shown.get(m, m)))
                   for t in (t1, t3))
     paths = write_table(t1, td / "mtst_table1", caption=(
-        "Seed 001 Table 1: radius r_val of the variable validation region by the leg's gait "
+        "Yorozu et al. 2015b Table 1: radius r_val of the variable validation region by the leg's gait "
         "phase at k-1 and whether it was observable (H = consecutive unobservable scans; "
         f"v_sw = {P.V_SW_MPS} m/s, v_st = {P.V_ST_MPS} m/s, dt = 0.05 s), with how often "
         "the proposed method used each cell (leg-scans) and the radii it realised."), notes=[
@@ -272,7 +272,7 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
         "paper gives none). Radii are recomputed from each track exactly as the tracker "
         "built them (gaitval.evaluate.mtst_tracking.gate_usage)."])
     paths += write_table(t3, td / "mtst_table3", caption=(
-        "Seed 001 Table 3: lost and false tracks per trial (a failed trial counted once) "
+        "Yorozu et al. 2015b Table 3: lost and false tracks per trial (a failed trial counted once) "
         "for Methods 1-3 and the proposed method, participants without / with a stick, "
         "and the tracking success rate; published values beside. Reference 'mocap': the "
         "track against the mocap leg points (stands in for the paper's video check); "
@@ -286,7 +286,7 @@ def write_mtst_tables(data: dict[str, pd.DataFrame], tables_dir, *,
                       "tracked successfully; no published values (the paper's are the "
                       "proposed method's).")
     paths += write_table(t4, td / "mtst_table4", caption=(
-        "Seed 001 Table 4: target-step judgement and cross-step detection against the "
+        "Yorozu et al. 2015b Table 4: target-step judgement and cross-step detection against the "
         "rater annotations on the trials the proposed method tracked successfully; "
         "success = (N - non-judgements or non-detections) / N, error rate = "
         "misjudgements / steps or false detections / detected cross steps; published "

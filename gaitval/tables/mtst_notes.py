@@ -2,7 +2,7 @@
 the likely cause.
 
 The direction statements are computed from the tables; the causes are the mechanisms
-found on the simulated twin (docs/mtst.md, "Reproduced vs published"), stated once per
+found on the simulated replica (docs/mtst.md, "Reproduced vs published"), stated once per
 kind of difference so a reader sees why, not only that, a number differs.
 """
 from __future__ import annotations
@@ -15,15 +15,15 @@ from gaitval.tables import _published_yorozu2015b as P
 #: cause of a difference, by (quantity, direction)
 CAUSES = {
     ("lost", "more"): (
-        "more lost tracks: on the twin the failures begin while a leg swings with no "
+        "more lost tracks: on the simulated replica the failures begin while a leg swings with no "
         "observation in its region or only a sliver (the share is computed above): the sensor "
         "stands on the walking line, so the back leg passes behind the front one at every "
         "step, and the constant-velocity prediction (Q = 5^2 m^2/s^4) of a hidden leg "
-        "accelerating into swing (the twin's shin leaves stance at about 1.5 times the "
+        "accelerating into swing (the simulated replica's shin leaves stance at about 1.5 times the "
         "walking speed, docs/simulator.md) falls behind; a fixed region of 1.5 w_l (0.15 m; "
         "w_l for Method 3) cannot recapture a leg that moves 0.1 m per scan at 2 m/s"),
     ("lost", "fewer"): (
-        "fewer lost tracks: a leg the twin hides reappears within a few scans and the "
+        "fewer lost tracks: a leg the simulated replica hides reappears within a few scans and the "
         "proposed region grows with H (Table 1), so a prediction is recaptured"),
     ("false", "more"): (
         "more false tracks: mostly left/right swaps that begin when a hidden leg reappears "
@@ -44,7 +44,7 @@ CAUSES = {
         "thresholds of eq. (9)-(10) do not see, or a short swap the mocap rule forgave) "
         "cannot be judged"),
     ("non", "fewer"): (
-        "fewer non-judgements / non-detections: the twin's rater judges hit or miss from "
+        "fewer non-judgements / non-detections: the simulated replica's rater judges hit or miss from "
         "the true foot (docs/simulator.md), with a foot close in size to the average foot "
         "of gaitval's region, while the paper's raters watched video of real feet"),
     ("mis", "more"): (
@@ -52,7 +52,7 @@ CAUSES = {
         "not mark, and for cross steps the swing round a foot placed close to the other "
         "leg's line (y'_st < w_c) without crossing it"),
     ("mis", "fewer"): (
-        "fewer misjudgements: the twin's targets never touch each other and its rater "
+        "fewer misjudgements: the simulated replica's targets never touch each other and its rater "
         "judges from the true foot"),
 }
 
@@ -132,7 +132,7 @@ def table4_notes(t4: pd.DataFrame, trials: pd.DataFrame) -> list[str]:
     notes = [f"{len(trials)} trials (the paper: 46 of 48) that the proposed method tracked "
              "successfully; steps = the rater's foot contacts (the paper: 414, 9.0 per "
              f"trial; here {trials['n_steps'].sum() / max(len(trials), 1):.1f} per trial: "
-             "the twin counts every contact from the start position to the goal)."]
+             "the simulated replica counts every contact from the start position to the goal)."]
     if "has_targets" in trials and (~trials["has_targets"].astype(bool)).any():
         notes.append(f"{int((~trials['has_targets'].astype(bool)).sum())} trial(s) had no "
                      "target layout and are left out of the target-step row.")

@@ -19,11 +19,14 @@ last and the same in ``.md``, ``index.html`` and ``.tex``:
   one, **ppm** one; any other float three decimals (the table may say otherwise, e.g.
   ``mtst_table3``: one).
 
-Fixed decimals per quantity mean no scientific notation and no float noise: a value that
-rounds to zero at its quantity's precision is printed as zero (``0.000``, never ``-0.000``
-nor ``-1.68e-18``) — the CSV keeps the exact value.  A quantity's decimals are its
-significant figures at the magnitude the papers report it (mm resolution for leg positions,
-0.1 % for rates).
+Fixed decimals per quantity mean no scientific notation and no float noise.  A non-zero
+value is never printed as zero: one that would round to zero at its quantity's precision
+is printed with two significant figures instead (``0.00025`` for 0.000246 in a column of
+three decimals, an ANOVA's small SS ``0.0031``); float noise below :data:`NOISE`
+(``-1.68e-18`` for an exact zero) is zero, never ``-0.000``.  The CSV keeps the exact
+value.  A quantity's decimals are its significant figures at the magnitude the papers
+report it (mm resolution for leg positions, 0.1 % for rates); a proportion is in per cent
+everywhere in a table (``*_rate`` and ``*_rate_*`` columns alike).
 
 API
 ---
@@ -48,8 +51,8 @@ import pandas as pd
 class Format:
     """How a column is printed.
 
-    ``kind``: ``"p"`` (p-value), ``"int"`` (count), ``"fixed"`` (``decimals`` decimals) or
-    ``"text"`` (as written); ``scale``: factor from the CSV's unit to the display unit;
+    ``kind``: ``"p"`` (p-value), ``"int"`` (count), ``"fixed"`` (``decimals`` decimals),
+    ``"sig"`` (``decimals`` significant figures) or ``"text"`` (as written); ``scale``: factor from the CSV's unit to the display unit;
     ``rename``: ``(old suffix, new suffix)`` of the header, or None.
     """
     kind: str
@@ -73,10 +76,13 @@ PAPER_TABLES = ("tug_table", "tug_failures", "mtst_table", "rollator_table", "ro
 #: Per-table formats of columns (the paper's precision where it differs from the rules).
 TABLE_COLUMNS: dict[str, dict[str, Format]] = {
     "rollator_table1": {c: Format("fixed", 2, 100.0) for c in (
-        "rmse_kf", "rmse_pf", "mad_kf", "mad_pf")},            # seed 002: cm, cm/s
+        "rmse_kf", "rmse_pf", "mad_kf", "mad_pf")},            # Chalvatzaki et al. 2017: cm, cm/s
     "rollator_table2": {"tracking_time_s": Format("fixed", 2)},
+    # Qi et al. 2014 Table C1: sums and mean squares span four orders of magnitude
+    # (0.0017 to 1.3), so significant figures, not decimals
+    "ultrasonic_tableC1": {"SS": Format("sig", 2), "MS": Format("sig", 2)},
 }
-#: Per-table formats of columns by prefix: an external method's columns (issue 37) are
+#: Per-table formats of columns by prefix: an external method's columns are
 #: named after it (``rmse_<method>``), so they are matched by their statistic.
 TABLE_PREFIXES: dict[str, dict[tuple[str, ...], Format]] = {
     "rollator_table1": {("rmse_", "mad_"): Format("fixed", 2, 100.0)},
@@ -116,6 +122,10 @@ def column_format(column: str, table: str | None = None) -> Format:
         return COUNT
     if low.endswith("_rate"):
         return Format("fixed", 1, 100.0, ("_rate", "_pct"))
+    if "_rate_" in low and not low.endswith(("_hz", "_pct")):
+        # a rate of a variant (success_rate_persistent_swap): per cent too, so that one
+        # table never shows a proportion both as a fraction and in per cent
+        return Format("fixed", 1, 100.0, ("_rate_", "_pct_"))
     if low.endswith("_pct") or low.endswith("_percent"):
         return Format("fixed", 1)
     if low.endswith("_mm"):
@@ -147,6 +157,8 @@ def display_name(column: str, table: str | None = None) -> str:
     base = name[:-len("_published")] if pub else name
     if base.endswith(old):
         base = base[:-len(old)] + new
+    elif old.endswith("_") and old in base:             # an infix (``_rate_``)
+        base = base.replace(old, new, 1)
     return base + ("_published" if pub else "")
 
 
@@ -196,12 +208,35 @@ def format_value(value, column: str, table: str | None = None) -> str:
     x = float(value)
     if f.kind == "p":
         return p_value(x)
+    if f.kind == "sig":
+        return number(x, f.decimals)
     integral = math.isfinite(x) and abs(x - round(x)) < 1e-9
     if f.kind == "int":
-        return str(int(round(x))) if integral else fixed(x, 1)
+        return str(int(round(x))) if integral else not_zero(x, fixed(x, 1))
     if isinstance(value, (int, np.integer)) and f.scale == 1.0:
         return str(int(value))                    # an integer column (rates in Hz, sizes)
-    return fixed(x, f.decimals)
+    return not_zero(x, fixed(x, f.decimals))
+
+
+#: Below this magnitude a value is float noise (``-1.68e-18`` for an exact zero) and
+#: printed as zero; any larger value is never printed as zero.
+NOISE = 1e-12
+
+
+def not_zero(x: float, text: str, sig: int = 2) -> str:
+    """``text`` (``x`` at its column's decimals), unless it reads zero for a non-zero
+    ``x``: then ``x`` to ``sig`` significant figures (``0.000246``, an ANOVA's small SS
+    ``0.0031``), never e-notation.  Float noise (:data:`NOISE`) stays zero."""
+    if math.isfinite(x) and abs(x) >= NOISE and _reads_zero(text):
+        return number(x, sig)
+    return text
+
+
+def _reads_zero(text: str) -> bool:
+    try:
+        return float(text) == 0
+    except ValueError:
+        return False
 
 
 def to_display(df: pd.DataFrame, table: str | None = None) -> pd.DataFrame:

@@ -1,4 +1,4 @@
-"""Seed 002 Tables I and II (KF vs PF on the rollator), published values beside.
+"""Chalvatzaki et al. 2017 Tables I and II (KF vs PF on the rollator), published values beside.
 
 Inputs are the per-trial evaluations of :mod:`gaitval.evaluate.rollator` (frames and
 summaries, with ``subject``, ``scenario``, ``repetition``).  Repetitions of a subject and
@@ -200,8 +200,8 @@ def write_rollator_tables(frames: pd.DataFrame, summary: pd.DataFrame, tables_di
     (:func:`gaitval.methods.display_name`); a modified KF or PF is named in a note of
     every table (the columns keep their ``_kf``/``_pf`` suffixes).  ``external``: every
     extra row's method (KF and PF first, then these); ``own``: those of them that are
-    gaitval's own methods (rollator.methods, issue 36), the others being another tracker's
-    tracks (tracking.external, issue 37) — each kind gets its own note."""
+    gaitval's own methods (rollator.methods), the others being another tracker's
+    tracks (tracking.external) — each kind gets its own note."""
     from gaitval.tables.rollator_notes import table1_notes, table2_notes
 
     td = Path(tables_dir)
@@ -211,13 +211,13 @@ def write_rollator_tables(frames: pd.DataFrame, summary: pd.DataFrame, tables_di
     changed = []
     mine = [m for m in external if m in own]
     theirs = [m for m in external if m not in own]
-    if mine:                      # gaitval's own extra methods (rollator.methods, issue 36)
+    if mine:                      # gaitval's own extra methods (rollator.methods)
         changed.append(
             f"Extra method{'s' * (len(mine) > 1)} {', '.join(mine)}: gaitval's own "
             "(rollator.methods), not the paper's, evaluated like the KF and PF; no published "
             "values, no re-initialisation count and no verdict; the people tracker runs with "
             "the KF's user window, detector and initialiser (docs/people.md)")
-    if theirs:                    # another tracker's tracks (tracking.external, issue 37)
+    if theirs:                    # another tracker's tracks (tracking.external)
         changed.append(
             f"External method{'s' * (len(theirs) > 1)} {', '.join(theirs)}: "
             "another tracker's tracks (tracking.external), evaluated like the KF and "
@@ -227,13 +227,13 @@ def write_rollator_tables(frames: pd.DataFrame, summary: pd.DataFrame, tables_di
                for tag, m in (("KF", kf), ("PF", pf)) if (shown or {}).get(m, m) != m]
     paths = write_table(t1, td / "rollator_table1", notes=changed + table1_notes(
         t1, imp, model_sources), caption=(
-        "Seed 002 Table I (tracking accuracy): RMSE and MAD of the mean position (x lateral, "
+        "Chalvatzaki et al. 2017 Table I (tracking accuracy): RMSE and MAD of the mean position (x lateral, "
         "y forward) and mean velocity of both legs, KF (§II) vs PF (§III), per scenario and "
         "subject (repetitions pooled), in the moving laser frame; shown in the paper's cm "
         "and cm/s, published values beside (the CSV holds m and m/s)."))
     paths += write_table(t2, td / "rollator_table2", notes=changed + table2_notes(
         t2, error_m), caption=(
-        "Seed 002 Table II (tracking robustness): time of correct tracking, error frames and "
+        "Chalvatzaki et al. 2017 Table II (tracking robustness): time of correct tracking, error frames and "
         "their share of the evaluated frames, KF re-initialisations, per scenario and "
         "subject (repetitions summed); published values beside; frames without a laser pose "
         "(rollator markers missing) or without a leg's truth are counted, not evaluated."))
@@ -241,6 +241,6 @@ def write_rollator_tables(frames: pd.DataFrame, summary: pd.DataFrame, tables_di
         "Mean over the Table I cells with a value of 100·(KF − PF)/KF; the published-cells "
         "column applies the same formula to the transcribed Table I (Scenario 2 "
         "reconstructed); the paper's text states ~30 % (RMSE) and ~43 % (MAD)."], caption=(
-        "Seed 002: average error reduction of the PF over the KF (Table I cells), ours and "
+        "Chalvatzaki et al. 2017: average error reduction of the PF over the KF (Table I cells), ours and "
         "published."))
     return paths

@@ -1,4 +1,4 @@
-"""Notes under seed 002's tables: what was computed how, and whether the paper's direction
+"""Notes under Chalvatzaki et al. 2017's tables: what was computed how, and whether the paper's direction
 (PF better than KF in RMSE, MAD and error frames) holds, counted cell by cell."""
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ def table1_notes(t1: pd.DataFrame, imp: pd.DataFrame, model_sources=()) -> list[
         "gaitval's laser-frame y and x (x points from the laser on the rollator towards "
         "the user).",
         "Errors of the mean of both legs over every evaluated scan with an estimate of both "
-        "legs, error frames included; MAD = mean absolute error (seed 002's usage). Truth: "
+        "legs, error frames included; MAD = mean absolute error (Chalvatzaki et al. 2017's usage). Truth: "
         "tibia-cylinder cross-section at laser height in the moving laser frame, velocities "
         "by differentiation of low-passed positions.",
         "PF parameters (velocity mixtures, window, region distributions, count kernel, "

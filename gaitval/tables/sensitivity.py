@@ -1,4 +1,4 @@
-"""Sensitivity of the verdicts to the twin's free choices (issue 34).
+"""Sensitivity of the verdicts to the simulated replica's free choices.
 
 The papers leave some set-up choices open (``docs/simulator.md``, "Free choices of the
 twin"); the simulated default study makes one choice for each.  For the two that matter
@@ -85,12 +85,12 @@ def write_sensitivity(reports: list[Path], out_stem: Path, names: list[str] | No
     n_flip = int((df["flips_under"] != "").sum())
     n_abs = int((df["absent_in"] != "").sum())
     caption = (f"Verdicts of the {names[0]} study beside the same verdicts under each "
-               f"alternative free choice of the twin ({', '.join(names[1:])}); "
+               f"alternative free choice of the simulated replica ({', '.join(names[1:])}); "
                f"{n_flip} of {len(df) - n_abs} verdicts computed under every alternative "
                f"flip" + (f" ({n_abs} not computed in some alternative)." if n_abs else "."))
     notes = ["Each alternative is the default study with one set-up choice the paper leaves "
              "open changed (config/studies/<name>.yaml; docs/simulator.md, 'Free choices "
-             "of the twin'); same seed, subjects and trials.",
+             "of the simulated replica'); same seed, subjects and trials.",
              "A verdict that flips depends on an unstated choice of the set-up: it is not "
              "evidence for or against a method."]
     return write_table(df, out_stem, caption=caption, notes=notes)

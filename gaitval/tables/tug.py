@@ -1,4 +1,4 @@
-"""Seed 000 Tables 2–5 from per-trial TUG evaluations, with the published values beside.
+"""Yorozu et al. 2015a Tables 2–5 from per-trial TUG evaluations, with the published values beside.
 
 Inputs are the outputs of :func:`gaitval.evaluate.tug.evaluate_tug_trial` concatenated
 over trials and methods: ``summaries`` (one row per trial and method) and ``frames``
@@ -29,11 +29,11 @@ CITATION = ("Yorozu, A.; Moriguchi, T.; Takahashi, M. Improved Leg Tracking Cons
             "Phase and Spline-Based Interpolation during Turning Motion in Walk Tests. "
             "Sensors 2015, 15, 22451-22472")
 
-#: seed 000 Table 2
+#: Yorozu et al. 2015a Table 2
 PUBLISHED_T2 = {"dt_s": 0.025, "q_accel_sd_mps2": 15.0, "r_sd_m": 0.04, "v_st_th_mps": 0.47,
                 "v_sw_th_mps": 0.93, "gate_g": 13.82, "n_ac": 40}
 
-#: seed 000 Table 3 (28 trials)
+#: Yorozu et al. 2015a Table 3 (28 trials)
 PUBLISHED_T3 = {
     "tug_m1": {"ft_turning": 12, "ft_return": 0, "sf_turning": 2, "n_success": 14,
                "n_trials": 28},
@@ -43,7 +43,7 @@ PUBLISHED_T3 = {
                "n_trials": 28},
 }
 
-#: seed 000 Table 4: (n_uo, n_steps, rmse_x, rmse_y) per TUG phase
+#: Yorozu et al. 2015a Table 4: (n_uo, n_steps, rmse_x, rmse_y) per TUG phase
 PUBLISHED_T4 = {
     "tug_m2": {"forward": (225, 6364, 0.042, 0.018), "turning": (255, 2264, 0.069, 0.062),
                "return": (344, 6686, 0.053, 0.028), "total": (824, 15314, 0.051, 0.032)},
@@ -52,7 +52,7 @@ PUBLISHED_T4 = {
 }
 PUBLISHED_T4_SUCCESS = {"tug_m2": 25, "tug_m3": 27}
 
-#: seed 000 Table 5: (time steps, rmse_x, rmse_y) per leg observation state
+#: Yorozu et al. 2015a Table 5: (time steps, rmse_x, rmse_y) per leg observation state
 PUBLISHED_T5 = {
     "tug_m2": {"observable": (14490, 0.047, 0.027), "unobservable": (824, 0.102, 0.081)},
     "tug_m3": {"observable": (15698, 0.045, 0.025), "unobservable": (970, 0.066, 0.052)},
@@ -347,10 +347,10 @@ def tug_table5(frames, summaries, definitions: Mapping | None = None) -> pd.Data
 
 
 #: The legend of the leg-pattern and gait-phase codes of the evidence sentences.
-PATTERN_LEGEND = ("Codes: leg patterns (seed 001 §2.3, gaitval.detect.legpatterns) SL one leg "
+PATTERN_LEGEND = ("Codes: leg patterns (Yorozu et al. 2015b §2.3, gaitval.detect.legpatterns) SL one leg "
                   "alone, LT two legs together, FS_O a leg partly hidden but observable, "
                   "FS_U only a sliver of a leg visible, UO unobservable (no observation); "
-                  "`SL×6 → LT×2` reads 6 scans SL, then 2 scans LT. Gait phases (seed 000 "
+                  "`SL×6 → LT×2` reads 6 scans SL, then 2 scans LT. Gait phases (Yorozu et al. 2015a "
                   "Fig. 6) 0 both legs in stance, 1/2 left leg swinging (accelerating/"
                   "decelerating), 3/4 right leg swinging, 5 both swinging.")
 
@@ -432,7 +432,7 @@ def write_tug_tables(frames, summaries, out_dir: str | Path, *,
     common = [f"Source: {CITATION}.",
               "Reproduced values from gaitval's evaluation of each trial; *_published "
               "columns transcribed from the paper."]
-    rules = ("Two judging rules side by side, fixed before the results (issue 34): the "
+    rules = ("Two judging rules side by side, fixed before the results: the "
              "columns without suffix use the paper's rule (every swap or lost event of >= "
              "0.20 s is false tracking; primary, compared with the published values); the "
              "*_persistent_swap columns count a left/right swap only when it lasts > 0.5 s "
@@ -455,21 +455,21 @@ def write_tug_tables(frames, summaries, out_dir: str | Path, *,
                 t["method"] = t["method"].map(lambda m: shown.get(m, m))
     paths = []
     paths += write_table(t2, out / "tug_table2", caption="TUG leg tracking: parameters used "
-                         "(seed 000 Table 2). N_bo, N_ao, the background model and the reading "
+                         "(Yorozu et al. 2015a Table 2). N_bo, N_ao, the background model and the reading "
                          "of eq. (3)–(4) are not given in the paper.", notes=common)
     paths += write_table(t3, out / "tug_table3", caption="TUG leg tracking: method "
-                         "definitions and tracking results per method (seed 000 Table 3). "
+                         "definitions and tracking results per method (Yorozu et al. 2015a Table 3). "
                          "Each failed trial counted once, in the TUG phase of its first "
                          "failure; ft_forward and sf_other have no published counterpart.",
                          notes=common + [rules, readings] + notes
                          + _evidence_notes(ev, t3) + legend)
     paths += write_table(t4, out / "tug_table4", caption="TUG leg tracking: occlusion rate "
                          "and RMSE of the leg trajectory per TUG phase over tracking-success "
-                         "trials (seed 000 Table 4; sensor frame x/y).",
+                         "trials (Yorozu et al. 2015a Table 4; sensor frame x/y).",
                          notes=common + [readings] + notes)
     paths += write_table(t5, out / "tug_table5", caption="TUG leg tracking: time steps and "
                          "RMSE per leg observation state over tracking-success trials "
-                         "(seed 000 Table 5).", notes=common + notes)
+                         "(Yorozu et al. 2015a Table 5).", notes=common + notes)
     paths += write_table(ev, out / "tug_failures", caption="TUG leg tracking: the first "
                          "failure of every trial a method did not track, with what the "
                          "tracker saw in the 0.5 s before (leg patterns, unobservable scans, "

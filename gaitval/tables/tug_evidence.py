@@ -1,6 +1,6 @@
 """Per-step evidence for the TUG tables: what each failing trial's tracker saw when it failed.
 
-Seed 000 Table 3 counts failures; a reviewer who finds the reproduced ranking different
+Yorozu et al. 2015a Table 3 counts failures; a reviewer who finds the reproduced ranking different
 from the paper's needs to see *where* and *why* each method failed.  For every trial a
 method did not track successfully, :func:`failure_evidence` finds the first failure in the
 evaluation frames and describes it: the trial, time, TUG phase and leg; for false tracking

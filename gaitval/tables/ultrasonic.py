@@ -1,4 +1,4 @@
-"""Seed 003 (Qi et al., Sensors 2014) Tables 2–8 and C1 from a gait-parameter table.
+"""Qi et al. 2014 (Qi et al., Sensors 2014) Tables 2–8 and C1 from a gait-parameter table.
 
 Input: the **gait parameter table** (one row per trial, stride and parameter, reference and
 ultrasonic value side by side; the contract is in :mod:`gaitval.tables.ultrasonic_params`).
@@ -19,7 +19,7 @@ References
 ----------
 Qi, Y.; Soh, C.B.; Gunawan, E.; Low, K.-S.; Thomas, R. Estimation of spatial-temporal gait
 parameters using a low-cost ultrasonic motion analysis system. Sensors 2014, 14(8),
-15434–15457 (seed 003), §4.4 and Tables 2–8, C1.
+15434–15457 (Qi et al. 2014), §4.4 and Tables 2–8, C1.
 """
 from __future__ import annotations
 
@@ -127,7 +127,7 @@ def _captions() -> dict[str, tuple[str, list[str]]]:
 def build_ultrasonic_tables(gait_params: pd.DataFrame,
                             strides_per_subject=PAPER_STRIDES_PER_SUBJECT,
                             seed: int = SAMPLE_SEED) -> dict[str, pd.DataFrame]:
-    """All seed 003 tables gaitval's statistics layer renders: ``{"table2": df, ...}``,
+    """All Qi et al. 2014 tables gaitval's statistics layer renders: ``{"table2": df, ...}``,
     on the strides :func:`~gaitval.tables.ultrasonic_params.sample_strides` draws
     (``strides_per_subject``: an int, default the paper's 10, or ``"all"``; ``seed``)."""
     gp = sample_strides(gait_params, strides_per_subject, seed)

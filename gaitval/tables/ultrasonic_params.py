@@ -1,4 +1,4 @@
-"""Seed 003's gait parameter table as the ultrasonic tables read it: names and checks.
+"""Qi et al. 2014's gait parameter table as the ultrasonic tables read it: names and checks.
 
 Input contract — the **gait parameter table** written by the ultrasonic gait-parameter step
 (:func:`gaitval.evaluate.ultrasonic.gait_parameters`): one row per (trial, stride,
@@ -14,7 +14,7 @@ References
 ----------
 Qi, Y.; Soh, C.B.; Gunawan, E.; Low, K.-S.; Thomas, R. Estimation of spatial-temporal gait
 parameters using a low-cost ultrasonic motion analysis system. Sensors 2014, 14(8),
-15434–15457 (seed 003), §4.4 and Tables 2–8, C1.
+15434–15457 (Qi et al. 2014), §4.4 and Tables 2–8, C1.
 """
 from __future__ import annotations
 
@@ -127,7 +127,7 @@ def strides_setting(value) -> int | None:
 
 def sample_strides(gait_params: pd.DataFrame, strides_per_subject=PAPER_STRIDES_PER_SUBJECT,
                    seed: int = SAMPLE_SEED) -> pd.DataFrame:
-    """The strides the seed 003 tables are computed on: a seeded draw per subject and speed.
+    """The strides the Qi et al. 2014 tables are computed on: a seeded draw per subject and speed.
 
     Parameters
     ----------

@@ -1,10 +1,10 @@
-"""Seed 003 Tables 7, 8 and C1: normality, speed comparison (paired t-tests) and ANOVA.
+"""Qi et al. 2014 Tables 7, 8 and C1: normality, speed comparison (paired t-tests) and ANOVA.
 
 References
 ----------
 Qi, Y.; Soh, C.B.; Gunawan, E.; Low, K.-S.; Thomas, R. Estimation of spatial-temporal gait
 parameters using a low-cost ultrasonic motion analysis system. Sensors 2014, 14(8),
-15434–15457 (seed 003), §4.4 and Tables 2–8, C1.
+15434–15457 (Qi et al. 2014), §4.4 and Tables 2–8, C1.
 """
 from __future__ import annotations
 
@@ -19,19 +19,19 @@ from gaitval.tables.ultrasonic_params import (PARAM_INFO, PARAMETERS, SPEEDS,
                                               SUMMARY_PARAMETERS, check_gait_params, n_text,
                                               select, strides_per_subject_of)
 
-#: Table 7's comparability with the published table (issue 34): the verdict page reads
+#: Table 7's comparability with the published table: the verdict page reads
 #: the fixed prefix "not comparable: ".
 TABLE7_NOT_COMPARABLE = (
     "not comparable: the published Table 7 is not a normality test - its H and p test the "
-    "null hypothesis 'mean is zero' (H = 0, p = 1.000 for every parameter, seed 003 "
+    "null hypothesis 'mean is zero' (H = 0, p = 1.000 for every parameter, Qi et al. 2014 "
     "§4.4.2), while gaitval's H and p are a Lilliefors test of normality")
-#: Table C1's two readings of "between groups" (issue 34).
+#: Table C1's two readings of "between groups".
 C1_GROUPINGS = ("subject", "stride_index")
 
 
 def table7(gait_params: pd.DataFrame, speed: str = "normal", column: str = "system",
            method: str = "lilliefors") -> pd.DataFrame:
-    """Normality of each gait parameter (seed 003 Table 7), done as a normality test.
+    """Normality of each gait parameter (Qi et al. 2014 Table 7), done as a normality test.
 
     Parameters
     ----------
@@ -156,7 +156,7 @@ def table8(gait_params: pd.DataFrame, alpha: float = 0.05) -> pd.DataFrame:
 def tableC1(gait_params: pd.DataFrame, speed: str = "normal", column: str = "system",
             max_strides_per_subject: int | None = None,
             groupings: tuple[str, ...] = C1_GROUPINGS) -> pd.DataFrame:
-    """One-way ANOVA of S, T, V, hS, vS (seed 003 Table C1), in both readings of its groups.
+    """One-way ANOVA of S, T, V, hS, vS (Qi et al. 2014 Table C1), in both readings of its groups.
 
     Parameters
     ----------

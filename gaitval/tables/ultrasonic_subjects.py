@@ -1,10 +1,10 @@
-"""Seed 003 Tables 2–6: per-subject reference and ultrasonic means, stds and RMSE.
+"""Qi et al. 2014 Tables 2–6: per-subject reference and ultrasonic means, stds and RMSE.
 
 References
 ----------
 Qi, Y.; Soh, C.B.; Gunawan, E.; Low, K.-S.; Thomas, R. Estimation of spatial-temporal gait
 parameters using a low-cost ultrasonic motion analysis system. Sensors 2014, 14(8),
-15434–15457 (seed 003), §4.4 and Tables 2–8, C1.
+15434–15457 (Qi et al. 2014), §4.4 and Tables 2–8, C1.
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ from gaitval.tables.ultrasonic_agreement import agreement_row
 from gaitval.tables.ultrasonic_params import (PARAM_INFO, check_gait_params, select,
                                               subject_order)
 
-#: agreement columns after the published ones (issue 16): table column (before the unit
+#: agreement columns after the published ones: table column (before the unit
 #: suffix) -> column of :func:`gaitval.tables.ultrasonic_agreement.agreement_row` shown on
 #: the ``average`` row; ``loa_low``/``loa_high`` also on every subject row (its strides)
 AGREEMENT_COLUMNS = {"loa_low": "loa_low", "loa_high": "loa_high",
@@ -105,7 +105,7 @@ def subject_table(gait_params: pd.DataFrame, parameter: str,
 
 def _with_agreement(out: pd.DataFrame, sub: pd.DataFrame, es: pd.DataFrame, order: list,
                     parameter: str, speed: str, u: str) -> pd.DataFrame:
-    """Append the agreement columns of :func:`subject_table` (issue 16)."""
+    """Append the agreement columns of :func:`subject_table`."""
     nan = np.full(len(out), np.nan)
     n_sub = len(order)
     row = agreement_row(sub, parameter, speed)
@@ -164,25 +164,25 @@ def agreement_note(table: pd.DataFrame, parameter: str) -> str:
 
 
 def table2(gait_params, speed="normal"):
-    """Seed 003 Table 2: stride length per subject (m). See :func:`subject_table`."""
+    """Qi et al. 2014 Table 2: stride length per subject (m). See :func:`subject_table`."""
     return subject_table(gait_params, "stride_length", speed)
 
 
 def table3(gait_params, speed="normal"):
-    """Seed 003 Table 3: stride duration per subject (s). See :func:`subject_table`."""
+    """Qi et al. 2014 Table 3: stride duration per subject (s). See :func:`subject_table`."""
     return subject_table(gait_params, "stride_duration", speed)
 
 
 def table4(gait_params, speed="normal"):
-    """Seed 003 Table 4: stride velocity per subject (m/s). See :func:`subject_table`."""
+    """Qi et al. 2014 Table 4: stride velocity per subject (m/s). See :func:`subject_table`."""
     return subject_table(gait_params, "stride_velocity", speed)
 
 
 def table5(gait_params, speed="normal"):
-    """Seed 003 Table 5: horizontal stride symmetry hS per subject. See :func:`subject_table`."""
+    """Qi et al. 2014 Table 5: horizontal stride symmetry hS per subject. See :func:`subject_table`."""
     return subject_table(gait_params, "h_symmetry", speed)
 
 
 def table6(gait_params, speed="normal"):
-    """Seed 003 Table 6: vertical stride symmetry vS per subject. See :func:`subject_table`."""
+    """Qi et al. 2014 Table 6: vertical stride symmetry vS per subject. See :func:`subject_table`."""
     return subject_table(gait_params, "v_symmetry", speed)

@@ -1,4 +1,4 @@
-"""Seed 003 Table 1: errors of the pendulum experiment in 3-D against motion capture.
+"""Qi et al. 2014 Table 1: errors of the pendulum experiment in 3-D against motion capture.
 
 References
 ----------
@@ -20,7 +20,7 @@ from gaitval.stats.noise import identify_noise, noise_to_config
 from gaitval.stats.summary import rmse
 from gaitval.tables.render import write_table
 
-#: Seed 003 Table 1 (mm), transcribed: mean, std, RMSE, Net RMSE per axis.  The paper's
+#: Qi et al. 2014 Table 1 (mm), transcribed: mean, std, RMSE, Net RMSE per axis.  The paper's
 #: Net RMSE column is cumulative: X alone, then sqrt(X^2 + Y^2), then all three axes.
 PUBLISHED_MM = {"X": (0.02, 4.08, 4.08, 4.08), "Y": (0.03, 0.72, 0.72, 4.14),
                 "Z": (0.09, 1.08, 1.08, 4.28)}
@@ -82,7 +82,7 @@ def write_ultrasonic_table1(errors: pd.DataFrame, stem: str | Path,
                      f"W sigmas = ({W}) m/s^2 by the minimum-RMSE search (paper: 30, 25, 10, "
                      "stated in mm/s).")
     caption = ("Errors of the pendulum experiment in 3D space compared with the motion "
-               "capture system (seed 003 Table 1), reproduced beside the published values.")
+               "capture system (Qi et al. 2014 Table 1), reproduced beside the published values.")
     return write_table(df, stem, caption=caption, notes=notes)
 
 
