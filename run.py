@@ -302,8 +302,11 @@ def closing_summary(target: Path, accept_refusals: bool) -> int:
     refused = [(st, t, r) for st, v in rec.items() for t, r in v["refused"].items()]
     print(f"[run.py] analysed {done} of {total} trials"
           + (f"; {len(refused)} refused:" if refused else ""), flush=True)
-    for st, t, r in refused:
-        print(f"[run.py]   REFUSED {st}/{t} ({r['protocol']}): {r['reason']}", flush=True)
+    import textwrap
+    for st, t, r in refused:             # wrapped: a reason names the file and the cause
+        print(textwrap.fill(f"REFUSED {st}/{t} ({r['protocol']}): {r['reason']}", width=110,
+                            initial_indent="[run.py]   ", subsequent_indent="[run.py]     "),
+              flush=True)
     if refused and not accept_refusals:
         print(f"[run.py] exit code {EXIT_REFUSED}: the report leaves the refused trials out "
               "(its top box says so); fix them, or accept the refusals with "
