@@ -6,7 +6,7 @@ include: "peer_common.smk"
 
 rule peer_agreement:
     input:
-        PEER_EXAMPLE,
+        [PEER_EXAMPLE] if PEER_EXAMPLE else [],
     output:
         csv=report(
             f"{REPORTS}/tables/peer_agreement.csv",
