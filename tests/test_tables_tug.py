@@ -206,3 +206,31 @@ def test_table3_has_the_persistent_swap_rule_after_the_papers():
     # summaries without the second rule: its columns are there and empty
     old = tug_table3(s.drop(columns="category_persistent_swap"))
     assert old["success_rate_persistent_swap"].isna().all()
+
+
+def test_a_run_whose_every_tug_trial_was_refused_gets_empty_tables_and_says_so(tmp_path):
+    """Every TUG trial refused at registration: the tables are written with their columns
+    and no row, the trajectory figure states why it is empty, and the verdict is 'not
+    comparable: no trial analysed' (the run used to stop with an internal error)."""
+    from gaitval.evaluate.tug import FRAME_COLUMNS
+    from gaitval.methods import get_method
+    from gaitval.report.tug_figures import write_tug_figures
+    from gaitval.report.verdicts import build_verdicts
+    from gaitval.tables.tug import write_tug_tables
+
+    frames = pd.DataFrame(columns=list(FRAME_COLUMNS))
+    summ = pd.DataFrame(columns=["trial", "method", "success", "category"])
+    events = pd.DataFrame(columns=["trial", "method", "side", "kind", "t_start_s",
+                                   "t_end_s", "tug_phase"])
+    paths = write_tug_tables(frames, summ, tmp_path / "tables",
+                             methods={"tug_m1": get_method("tug_m1")})
+    for n in (3, 4, 5):
+        t = pd.read_csv(tmp_path / "tables" / f"tug_table{n}.csv")
+        assert t.empty and "method" in t.columns
+    assert len(paths) >= 12
+    figs = write_tug_figures(frames, summ, events, tmp_path / "figures")
+    assert [p.name for p in figs] == ["tug_trajectories.png"]
+    v = build_verdicts(tmp_path / "tables")
+    tug = v[v["study"] == "tug"]
+    assert len(tug) == 1 and tug["outcome"].iloc[0] == "not comparable"
+    assert "refused at registration" in tug["why"].iloc[0]

@@ -89,3 +89,12 @@ def clip_to_reference(ax, ref_x, ref_y, shown_x, shown_y, *, what: str = "track"
                 va="bottom", fontsize=7, color="tab:red",
                 bbox={"facecolor": "white", "alpha": 0.8, "lw": 0, "pad": 1})
     return outside
+
+
+def statement_figure(path, text: str):
+    """A PNG that states why a declared figure has nothing to draw (the workflow declares
+    every figure, so a figure without data is a statement, not a missing file)."""
+    fig, ax = plt.subplots(figsize=(6, 1.6))
+    ax.axis("off")
+    ax.text(0.5, 0.5, text, ha="center", va="center", fontsize=9, wrap=True)
+    return save_figure(fig, path)

@@ -16,7 +16,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from gaitval.report.figures import clip_to_reference, save_figure  # noqa: E402
+from gaitval.report.figures import (clip_to_reference, save_figure,  # noqa: E402
+                                    statement_figure)
 
 COLORS = {"L": "tab:blue", "R": "tab:red"}
 
@@ -145,6 +146,11 @@ def write_tug_figures(frames: pd.DataFrame, summaries: pd.DataFrame, events: pd.
         paths.append(plot_trial_trajectories(frames, rows, out / "tug_trajectories.png",
                                              methods=main_methods(summaries["method"]),
                                              summaries=summaries))
+    else:
+        paths.append(statement_figure(out / "tug_trajectories.png", "tug_trajectories: not "
+                                      "drawn — no TUG trial was analysed (every trial was "
+                                      "refused at registration; the report's top box says "
+                                      "why)"))
     ft = events[events["kind"].isin(["swap", "lost"])] if events is not None else None
     if ft is not None and len(ft):
         ev = ft.sort_values(["method", "trial", "t_start_s"], kind="stable").iloc[0]

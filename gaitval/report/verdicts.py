@@ -637,6 +637,13 @@ def build_verdicts(tables_dir: str | Path, data: dict[str, str] | None = None
                              "no study of the run has this protocol", ""))
             rows[-1]["outcome"] = "not run"
             continue
+        if tables[need].empty:        # every trial of the protocol refused at registration
+            rows.append(_row(study, "all comparisons of the paper", need, "see the paper",
+                             "no trial analysed", None, None,
+                             "no trial of this protocol was analysed: every one was refused "
+                             "at registration (the report's top box says why)", ""))
+            rows[-1]["data"] = (data or {}).get(study, "")
+            continue
         got = BUILDERS[study](tables, notes)
         for r in got:
             r["data"] = (data or {}).get(study, "")

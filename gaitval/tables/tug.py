@@ -74,6 +74,17 @@ def _tidy_counts(df: pd.DataFrame, cols) -> pd.DataFrame:
     return df
 
 
+#: Table 4's and Table 5's columns (so a run whose every trial was refused at
+#: registration still gets the tables, with no row)
+T4_COLUMNS = ["method", "base_method", "phase_reading", "label", "tug_phase",
+              "n_success_trials", "n_success_trials_published", "n_uo", "n_steps",
+              "occlusion_rate", "n_uo_published", "n_steps_published",
+              "occlusion_rate_published", "rmse_x_m", "rmse_x_m_published", "rmse_y_m",
+              "rmse_y_m_published"]
+T5_COLUMNS = ["method", "label", "observation_state", "time_steps", "time_steps_published",
+              "rmse_x_m", "rmse_x_m_published", "rmse_y_m", "rmse_y_m_published"]
+
+
 def _concat(x) -> pd.DataFrame:
     if isinstance(x, pd.DataFrame):
         return x
@@ -313,7 +324,8 @@ def tug_table4(frames, summaries, definitions: Mapping | None = None) -> pd.Data
                 "rmse_x_m": _rmse(e["err_x_m"]), "rmse_x_m_published": pub[2] if pub else np.nan,
                 "rmse_y_m": _rmse(e["err_y_m"]), "rmse_y_m_published": pub[3] if pub else np.nan,
             })
-    t = _tidy_counts(pd.DataFrame(rows), ["n_success_trials_published", "n_uo_published",
+    t = _tidy_counts(pd.DataFrame(rows, columns=T4_COLUMNS),
+                     ["n_success_trials_published", "n_uo_published",
                                           "n_steps_published"])
     # results first, the method's base (a definition) last
     return t[[c for c in t.columns if c != "base_method"] + ["base_method"]]
@@ -343,7 +355,7 @@ def tug_table5(frames, summaries, definitions: Mapping | None = None) -> pd.Data
                 "rmse_x_m": _rmse(e["err_x_m"]), "rmse_x_m_published": pub[1] if pub else np.nan,
                 "rmse_y_m": _rmse(e["err_y_m"]), "rmse_y_m_published": pub[2] if pub else np.nan,
             })
-    return _tidy_counts(pd.DataFrame(rows), ["time_steps_published"])
+    return _tidy_counts(pd.DataFrame(rows, columns=T5_COLUMNS), ["time_steps_published"])
 
 
 #: The legend of the leg-pattern and gait-phase codes of the evidence sentences.
