@@ -268,6 +268,8 @@ def test_benchmark_table_sets_published_rows_beside_gaitvals():
     ours = b.iloc[3]
     assert (ours["matched"], ours["misses"], ours["idsw"], ours["idsw_ref"]) == (168, 28, 2, 4)
     assert ours["fp"] == ""                                   # following: FPs ignored
-    assert ours["mota_pct"] == pytest.approx(100 * (1 - (28 + 2) / 200))
+    # MOTA from the reference script's ID switches (as the published rows), motmetrics' beside
+    assert ours["mota_pct"] == pytest.approx(100 * (1 - (28 + 4) / 200))
+    assert ours["mota_pct_motmetrics"] == pytest.approx(100 * (1 - (28 + 2) / 200))
     assert ours["motp_m"] == pytest.approx((91 * 0.1 + 81 * 0.2) / 172)   # over all pairs
     assert benchmark_table(pd.DataFrame([{**row, "benchmark_set": ""}])).empty

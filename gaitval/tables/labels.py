@@ -32,6 +32,22 @@ PUBLISHED = ", published"
 
 #: display name -> label (with the unit, where the column has one)
 LABELS: dict[str, str] = {
+    'benchmark_set': 'Benchmark set',
+    'online': 'Online',
+    'matched': 'Matched',
+    'matched_pct': 'Matched (%)',
+    'misses': 'Misses',
+    'idsw': 'ID switches (py-motmetrics)',
+    'idsw_ref': 'ID switches (reference script)',
+    'fp': 'False positives',
+    'mota_pct': 'MOTA (%)',
+    'mota_pct_motmetrics': "MOTA with py-motmetrics' ID switches (%)",
+    'motp_m': 'MOTP (m)',
+    'mota': 'MOTA',
+    'idf1': 'IDF1',
+    'fn': 'Misses (FN)',
+    'mota_following': 'MOTA, following mode',
+    'init': 'Initialisation',
     'alternative': 'Alternative',
     'anchors': 'Anchors',
     'annotations': 'Annotations',
