@@ -261,3 +261,14 @@ def test_the_top_says_how_the_twin_fares_on_its_physical_checks(tmp_path):
     assert "1 has no reference and is shown only" in top
     assert "1 fail</strong>: tug_occlusion (tug, turning)" in top
     assert "passes 2 of its 4 physical checks" in md.read_text()
+
+
+def test_a_mean_sd_verdict_checks_the_sd_by_an_f_test():
+    """Table 8's rows compare the SD over subjects too: two SDs of ten subjects each are
+    told apart by the two-sided F-test at 95 % only outside about 0.50-2.01 x (F(9, 9)
+    quantiles 0.248 and 4.03, NIST/SEMATECH e-Handbook, F distribution table)."""
+    from gaitval.report.verdicts import sd_interval
+
+    lo, hi = sd_interval(0.1, 10, 10)
+    assert lo == pytest.approx(0.1 * 0.2484 ** 0.5, rel=2e-3)
+    assert hi == pytest.approx(0.1 * 4.026 ** 0.5, rel=2e-3)

@@ -478,6 +478,23 @@ def _ns_nv_reason(t8: pd.DataFrame, sym: str) -> str:
             "accuracy (Table 8 note).")
 
 
+#: Qi et al. 2014: ten subjects walked on the treadmill (Table 8's SDs are over them).
+PAPER_SUBJECTS_US = 10
+
+
+def sd_interval(sd_paper: float, n_paper: int, n_ours: int, level: float = 0.95
+                ) -> tuple[float, float]:
+    """The SDs of ``n_ours`` values that the two-sided F-test of two variances (``level``)
+    does not tell apart from the paper's ``sd_paper`` of ``n_paper`` values: both are
+    sample SDs, so neither is the population's."""
+    from scipy import stats
+
+    a = (1 - level) / 2
+    lo = stats.f.ppf(a, n_ours - 1, n_paper - 1)
+    hi = stats.f.ppf(1 - a, n_ours - 1, n_paper - 1)
+    return float(sd_paper * np.sqrt(lo)), float(sd_paper * np.sqrt(hi))
+
+
 def ultrasonic_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
     """Qi et al. 2014: pendulum bias within its spread (Table 1); the system's stride parameters
     at normal speed within the published mean ± SD (Table 8); the direction of the speed
@@ -505,15 +522,25 @@ def ultrasonic_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -
         small = None if np.isfinite(r.normal_std) else \
             "too small: fewer than two subjects, no standard deviation"
         dev = abs(r.normal_mean - r.normal_mean_published)
-        ok = dev <= r.normal_std_published
+        mean_ok = dev <= r.normal_std_published
+        # the SD over subjects too: not told apart from the published one by an F-test
+        n_us = int(getattr(r, "n_subjects", PAPER_SUBJECTS_US))
+        lo, hi = (sd_interval(r.normal_std_published, PAPER_SUBJECTS_US, n_us)
+                  if n_us >= 2 else (np.nan, np.nan))
+        sd_ok = bool(lo <= r.normal_std <= hi) if np.isfinite(r.normal_std) else False
+        ok = mean_ok and sd_ok
+        u = "" if unit == "-" else " " + unit
         rows.append(_row(st, f"{r.symbol} ({r.parameter}) at normal speed", "Table 8",
                          _pm(r.normal_mean_published, r.normal_std_published, unit),
                          _pm(r.normal_mean, r.normal_std, unit),
-                         "value inside published mean ± SD", ok,
-                         f"mean differs from the paper's by {number(dev)}"
-                         f"{'' if unit == '-' else ' ' + unit}, "
-                         f"{'within' if ok else 'more than'} its SD "
-                         f"{number(r.normal_std_published)}.", "ultrasonic_table8",
+                         "mean inside published mean ± SD; SDs equal by an F-test "
+                         "(95 %)", ok,
+                         f"mean differs from the paper's by {number(dev)}{u}, "
+                         f"{'within' if mean_ok else 'more than'} its SD "
+                         f"{number(r.normal_std_published)}; the SD over subjects "
+                         f"{number(r.normal_std)}{u} is {'inside' if sd_ok else 'outside'} "
+                         f"{number(lo)}–{number(hi)}{u} (F-test of the two SDs, "
+                         f"{n_us} and 10 subjects).", "ultrasonic_table8",
                          not_comparable=nc or small))
         pub = {s: getattr(r, f"{s}_mean_published") for s in _SPEED_ORDER}
         rep = {s: getattr(r, f"{s}_mean") for s in _SPEED_ORDER}
