@@ -314,3 +314,22 @@ def test_reproduce_script_quotes_every_value_and_holds_no_absolute_path(tmp_path
     with_url = reproduce_script({"git_commit": "abc", "repository":
                                  "https://example.org/gaitval.git"}, "reports/tiny")
     assert "REPO=${1:-https://example.org/gaitval.git}" in with_url
+
+
+def test_step_records_and_the_config_record_hold_no_absolute_path(tmp_path, monkeypatch):
+    from types import SimpleNamespace
+
+    from gaitval.report.provenance import REPO, command_line, write_workflow_record
+
+    monkeypatch.chdir(tmp_path)
+    peer = str(REPO / "pyproject.toml")
+    cmd = command_line(["gaitval", "peer", peer, "--out-stem", "reports/t/x"])
+    assert str(REPO) not in cmd and cmd.endswith("pyproject.toml --out-stem reports/t/x")
+    prov = tmp_path / "reports" / "t" / "provenance"
+    out = SimpleNamespace(config=prov / "config.yaml", inputs=prov / "inputs.txt",
+                          rebuild=prov / "rebuild.json")
+    write_workflow_record({"run": ["t"], "peer_results": peer, "note": "/not/a/file"}, [],
+                          out, str(tmp_path / "log"), command="python3 run.py report",
+                          chash="abc")
+    text = out.config.read_text()
+    assert str(REPO) not in text and "pyproject.toml" in text and "/not/a/file" in text

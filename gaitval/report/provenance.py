@@ -85,6 +85,8 @@ def command_line(argv: list[str] | None = None) -> str:
     argv = list(sys.argv if argv is None else argv)
     if argv and (argv[0].endswith("__main__.py") or argv[0].endswith("/gaitval")):
         argv[0] = "gaitval"
+    # an absolute path of this machine, relative to the working folder (portable records)
+    argv = [relative_path(a) if _is_local_path(a) else a for a in argv]
     return " ".join(shlex.quote(a) for a in argv)
 
 
@@ -400,9 +402,22 @@ def rebuild_command(configfiles: list[str | Path], overrides: dict, workdir: str
     return " ".join(shlex.quote(a) for a in args)
 
 
-def _is_local_path(value: str) -> bool:
+def _portable(value):
+    """``value`` (a resolved config) with every string that is an absolute path of this
+    machine made relative to the working folder, as Snakemake reads it there: no report
+    holds the building machine's absolute paths."""
+    if isinstance(value, dict):
+        return {k: _portable(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_portable(v) for v in value]
+    return relative_path(value) if _is_local_path(value) else value
+
+
+def _is_local_path(value) -> bool:
     """An absolute path of an existing file or folder (a --config value such as
-    ``peer_results=/home/me/...``): written relative to the checkout instead."""
+    ``peer_results=/home/me/...``): written relative instead."""
+    if not isinstance(value, str) or not value.startswith(("/", "\\")) and ":" not in value:
+        return False
     try:
         return Path(value).is_absolute() and Path(value).exists()
     except (OSError, ValueError):
@@ -416,7 +431,7 @@ def write_workflow_record(config: dict, inputs, output, log: str, *, command: st
     the rebuild command (``output.rebuild``)."""
     import yaml
 
-    resolved = json.loads(json.dumps(config, default=str))
+    resolved = _portable(json.loads(json.dumps(config, default=str)))
     write_text(output.config, yaml.safe_dump(resolved, sort_keys=True))
     write_text(output.inputs, "".join(f"{relative_path(p)}\n" for p in inputs))
     write_text(output.rebuild, json.dumps(
