@@ -143,10 +143,11 @@ def test_killed_at_each_rule_in_turn_both_ways_resumes_to_the_same_report(tiny_r
     by_mode = {m: {r for r, mm in killed if mm == m} for m in ("group", "snakemake")}
     print(f"killed {len(killed)} times: group at {sorted(by_mode['group'])}; "
           f"snakemake alone at {sorted(by_mode['snakemake'])}")
-    # every rule was killed at least once each way, but those that had no job left to
-    # start when their turn came (all their jobs finished before an earlier kill)
-    assert len(by_mode["group"]) >= len(rules) // 2 and len(by_mode["snakemake"]) >= \
-        len(rules) // 2, (by_mode, rules)
+    # every rule was killed at least once each way, but a few sub-second local jobs
+    # (study_config, report_config) that start beside a killed one and finish before the
+    # kill: they have no job left to start when their turn comes
+    for mode, hit in by_mode.items():
+        assert len(hit) >= len(rules) - 3, (mode, sorted(set(rules) - hit))
     ref_rd, rd = tiny_run / "reports" / "tiny", work / "reports" / "tiny"
     for sub, pattern in (("tables", "*"), ("figures", "*.png")):
         ref = sorted(p.name for p in (ref_rd / sub).glob(pattern))

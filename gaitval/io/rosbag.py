@@ -147,7 +147,8 @@ def _read_topic(reader, topic: str, path: Path, trial: str | None) -> dict[str, 
     try:
         for k, (con, ts, raw) in enumerate(reader.messages(connections=conns)):
             m = reader.deserialize(raw, con.msgtype)
-            r = np.asarray(m.ranges, dtype=np.float64)
+            with np.errstate(invalid="ignore"):   # a signalling NaN: no return, cleaned
+                r = np.asarray(m.ranges, dtype=np.float64)
             geo = (r.size, float(m.angle_min), float(m.angle_increment))
             if first is None:
                 first = m
