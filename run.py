@@ -19,9 +19,11 @@ alternative free choice of the simulated replica: ``reports/default/tables/sensi
 Resuming after a kill (power cut, killed cluster job): ``report`` finds Snakemake's lock
 left behind in ``.snakemake/locks``; when no live Snakemake works in this folder it
 removes it (``snakemake --unlock``), ends the job processes the dead run left behind
-(they would keep writing), and goes on; the profile's ``rerun-incomplete`` redoes the jobs
-that were cut off.  Outputs are written atomically, so the tables come out byte-identical
-to an uninterrupted run.
+(they would keep writing; a job's processes also end by themselves with their Snakemake,
+``gaitval/jobs/lifeline.py``), and goes on.  The workflow then removes the outputs the
+dead run left marked incomplete before Snakemake plans (``gaitval/jobs/resume.py``), so
+the jobs that were cut off run again, and the report rule refuses to write the index while
+a table or figure is missing: the tables come out byte-identical to an uninterrupted run.
 """
 from __future__ import annotations
 

@@ -43,6 +43,59 @@ class Problem:
     source: str = ""
 
 
+#: An id (study, subject, trial) names a folder (``results/<study>/ingest/<trial>/``), a
+#: word of a job's command line and part of a Snakemake file pattern.
+ID_MAX_LEN = 128
+_ID_CHARS = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_.-")
+
+
+def id_problem(value: str) -> str | None:
+    """Why ``value`` cannot be an id (study, subject, trial), or None.
+
+    Ids name folders (``results/<study>/ingest/<trial>/``) and are words of the verbs'
+    command lines: letters, digits and ``_ . -`` only (no braces, which Snakemake reads
+    as a wildcard), at most 128 characters, not starting with ``-`` (every verb would
+    read it as an option), and neither ``.`` nor ``..`` (they would name the folder
+    itself or its parent)."""
+    if not value:
+        return "is empty"
+    if len(value) > ID_MAX_LEN:
+        return f"is {len(value)} characters long (at most {ID_MAX_LEN})"
+    if value in (".", ".."):
+        return f"{value!r} names a folder's own or parent folder"
+    bad = sorted(set(value) - _ID_CHARS)
+    if bad:
+        shown = ", ".join(repr(c) for c in bad[:5])
+        return f"has the character(s) {shown}; ids use letters, digits and _ . - only"
+    if value.startswith("-"):
+        return "starts with '-' (a command line would read it as an option)"
+    return None
+
+
+def path_value_problem(value: str, *, strict: bool = False) -> str | None:
+    """Why ``value`` cannot be a folder or file path the workflow forms file patterns
+    from (a trial sheet's file, ``data_dir``, ``results_dir``, ``reports_dir``), or None:
+    no braces (Snakemake would read ``{...}`` as a wildcard), no control characters, and,
+    ``strict``: every part of the path an id (:func:`id_problem`; ``..`` and a leading
+    ``/`` allowed), for the folders gaitval writes into."""
+    text = str(value)
+    if not text.strip():
+        return "is empty"
+    if "{" in text or "}" in text:
+        return "holds a brace ('{' or '}'), which Snakemake reads as a wildcard"
+    ctl = sorted({repr(ch) for ch in text if ord(ch) < 32 or ord(ch) == 127})
+    if ctl:
+        return f"holds control character(s) {', '.join(ctl)}"
+    if strict:
+        for part in text.split("/"):
+            if part in ("", "..", "."):
+                continue
+            why = id_problem(part)
+            if why:
+                return f"has the folder name {part[:40]!r} that {why}"
+    return None
+
+
 @functools.lru_cache(maxsize=4)
 def _load_schema(path: str) -> dict:
     p = Path(path)
@@ -86,6 +139,11 @@ def _suggest(key: str, parent: tuple, here: list[str], root: dict) -> str:
     if close:
         return f" — did you mean {dotted(parent + (close[0],))}?"
     elsewhere = [p for p in _key_paths(root, root) if p[-1] == key]
+    if elsewhere and tuple(elsewhere[0]) == tuple(parent) + (key,):
+        # the same key at the same place of the workflow config: valid there, not here
+        # (reports_dir in a study.yaml)
+        return (f" — {dotted(elsewhere[0])} is a key of the workflow config "
+                "(config/config.yaml, a --configfile or --config), not of this file")
     if elsewhere:
         return f" — did you mean {dotted(elsewhere[0])}?"
     return f" (valid keys here: {', '.join(sorted(here))})" if here else ""
@@ -253,16 +311,50 @@ def check_config(config: Mapping, layers: Sequence[tuple[str, Any]] | None = Non
 
 
 def run_problems(config: Mapping) -> list[Problem]:
-    """Each name in ``run`` that is no key of ``studies`` (with the nearest one)."""
+    """Each name in ``run`` that is no key of ``studies`` (with the nearest one), each
+    study name that is no id (:func:`id_problem`: it names folders and file patterns), and
+    ``reports_dir``, ``results_dir``, ``data_dir`` that cannot name the folders the
+    workflow writes (:func:`path_value_problem`): a clear config error before any job."""
     studies = list((config.get("studies") or {}) if isinstance(config, Mapping) else {})
     out = []
+    for name in studies:
+        why = id_problem(str(name))
+        if why:
+            out.append(Problem(("studies", name), f"studies: the study name {str(name)[:40]!r} "
+                                                  f"{why}"))
     for i, name in enumerate(config.get("run") or []):
+        why = id_problem(str(name))
+        if why:
+            out.append(Problem(("run", i), f"run[{i}]: the study name {str(name)[:40]!r} "
+                                           f"{why}"))
+            continue
         if name in studies:
             continue
         close = difflib.get_close_matches(str(name), studies, n=1, cutoff=0.6)
         tip = f" — did you mean {close[0]}?" if close else ""
         out.append(Problem(("run", i), f"run[{i}]: no study {name!r} under studies:{tip} "
                                        f"(studies: {', '.join(sorted(studies))})"))
+    lowered: dict[str, str] = {}
+    for name in studies:                  # folders that differ in case only are one folder
+        other = lowered.setdefault(str(name).lower(), str(name))  # on macOS and Windows
+        if other != name:
+            out.append(Problem(("studies", name), f"studies: {name!r} and {other!r} differ "
+                                                  "only in case (one folder on macOS and "
+                                                  "Windows)"))
+    for key, strict in (("reports_dir", True), ("results_dir", True), ("data_dir", False)):
+        value = config.get(key) if isinstance(config, Mapping) else None
+        if value is None:
+            continue
+        why = path_value_problem(str(value), strict=strict)
+        if why:
+            out.append(Problem((key,), f"{key}: {str(value)[:60]!r} {why}"))
+    for study, entry in (config.get("studies") or {}).items():
+        for key in ("trial_sheet", "subjects"):
+            value = (entry or {}).get(key) if isinstance(entry, Mapping) else None
+            why = path_value_problem(str(value)) if value else None
+            if why:
+                out.append(Problem(("studies", study, key),
+                                   f"studies.{study}.{key}: {str(value)[:60]!r} {why}"))
     return out
 
 

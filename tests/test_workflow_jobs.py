@@ -147,16 +147,16 @@ def test_ctrl_c_stops_a_batch_job(tiny_data, tmp_path):
                             start_new_session=True, preexec_fn=as_from_a_terminal)
     deadline = time.time() + 300
     try:
-        # a registration batch whose workers are at work (a trial's folder in its
-        # .partial twin), so that the Ctrl-C reaches running workers
+        # a registration batch whose workers are at work (a trial's first file in its
+        # family's folder), so that the Ctrl-C reaches running workers
         reg = tmp_path / "results" / "tiny" / "register"
 
         def working() -> bool:
-            for d in reg.glob("*.partial"):
+            for d in reg.glob("*"):
                 try:
-                    if any(d.iterdir()):
+                    if d.is_dir() and any(d.iterdir()):
                         return True
-                except FileNotFoundError:         # renamed: that family's batch ended
+                except FileNotFoundError:
                     continue
             return False
 

@@ -103,6 +103,7 @@ def describe_c3d(path: str | Path, *, trial: str | None = None) -> dict[str, Any
         "t_end_s": float(t[-1]),
         "duration_s": float(n / tr.rate_hz),
         "units": tr.units,
+        "units_assumed": bool(tr.meta.get("units_assumed")),
         "gaps": {lab: int(k) for lab, k in zip(tr.labels, counts) if k},
         "gap_fraction": float(miss.mean()) if miss.size else 0.0,
         "events": [{"context": str(r.context), "label": str(r.label),

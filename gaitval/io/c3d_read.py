@@ -219,6 +219,7 @@ def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "s
     gap = neg | zero | ~np.all(np.isfinite(xyz), axis=2)
     xyz[gap] = np.nan
     xyz, up = _vertical(xyz, vertical, path, trial)
+    scale_warnings = _scale_problems(xyz, units, units_assumed, up, path, trial)
 
     rate = _first_number(_param(c, "POINT", "RATE"), None)
     rate = float(rate) if rate else float(c["header"]["points"]["frame_rate"])
@@ -260,7 +261,10 @@ def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "s
                      if dups else [])
         + ([f"the markers say {up} points up; rotated to gaitval's z-up field frame"]
            if vertical == "auto" and up not in (None, "+z") and not up.startswith("+z")
-           else []),
+           else [])
+        + (["POINT:UNITS is blank: the coordinates are taken as mm (the C3D default)"]
+           if units_assumed else [])
+        + scale_warnings,
     }
     return MocapTrial(path=str(path), rate_hz=rate, first_frame=int(ff), labels=labels,
                       xyz=xyz, events=events, units=units, meta=meta)
@@ -307,6 +311,60 @@ def _vertical(xyz: np.ndarray, vertical: str, path: Path, trial: str | None
     log.warning("%s: the markers say %s points up; rotated to gaitval's z-up field frame",
                 path, up)
     return to_z_up(xyz, up), up
+
+
+#: A walking subject in a motion-capture volume: the markers' median distance from the
+#: origin is metres (a large hall: tens of metres), one frame's markers span under
+#: ~2.5 m vertically (a person; a pole).  Past these, the declared unit is wrong.
+MAX_MEDIAN_DISTANCE_M = 100.0
+MAX_VERTICAL_SPAN_M = 5.0
+#: below these, the coordinates are most likely metres declared as mm (a warning: a small
+#: calibration object can be this small)
+MIN_VERTICAL_SPAN_M = 0.02
+MIN_MEDIAN_DISTANCE_M = 0.05
+
+
+def _scale_problems(xyz: np.ndarray, units: str, units_assumed: bool, up: str,
+                    path: Path, trial: str | None) -> list[str]:
+    """The marker positions against the declared ``POINT:UNITS``: a file whose markers
+    sit kilometres from the origin, or whose body spans tens of metres vertically, has the
+    wrong unit (``'m'`` or ``'cm'`` on millimetre data): a FileFormatError naming the unit
+    that would fit.  Markers that all sit within millimetres (metres declared as mm): a
+    warning (returned, and logged)."""
+    ok = np.isfinite(xyz).all(axis=2)
+    if ok.sum() < 3:
+        return []
+    dist = float(np.median(np.linalg.norm(xyz[ok], axis=1)))
+    z = np.where(ok, xyz[:, :, 2], np.nan)
+    rows = ok.sum(axis=1) >= 2
+    span = 0.0
+    if rows.any() and not str(up).startswith("+z (as stored"):
+        with np.errstate(all="ignore"):
+            zz = z[rows]
+            span = float(np.median(np.nanmax(zz, axis=1) - np.nanmin(zz, axis=1)))
+    declared = f"POINT:UNITS {units!r}" + (" (blank: mm assumed)" if units_assumed else "")
+    scale = UNIT_SCALE[units]
+
+    def fitting() -> str:
+        ref = span if span > 0 else dist
+        good = [u for u, f in UNIT_SCALE.items()
+                if u != units and 0.3 <= ref / scale * f <= (2.5 if span > 0 else 20.0)]
+        return (f"; the data look like {good[0]} (set POINT:UNITS to {good[0]!r})"
+                if good else "")
+
+    if dist > MAX_MEDIAN_DISTANCE_M or span > MAX_VERTICAL_SPAN_M:
+        raise FileFormatError(
+            f"{declared} puts the markers a median {dist:.4g} m from the origin, one "
+            f"frame's markers spanning {span:.4g} m vertically; a walking subject is metres "
+            f"from the origin and under 2.5 m tall: the declared unit is wrong{fitting()}",
+            path=path, trial=trial)
+    if span and span < MIN_VERTICAL_SPAN_M and dist < MIN_MEDIAN_DISTANCE_M:
+        msg = (f"{declared}: the markers sit a median {dist * 1000:.3g} mm from the origin "
+               f"and one frame's span {span * 1000:.3g} mm vertically, too small for a "
+               f"person{fitting()}")
+        log.warning("%s: %s", path, msg)
+        return [msg]
+    return []
 
 
 def _units(c, path: Path, trial: str | None) -> tuple[str, bool]:

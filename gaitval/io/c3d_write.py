@@ -69,6 +69,11 @@ def write_c3d(path: str | Path, labels: list[str], xyz_m: np.ndarray, rate_hz: f
     if xyz.ndim != 3 or xyz.shape[2] != 3:
         raise ValueError(f"xyz_m must have shape (n_frames, n_markers, 3), not {xyz.shape}")
     n_frames, n_markers, _ = xyz.shape
+    if n_frames == 0 or n_markers == 0:
+        raise ValueError(f"{path}: a C3D file needs at least one frame and one marker "
+                         f"(xyz_m holds {n_frames} frames of {n_markers} markers)")
+    if not (np.isfinite(float(rate_hz)) and float(rate_hz) > 0):
+        raise ValueError(f"{path}: rate_hz must be a finite number > 0, not {rate_hz!r}")
     labels = [str(s) for s in labels]
     if len(labels) != n_markers:
         raise ValueError(f"{len(labels)} labels for {n_markers} markers")

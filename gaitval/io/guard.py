@@ -149,6 +149,14 @@ def enough_rows(t, minimum: int, path: Path, trial: str | None, *, what: str,
         raise FileFormatError(f"{what} holds {n} {unit}{'s' if n != 1 else ''}; at least "
                               f"{minimum} are needed (a rate and a duration)", path=path,
                               trial=trial)
-    if n >= 2 and not np.any(np.diff(np.asarray(t, dtype=float)) > 0):
+    d = np.diff(np.asarray(t, dtype=float))
+    if n >= 2 and not np.any(d > 0):
         raise FileFormatError(f"{what}: the column 't_s' never advances over its {n} "
                               f"{unit}s (no rate)", path=path, trial=trial)
+    if n >= 2 and not np.median(d) > 0:
+        # the rate is 1 / the median step: a median step of 0 would be an infinite rate
+        raise FileFormatError(
+            f"{what}: the column 't_s' advances in only {int((d > 0).sum())} of its "
+            f"{len(d)} steps (median step {float(np.median(d)):g} s), so no sampling rate "
+            f"follows from it (timestamps rounded to whole seconds?)", path=path,
+            trial=trial, hint="store the times with their full resolution")

@@ -67,6 +67,27 @@ SPEEDS = ("slow", "normal", "fast")
 STICK_WORDS = {"stick": True, "cane": True, "nostick": False, "no-stick": False}
 _REPETITION = re.compile(r"^(?:t|r|rep|trial)?(\d{1,6})$")
 _ID_BAD = re.compile(r"[^A-Za-z0-9_.-]")
+
+
+def _as_id(text: str, fallback: str) -> str:
+    """``text`` as an id (gaitval.configcheck.id_problem): other characters as ``_``, no
+    leading ``-`` or ``.`` (a command line would read ``-rf`` as options)."""
+    return _ID_BAD.sub("_", text).lstrip("-.")[:100] or fallback
+
+
+def _unique_id(candidates: list[str], taken: set[str]) -> str:
+    """The first of ``candidates`` (ids) no id in ``taken`` (lower case) equals up to
+    case, else the last one with ``_2``, ``_3``, ...: ids that differ only in case name
+    one folder on macOS and Windows.  Adds the id to ``taken``."""
+    for c in candidates:
+        if c.lower() not in taken:
+            taken.add(c.lower())
+            return c
+    n = 2
+    while f"{candidates[-1]}_{n}".lower() in taken:
+        n += 1
+    taken.add(f"{candidates[-1]}_{n}".lower())
+    return f"{candidates[-1]}_{n}"
 #: folders never scanned: what gaitval or a simulator writes, and hidden folders
 SKIP_DIRS = {"truth", "results", "reports", "logs", ".snakemake"}
 SUFFIXES = (("c3d", (".c3d",)), ("scanlog", (".scan.parquet",)),
@@ -301,7 +322,7 @@ def _trial_from_name(stem: str, kind: str, labels: list[str]) -> dict:
             out.setdefault("repetition", int(_REPETITION.match(lw).group(1)))
         else:
             rest.append(w)
-    rest = [_ID_BAD.sub("_", w) for w in rest]          # ids: letters, digits, _ . -
+    rest = [w for w in (_as_id(w, "") for w in rest) if w]  # ids: letters, digits, _ . -
     if out.get("protocol") == "pendulum":
         out["subject"] = "pendulum"
         rest = [w for w in rest if w.lower() != "pendulum"]
@@ -321,7 +342,7 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
     folder = Path(folder)
     if not folder.is_dir():
         raise GaitvalError(f"init-study: {folder} is not a folder")
-    study = study or _ID_BAD.sub("_", folder.resolve().name) or "study"
+    study = study or _as_id(folder.resolve().name, "study")
     res = InitResult(folder)
     sheet, subjects_csv = folder / "trials.csv", folder / "subjects.csv"
     for p in (sheet, subjects_csv):
@@ -363,10 +384,8 @@ def init_study(folder, *, study: str | None = None, force: bool = False,
         elif f.get("subject") and info.get("protocol") != "pendulum":
             info["subject"] = f["subject"]           # the name has no subject word
             id_source.setdefault("the C3D's SUBJECTS:NAMES", []).append(s.stem)
-        trial = _ID_BAD.sub("_", s.stem)
-        if trial in ids:
-            trial = _ID_BAD.sub("_", s.rel.rsplit(".", 2)[0].replace("/", "_"))
-        ids.add(trial)
+        trial = _unique_id([_as_id(s.stem, "trial"),
+                            _as_id(s.rel.rsplit(".", 2)[0].replace("/", "_"), "trial")], ids)
         row = {"study": study, "trial": trial, "sensor_file": s.rel,
                "sensor_kind": "ultrasonic" if s.kind == "ultrasonic" else "lrs",
                "mocap_file": c3d.rel if c3d else "", **info}

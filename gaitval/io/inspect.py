@@ -226,7 +226,8 @@ def format_description(d: dict[str, Any]) -> str:
             _row("frames", f"{d['n_frames']}  (frames {d['first_frame']}..{d['last_frame']}, "
                  f"t = {_f(d['t_start_s'])} .. {_f(d['t_end_s'])} s, "
                  f"{_f(d['duration_s'])} s)"),
-            _row("units", f"{d['units']} in the file -> m"),
+            _row("units", ("POINT:UNITS blank: mm assumed (the C3D default) -> m"
+                           if d.get("units_assumed") else f"{d['units']} in the file -> m")),
             _row("up", str(d.get("vertical_axis")) + ("" if str(d.get("vertical_axis",
                  "+z")).startswith("+z") else " in the file -> turned to +z")),
             _row("markers", f"{d['n_markers']}: " + _wrap(d["labels"])),

@@ -83,20 +83,31 @@ def _open(path: Path, trial: str | None):
 
     if not path.exists():
         raise FileFormatError("ROS bag not found", path=path, trial=trial)
+    if path.is_file():
+        # ROS 1: the magic line and every record's header and length checked (seeking over
+        # the data, never holding it), and the index against the records, before the bag
+        # library reads anything: it reads the whole index into memory first, 2 GB for a
+        # 1 GB file of zeros
+        from gaitval.io.rosbag_check import check_structure
+        check_structure(path, trial)
     try:
         reader = AnyReader([path], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
         reader.open()
     except Exception as exc:  # rosbags raises AnyReaderError / ReaderError / OSError
-        raise FileFormatError(f"not a readable ROS bag: {type(exc).__name__}: {exc}",
+        raise FileFormatError(f"not a readable ROS bag: {_exc_text(exc)}",
                               path=path, trial=trial) from None
-    if path.is_file():                      # ROS 1: the index must agree with the records
-        from gaitval.io.rosbag_check import check_structure
-        try:
-            check_structure(path, trial)
-        except FileFormatError:
-            reader.close()
-            raise
     return reader
+
+
+def _exc_text(exc: BaseException) -> str:
+    """A library's exception as text; one without a message (a bare ``assert`` of the
+    bag library on a field it did not expect) says what it is instead of nothing."""
+    text = str(exc).strip()
+    if isinstance(exc, AssertionError) or not text:
+        return (f"the bag library's own consistency check failed ({type(exc).__name__}"
+                f"{': ' + text if text else ''}): a field of a record or message holds a "
+                "value the format does not allow")
+    return f"{type(exc).__name__}: {text}"
 
 
 def _norm(topic: str) -> str:
@@ -136,7 +147,8 @@ def _read_topic(reader, topic: str, path: Path, trial: str | None) -> dict[str, 
     try:
         for k, (con, ts, raw) in enumerate(reader.messages(connections=conns)):
             m = reader.deserialize(raw, con.msgtype)
-            r = np.asarray(m.ranges, dtype=np.float64)
+            with np.errstate(invalid="ignore"):   # a signalling NaN: no return, cleaned
+                r = np.asarray(m.ranges, dtype=np.float64)
             geo = (r.size, float(m.angle_min), float(m.angle_increment))
             if first is None:
                 first = m
@@ -161,7 +173,7 @@ def _read_topic(reader, topic: str, path: Path, trial: str | None) -> dict[str, 
         raise
     except Exception as exc:
         raise FileFormatError(f"cannot decode LaserScan messages on {topic}: "
-                              f"{type(exc).__name__}: {exc}", path=path, trial=trial) from None
+                              f"{_exc_text(exc)}", path=path, trial=trial) from None
     if first is None:
         raise FileFormatError(f"topic {topic} holds no messages", path=path, trial=trial)
     _check_message_counts(reader, conns, per_conn, topic, path, trial)

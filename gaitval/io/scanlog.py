@@ -32,6 +32,7 @@ Reading it without gaitval::
 from __future__ import annotations
 
 import json
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -39,9 +40,11 @@ import pandas as pd
 
 from gaitval.errors import FileFormatError
 from gaitval.io.atomic import atomic_path
-from gaitval.io.guard import (column_kind, column_names, enough_rows, json_meta, loader,
+from gaitval.io.guard import (column_kind, enough_rows, json_meta, loader,
                               number, text_field, version_field)
 from gaitval.types import ScanSeries
+
+log = logging.getLogger("gaitval.io.scanlog")
 
 META_KEY = b"gaitval:scanlog"
 FORMAT = "gaitval-scanlog"
@@ -50,6 +53,9 @@ SUFFIX = ".scan.parquet"
 #: physical bounds of the metadata (a scan of a 2-D laser scanner: 5-100 Hz, <= 10k beams)
 MAX_SCAN_TIME_S = 10.0
 MAX_BEAMS = 100_000
+#: scans x beams a scan log may hold (float64: 1 GB); a longer recording is split into
+#: trials (half an hour of a 40 Hz, 1081-beam scanner is 78 M).
+MAX_RANGE_VALUES = 125_000_000
 #: a scan spans at most one turn (radians, with a little slack for rounding)
 MAX_SPAN_RAD = 2 * np.pi + 1e-3
 #: the beams of one scan are taken within this many seconds (time_increment x n_beams)
@@ -169,29 +175,45 @@ def read_scanlog(path: str | Path, *, trial: str | None = None) -> ScanSeries:
 
 
 def _read_scanlog(path: Path, trial: str | None) -> ScanSeries:
-    from gaitval.io.parquet import read_table
+    import pyarrow.parquet as pq
 
     if not path.is_file():
         raise FileFormatError("scan log not found", path=path, trial=trial)
+    # the footer first (schema, metadata, row count): the size is checked before a value
+    # is read, so a small file announcing millions of scans of thousands of beams is
+    # refused without the memory it would take
     try:
-        tab = read_table(path)
+        with pq.ParquetFile(path) as pf:
+            md = pf.schema_arrow.metadata or {}
+            n_rows = int(pf.metadata.num_rows)
+            if META_KEY not in md:
+                raise FileFormatError("Parquet file has no 'gaitval:scanlog' metadata; is "
+                                      "it a gaitval scan log?", path=path, trial=trial,
+                                      hint="see docs/formats.md")
+            meta = json_meta(md[META_KEY], META_KEY.decode(), path, trial)
+            g = _meta_fields(meta, path, trial)
+            if n_rows * g["n_beams"] > MAX_RANGE_VALUES:
+                raise FileFormatError(
+                    f"scan log announces {n_rows:,} scans x {g['n_beams']:,} beams = "
+                    f"{n_rows * g['n_beams']:,} ranges; gaitval reads at most "
+                    f"{MAX_RANGE_VALUES:,} per file ({MAX_RANGE_VALUES * 8 / 1e9:.1f} GB "
+                    "as numbers)", path=path, trial=trial,
+                    hint="split the recording into trials (one scan log per trial)")
+            for col in ("t_s", "ranges"):
+                if col not in pf.schema_arrow.names:
+                    raise FileFormatError(f"scan log has no '{col}' column", path=path,
+                                          trial=trial)
+            tab = pf.read(columns=["t_s", "ranges"], use_threads=False)
+    except FileFormatError:
+        raise
     except Exception as exc:  # noqa: BLE001 - pyarrow: ArrowInvalid, OSError, ...
         raise FileFormatError(f"not a readable Parquet scan log: {exc}", path=path,
                               trial=trial) from None
-    md = tab.schema.metadata or {}
-    if META_KEY not in md:
-        raise FileFormatError("Parquet file has no 'gaitval:scanlog' metadata; is it a "
-                              "gaitval scan log?", path=path, trial=trial,
-                              hint="see docs/formats.md")
-    meta = json_meta(md[META_KEY], META_KEY.decode(), path, trial)
-    g = _meta_fields(meta, path, trial)
-    for col in ("t_s", "ranges"):
-        if col not in column_names(tab, path, trial):
-            raise FileFormatError(f"scan log has no '{col}' column", path=path, trial=trial)
     t, raw = _columns(tab, g["n_beams"], g["unit"], path, trial)
     enough_rows(t, 2, path, trial, what="scan log", unit="scan")
     if g["unit"] == "mm":
         raw = raw / 1000.0
+    _range_plausibility(raw, g, path, trial)
     ranges, n_bad = clean_ranges(raw, g["rmin"], g["rmax"])
     return ScanSeries(
         t=t, ranges=ranges, angle_min=g["amin"], angle_increment=g["ainc"],
@@ -200,6 +222,32 @@ def _read_scanlog(path: Path, trial: str | None) -> ScanSeries:
         mounting_height_m=g["height"], source=str(path),
         timestamp_issues=check_timestamps(t), n_no_return_raw=n_bad,
         meta={k: v for k, v in meta.items() if k not in {"n_beams"}})
+
+
+def _range_plausibility(raw: np.ndarray, g: dict, path: Path, trial: str | None) -> None:
+    """Ranges that cannot be a recording: every range negative (no scanner measures a
+    negative distance; a sign or offset error), or not one range inside
+    ``[range_min_m, range_max_m]`` in the whole log (the unit or the limits are wrong):
+    a FileFormatError instead of a log that loads as 100 % "no return"."""
+    with np.errstate(invalid="ignore"):
+        finite = np.isfinite(raw)
+        n_finite = int(finite.sum())
+        n_neg = int((raw < 0).sum())
+        n_valid = int((finite & (raw > 0) & (raw >= g["rmin"]) & (raw <= g["rmax"])).sum())
+    if n_finite and n_neg == n_finite:
+        raise FileFormatError(f"every one of the {n_finite:,} ranges is negative; a laser "
+                              "scanner measures distances >= 0 (a sign or offset error?)",
+                              path=path, trial=trial)
+    if n_finite and n_valid == 0:
+        lo, hi = float(np.nanmin(raw[finite])), float(np.nanmax(raw[finite]))
+        raise FileFormatError(
+            f"none of the {n_finite:,} ranges lies within range_min_m..range_max_m "
+            f"({g['rmin']:g}..{g['rmax']:g} m; the ranges span {lo:.4g}..{hi:.4g} m "
+            f"read as {g['unit']}): the log would be all 'no return'", path=path,
+            trial=trial, hint="check range_unit and the range limits in the metadata")
+    if n_neg and n_neg > 0.5 * n_finite:
+        log.warning("%s: %d of %d ranges are negative (read as no return)", path, n_neg,
+                    n_finite)
 
 
 def _meta_fields(meta: dict, path: Path, trial: str | None) -> dict:

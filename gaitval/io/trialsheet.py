@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import copy
 import difflib
+import logging
 import math
 import warnings
 from pathlib import Path
@@ -30,7 +31,10 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from gaitval.configcheck import ID_MAX_LEN, id_problem, path_value_problem  # noqa: F401
 from gaitval.errors import GaitvalError, TrialSheetError
+
+log = logging.getLogger("gaitval.io.trialsheet")
 
 SCHEMA_DIR = Path(__file__).resolve().parents[2] / "workflow" / "schemas"
 TRUE = {"true", "yes", "1", "y", "t"}
@@ -50,29 +54,8 @@ def load_schema(name: str) -> dict:
 
 #: Id columns: each becomes a folder name under results/ and a word of a job's command.
 ID_COLUMNS = ("study", "subject", "trial")
-ID_MAX_LEN = 128
-_ID_CHARS = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_.-")
 #: Whole numbers past this are typos (``repetition=1e308``), not counts.
 MAX_INTEGER = 1_000_000
-
-
-def id_problem(value: str) -> str | None:
-    """Why ``value`` cannot be an id (study, subject, trial), or None.
-
-    Ids name folders (``results/<study>/ingest/<trial>/``): letters, digits and ``_ . -``
-    only, at most 128 characters, and neither ``.`` nor ``..`` (they would name the folder
-    itself or its parent)."""
-    if not value:
-        return "is empty"
-    if len(value) > ID_MAX_LEN:
-        return f"is {len(value)} characters long (at most {ID_MAX_LEN})"
-    if value in (".", ".."):
-        return f"{value!r} names a folder's own or parent folder"
-    bad = sorted(set(value) - _ID_CHARS)
-    if bad:
-        shown = ", ".join(repr(c) for c in bad[:5])
-        return f"has the character(s) {shown}; ids use letters, digits and _ . - only"
-    return None
 
 
 def _control_chars(value: str) -> list[str]:
@@ -328,6 +311,18 @@ def sheet_problems(path: str | Path, subjects: str | Path | None = None, *,
             problems.append(TrialSheetError(f"trial id {trial!r} appears on rows "
                                             f"{[int(r) for r in rows]}; trial ids must be "
                                             "unique", path=path, trial=trial))
+    # ids that differ only in case name one folder on macOS and Windows
+    folded = df.assign(_key=df["trial"].astype(str).str.lower()).drop_duplicates("trial")
+    for _, grp in folded.groupby("_key", sort=False):
+        if len(grp) > 1:
+            ids = [str(t) for t in grp["trial"]]
+            problems.append(TrialSheetError(
+                f"trial ids {', '.join(repr(t) for t in ids)} (rows "
+                f"{[int(r) for r in grp['row_line']]}) differ only in case; their folders "
+                "would be one on macOS and Windows", path=path, trial=ids[0],
+                hint="give each trial an id that differs in more than case"))
+    if only is None:
+        _warn_reused_recordings(df, path)
     sub_path = Path(subjects) if subjects is not None else path.parent / "subjects.csv"
     sub_only = None if only is None else next((r["subject"] for r in records
                                                 if "subject" in r), "")
@@ -417,9 +412,31 @@ def _is_dir(p: Path) -> bool:
         return False
 
 
+def _warn_reused_recordings(df: pd.DataFrame, path: Path) -> None:
+    """A warning for each recording (mocap or sensor file) that several rows name: a sheet
+    has no time windows, so such rows analyse the same data again and count it as more
+    trials (a copy-paste error, usually)."""
+    for col in ("mocap_file", "sensor_file"):
+        if col not in df:
+            continue
+        named = df[[col, "row_line"]][df[col].astype(str).str.strip() != ""]
+        for f, rows in named.groupby(col, sort=True)["row_line"]:
+            if len(rows) > 1:
+                lines = [int(r) for r in rows]
+                log.warning("%s: %s %r is named by %d rows (%s); each analyses the same "
+                            "recording again and counts as a trial of its own", path, col,
+                            f, len(lines), ", ".join(map(str, lines[:10]))
+                            + (", ..." if len(lines) > 10 else ""))
+
+
 def _path_problem(base: Path, rel: str, col: str, check_files: bool, allow_outside: bool,
                   add) -> None:
-    """A path that is too long, leaves the sheet's folder, or names no file."""
+    """A path that is too long, leaves the sheet's folder, holds a brace (Snakemake reads
+    ``{...}`` in an input's path as a wildcard), or names no file."""
+    why = path_value_problem(rel)
+    if why and "brace" in why:
+        add(col, f"path {rel[:60]!r}{'...' if len(rel) > 60 else ''} {why}; rename the file")
+        return
     try:
         target = (base / rel).resolve()
         inside = target.is_relative_to(base.resolve())

@@ -27,6 +27,7 @@ import copy
 import io
 import logging
 import multiprocessing
+import os
 import shlex
 import sys
 import time
@@ -121,22 +122,19 @@ class VerbFailed(GaitvalError):
     """A verb of :func:`run_verbs` exited with a non-zero status (its message printed)."""
 
 
-def run_verbs(argvs: list[list[str]], shown: list[list[str]] | None = None) -> None:
+def run_verbs(argvs: list[list[str]]) -> None:
     """A task: gaitval verbs one after the other, each as ``gaitval ARGV`` on the command
     line would run it (:func:`gaitval.cli.main`'s parser and exit codes); the first that
     fails stops the task.  Each verb's command line goes to the log first (``$ gaitval
-    ...``, quoted as a shell would need it; ``shown``: the command lines to show instead,
-    the job's final paths where it writes into a staging folder, :func:`staged`): the
-    same step, by hand."""
+    ...``, quoted as a shell would need it): the same step, by hand."""
     from gaitval.cli import parser
     from gaitval.cli_exit import run_verb
 
     saved = sys.argv
     try:
-        for i, argv in enumerate(argvs):
+        for argv in argvs:
             sys.argv = ["gaitval", *argv]        # what a table's provenance records
-            show = ["gaitval", *(shown[i] if shown else argv)]
-            print(f"$ {shlex.join(show)}", flush=True)        # the same step by hand
+            print(f"$ {shlex.join(sys.argv)}", flush=True)   # the same step by hand
             args = copy.deepcopy(parser().parse_args(list(argv)))
             rc = run_verb(args.func, args)
             if rc:
@@ -166,7 +164,11 @@ def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None) 
     results: list[tuple[bool, str, str, float] | None] = [None] * len(tasks)
     failed: int | None = None
     t0 = time.perf_counter()
-    with cf.ProcessPoolExecutor(max_workers=processes, mp_context=_context()) as pool:
+    # each worker dies with this process (a Snakemake killed alone): gaitval/jobs/lifeline.py
+    from gaitval.jobs.lifeline import pool_worker
+
+    with cf.ProcessPoolExecutor(max_workers=processes, mp_context=_context(),
+                                initializer=pool_worker, initargs=(os.getpid(),)) as pool:
         futures = {pool.submit(_call, t.func, t.kwargs): i for i, t in enumerate(tasks)}
         for fut in cf.as_completed(futures):
             i = futures[fut]
@@ -204,40 +206,6 @@ def _write_log(log, tasks, results, processes, wall) -> None:
         lines.append(f"-- {task_cpu:.3f} s cpu")
     Path(log).parent.mkdir(parents=True, exist_ok=True)
     Path(log).write_text("\n".join(lines) + "\n", encoding="utf-8")
-
-
-@contextlib.contextmanager
-def staged(outdirs):
-    """Write a job's output folders atomically: the tasks write into ``<folder>.partial``
-    (``swap`` maps a word of a command line naming a path in a folder to the same path in
-    its ``.partial`` twin), and only when every task succeeded does each twin replace its
-    folder (a rename).  A job killed half-way leaves no folder that looks finished, whatever
-    Snakemake's own record of it."""
-    import os
-    import shutil
-
-    pairs = [(Path(d), Path(f"{d}.partial")) for d in outdirs]
-    for _, tmp in pairs:
-        shutil.rmtree(tmp, ignore_errors=True)
-        tmp.mkdir(parents=True)
-
-    def swap(word: str) -> str:
-        for final, tmp in pairs:
-            head = str(final)
-            if word == head or word.startswith(head + "/"):
-                return str(tmp) + word[len(head):]
-        return word
-
-    try:
-        yield swap
-    except BaseException:
-        for _, tmp in pairs:
-            shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    for final, tmp in pairs:
-        if final.exists():
-            shutil.rmtree(final)
-        os.replace(tmp, final)
 
 
 def by_size(tasks: list[Task], sizes: list[float]) -> list[Task]:

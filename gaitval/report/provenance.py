@@ -85,6 +85,8 @@ def command_line(argv: list[str] | None = None) -> str:
     argv = list(sys.argv if argv is None else argv)
     if argv and (argv[0].endswith("__main__.py") or argv[0].endswith("/gaitval")):
         argv[0] = "gaitval"
+    # an absolute path of this machine, relative to the working folder (portable records)
+    argv = [relative_path(a) if _is_local_path(a) else a for a in argv]
     return " ".join(shlex.quote(a) for a in argv)
 
 
@@ -213,9 +215,24 @@ def git_origin(repo: Path = REPO) -> str:
     return url or str(repo)
 
 
-def reproduce_script(rec: dict, reports_rel: str) -> str:
+def is_remote_url(url: str) -> bool:
+    """A repository address another machine can clone (``https://``, ``ssh://``,
+    ``git@host:path``), not a folder of this machine."""
+    import re
+
+    return bool(re.match(r"^[A-Za-z][A-Za-z0-9+.-]*://", url)
+                or re.match(r"^[\w.-]+@[\w.-]+:", url))
+
+
+def reproduce_script(rec: dict, reports_rel: str, repo_from_prov: str | None = None) -> str:
     """``reproduce.sh``: a new checkout of the commit, the environment from the lock,
-    the report's command, then its inputs and tables checked against the manifests."""
+    the report's command, then its inputs and tables checked against the manifests.
+
+    Every value is quoted for the shell (:func:`shlex.quote`), outside any double quotes.
+    The repository defaults to the report's ``repository`` when that is an address
+    another machine can clone, else to the checkout found from the script's own folder
+    (``repo_from_prov``: the checkout relative to ``provenance/``); the script holds no
+    absolute path of the machine that built it."""
     commit = str(rec.get("git_commit", "unknown"))
     plain = commit.removesuffix("+dirty")
     args = shlex.split(rec.get("command") or "python3 run.py report")
@@ -229,25 +246,35 @@ def reproduce_script(rec: dict, reports_rel: str) -> str:
             keep.append(a)
     command = " ".join(shlex.quote(a) for a in keep)
     q = shlex.quote
+    origin = str(rec.get("repository") or "")
+    if is_remote_url(origin):
+        repo_line = f"REPO=${{1:-{q(origin)}}}"
+    else:
+        rel = repo_from_prov or "../../.."
+        repo_line = ('REPO=${1:-$(cd "$PROV"/' + q(rel) + ' 2>/dev/null && git rev-parse '
+                     '--show-toplevel 2>/dev/null || true)}')
     lines = [
         "#!/usr/bin/env bash",
-        f"# Rebuild the gaitval report {reports_rel} from nothing and check that its inputs",
-        "# and tables are identical: a new checkout of the commit, the environment built",
-        "# from the hashed lock, the report's own command.  Written by gaitval",
+        f"# Rebuild the gaitval report {reports_rel!r} from nothing and check that its",
+        "# inputs and tables are identical: a new checkout of the commit, the environment",
+        "# built from the hashed lock, the report's own command.  Written by gaitval",
         "# (gaitval/report/provenance.py).",
         "#",
         "#   bash reproduce.sh [REPOSITORY] [FOLDER]",
         "#",
         "# REPOSITORY  gaitval's git repository, a URL or a folder (default: the one the",
-        "#             report was made from)",
+        "#             report was made from, found relative to this script when it was a",
+        "#             folder)",
         "# FOLDER      a new folder for the checkout (default: ./gaitval-<commit>); data the",
         "#             studies read from outside the checkout (../shared/...) must sit",
         "#             beside it as they did beside the original",
         "set -euo pipefail",
         'PROV=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)',
         f"COMMIT={q(plain)}",
-        f"REPO=${{1:-{q(rec.get('repository') or str(REPO))}}}",
-        f'DEST=${{2:-gaitval-{plain[:12]}}}',
+        repo_line,
+        'if [ -z "$REPO" ]; then echo "reproduce.sh: no gaitval repository found beside '
+        'this report; give it: bash reproduce.sh REPOSITORY [FOLDER]" >&2; exit 2; fi',
+        f"DEST=${{2:-{q('gaitval-' + plain[:12])}}}",
         'if [ -e "$DEST" ]; then echo "reproduce.sh: $DEST exists; name a new folder" >&2;'
         " exit 2; fi",
     ]
@@ -265,8 +292,9 @@ def reproduce_script(rec: dict, reports_rel: str) -> str:
         command,
         'sha256sum -c --quiet "$PROV/inputs.sha256"',
         f'(cd {q(reports_rel)} && sha256sum -c --quiet "$PROV/tables.sha256")',
-        'echo "reproduce.sh: inputs and tables identical to the report\'s ($DEST/'
-        + reports_rel + ')"',
+        # the values as printf's arguments, each quoted: none is ever read as shell code
+        "printf 'reproduce.sh: inputs and tables identical to those of the report "
+        "(%s/%s)\\n' \"$DEST\" " + q(reports_rel),
     ]
     return "\n".join(lines) + "\n"
 
@@ -307,15 +335,27 @@ def write_report_provenance(reports_dir: str | Path) -> dict | None:
                    environment_vs_lock=diff)
     write_text(prov / "tables.sha256", tables_manifest(reports_dir))
     rec.update(environment="provenance/environment.txt", n_distributions=len(env),
-               git_commit=git_commit(), repository=git_origin(),
+               git_commit=git_commit(), repository=_portable_origin(reports_dir),
                gaitval_version=__version__, python=platform.python_version(),
                platform=f"{platform.system()} {platform.machine()}",
                tables="provenance/tables.sha256", reproduce="provenance/reproduce.sh")
     rel = relative_path(reports_dir)
-    write_text(prov / "reproduce.sh", reproduce_script(rec, rel))
+    write_text(prov / "reproduce.sh",
+               reproduce_script(rec, rel, relative_path(REPO, prov.resolve())))
     os.chmod(prov / "reproduce.sh", 0o755 & ~_umask())
     write_text(prov / "report.json", json.dumps(rec, indent=1, sort_keys=True) + "\n")
     return rec
+
+
+def _portable_origin(reports_dir) -> str:
+    """The repository for ``report.json``: its clone address when it has one another
+    machine can reach, else the checkout relative to the report folder (no absolute path
+    of this machine in a report)."""
+    origin = git_origin()
+    if is_remote_url(origin):
+        return origin
+    return relative_path(origin if Path(origin).is_dir() else REPO,
+                         Path(reports_dir).resolve())
 
 
 def _umask() -> int:
@@ -345,15 +385,43 @@ def rebuild_command(configfiles: list[str | Path], overrides: dict, workdir: str
     ``--configfile``/``--config`` the run was given (and ``--directory`` when it did not
     run in the checkout)."""
     args = ["python3", "run.py", "report"]
-    if Path(workdir).resolve() != Path(repo).resolve():
-        args += ["--directory", str(workdir)]
+    base, work = Path(repo).resolve(), Path(workdir).resolve()
+
+    def portable(path, start=base) -> str:     # relative: no absolute path of this machine
+        return relative_path(path, start) if Path(path).is_absolute() else str(path)
+
+    if work != base:                             # run.py works in the checkout
+        args += ["--directory", portable(workdir)]
     for f in configfiles:
-        args += ["--configfile", str(f)]
-    if overrides:
+        args += ["--configfile", portable(f)]
+    if overrides:                                # Snakemake reads these in the work folder
         args.append("--config")
-        args += [f"{k}={v if isinstance(v, str) else json.dumps(v)}"
+        args += [f"{k}={portable(v, work) if _is_local_path(v) else v}"
+                 if isinstance(v, str) else f"{k}={json.dumps(v)}"
                  for k, v in overrides.items()]
     return " ".join(shlex.quote(a) for a in args)
+
+
+def _portable(value):
+    """``value`` (a resolved config) with every string that is an absolute path of this
+    machine made relative to the working folder, as Snakemake reads it there: no report
+    holds the building machine's absolute paths."""
+    if isinstance(value, dict):
+        return {k: _portable(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_portable(v) for v in value]
+    return relative_path(value) if _is_local_path(value) else value
+
+
+def _is_local_path(value) -> bool:
+    """An absolute path of an existing file or folder (a --config value such as
+    ``peer_results=/home/me/...``): written relative instead."""
+    if not isinstance(value, str) or not value.startswith(("/", "\\")) and ":" not in value:
+        return False
+    try:
+        return Path(value).is_absolute() and Path(value).exists()
+    except (OSError, ValueError):
+        return False
 
 
 def write_workflow_record(config: dict, inputs, output, log: str, *, command: str,
@@ -363,7 +431,7 @@ def write_workflow_record(config: dict, inputs, output, log: str, *, command: st
     the rebuild command (``output.rebuild``)."""
     import yaml
 
-    resolved = json.loads(json.dumps(config, default=str))
+    resolved = _portable(json.loads(json.dumps(config, default=str)))
     write_text(output.config, yaml.safe_dump(resolved, sort_keys=True))
     write_text(output.inputs, "".join(f"{relative_path(p)}\n" for p in inputs))
     write_text(output.rebuild, json.dumps(

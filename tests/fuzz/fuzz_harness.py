@@ -12,6 +12,12 @@ Outcomes of one mutant (``run_mutant``):
                   unmutated seed holds, or lost a topic, without a warning     (a failure)
 ``nonfinite``     the loader returned, but a key number (rate, duration, count, start
                   time, temperature) is NaN, inf or missing                  (a failure)
+``implausible``   a mutant of a plausibility class (``fuzz_mutators.IMPLAUSIBLE``: a
+                  C3D whose POINT:UNITS or scale is wrong, a scan log whose ranges are
+                  all negative or beyond its limits, an ultrasonic log stamped in whole
+                  seconds) loaded without an error or a warning         (a failure);
+                  the summary counts those mutants (``plaus``) and how many were refused
+                  or warned about (``caught``)
 ``unsafe``        a trial sheet loaded with a study, subject or trial id that cannot name
                   a folder or stay one shell word (``..``, ``a b``, ``$(id)``)  (a failure)
 ``error``         a GaitvalError naming the mutant's file
@@ -46,7 +52,8 @@ import fuzz_mutators as M  # noqa: E402
 import fuzz_seeds as S  # noqa: E402
 
 KINDS = ("c3d", "bag", "scanlog", "ultrasonic", "annotations", "sheet")
-FAILURES = ("short", "nonfinite", "unsafe", "unnamed", "foreign", "crash", "hang")
+FAILURES = ("short", "nonfinite", "unsafe", "implausible", "unnamed", "foreign", "crash",
+            "hang")
 #: the numbers a load must give finitely, per kind (bags: per LaserScan topic)
 FINITE_KEYS = {"c3d": ("rate_hz", "n_frames", "n_markers", "t_start_s", "t_end_s",
                        "duration_s"),
@@ -72,13 +79,17 @@ def make_mutant(kind: str, seed: int, index: int, work: Path) -> tuple[Path, str
         seeds = M.C3D_SEEDS if kind == "c3d" else M.BAG_SEEDS
         name = seeds[index % len(seeds)]
         src = M.REALDATA / ("c3d" if kind == "c3d" else "lrs") / name
+        out = d / (f"m.{kind}")
+        if kind == "c3d" and rng.random() < 0.1:
+            return out, f"{name}: {M.c3d_implausible(src, out, rng)}"
         data = src.read_bytes()
         data, what = (M.c3d_mutation if kind == "c3d" else M.bag_mutation)(data, rng)
-        out = d / (f"m.{kind}")
         out.write_bytes(data)
         return out, f"{name}: {what}"
     if kind in ("scanlog", "ultrasonic"):
         out = d / ("m.scan.parquet" if kind == "scanlog" else "m.us.parquet")
+        if rng.random() < 0.1:
+            return out, M.parquet_implausible(kind, out, rng)
         return out, M.parquet_mutation(kind, out, rng)
     if kind == "annotations":
         out = d / "m.annotations.csv"
@@ -276,6 +287,9 @@ def fuzz_one(task: tuple[str, int, int, str]) -> dict:
     path, what = make_mutant(kind, seed, index, Path(work))
     seed_name = what.split(":", 1)[0] if kind in ("c3d", "bag") else kind
     res = run_mutant(kind, path, base=baseline(kind, seed_name))
+    if M.IMPLAUSIBLE in what and res["outcome"] == "load":    # loaded quietly: wrong
+        res = {**res, "outcome": "implausible",
+               "detail": "an implausible file loaded without an error or a warning"}
     shutil.rmtree(Path(work) / f"{kind}_{index}", ignore_errors=True)
     return {"kind": kind, "index": index, "what": what, **res}
 
@@ -285,23 +299,26 @@ def summarise(results: list[dict]) -> dict[str, dict[str, int]]:
     table: dict[str, dict[str, int]] = {}
     for r in results:
         row = table.setdefault(r["kind"], {"mutants": 0, "load": 0, "warned": 0,
-                                           "error": 0, "contained": 0,
-                                           **{f: 0 for f in FAILURES}})
+                                           "error": 0, "contained": 0, "plaus": 0,
+                                           "caught": 0, **{f: 0 for f in FAILURES}})
         row["mutants"] += 1
         row[r["outcome"]] += 1
+        if M.IMPLAUSIBLE in r.get("what", ""):     # the plausibility classes
+            row["plaus"] += 1
+            row["caught"] += r["outcome"] in ("error", "warned")
         row["contained"] += r["detail"].startswith("contained")
     return table
 
 
 def format_table(table: dict[str, dict[str, int]]) -> str:
     cols = ["mutants", "load", "warned", "error", "contained", "crash", "hang", "foreign",
-            "unnamed", "short", "nonfinite", "unsafe"]
-    lines = [f"{'file type':<12}" + "".join(f"{c:>10}" for c in cols)]
+            "unnamed", "short", "nonfinite", "unsafe", "plaus", "caught", "implausible"]
+    lines = [f"{'file type':<12}" + "".join(f"{c:>12}" for c in cols)]
     total = {c: 0 for c in cols}
     for kind in KINDS:
         if kind in table:
-            lines.append(f"{kind:<12}" + "".join(f"{table[kind][c]:>10}" for c in cols))
+            lines.append(f"{kind:<12}" + "".join(f"{table[kind][c]:>12}" for c in cols))
             for c in cols:
                 total[c] += table[kind][c]
-    lines.append(f"{'all':<12}" + "".join(f"{total[c]:>10}" for c in cols))
+    lines.append(f"{'all':<12}" + "".join(f"{total[c]:>12}" for c in cols))
     return "\n".join(lines)

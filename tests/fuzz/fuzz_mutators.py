@@ -290,3 +290,51 @@ def text_mutation(text: str, rng: np.random.Generator, cells: bool = True
     lines[i] = ",".join(parts)
     return "\n".join(lines).encode("utf-8", "surrogatepass"), \
         f"line {i} cell {j} = {parts[j][:20]!r}"
+
+
+#: Mutations whose file is readable but says something implausible: the loader must refuse
+#: it or warn (a quiet load is the failure ``implausible``).  Each description starts
+#: with IMPLAUSIBLE.
+IMPLAUSIBLE = "implausible"
+
+
+def c3d_implausible(src: Path, out: Path, rng: np.random.Generator) -> str:
+    """A real C3D with its declared unit or its scale made wrong (ezc3d rewrites it)."""
+    import ezc3d
+
+    how = str(rng.choice(["units m", "units cm", "units blank", "km"]))
+    for path in (src, REALDATA / "c3d" / "opensim_walking2.c3d"):
+        c = ezc3d.c3d(str(path))
+        if how.startswith("units"):
+            unit = {"units m": "m", "units cm": "cm", "units blank": ""}[how]
+            c["parameters"]["POINT"]["UNITS"]["value"] = [unit]
+        else:                   # every coordinate x 1e6 with mm declared: kilometres
+            pts = c["data"]["points"]
+            pts[:3] *= 1e6
+            c["data"]["points"] = pts
+        try:
+            c.write(str(out))
+            break
+        except (ValueError, RuntimeError):  # ezc3d cannot write this seed back (LABELS2)
+            continue
+    return f"{IMPLAUSIBLE} {how}" + ("" if path == src else f" (of {path.name})")
+
+
+def parquet_implausible(kind: str, path: Path, rng: np.random.Generator) -> str:
+    """A scan log whose ranges are all negative or all beyond its limits (metres written
+    as mm...), or an ultrasonic log stamped in whole seconds."""
+    import pyarrow as pa
+
+    import fuzz_seeds
+    cols, key, meta = fuzz_seeds.parquet_parts(kind)
+    if kind == "scanlog":
+        nb = int(meta["n_beams"])
+        ranges = np.asarray(cols["ranges"].flatten(), dtype=np.float32)
+        how = str(rng.choice(["negative", "x1000"]))
+        ranges = -ranges if how == "negative" else ranges * 1000.0
+        cols["ranges"] = pa.FixedSizeListArray.from_arrays(pa.array(ranges), nb)
+    else:
+        how = "whole-second stamps"
+        cols["t_s"] = np.floor(np.asarray(cols["t_s"], dtype=float))
+    _write_parquet(path, cols, key, meta)
+    return f"{kind}: {IMPLAUSIBLE} {how}"

@@ -225,6 +225,24 @@ def batch_threads():
 
 
 BATCH_THREADS = batch_threads()
+# What a killed run left unfinished (outputs Snakemake still marks incomplete) is removed
+# before Snakemake plans this run, so the jobs that make it run again: Snakemake 9 itself
+# overlooks the marks of jobs it adds after a checkpoint (gaitval/jobs/resume.py).  Only in
+# the main Snakemake (not a cluster job's), not on a dry run, and only when no Snakemake
+# holds a lock here.
+if workflow.is_main_process and not {"-n", "--dry-run", "--dryrun"} & set(sys.argv):
+    from gaitval.jobs.resume import clear_interrupted
+
+    _removed = clear_interrupted(".")
+    if _removed:
+        print(f"gaitval: removed {len(_removed)} output(s) an interrupted run left "
+              f"unfinished; their jobs run again: {', '.join(_removed[:6])}"
+              + (", ..." if len(_removed) > 6 else ""), file=sys.stderr)
+# The jobs' processes end with this Snakemake (gaitval/jobs/lifeline.py): a shell job's
+# `python -m gaitval` watches this pid, as the batch pool's workers do.
+import os as _os
+
+_os.environ["GAITVAL_RUN_PID"] = str(_os.getpid())
 
 
 # The batch jobs' pool: its forkserver imports numpy, pandas, scipy and gaitval (~2 CPU-s)
@@ -255,17 +273,17 @@ def verb(*words):
 def run_trials(tasks, threads, log, sizes=None, outdirs=()):
     """Run a batch job's tasks (label, [verb, ...]) in the pool (gaitval.jobs.batch),
     largest first when their ``sizes`` are given.  ``outdirs``: the job's `directory()`
-    outputs, written atomically (gaitval.jobs.batch.staged: the tasks write into a
-    `.partial` twin that replaces the folder when all succeeded)."""
-    from gaitval.jobs.batch import Task, by_size, run_batch, run_verbs, staged
+    outputs, made first (a batch of no trial still leaves its folder).  A job killed
+    half-way leaves them marked incomplete by Snakemake, and the next run removes and
+    redoes them (gaitval.jobs.resume)."""
+    from gaitval.jobs.batch import Task, by_size, run_batch, run_verbs
 
-    with staged(outdirs) as swap:
-        tasks = [Task(label, run_verbs, {"argvs": [[swap(w) for w in argv] for argv in argvs],
-                                         "shown": argvs})
-                 for label, argvs in tasks]
-        if sizes is not None:
-            tasks = by_size(tasks, sizes)
-        run_batch(tasks, threads, log)
+    for d in outdirs:
+        Path(d).mkdir(parents=True, exist_ok=True)
+    tasks = [Task(label, run_verbs, {"argvs": argvs}) for label, argvs in tasks]
+    if sizes is not None:
+        tasks = by_size(tasks, sizes)
+    run_batch(tasks, threads, log)
 
 
 def run_verb_job(argv, log):

@@ -64,6 +64,11 @@ rule report:
     log:
         f"logs/report/{RUN_NAME}.log",
     run:
+        # no index over a partial report: every item a step's provenance lists is there,
+        # no file of the report is left unfinished by an interrupted job (jobs/resume.py)
+        from gaitval.jobs.resume import refuse_unfinished
+
+        refuse_unfinished(params.reports, own_outputs=list(output))
         run_verb_job(verb("report", "--reports-dir", params.reports, "--studies",
                           params.studies), log[0])
 
