@@ -468,11 +468,14 @@ def _ns_nv_reason(t8: pd.DataFrame, sym: str) -> str:
     pro = t8[t8["quantity"] == "pro"].set_index("symbol")
     if base not in pro.index or sym not in pro.index:
         return "NS and NV compare definitions of n, not accuracy (Table 8 note)."
-    n_rep = pro.loc[base, "normal_mean"] / pro.loc[sym, "normal_mean"]
-    if "normal_n" in pro.columns and np.isfinite(pro.loc[sym, "normal_n"]):
-        n_rep = float(pro.loc[sym, "normal_n"])
+    n_rep = f"{pro.loc[base, 'normal_mean'] / pro.loc[sym, 'normal_mean']:.0f}"
+    if "normal_n" in pro.columns:
+        # one number, or a range ("9-10") where the subjects' stride counts differ
+        given = str(pro.loc[sym, "normal_n"]).strip()
+        num = pd.to_numeric(given, errors="coerce")
+        n_rep = f"{float(num):.0f}" if np.isfinite(num) else (given or n_rep)
     n_pub = pro.loc[base, "normal_mean_published"] / pro.loc[sym, "normal_mean_published"]
-    return (f"{sym} = {base}/n: gaitval divides by the {n_rep:.0f} strides per subject it "
+    return (f"{sym} = {base}/n: gaitval divides by the {n_rep} strides per subject it "
             f"samples (the paper's Tables 2-6 sample size), the paper's values imply "
             f"n ≈ {n_pub:.0f} at normal speed; the rows compare definitions of n, not "
             "accuracy (Table 8 note).")
