@@ -256,7 +256,8 @@ def registration_summary(inputs: list[str | Path], study: str, out_csv, out_stem
                if show["manual_pose_diff_m"].notna().any() else [])
     show = show[[C.TRIAL, "protocol", C.X, C.Y, "yaw_deg", "pose_source", *by_hand,
                  C.CLOCK_OFFSET, "clock_drift_ppm", "pole_residual_m", "sync_peak",
-                 "joint_centre_source", "gt_frames_excluded", "status", "reason"]]
+                 "joint_centre_source", "gt_frames_excluded", "legs_in_view", "legs_seen",
+                 "status", "reason"]]
     n_ref = int((df["status"] != "ok").sum())
     notes = [f"{n_ref} trial(s) refused; their reason is given and later tables leave them "
              "out."] if n_ref else []
@@ -267,8 +268,11 @@ def registration_summary(inputs: list[str | Path], study: str, out_csv, out_stem
         "rollator trials have a per-frame pose, shown "
         "empty; ultrasonic trials show the receiver frame), clock offset and drift (sensor "
         "minus mocap), worst pole residual, correlation peak of the clock synchronisation, "
-        "which joint-centre source built the ground truth, and mocap frames excluded for "
-        "gaps longer than groundtruth.max_gap_s. Reviewers read this table first."))
+        "which joint-centre source built the ground truth, mocap frames excluded for "
+        "gaps longer than groundtruth.max_gap_s, and the registration's plausibility: "
+        "the share of the walk with a mocap leg in the laser's view and, of those frames, "
+        "with a laser return near a leg (at least 0.5 each, else the trial is refused). "
+        "Reviewers read this table first."))
     stamp(Path(out_stem).name, paths, reports_dir, config_hash_=config_hash)
     return df
 

@@ -32,6 +32,8 @@ PUBLISHED = ", published"
 
 #: display name -> label (with the unit, where the column has one)
 LABELS: dict[str, str] = {
+    'legs_in_view': 'Legs in view (share of the walk)',
+    'legs_seen': 'Return near a leg (share in view)',
     'benchmark_set': 'Benchmark set',
     'online': 'Online',
     'matched': 'Matched',
