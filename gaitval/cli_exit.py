@@ -43,12 +43,26 @@ def argparse_suppress():
     return argparse.SUPPRESS
 
 
+class _StderrHandler(logging.StreamHandler):
+    """A stream handler that writes to whatever ``sys.stderr`` is when it writes: the CLI
+    called in-process (a library caller, a test capturing stderr) may have replaced the
+    stream it had when the handler was made, and that one may be closed."""
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value):       # StreamHandler.__init__ assigns it: always sys.stderr
+        pass
+
+
 def configure_logging(verbose: int, quiet: int) -> None:
     """gaitval's log messages to stderr: INFO (progress) by default, -q WARNING, -v DEBUG."""
     level = logging.INFO - 10 * (verbose or 0) + 10 * (quiet or 0)
     log = logging.getLogger("gaitval")
     if not any(getattr(h, "_gaitval_cli", False) for h in log.handlers):
-        h = logging.StreamHandler(sys.stderr)
+        h = _StderrHandler()
         h.setFormatter(logging.Formatter("gaitval: %(message)s"))
         h._gaitval_cli = True
         log.addHandler(h)

@@ -69,8 +69,10 @@ def _run_until_rule(work: Path, pending: list[str], mode: str, rng: random.Rando
     "group": the whole run; "snakemake": Snakemake alone) after a short random delay and
     return that rule; None when the run ended before any of them started (it must then
     have succeeded)."""
+    # Snakemake's own console (rule by rule), not gaitval's one line per finished step
     p = subprocess.Popen(_report(work), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                         text=True, start_new_session=True)
+                         text=True, start_new_session=True,
+                         env={**os.environ, "GAITVAL_CONSOLE": "raw"})
     hit = None
     for line in p.stdout:
         log.write(line)

@@ -100,20 +100,23 @@ def paper_figure_inputs(protocol):
     if s is None:
         return []
     r = f"{RESULTS}/{s}"
+    # the ingested scans, where the study has mocap trials (a study with rater annotations
+    # only has no ingest job: its figures draw without the scans)
+    ingest = [f"{r}/ingest"] if mocap_trial_ids(s) else []
     if protocol == "tug":
         ms = [m for m in ("tug_m1", "tug_m2", "tug_m3") if m in tug_runs()]
-        return ([f"{r}/ingest"] + [f"{r}/evaluate/{m}" for m in ms]
+        return (ingest + [f"{r}/evaluate/{m}" for m in ms]
                 + [f"{r}/config_views/tug/{m}.json" for m in ms])
     if protocol == "mtst":
         ms = [m for m in ("mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed")
               if m in mtst_methods()]
-        return ([f"{r}/ingest", f"{r}/config_views/mtst/{STUDY_VIEW}.json"]
+        return (ingest + [f"{r}/config_views/mtst/{STUDY_VIEW}.json"]
                 + register_dirs(s) + [f"{r}/mtst_eval/{m}" for m in ms]
                 + [f"{r}/mtst_track/{m}" for m in ms]
                 + [f"{r}/config_views/mtst/{m}.json" for m in ms])
     if protocol == "rollator":
         rc = rollator_cfg()
-        return [f"{r}/ingest"] + [f"{r}/rollator/{m}" for m in (rc["kf_method"],
+        return ingest + [f"{r}/rollator/{m}" for m in (rc["kf_method"],
                                                                 rc["pf_method"])]
     return [f"{r}/ultrasonic", f"{r}/config_views/ultrasonic/{STUDY_VIEW}.json"]
 
