@@ -227,7 +227,7 @@ def test_the_detection_table_and_its_report_section(tmp_path):
     item = sec["detections"]["items"][0]
     assert item["stem"] == "detections_table" and "no row in the tracking tables" in \
         " ".join(item["notes"])
-    assert "left_detection_pct" in [h for h, _ in item["header"]]
+    assert "Left detection (%)" in [h for h, _ in item["header"]]   # its label, with its unit
 
 
 def test_rollator_detections_in_the_mocap_frame_are_refused_and_a_third_clock_is_offset(

@@ -36,8 +36,20 @@ DATA_FIGURES = [
     ("003", "Figure A1", "ultrasonic_figA1"),
     ("003", "Figure B1", "ultrasonic_figB1"),
 ]
-#: How a caption names its paper's figure ("cf. seed 000 Fig. 12").
-CF = re.compile(r"cf\. seed (\d{3}) Figs?\. ([0-9A-Z]+)")
+#: How a caption names its paper's figure ("cf. Yorozu et al. 2015a Fig. 12"), by author
+#: and year; the seed file prefix each stands for.
+AUTHOR_YEAR = {"Yorozu et al. 2015a": "000", "Yorozu et al. 2015b": "001",
+               "Chalvatzaki et al. 2017": "002", "Qi et al. 2014": "003"}
+_CF = re.compile(r"cf\. (Yorozu et al\. 2015[ab]|Chalvatzaki et al\. 2017|Qi et al\. 2014)"
+                 r"\s+Figs?\. ([0-9A-Z]+)")
+
+
+class CF:
+    """``findall(caption)`` -> [(seed prefix, figure number)], as the test reads them."""
+
+    @staticmethod
+    def findall(text: str) -> list[tuple[str, str]]:
+        return [(AUTHOR_YEAR[a], n) for a, n in _CF.findall(text)]
 #: Height in pixels below which a PNG is the "not drawn" statement, not a figure.
 PLACEHOLDER_PX = 300
 

@@ -218,8 +218,8 @@ def add_paper_figure_verbs(sub) -> None:
         return 0
 
     s = sub.add_parser("paper-figures", help="the papers' example figures of one protocol "
-                       "(seed 000 Figs. 12-13, seed 001 Figs. 6a, 8, 9, seed 002 Fig. 5, "
-                       "seed 003 Figs. 2-4) from a run's results")
+                       "(Yorozu et al. 2015a Figs. 12-13, Yorozu et al. 2015b Figs. 6a, 8, 9, Chalvatzaki et al. 2017 Fig. 5, "
+                       "Qi et al. 2014 Figs. 2-4) from a run's results")
     s.add_argument("protocol", choices=PROTOCOLS, help="which paper's figures: "
                    + ", ".join(PROTOCOLS))
     s.add_argument("--results", nargs="+", required=True, metavar="DIR",

@@ -62,32 +62,32 @@ PAPER_FIGURE_CAPTIONS = {
     "leg positions with their patterns, each leg's estimate and last scans) of Methods 1 "
     "and 2 around Method 1's first false tracking, in the turn where there is one (the "
     "title says which situation the run gave); the gates are not drawn, the track files "
-    "do not keep them (cf. seed 000 Fig. 12).",
+    "do not keep them (cf. Yorozu et al. 2015a Fig. 12).",
     "tug_fig13": "TUG: the hidden leg during Method 2's longest occlusion in the turn, "
     "tracked by Method 2 (no interpolation) and Method 3 (Catmull–Rom) against VICON, and "
-    "its position error over time (cf. seed 000 Fig. 13).",
+    "its position error over time (cf. Yorozu et al. 2015a Fig. 13).",
     "mtst_fig6a": "MTST: foot contacts of the proposed method near an assigned target, "
     "relative to the target's centre, with the target and the judgement region of a "
-    "participant of the default height (cf. seed 001 Fig. 6a).",
+    "participant of the default height (cf. Yorozu et al. 2015b Fig. 6a).",
     "mtst_fig8": "MTST: scan snapshots of Method 1 (no FS_U) and Method 2 (FS_U) around "
     "Method 1's first lost track, each method's observations with their patterns; the "
-    "validation regions are not drawn (cf. seed 001 Fig. 8).",
+    "validation regions are not drawn (cf. Yorozu et al. 2015b Fig. 8).",
     "mtst_fig9": "MTST: scan snapshots of Method 2 (large fixed region) and the proposed "
     "method (variable region, its radii per panel) where the legs were close together "
     "(Method 2's first switch, else the legs' closest approach), each method's "
-    "observations with their patterns (cf. seed 001 Fig. 9).",
+    "observations with their patterns (cf. Yorozu et al. 2015b Fig. 9).",
     "rollator_fig5": "Rollator: KF and PF estimates on the laser scan where the KF's "
     "error began with clutter and with a hidden leg; the KF's detections and the PF's "
-    "particles are not drawn, the track files do not keep them (cf. seed 002 Fig. 5).",
+    "particles are not drawn, the track files do not keep them (cf. Chalvatzaki et al. 2017 Fig. 5).",
     "ultrasonic_fig2": "Ultrasonic: the heel's horizontal displacement of the most "
-    "symmetric normal-speed trial and its biased and unbiased autocorrelation (cf. seed "
-    "003 Fig. 2).",
+    "symmetric normal-speed trial and its biased and unbiased autocorrelation (cf. Qi et al. "
+    "2014 Fig. 2).",
     "ultrasonic_fig3": "Ultrasonic: horizontal and vertical unbiased autocorrelation of the "
     "most symmetric normal-speed trial over one symmetry window, R1 and R2 marked (cf. "
-    "seed 003 Fig. 3).",
+    "Qi et al. 2014 Fig. 3).",
     "ultrasonic_fig4": "Ultrasonic: as Fig. 3 for the run's least symmetric trial; the "
-    "paper shows an abnormal gait, the twin simulates none, so this is not one (cf. seed "
-    "003 Fig. 4).",
+    "paper shows an abnormal gait, the simulated replica has none, so this is not one (cf. Qi et al. "
+    "2014 Fig. 4).",
 }
 #: Captions of the figures, by stem (``{p}``: the parameter of a per-parameter figure).
 FIGURE_CAPTIONS = {

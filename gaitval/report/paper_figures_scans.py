@@ -1,6 +1,6 @@
 """Scan snapshots: the laser points of a few consecutive scans with the tracked and the true
 legs, one row per method and one column per scan — what the papers' example figures of a
-tracking situation show (seed 000 Fig. 12, seed 001 Figs. 8 and 9, seed 002 Fig. 5).
+tracking situation show (Yorozu et al. 2015a Fig. 12, Yorozu et al. 2015b Figs. 8 and 9, Chalvatzaki et al. 2017 Fig. 5).
 
 What a snapshot can show is what the run keeps: the raw scan (the ingested scan log), each
 method's estimate per scan and leg with its pattern (``UO``: no observation associated),
