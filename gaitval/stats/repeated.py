@@ -356,7 +356,10 @@ def _prop_bias_one(r: np.ndarray, p: np.ndarray, codes: np.ndarray | None,
     n_sub = int(codes.max()) + 1 if codes is not None and N else N
     out.update(n=N, n_subjects=n_sub, significant=False,
                model="ols" if codes is None else "mixed")
-    if N < 3 or np.ptp(a) == 0 or np.ptp(d) == 0:
+    # differences that vary by round-off only (a system that is the reference up to a
+    # unit or frame conversion) have no slope to test: the fit would regress noise
+    scale = float(np.max(np.abs(a))) if N else 0.0
+    if N < 3 or np.ptp(a) == 0 or np.ptp(d) <= 1e-9 * scale:
         return out
     X = np.column_stack([np.ones(N), a])
     if codes is None or n_sub == N:
