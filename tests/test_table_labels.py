@@ -1,8 +1,8 @@
-"""Journal-ready tables over a built report (the tiny study: ``python3 run.py report
---config 'run=["tiny"]'``): no HTML or LaTeX header is a machine name, every column has a
-declared label (gaitval.tables.labels), no rendered cell reads zero where the CSV holds
-a non-zero value, and nothing a reader sees says "seed 00N", "twin" or an issue number.
-Skipped with the reason when no report is built in this checkout."""
+"""Journal-ready tables over a built report (the tiny study's, built once per session by
+the ``tiny_run`` fixture, as the README's report command builds it): no HTML or LaTeX
+header is a machine name, every column has a declared label (gaitval.tables.labels), no
+rendered cell reads zero where the CSV holds a non-zero value, and nothing a reader sees
+says "seed 00N", "twin" or an issue number."""
 from __future__ import annotations
 
 import re
@@ -15,11 +15,7 @@ from gaitval.tables.labels import LABELS, PUBLISHED, label
 from gaitval.tables.numbers import NOISE, to_display
 
 ROOT = Path(__file__).resolve().parents[1]
-REPORT = ROOT / "reports" / "tiny"
-
-if not (REPORT / "index.html").is_file():
-    pytest.skip("the tiny report is not built here (python3 run.py report --config "
-                "'run=[\"tiny\"]')", allow_module_level=True)
+pytestmark = pytest.mark.slow          # the tiny report is built for them
 
 sys_path_tests = Path(__file__).resolve().parent
 import sys  # noqa: E402
@@ -27,7 +23,16 @@ import sys  # noqa: E402
 sys.path.insert(0, str(sys_path_tests))
 from test_report_numbers import html_tables, md_tables  # noqa: E402
 
-TABLES = sorted((REPORT / "tables").glob("*.csv"))
+
+
+@pytest.fixture(scope="module")
+def REPORT(tiny_run) -> Path:
+    return tiny_run / "reports" / "tiny"
+
+
+@pytest.fixture(scope="module")
+def TABLES(REPORT) -> list[Path]:
+    return sorted((REPORT / "tables").glob("*.csv"))
 
 
 def _tex_headers(tex: str) -> list[str]:
@@ -39,7 +44,7 @@ def _tex_headers(tex: str) -> list[str]:
     return out
 
 
-def test_no_html_or_latex_header_contains_an_underscore():
+def test_no_html_or_latex_header_contains_an_underscore(REPORT, TABLES):
     assert TABLES
     bad = []
     for anchor, header, _ in html_tables(REPORT / "index.html"):
@@ -51,7 +56,7 @@ def test_no_html_or_latex_header_contains_an_underscore():
     assert bad == []
 
 
-def test_every_column_of_the_built_report_has_a_declared_label():
+def test_every_column_of_the_built_report_has_a_declared_label(TABLES):
     missing = set()
     for csv in TABLES:
         for c in to_display(pd.read_csv(csv), csv.stem).columns:
@@ -69,7 +74,7 @@ def _reads_zero(cell: str) -> bool:
         return False
 
 
-def test_no_rendered_cell_shows_zero_for_a_non_zero_value():
+def test_no_rendered_cell_shows_zero_for_a_non_zero_value(TABLES):
     """Each .md table (whose strings the HTML and LaTeX print too) against its CSV, cell
     by cell (the Markdown keeps the CSV's rows and columns in order)."""
     checked, bad = 0, []
@@ -91,7 +96,7 @@ def test_no_rendered_cell_shows_zero_for_a_non_zero_value():
     assert bad == []
 
 
-def test_html_cells_are_the_markdown_cells():
+def test_html_cells_are_the_markdown_cells(REPORT, TABLES):
     """So the zero check of the Markdown holds for the HTML too."""
     html = {a: (h, r) for a, h, r in html_tables(REPORT / "index.html")}
     for csv in TABLES:
@@ -101,7 +106,7 @@ def test_html_cells_are_the_markdown_cells():
         assert sorted(map(sorted, rows)) == sorted(map(sorted, mrows))
 
 
-def test_no_seed_numbers_twin_or_issue_numbers_in_what_a_reader_sees():
+def test_no_seed_numbers_twin_or_issue_numbers_in_what_a_reader_sees(REPORT):
     files = [REPORT / "index.md", REPORT / "index.html", REPORT / "verdicts.md",
              *(REPORT / "tables").glob("*.md"), *(REPORT / "tables").glob("*.tex")]
     bad = []
