@@ -12,7 +12,10 @@ rule in turn and in both ways (``kill -9`` of the whole process group, like a po
 then of Snakemake alone), then lets the same command finish, and compares with the
 session's uninterrupted run of the same study (``tiny_run``, tests/conftest.py).  One
 chain of runs, not one run per kill: each resumed run is killed at the next rule it
-starts, so the whole test costs one report plus a Snakemake start per kill.
+starts, so the whole test costs one report plus a Snakemake start per kill.  The suite
+kills at six rules each way (the audit's ``ultrasonic_tables`` and five drawn by a seeded
+sample) to keep CI's time; ``GAITVAL_EXHAUSTIVE_KILLS=1`` kills at every rule in turn
+(18 of the 20 rules each way, 36 kills: passed on this code).
 """
 from __future__ import annotations
 
@@ -120,6 +123,13 @@ def _rules_of(run: Path) -> list[str]:
 def test_killed_at_each_rule_in_turn_both_ways_resumes_to_the_same_report(tiny_run, tmp_path):
     rules = _rules_of(tiny_run)
     assert len(rules) > 10, rules
+    all_rules = rules
+    if os.environ.get("GAITVAL_EXHAUSTIVE_KILLS") != "1":
+        # CI's time: the audit's rule (ultrasonic_tables) and five others drawn by a
+        # seeded sample, each way; GAITVAL_EXHAUSTIVE_KILLS=1 kills at every rule
+        others = [r for r in rules if r != "ultrasonic_tables"]
+        rules = [r for r in rules if r == "ultrasonic_tables"
+                 or r in random.Random(5252).sample(others, 5)]
     work = tmp_path / "work"
     work.mkdir()
     copy_run(tiny_run / "data", work / "data")        # the same study: nothing simulated
@@ -149,7 +159,8 @@ def test_killed_at_each_rule_in_turn_both_ways_resumes_to_the_same_report(tiny_r
     # (study_config, report_config) that start beside a killed one and finish before the
     # kill: they have no job left to start when their turn comes
     for mode, hit in by_mode.items():
-        assert len(hit) >= len(rules) - 3, (mode, sorted(set(rules) - hit))
+        assert len(hit) >= len(rules) - (3 if rules is all_rules else 2), \
+            (mode, sorted(set(rules) - hit))
     ref_rd, rd = tiny_run / "reports" / "tiny", work / "reports" / "tiny"
     for sub, pattern in (("tables", "*"), ("figures", "*.png")):
         ref = sorted(p.name for p in (ref_rd / sub).glob(pattern))
