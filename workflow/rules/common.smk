@@ -242,7 +242,7 @@ if workflow.is_main_process and not {"-n", "--dry-run", "--dryrun"} & set(sys.ar
 # `python -m gaitval` watches this pid, as the batch pool's workers do.
 import os as _os
 
-_os.environ["GAITVAL_RUN_PID"] = str(_os.getpid())
+_os.environ.update(GAITVAL_RUN_PID=str(_os.getpid()))
 
 
 # The batch jobs' pool: its forkserver imports numpy, pandas, scipy and gaitval (~2 CPU-s)
