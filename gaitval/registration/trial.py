@@ -313,8 +313,8 @@ def _implausible(attempt, ce, pl, pose, source, manual, trial, other_poses, tid)
         if cand.pose is pose and manual is not None:        # the clock candidate
             cause += (f": the subject's motion gives {ce2.clock_offset_s:.3f} s "
                       f"({ce2.clock_offset_s - manual:+.2f} s)")
-        return RegistrationError(f"{what}; probable cause: {cause} (with that correction "
-                                 f"the laser sees the legs in {pl2.seen:.0%} of the walk)",
+        return RegistrationError(f"{what}; probable cause: {cause}; with that correction "
+                                 f"the laser sees the legs in {pl2.seen:.0%} of the walk",
                                  path=src, trial=tid, hint=cand.fix)
     if source == "manual":
         same = PL.same_pose_as(pose, {t: p for t, p in other_poses.items() if t != tid})
