@@ -46,7 +46,7 @@ def current(meta: dict) -> bool:
     from gaitval.report.provenance import source_digest
 
     return (meta.get("code_digest") == source_digest()
-            and meta.get("config_digest") == config_digest())
+            and meta.get("config_digest") == config_digest(meta.get("config_path")))
 
 
 def share_column(verdicts: pd.DataFrame, tables_dir: str | Path) -> list[str]:

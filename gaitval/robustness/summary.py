@@ -166,6 +166,7 @@ def write_robustness(design: pd.DataFrame, reports_dir: str | Path, cfg: dict,
     files = write_table(tab, out / "robustness", caption=caption, notes=notes)
     files.append(write_text(out / "robustness.html", _html(tab, caption, notes)))
     meta = {"code_digest": source_digest(), "config_digest": config_digest(cfg.get("_path")),
+            "config_path": str(Path(cfg["_path"]).resolve()) if cfg.get("_path") else None,
             "base_study": str(cfg.get("base_study", "default")), "n_twins": n,
             "twins": list(design.index)}
     files.append(write_text(out / "robustness.json", json.dumps(meta, indent=1) + "\n"))
