@@ -72,24 +72,40 @@ def sd_interval(sd_paper: float, n_paper: int, n_ours: int, level: float = 0.95
     return float(sd_paper * np.sqrt(lo)), float(sd_paper * np.sqrt(hi))
 
 
+#: Table 1's SD per axis: the reproduced within this factor of the paper's, either way.
+#: The paper gives no count of independent samples (the errors are autocorrelated along
+#: the swing), so no sampling interval of its SD exists; 1.5 is the twin's tolerance for
+#: the same SD in physics.csv (``pendulum_error_sd``), stated before the twin was changed.
+PENDULUM_SD_FACTOR = 1.5
+
+
+def _pendulum_row(r) -> dict:
+    """One axis of Table 1: the mean error within the paper's ± SD, and the SD within
+    :data:`PENDULUM_SD_FACTOR` of the paper's."""
+    dev = abs(r.mean_mm - r.mean_mm_published)
+    mean_ok = dev <= r.std_mm_published
+    lo, hi = r.std_mm_published / PENDULUM_SD_FACTOR, r.std_mm_published * PENDULUM_SD_FACTOR
+    sd_ok = bool(lo <= r.std_mm <= hi)
+    return _row("ultrasonic", f"Pendulum error, {r.axis} axis: mean and SD", "Table 1",
+                f"{r.mean_mm_published:.2f} ± {r.std_mm_published:.2f} mm",
+                f"{r.mean_mm:.2f} ± {r.std_mm:.2f} mm",
+                f"mean inside published mean ± SD; SD within a factor {PENDULUM_SD_FACTOR}",
+                mean_ok and sd_ok,
+                f"mean differs from the paper's by {dev:.2f} mm, "
+                f"{'within' if mean_ok else 'more than'} its SD {r.std_mm_published:.2f} mm; "
+                f"the SD {r.std_mm:.2f} mm is {'inside' if sd_ok else 'outside'} "
+                f"{lo:.2f}–{hi:.2f} mm.", "ultrasonic_table1")
+
+
 def ultrasonic_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
-    """Qi et al. 2014: pendulum bias within its spread (Table 1); the system's stride parameters
+    """Qi et al. 2014: pendulum bias within its spread and its SD (Table 1); the system's stride parameters
     at normal speed within the published mean ± SD (Table 8); the direction of the speed
     effects (Table 8); normality (Table 7) and no subject effect (Table C1)."""
     st = "ultrasonic"
     rows = []
     t1 = t.get("ultrasonic_table1")
     if t1 is not None:
-        for r in t1.itertuples(index=False):
-            ok = abs(r.mean_mm - r.mean_mm_published) <= r.std_mm_published
-            rows.append(_row(st, f"Pendulum error, {r.axis} axis: mean within the paper's "
-                             "± SD", "Table 1", f"{r.mean_mm_published:.2f} ± "
-                             f"{r.std_mm_published:.2f} mm", f"{r.mean_mm:.2f} ± "
-                             f"{r.std_mm:.2f} mm", "value inside published mean ± SD", ok,
-                             f"mean differs from the paper's by "
-                             f"{abs(r.mean_mm - r.mean_mm_published):.2f} mm, "
-                             f"{'within' if ok else 'more than'} its SD "
-                             f"{r.std_mm_published:.2f} mm.", "ultrasonic_table1"))
+        rows += [_pendulum_row(r) for r in t1.itertuples(index=False)]
     t8 = t["ultrasonic_table8"]
     ns_nv = _says(notes, "ultrasonic_table8")
     pro = t8[t8["quantity"] == "pro"]
