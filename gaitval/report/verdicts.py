@@ -49,6 +49,7 @@ from gaitval.report.verdicts_common import (  # noqa: F401  (re-exported)
     MAX_CI_WIDTH, MIN_SUBJECTS_CELLS, MIN_SUBJECTS_T, MIN_SUCCESS_TRIALS, NOT_COMPARABLE_NOTE,
     SHORT, _broken_pairs, _ci, _order, _pct, _proportion_verdict, _ranking, _row,
     _same_ranking, wilson)
+from gaitval.report.verdicts_occlusion import tug_occlusion_verdicts
 from gaitval.report.verdicts_ultrasonic import (  # noqa: F401  (re-exported)
     PAPER_SUBJECTS_US, sd_interval, ultrasonic_verdicts)
 
@@ -122,10 +123,12 @@ def _tug_reading_rows(g: pd.DataFrame) -> dict[str, dict]:
     return out
 
 
-def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
+def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None,
+                 physics: list[Path] | None = None) -> list[dict]:
     """Yorozu et al. 2015a: success ranking and per-method success (Table 3; primary reading of
     eq. (3)–(4), the other beside); Method 3 below Method 2 in turning-phase (Table 4) and
-    unobservable (Table 5) RMSE."""
+    unobservable (Table 5) RMSE; Method 2's occluded leg-scans per phase, tracker-counted
+    as the paper's, the truth beside (``physics``: the studies' ``physics.csv``)."""
     st = "tug"
     t3 = t["tug_table3"]
     if "phase_reading" not in t3:
@@ -189,6 +192,8 @@ def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[
                          fmt(a.rmse_x_m_published, b.rmse_x_m_published,
                              a.rmse_y_m_published, b.rmse_y_m_published), rep,
                          "direction", ok, why, name))
+    if t.get("tug_table4") is not None:
+        rows += tug_occlusion_verdicts(t["tug_table4"], primary, physics)
     return rows
 
 
@@ -357,8 +362,8 @@ def _notes(md: Path) -> list[str]:
             if ln.startswith("- ")]
 
 
-def build_verdicts(tables_dir: str | Path, data: dict[str, str] | None = None
-                   ) -> pd.DataFrame:
+def build_verdicts(tables_dir: str | Path, data: dict[str, str] | None = None,
+                   physics: list[Path] | None = None) -> pd.DataFrame:
     """Every verdict of the studies whose tables are in ``tables_dir`` (see module notes).
 
     Parameters
@@ -368,6 +373,9 @@ def build_verdicts(tables_dir: str | Path, data: dict[str, str] | None = None
     data : mapping, optional
         Paper (``tug``, ``mtst``, ``rollator``, ``ultrasonic``) → what its data are
         (:func:`gaitval.report.datakind.paper_data`); the ``data`` column.
+    physics : list of path, optional
+        The run's simulated studies' ``physics.csv``: the TUG occlusion verdicts show the
+        twin's truth occlusion beside the tracker-counted one they compare.
 
     Returns
     -------
@@ -394,7 +402,8 @@ def build_verdicts(tables_dir: str | Path, data: dict[str, str] | None = None
                              "at registration (the report's top box says why)", ""))
             rows[-1]["data"] = (data or {}).get(study, "")
             continue
-        got = BUILDERS[study](tables, notes)
+        got = (BUILDERS[study](tables, notes, physics) if study == "tug"
+               else BUILDERS[study](tables, notes))
         for r in got:
             r["data"] = (data or {}).get(study, "")
         rows += got
