@@ -28,7 +28,8 @@ TINY = {"n_twins": 2, "design_seed": 5, "base_preset": "tiny", "base_study": "ti
                     "tug_sensor_behind_m": {"range": [-1.0, -0.4]},
                     "mtst_sensor_place": {"choices": ["line", "beside"]},
                     "mtst_sensor_distance": {"range": [0.0, 1.0]},
-                    "leg_width_scale": {"range": [0.8, 1.3], "set": "leg_width_scale"},
+                    "leg_width_scale": {"range": [0.8, 1.3], "set": "leg_width_scale",
+                                        "protocols": ["tug", "mtst", "rollator"]},
                     "seed": {"integer": [1, 99999999], "set": "seed"}}}
 
 
@@ -121,6 +122,9 @@ def test_table_names_the_choice_that_moves_a_verdict(tmp_path):
     assert tab.loc["right only", "robustness"] == "hinges on the set-up"
     assert tab.loc["right only", "moved_most_by"].startswith("tug_turn_to_sit ρ=+1.00")
     assert "mtst_" not in tab.loc["right only", "moved_most_by"]      # another protocol's
+    from gaitval.robustness.summary import relevant
+    assert relevant(d.columns, "ultrasonic", cfg) == ["seed"]        # leg width: laser only
+    assert "leg_width_scale" in relevant(d.columns, "tug", cfg)
     assert tab.loc["never", "robustness"] == "not comparable in any twin"
 
 

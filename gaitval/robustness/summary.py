@@ -58,14 +58,22 @@ def classify(lo: float, hi: float, comparable: int = 1) -> str:
     return "hinges on the set-up"
 
 
-#: A choice named ``<protocol>_...`` can move only that protocol's verdicts; the others
-#: (leg width, the study seed) any protocol's.
+#: A choice named ``<protocol>_...`` can move only that protocol's verdicts; another
+#: one (the study seed) any protocol's, unless its ``protocols:`` key in the
+#: configuration names the ones it acts on (the leg width: the laser protocols).
 PROTOCOLS = ("tug", "mtst", "rollator", "ultrasonic")
 
 
-def relevant(columns, study: str) -> list[str]:
+def relevant(columns, study: str, cfg: dict | None = None) -> list[str]:
     """The design's choices that can move a verdict of ``study``."""
-    return [c for c in columns if c.split("_")[0] == study or c.split("_")[0] not in PROTOCOLS]
+    out = []
+    for c in columns:
+        spec = ((cfg or {}).get("factors") or {}).get(c) or {}
+        acts = spec.get("protocols") or ([c.split("_")[0]] if c.split("_")[0] in PROTOCOLS
+                                         else list(PROTOCOLS))
+        if study in acts:
+            out.append(c)
+    return out
 
 
 def movers(x: pd.DataFrame, y: pd.Series, k: int = N_MOVERS) -> str:
@@ -77,11 +85,15 @@ def movers(x: pd.DataFrame, y: pd.Series, k: int = N_MOVERS) -> str:
     for c in x.columns:
         if x[c].nunique() < 2:
             continue
-        r = spearmanr(x[c].to_numpy(), y.to_numpy()).statistic
-        if np.isfinite(r):
-            rho[c] = float(r)
-    top = sorted(rho, key=lambda c: -abs(rho[c]))[:k]
-    return "; ".join(f"{c} ρ={rho[c]:+.2f}" for c in top)
+        res = spearmanr(x[c].to_numpy(), y.to_numpy())
+        if np.isfinite(res.statistic):
+            rho[c] = (float(res.statistic), float(res.pvalue))
+    if not rho:
+        return "none: no choice varies with it"
+    top = sorted(rho, key=lambda c: -abs(rho[c][0]))[:k]
+    return "; ".join(f"{c} ρ={rho[c][0]:+.2f}" + (f" (p {rho[c][1]:.2g})"
+                                                    if np.isfinite(rho[c][1]) else "")
+                     for c in top)
 
 
 def robustness_table(design: pd.DataFrame, outcomes: pd.DataFrame, cfg: dict
@@ -102,7 +114,7 @@ def robustness_table(design: pd.DataFrame, outcomes: pd.DataFrame, cfg: dict
                      "share": f"{k}/{n}", "share_frac": k / n if n else np.nan,
                      "ci95_lo": float(lo), "ci95_hi": float(hi),
                      "ci95": f"{lo:.2f}–{hi:.2f}", "robustness": classify(lo, hi, scored),
-                     "moved_most_by": movers(x[relevant(x.columns, key[0])], yes),
+                     "moved_most_by": movers(x[relevant(x.columns, key[0], cfg)], yes),
                      "outcomes": "; ".join(f"{o} {int(c)}" for o, c in counts.items())})
     return pd.DataFrame(rows)
 
@@ -160,8 +172,10 @@ def write_robustness(design: pd.DataFrame, reports_dir: str | Path, cfg: dict,
                "move it most (Spearman's ρ between the choice and the verdict).")
     notes = [f"Robust: the Wilson 95 % lower bound of the share ≥ {ROBUST_SHARE} (robust: not "
              f"reproduced: upper bound ≤ {1 - ROBUST_SHARE:.1f}); stated before the ensemble ran.",
-             "A twin where a verdict is not comparable counts as not reproducing it."
-             ] + protocol_notes(tab)
+             "A twin where a verdict is not comparable counts as not reproducing it.",
+             f"Moved most by: Spearman's ρ over the {n} twins with its p-value; with few "
+             "twins every varied choice correlates by chance (two twins: ρ = ±1 for all), "
+             "so a named choice is a lead to test, not a finding."] + protocol_notes(tab)
     out = Path(out_dir)
     files = write_table(tab, out / "robustness", caption=caption, notes=notes)
     files.append(write_text(out / "robustness.html", _html(tab, caption, notes)))
