@@ -245,7 +245,10 @@ def robustness(rest: list[str], env: dict) -> int:
     rc = subprocess.call(cmd, env=env)
     if rc:
         return rc
-    base = json.loads(Path("reports/robustness/robustness.json").read_text())["base_study"]
+    record = Path("reports/robustness/robustness.json")
+    if {"-n", "--dry-run", "--dryrun"} & set(rest) or not record.is_file():
+        return 0                                              # a dry run: no table
+    base = json.loads(record.read_text(encoding="utf-8"))["base_study"]
     if not Path(f"reports/{base}/verdicts.csv").is_file():
         print(f"[run.py] reports/{base} is not built; its verdicts show the shares after "
               f"python3 run.py report --config 'run=[\"{base}\"]'", flush=True)

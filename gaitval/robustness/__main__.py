@@ -14,12 +14,22 @@ import argparse
 import sys
 from pathlib import Path
 
-import pandas as pd
 
-from gaitval.robustness.design import load_config, write_ensemble
+from gaitval.robustness.design import load_config, read_design, write_ensemble
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The command line; a gaitval error ends it with its one-line message (exit 2)."""
+    from gaitval.errors import GaitvalError
+
+    try:
+        return _main(argv)
+    except GaitvalError as exc:
+        print(f"gaitval.robustness: {exc}", file=sys.stderr)
+        return 2
+
+
+def _main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     argv = list(sys.argv[1:] if argv is None else argv)
     extra = argv[argv.index("--") + 1:] if "--" in argv else []
@@ -45,7 +55,7 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     from gaitval.robustness.summary import write_robustness
 
-    design = pd.read_csv(a.out / "design.csv", index_col="twin")
+    design = read_design(a.out)
     for p in write_robustness(design, a.reports_dir or a.out / "twins", cfg, a.out):
         print(p)
     return 0

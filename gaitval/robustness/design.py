@@ -149,6 +149,15 @@ def write_ensemble(cfg: dict, out_dir: str | Path) -> tuple[pd.DataFrame, Path]:
     return table, conf
 
 
+def read_design(out_dir: str | Path) -> pd.DataFrame:
+    """The design an ensemble wrote (``<out_dir>/design.csv``)."""
+    f = Path(out_dir) / "design.csv"
+    if not f.is_file():
+        raise ConfigError("no design of a robustness ensemble here", path=f,
+                          hint="python -m gaitval.robustness design --out DIR writes it")
+    return pd.read_csv(f, index_col="twin")
+
+
 def coded(table: pd.DataFrame, cfg: dict) -> pd.DataFrame:
     """The design as numbers for a rank correlation: a choice by its place in the
     factor's ``choices`` (0 for the first), a numeric factor as it is."""

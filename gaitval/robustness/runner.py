@@ -12,10 +12,11 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pandas as pd
 
-from gaitval.robustness.design import ROOT, load_config, write_ensemble
+from gaitval.robustness.design import ROOT, load_config, read_design, write_ensemble
 
+#: Snakemake's dry-run flags: the twins' jobs are listed, no table is made.
+DRY_RUN = {"-n", "--dry-run", "--dryrun"}
 #: Where the ensemble writes, relative to the working folder.
 OUT = Path("reports") / "robustness"
 
@@ -45,7 +46,10 @@ def run_ensemble(config: str | Path | None = None, workdir: str | Path = ".",
         rc = subprocess.call(cmd, cwd=work)
         if rc:
             return rc
-    for p in write_robustness(pd.read_csv(out / "design.csv", index_col="twin"),
+    if DRY_RUN & set(extra):
+        print("[robustness] dry run: no twin report, no table", flush=True)
+        return 0
+    for p in write_robustness(read_design(out),
                               out / "twins", cfg, out):
         print(p, flush=True)
     return 0
