@@ -15,6 +15,8 @@ Snakemake's own console instead.
 Also: ``python3 run.py bench benchmarks/NAME.py`` (installs the benchmark-only extras), and
 ``python3 run.py sensitivity`` (the default report beside the same study under each
 alternative free choice of the simulated replica: ``reports/default/tables/sensitivity.*``).
+``python3 run.py robustness [--ensemble FILE]`` (twins of the default study drawn over the
+free choices' plausible ranges, config/robustness.yaml: ``reports/robustness/robustness.*``).
 
 Resuming after a kill (power cut, killed cluster job): ``report`` finds Snakemake's lock
 left behind in ``.snakemake/locks``; when no live Snakemake works in this folder it
@@ -219,6 +221,46 @@ def sensitivity(rest: list[str], env: dict) -> int:
     return 0
 
 
+def robustness(rest: list[str], env: dict) -> int:
+    """The robustness ensemble (docs/simulator.md, "Robustness ensemble";
+    ``gaitval.robustness``): twins drawn from ``--ensemble FILE`` (default
+    config/robustness.yaml), each twin's report built by the workflow as any study's
+    (reports/robustness/twins/), the table reports/robustness/robustness.*, then the base
+    study's report again so its verdicts show the shares.  Other arguments go to Snakemake
+    (e.g. another profile)."""
+    import json
+
+    ensure_env("test")
+    pick = []
+    if "--ensemble" in rest:
+        i = rest.index("--ensemble")
+        pick, rest = ["--config", rest[i + 1]], rest[:i] + rest[i + 2:]
+    rest, logger = console_args(rest, env)
+    cmd = [str(PY), "-m", "gaitval.robustness", "run", *pick, "--",
+           "--profile", "workflow/profiles/default", *logger, *rest]
+    print("[run.py] " + " ".join(cmd), flush=True)
+    plain = [str(BIN / "snakemake"), "--profile", "workflow/profiles/default", *rest]
+    if not clear_stale_lock(plain, env, _workdir(rest)):
+        return 1
+    rc = subprocess.call(cmd, env=env)
+    if rc:
+        return rc
+    record = Path("reports/robustness/robustness.json")
+    if {"-n", "--dry-run", "--dryrun"} & set(rest) or not record.is_file():
+        return 0                                              # a dry run: no table
+    base = json.loads(record.read_text(encoding="utf-8"))["base_study"]
+    if not Path(f"reports/{base}/verdicts.csv").is_file():
+        print(f"[run.py] reports/{base} is not built; its verdicts show the shares after "
+              f"python3 run.py report --config 'run=[\"{base}\"]'", flush=True)
+    else:
+        cmd = [str(PY), "-m", "gaitval", "report", "--reports-dir", f"reports/{base}",
+               "--studies", base]
+        print("[run.py] " + " ".join(cmd), flush=True)
+        rc = subprocess.call(cmd, env=env)
+    print("[run.py] robustness table: reports/robustness/robustness.html", flush=True)
+    return rc
+
+
 def _has_logger_plugins() -> bool:
     """Whether the environment's Snakemake takes logger plugins (Snakemake 9; 8 has none,
     and then its own console is the one there is)."""
@@ -246,7 +288,7 @@ def console_args(rest: list[str], env: dict) -> tuple[list[str], list[str]]:
 
 
 def main(argv: list[str]) -> int:
-    if not argv or argv[0] not in ("report", "test", "bench", "sensitivity"):
+    if not argv or argv[0] not in ("report", "test", "bench", "sensitivity", "robustness"):
         print(__doc__)
         return 2
     verb, rest = argv[0], argv[1:]
@@ -256,6 +298,8 @@ def main(argv: list[str]) -> int:
     env = dict(os.environ, MPLBACKEND="Agg", PATH=f"{BIN}{os.pathsep}{os.environ['PATH']}")
     if verb == "sensitivity":
         return sensitivity(rest, env)
+    if verb == "robustness":
+        return robustness(rest, env)
     if verb == "report":
         ensure_env("test")
         rest, logger = console_args(rest, env)

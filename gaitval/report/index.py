@@ -297,7 +297,8 @@ def collect(reports_dir: str | Path, study_names: list[str] | None = None,
     present = {p.stem for p in tables}
     studies = run_data(rd, study_names)
     verdicts = build_verdicts(rd / "tables", {p: paper_data(studies, p)
-                                              for p in PAPER_PROTOCOLS})
+                                              for p in PAPER_PROTOCOLS},
+                              [Path(s.checks["path"]) for s in studies if s.checks])
     sections = []
     for sec in SECTION_TITLES:
         items = []

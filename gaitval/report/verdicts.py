@@ -39,17 +39,23 @@ Qi, Y. et al. Sensors 2014, 14(8), 15434–15457 (Qi et al. 2014, ultrasonic).
 """
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from gaitval.tables.numbers import number, p_value
+from gaitval.report.robustness_share import share_column
+from gaitval.report.verdicts_common import (  # noqa: F401  (re-exported)
+    MAX_CI_WIDTH, MIN_SUBJECTS_CELLS, MIN_SUBJECTS_T, MIN_SUCCESS_TRIALS, NOT_COMPARABLE_NOTE,
+    SHORT, _broken_pairs, _ci, _order, _pct, _proportion_verdict, _ranking, _row,
+    _same_ranking, wilson)
+from gaitval.report.verdicts_occlusion import tug_occlusion_verdicts
+from gaitval.report.verdicts_ultrasonic import (  # noqa: F401  (re-exported)
+    PAPER_SUBJECTS_US, sd_interval, ultrasonic_verdicts)
 
 #: Columns of :func:`build_verdicts`.
 VERDICT_COLUMNS = ("study", "data", "comparison", "source", "table", "published",
-                   "reproduced", "criterion", "outcome", "why", "alternative")
+                   "reproduced", "criterion", "outcome", "why", "alternative", "robustness")
 OUTCOMES = ("reproduced", "not reproduced", "not comparable", "not run")
 STUDIES = {"tug": "TUG leg tracking (Yorozu et al. 2015a)", "mtst": "MTST (Yorozu et al. 2015b)",
            "rollator": "Robotic rollator (Chalvatzaki et al. 2017)", "ultrasonic": "Ultrasonic (Qi et al. 2014)"}
@@ -59,109 +65,8 @@ REQUIRED = {"tug": "tug_table3", "mtst": "mtst_table3", "rollator": "rollator_ta
 #: The papers' methods, the only rows a published comparison can be made for.
 PAPER_METHODS = {"tug": ("tug_m1", "tug_m2", "tug_m3"),
                  "mtst": ("mtst_m1", "mtst_m2", "mtst_m3", "mtst_proposed")}
-SHORT = {"tug_m1": "M1", "tug_m2": "M2", "tug_m3": "M3", "mtst_m1": "M1", "mtst_m2": "M2",
-         "mtst_m3": "M3", "mtst_proposed": "proposed"}
 #: TUG: the primary reading of seed000 eq. (3)-(4) (module notes).
 PRIMARY_READING = "swing_first"
-#: A 95 % interval wider than this (as a proportion) is too wide to test a published
-#: value with: the comparison is "not comparable: too small".
-MAX_CI_WIDTH = 0.5
-#: Fewer tracking-success trials than this: an RMSE compares single walks (TUG Tables 4-5).
-MIN_SUCCESS_TRIALS = 2
-#: Fewer subjects than this: a paired t-test (ultrasonic Table 8) has under 2 degrees of
-#: freedom, a "most subject × scenario cells" majority (rollator Table I) is one subject's.
-MIN_SUBJECTS_T = 3
-MIN_SUBJECTS_CELLS = 2
-#: What a table's notes say when its numbers are not comparable with the paper's.
-NOT_COMPARABLE_NOTE = {"ultrasonic_table7": "not comparable",
-                       "ultrasonic_tableC1": "not consistent with subjects as groups",
-                       "ultrasonic_table8": "divide by the number of strides n"}
-
-
-def wilson(k: float, n: float, z: float = 1.959964) -> tuple[float, float]:
-    """Wilson score 95% interval of the proportion ``k/n`` (NaN, NaN when ``n`` is 0)."""
-    if not n:
-        return (np.nan, np.nan)
-    p = k / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return (c - h, c + h)
-
-
-def _row(study, comparison, source, published, reproduced, criterion, ok, why, table,
-         not_comparable: str | None = None) -> dict:
-    """One verdict; ``ok`` None or ``not_comparable`` set → ``not comparable``."""
-    if not_comparable:
-        outcome, why = "not comparable", not_comparable
-    elif ok is None or (isinstance(ok, float) and math.isnan(ok)):
-        outcome = "not comparable"
-    else:
-        outcome = "reproduced" if bool(ok) else "not reproduced"
-    return {"study": study, "data": "", "comparison": comparison, "source": source,
-            "published": published, "reproduced": reproduced, "criterion": criterion,
-            "outcome": outcome, "why": why, "alternative": "", "table": table}
-
-
-def _pct(x: float) -> str:
-    return f"{100 * x:.1f}%"
-
-
-def _ci(lo: float, hi: float) -> str:
-    return f"95% CI {100 * lo:.1f}–{100 * hi:.1f}%"
-
-
-def _proportion_verdict(k, n, published_frac):
-    """(reproduced text, ok or None, too-small reason or None) of a proportion ``k/n``
-    against a published proportion, by the Wilson interval."""
-    lo, hi = wilson(k, n)
-    if not n:
-        return "no trials", None, "too small: no trials to compare"
-    text = f"{_pct(k / n)} ({int(k)}/{int(n)}); {_ci(lo, hi)}"
-    if hi - lo > MAX_CI_WIDTH:
-        return text, None, (f"too small: with {int(n)} trial{'s' * (int(n) != 1)} the 95% "
-                            f"CI spans {100 * (hi - lo):.0f} percentage points, too wide "
-                            "to test the paper's value")
-    return text, lo <= published_frac <= hi, None
-
-
-def _order(values: dict[str, float], higher_first: bool = True) -> list[str]:
-    keys = list(values)
-    return sorted(keys, key=lambda m: ((-values[m] if higher_first else values[m]),
-                                       keys.index(m)))
-
-
-def _ranking(values: dict[str, float], fmt, higher_first=True) -> str:
-    """``"M3 96.4 % > M2 89.3 % = M1 89.3 %"`` (ties, at the printed precision, as ``=``)."""
-    order = _order(values, higher_first)
-    out = ""
-    for i, m in enumerate(order):
-        if i:
-            tie = fmt(values[m]) == fmt(values[order[i - 1]])
-            out += " = " if tie else (" > " if higher_first else " < ")
-        out += f"{SHORT.get(m, m)} {fmt(values[m])}"
-    return out
-
-
-def _same_ranking(pub: dict[str, float], rep: dict[str, float]) -> bool:
-    """Every pair the paper ranks strictly is ranked the same way, strictly."""
-    ms = [m for m in pub if m in rep]
-    return all(np.sign(pub[a] - pub[b]) == np.sign(rep[a] - rep[b])
-               for i, a in enumerate(ms) for b in ms[i + 1:] if pub[a] != pub[b])
-
-
-def _broken_pairs(pub: dict[str, float], rep: dict[str, float], fmt) -> str:
-    ms = [m for m in pub if m in rep]
-    bad = [(a, b) for i, a in enumerate(ms) for b in ms[i + 1:] if pub[a] != pub[b]
-           and np.sign(pub[a] - pub[b]) != np.sign(rep[a] - rep[b])]
-    out = []
-    for a, b in bad:
-        hi, lo = (a, b) if pub[a] > pub[b] else (b, a)
-        out.append(f"{SHORT.get(hi, hi)} {fmt(rep[hi])} is not above "
-                   f"{SHORT.get(lo, lo)} {fmt(rep[lo])}")
-    return "; ".join(out)
-
-
 # -- TUG (Yorozu et al. 2015a) ------------------------------------------------------------------------
 _TUG_FAIL = (("ft_turning", "false tracking in turning"), ("ft_return",
              "false tracking on return"), ("ft_forward", "false tracking forward"),
@@ -218,10 +123,12 @@ def _tug_reading_rows(g: pd.DataFrame) -> dict[str, dict]:
     return out
 
 
-def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
+def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None,
+                 physics: list[Path] | None = None) -> list[dict]:
     """Yorozu et al. 2015a: success ranking and per-method success (Table 3; primary reading of
     eq. (3)–(4), the other beside); Method 3 below Method 2 in turning-phase (Table 4) and
-    unobservable (Table 5) RMSE."""
+    unobservable (Table 5) RMSE; Method 2's occluded leg-scans per phase, tracker-counted
+    as the paper's, the truth beside (``physics``: the studies' ``physics.csv``)."""
     st = "tug"
     t3 = t["tug_table3"]
     if "phase_reading" not in t3:
@@ -285,6 +192,8 @@ def tug_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[
                          fmt(a.rmse_x_m_published, b.rmse_x_m_published,
                              a.rmse_y_m_published, b.rmse_y_m_published), rep,
                          "direction", ok, why, name))
+    if t.get("tug_table4") is not None:
+        rows += tug_occlusion_verdicts(t["tug_table4"], primary, physics)
     return rows
 
 
@@ -442,190 +351,6 @@ def rollator_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> 
     return rows
 
 
-# -- Ultrasonic (Qi et al. 2014) -----------------------------------------------------------------
-_SPEED_ORDER = ("slow", "normal", "fast")
-
-
-def _says(notes: dict | None, table: str) -> bool:
-    """Does ``table``'s notes call its numbers not comparable (:data:`NOT_COMPARABLE_NOTE`)?"""
-    phrase = NOT_COMPARABLE_NOTE[table].lower()
-    return any(phrase in n.lower() for n in (notes or {}).get(table, []))
-
-
-def _pm(mean: float, sd: float, unit: str = "") -> str:
-    """``mean ± sd`` with decimals that give the SD two significant figures (at least the
-    paper's three), never e-notation."""
-    dec = 3
-    if np.isfinite(sd) and sd > 0:
-        dec = min(max(3, 1 - math.floor(math.log10(abs(sd)))), 8)
-    u = f" {unit}" if unit and unit != "-" else ""
-    return f"{mean:.{dec}f} ± {sd:.{dec}f}{u}".replace("-0.000 ", "0.000 ")
-
-
-def _ns_nv_reason(t8: pd.DataFrame, sym: str) -> str:
-    """NS, NV divide S, V by the number of strides n: the n each side implies."""
-    base = {"NS": "S", "NV": "V"}[sym]
-    pro = t8[t8["quantity"] == "pro"].set_index("symbol")
-    if base not in pro.index or sym not in pro.index:
-        return "NS and NV compare definitions of n, not accuracy (Table 8 note)."
-    n_rep = f"{pro.loc[base, 'normal_mean'] / pro.loc[sym, 'normal_mean']:.0f}"
-    if "normal_n" in pro.columns:
-        # one number, or a range ("9-10") where the subjects' stride counts differ
-        given = str(pro.loc[sym, "normal_n"]).strip()
-        num = pd.to_numeric(given, errors="coerce")
-        n_rep = f"{float(num):.0f}" if np.isfinite(num) else (given or n_rep)
-    n_pub = pro.loc[base, "normal_mean_published"] / pro.loc[sym, "normal_mean_published"]
-    return (f"{sym} = {base}/n: gaitval divides by the {n_rep} strides per subject it "
-            f"samples (the paper's Tables 2-6 sample size), the paper's values imply "
-            f"n ≈ {n_pub:.0f} at normal speed; the rows compare definitions of n, not "
-            "accuracy (Table 8 note).")
-
-
-#: Qi et al. 2014: ten subjects walked on the treadmill (Table 8's SDs are over them).
-PAPER_SUBJECTS_US = 10
-
-
-def sd_interval(sd_paper: float, n_paper: int, n_ours: int, level: float = 0.95
-                ) -> tuple[float, float]:
-    """The SDs of ``n_ours`` values that the two-sided F-test of two variances (``level``)
-    does not tell apart from the paper's ``sd_paper`` of ``n_paper`` values: both are
-    sample SDs, so neither is the population's."""
-    from scipy import stats
-
-    a = (1 - level) / 2
-    lo = stats.f.ppf(a, n_ours - 1, n_paper - 1)
-    hi = stats.f.ppf(1 - a, n_ours - 1, n_paper - 1)
-    return float(sd_paper * np.sqrt(lo)), float(sd_paper * np.sqrt(hi))
-
-
-def ultrasonic_verdicts(t: dict[str, pd.DataFrame], notes: dict | None = None) -> list[dict]:
-    """Qi et al. 2014: pendulum bias within its spread (Table 1); the system's stride parameters
-    at normal speed within the published mean ± SD (Table 8); the direction of the speed
-    effects (Table 8); normality (Table 7) and no subject effect (Table C1)."""
-    st = "ultrasonic"
-    rows = []
-    t1 = t.get("ultrasonic_table1")
-    if t1 is not None:
-        for r in t1.itertuples(index=False):
-            ok = abs(r.mean_mm - r.mean_mm_published) <= r.std_mm_published
-            rows.append(_row(st, f"Pendulum error, {r.axis} axis: mean within the paper's "
-                             "± SD", "Table 1", f"{r.mean_mm_published:.2f} ± "
-                             f"{r.std_mm_published:.2f} mm", f"{r.mean_mm:.2f} ± "
-                             f"{r.std_mm:.2f} mm", "value inside published mean ± SD", ok,
-                             f"mean differs from the paper's by "
-                             f"{abs(r.mean_mm - r.mean_mm_published):.2f} mm, "
-                             f"{'within' if ok else 'more than'} its SD "
-                             f"{r.std_mm_published:.2f} mm.", "ultrasonic_table1"))
-    t8 = t["ultrasonic_table8"]
-    ns_nv = _says(notes, "ultrasonic_table8")
-    pro = t8[t8["quantity"] == "pro"]
-    for r in pro.itertuples(index=False):
-        unit = str(r.unit)
-        nc = _ns_nv_reason(t8, r.symbol) if ns_nv and r.symbol in ("NS", "NV") else None
-        small = None if np.isfinite(r.normal_std) else \
-            "too small: fewer than two subjects, no standard deviation"
-        dev = abs(r.normal_mean - r.normal_mean_published)
-        mean_ok = dev <= r.normal_std_published
-        # the SD over subjects too: not told apart from the published one by an F-test
-        n_us = int(getattr(r, "n_subjects", PAPER_SUBJECTS_US))
-        lo, hi = (sd_interval(r.normal_std_published, PAPER_SUBJECTS_US, n_us)
-                  if n_us >= 2 else (np.nan, np.nan))
-        sd_ok = bool(lo <= r.normal_std <= hi) if np.isfinite(r.normal_std) else False
-        ok = mean_ok and sd_ok
-        u = "" if unit == "-" else " " + unit
-        rows.append(_row(st, f"{r.symbol} ({r.parameter}) at normal speed", "Table 8",
-                         _pm(r.normal_mean_published, r.normal_std_published, unit),
-                         _pm(r.normal_mean, r.normal_std, unit),
-                         "mean inside published mean ± SD; SDs equal by an F-test "
-                         "(95 %)", ok,
-                         f"mean differs from the paper's by {number(dev)}{u}, "
-                         f"{'within' if mean_ok else 'more than'} its SD "
-                         f"{number(r.normal_std_published)}; the SD over subjects "
-                         f"{number(r.normal_std)}{u} is {'inside' if sd_ok else 'outside'} "
-                         f"{number(lo)}–{number(hi)}{u} (F-test of the two SDs, "
-                         f"{n_us} and 10 subjects).", "ultrasonic_table8",
-                         not_comparable=nc or small))
-        pub = {s: getattr(r, f"{s}_mean_published") for s in _SPEED_ORDER}
-        rep = {s: getattr(r, f"{s}_mean") for s in _SPEED_ORDER}
-        p_pub = {s: getattr(r, f"{s}_p_published") for s in ("slow", "fast")}
-        p_rep = {s: getattr(r, f"{s}_p") for s in ("slow", "fast")}
-
-        def trend(v, p):
-            return ", ".join(f"{s} {'<' if v[s] < v['normal'] else '>'} normal"
-                             f"{'*' if p[s] < 0.05 else ''} (p {p_value(p[s])})"
-                             for s in ("slow", "fast"))
-        same = all((np.sign(pub[s] - pub["normal"]) == np.sign(rep[s] - rep["normal"]))
-                   and ((p_pub[s] < 0.05) == (p_rep[s] < 0.05)) for s in ("slow", "fast"))
-        n_subj = int(getattr(r, "n_subjects", MIN_SUBJECTS_T))
-        small_t = (None if np.isfinite(list(p_rep.values())).all()
-                   and n_subj >= MIN_SUBJECTS_T else
-                   f"too small: a paired t-test on {n_subj} subject(s) has "
-                   f"{max(n_subj - 1, 0)} degree(s) of freedom (the paper: 10 subjects)")
-        differ = [s for s in ("slow", "fast")
-                  if not ((np.sign(pub[s] - pub["normal"]) == np.sign(rep[s] - rep["normal"]))
-                          and ((p_pub[s] < 0.05) == (p_rep[s] < 0.05)))]
-        why = ("direction and significance as the paper's at both speeds." if same else
-               "differs at " + " and ".join(differ) + " speed: "
-               + "; ".join(f"{s} {number(rep[s])} vs normal {number(rep['normal'])}, "
-                           f"p {p_value(p_rep[s])} (paper {number(pub[s])} vs "
-                           f"{number(pub['normal'])}, p {p_value(p_pub[s])})"
-                           for s in differ) + ".")
-        rows.append(_row(st, f"{r.symbol}: effect of speed (* p < 0.05)", "Table 8",
-                         trend(pub, p_pub), trend(rep, p_rep), "direction and significance",
-                         same, why, "ultrasonic_table8", not_comparable=nc or small_t))
-    t7 = t.get("ultrasonic_table7")
-    if t7 is not None:
-        nc7 = _says(notes, "ultrasonic_table7")
-        for r in t7.itertuples(index=False):
-            known = np.isfinite([r.H, r.H_published]).all()
-            said = str(getattr(r, "comparability", "") or "")
-            if said.lower().startswith("not comparable"):         # the table's own word
-                nc7 = True
-            reason = (f"the paper's H = {r.H_published:.0f}, p = {r.p_published:.3f} test "
-                      "'mean is zero', not normality; gaitval's Lilliefors test gives "
-                      f"H = {r.H:.0f}, p {p_value(r.p)} (Table 7 note)." if nc7 and known
-                      else None if known else "too small: too few strides for the test")
-            rows.append(_row(st, f"{r.symbol} normally distributed (Lilliefors)", "Table 7",
-                             f"H = {r.H_published:.0f}", f"H = {r.H:.0f} (p {p_value(r.p)})"
-                             if known else "too few strides", "same test decision",
-                             int(r.H) == int(r.H_published) if known else None,
-                             f"H = {r.H:.0f} against the paper's {r.H_published:.0f}."
-                             if known else "", "ultrasonic_table7", not_comparable=reason))
-    c1 = t.get("ultrasonic_tableC1")
-    if c1 is not None:
-        ncc = _says(notes, "ultrasonic_tableC1")
-        between = c1[c1["source"] == "between"]
-        if "grouping" not in between.columns:
-            between = between.assign(grouping="subject")
-        # one primary reading, the paper's words ("between subjects"); the other reading of
-        # its groups (the stride index, which its numbers imply) beside it, not counted
-        alt = {r.symbol: r for r in between[between["grouping"] != "subject"]
-               .itertuples(index=False)}
-        for r in between[between["grouping"] == "subject"].itertuples(index=False):
-            known = np.isfinite(r.p) and np.isfinite(r.F)
-            reason = (f"the paper says it groups by subject, but its numbers cannot come "
-                      f"from that grouping (its own Tables 2-4 imply F >> 1; gaitval: F "
-                      f"{r.F:.2f}); they match grouping by stride index (Table C1 note)."
-                      if ncc and known else None if known else
-                      f"too small: F is undefined with {int(r.df) + 1 if np.isfinite(r.df) else 'too few'} "
-                      "subject group(s)")
-            ok = (r.p < 0.05) == (r.p_published < 0.05) if known else None
-            row = _row(st, f"{r.symbol}: no difference between subjects (ANOVA)",
-                       "Table C1", f"F {r.F_published:.2f}, p {p_value(r.p_published)}",
-                       f"F {r.F:.2f}, p {p_value(r.p)}" if known else "F undefined",
-                       "same test decision at 0.05", ok,
-                       f"p {p_value(r.p)} against the paper's {p_value(r.p_published)}.",
-                       "ultrasonic_tableC1", not_comparable=reason)
-            a = alt.get(r.symbol)
-            if a is not None and np.isfinite(a.p) and np.isfinite(a.F):
-                a_ok = (a.p < 0.05) == (a.p_published < 0.05)
-                row["alternative"] = (f"groups = stride index: F {a.F:.2f}, p {p_value(a.p)} "
-                                      f"({'reproduced' if a_ok else 'not reproduced'}, "
-                                      "not counted)")
-            rows.append(row)
-    return rows
-
-
 BUILDERS = {"tug": tug_verdicts, "mtst": mtst_verdicts, "rollator": rollator_verdicts,
             "ultrasonic": ultrasonic_verdicts}
 
@@ -637,8 +362,8 @@ def _notes(md: Path) -> list[str]:
             if ln.startswith("- ")]
 
 
-def build_verdicts(tables_dir: str | Path, data: dict[str, str] | None = None
-                   ) -> pd.DataFrame:
+def build_verdicts(tables_dir: str | Path, data: dict[str, str] | None = None,
+                   physics: list[Path] | None = None) -> pd.DataFrame:
     """Every verdict of the studies whose tables are in ``tables_dir`` (see module notes).
 
     Parameters
@@ -648,6 +373,9 @@ def build_verdicts(tables_dir: str | Path, data: dict[str, str] | None = None
     data : mapping, optional
         Paper (``tug``, ``mtst``, ``rollator``, ``ultrasonic``) → what its data are
         (:func:`gaitval.report.datakind.paper_data`); the ``data`` column.
+    physics : list of path, optional
+        The run's simulated studies' ``physics.csv``: the TUG occlusion verdicts show the
+        twin's truth occlusion beside the tracker-counted one they compare.
 
     Returns
     -------
@@ -674,11 +402,14 @@ def build_verdicts(tables_dir: str | Path, data: dict[str, str] | None = None
                              "at registration (the report's top box says why)", ""))
             rows[-1]["data"] = (data or {}).get(study, "")
             continue
-        got = BUILDERS[study](tables, notes)
+        got = (BUILDERS[study](tables, notes, physics) if study == "tug"
+               else BUILDERS[study](tables, notes))
         for r in got:
             r["data"] = (data or {}).get(study, "")
         rows += got
-    return pd.DataFrame(rows, columns=list(VERDICT_COLUMNS))
+    out = pd.DataFrame(rows, columns=list(VERDICT_COLUMNS))
+    out["robustness"] = share_column(out, td)
+    return out
 
 
 def summary_lines(v: pd.DataFrame) -> list[str]:

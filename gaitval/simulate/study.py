@@ -196,9 +196,29 @@ def _subject_rows(study_cfg: dict, seed: int):
             stick = i >= n - n_stick
             subj, gp = P.sample_subject(_rng(seed, 1, k), group, f"{prefix}{i + 1:02d}",
                                         c["sensor_height_m"], stick=stick)
-            out.append((proto, subj, gp))
+            out.append((proto, *_subject_choices(study_cfg, proto, subj, gp)))
             k += 1
     return out
+
+
+def _subject_choices(study_cfg: dict, proto: str, subj: dict, gp: GaitParams
+                     ) -> tuple[dict, GaitParams]:
+    """A participant with the preset's free choices of the participants applied after
+    their draws (so every other draw is unchanged): ``leg_width_scale`` (top level)
+    scales the leg width at the scan height, ``tug.turn_step_factor`` replaces the turning
+    step length factor, ``mtst.step_width_scale`` scales the step width.  Absent keys
+    change nothing (docs/simulator.md, "Plausible ranges")."""
+    from dataclasses import replace
+
+    c = study_cfg.get(proto) or {}
+    scale = float(study_cfg.get("leg_width_scale", 1.0))
+    if scale != 1.0:
+        subj = {**subj, "leg_width_m": round(subj["leg_width_m"] * scale, 4)}
+    if proto == "tug" and "turn_step_factor" in c:
+        gp = replace(gp, turn_step_factor=float(c["turn_step_factor"]))
+    if proto == "mtst" and "step_width_scale" in c:
+        gp = replace(gp, step_width_m=gp.step_width_m * float(c["step_width_scale"]))
+    return subj, gp
 
 
 def _subject_trials(proto: str, c: dict, study: str, subj: dict, gp: GaitParams, rng_s,
