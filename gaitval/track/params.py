@@ -1,0 +1,82 @@
+"""Declared parameters: each part's parameters written once, with unit and source.
+
+A role's part (a filter, a gate, …) is a dataclass whose fields are its parameters, each
+declared with :func:`param`: default, unit and where the value comes from (a paper's
+equation or table, or ``"no source"`` for gaitval's own choices).  The constructor
+(what :meth:`gaitval.registry.Registry.build` and the method overrides call), the
+class's ``Parameters`` documentation (:func:`declared`) and the reference table of
+``docs/tracking.md`` (:func:`markdown_table`, checked by ``tests/test_track_roles.py``) are
+all drawn from that one declaration.
+
+Examples
+--------
+>>> from dataclasses import dataclass
+>>> @declared
+... @dataclass(eq=False)
+... class Gate:
+...     '''A gate.'''
+...     g: float = param(13.82, "λ²", "seed000 Table 2", "G, the gate's size")
+>>> Gate().g
+13.82
+>>> print(Gate.__doc__.splitlines()[-1])
+        G, the gate's size [λ²; default 13.82; seed000 Table 2].
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, NamedTuple
+
+NO_SOURCE = "no source"
+
+
+class Declared(NamedTuple):
+    """One declared parameter of a part."""
+
+    name: str
+    default: Any
+    unit: str
+    source: str
+    doc: str
+
+
+def param(default, unit: str, source: str, doc: str):
+    """A dataclass field declaring one parameter (``unit`` ``"-"`` for a plain number or a
+    choice; ``source`` a paper's equation/table or :data:`NO_SOURCE`)."""
+    return dataclasses.field(default=default, metadata={"unit": unit, "source": source,
+                                                         "doc": doc})
+
+
+def parameters(cls) -> list[Declared]:
+    """The declared parameters of a part's class (fields made with :func:`param`), in
+    constructor order."""
+    if not dataclasses.is_dataclass(cls):
+        return []
+    return [Declared(f.name, f.default, f.metadata["unit"], f.metadata["source"],
+                     f.metadata["doc"])
+            for f in dataclasses.fields(cls) if f.init and "unit" in f.metadata]
+
+
+def declared(cls):
+    """Class decorator (above ``@dataclass``): appends the ``Parameters`` section, drawn
+    from the declarations, to the class's docstring."""
+    rows = parameters(cls)
+    if rows:
+        lines = ["", "", "    Parameters", "    ----------"]
+        for p in rows:
+            lines += [f"    {p.name}",
+                      f"        {p.doc} [{p.unit}; default {p.default!r}; {p.source}]."]
+        cls.__doc__ = (cls.__doc__ or "").rstrip() + "\n".join(lines)
+    return cls
+
+
+def markdown_table(registries: dict[str, Any]) -> str:
+    """One Markdown table of every declared parameter of the parts of ``registries``
+    (``{role key: Registry}``): role, part, parameter, default, unit, source."""
+    out = ["| role | part | parameter | default | unit | source |",
+           "|---|---|---|---|---|---|"]
+    for role, reg in registries.items():
+        for name in reg.names():
+            for p in parameters(reg[name]):
+                out.append(f"| `{role}` | `{name}` | `{p.name}` | `{p.default!r}` | "
+                           f"{p.unit} | {p.source} |")
+    return "\n".join(out) + "\n"
