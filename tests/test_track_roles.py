@@ -320,3 +320,22 @@ def test_the_roles_fast_kernels_equal_their_generic_form(method):
     assert got.refiltered == want.refiltered and got.swapped_sides == want.swapped_sides
     if method == "tug_m3":
         assert got.refiltered                                 # the re-filter path ran
+
+
+def test_the_parameter_table_in_the_docs_is_the_declared_one():
+    """docs/tracking.md's table of the parts' parameters is the one drawn from their
+    declarations (gaitval/track/params.py), so the two cannot drift apart."""
+    from pathlib import Path
+
+    from gaitval.track.params import markdown_table, parameters
+    from gaitval.track.roles import ROLE_REGISTRIES
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "tracking.md").read_text()
+    begin, end = "<!-- parameters: begin (generated) -->\n", "<!-- parameters: end -->"
+    assert doc[doc.index(begin) + len(begin):doc.index(end)] == markdown_table(ROLE_REGISTRIES)
+    # the declarations are the constructors' parameters, with their defaults
+    gate = ROLE_REGISTRIES["gate"]["chi2"]
+    (g,) = parameters(gate)
+    assert (g.name, g.default, g.source) == ("g", 13.82, "seed000 Table 2")
+    assert gate().g == 13.82 and gate(g=9.21).g == 9.21
+    assert "seed000 Table 2" in gate.__doc__

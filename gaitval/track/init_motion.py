@@ -13,10 +13,15 @@ scanners. ICRA 2015 (the leg_tracker recordings of empty scenes, ``negative_*.ba
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
+from gaitval.track.params import NO_SOURCE, coerce, declared, param
 
+
+@declared
+@dataclass(eq=False)
 class MotionCheck:
     """Is there a leg-like pair that moves?  (Used by :class:`ClosestMovingPair`.)
 
@@ -38,16 +43,19 @@ class MotionCheck:
     (``positive_1.bag``, every simulated TUG and MTST trial) reach 0.5 m.
     """
 
-    def __init__(self, min_travel_m: float = 0.5, max_step_m: float = 0.7,
-                 max_lost_scans: int = 8, per_scan: int = 3, still_min_obs: int = 8,
-                 still_lag: int = 3, still_radius_m: float = 0.05):
-        self.min_travel_m = float(min_travel_m)
-        self.max_step_m = float(max_step_m)
-        self.max_lost_scans = int(max_lost_scans)
-        self.per_scan = int(per_scan)
-        self.still_min_obs = int(still_min_obs)
-        self.still_lag = int(still_lag)
-        self.still_radius_m = float(still_radius_m)
+    min_travel_m: float = param(0.5, "m", NO_SOURCE, "net travel both legs must reach")
+    max_step_m: float = param(0.7, "m", NO_SOURCE, "largest step of a leg between scans")
+    max_lost_scans: int = param(8, "scans", NO_SOURCE, "a leg lost longer ends the follow")
+    per_scan: int = param(3, "pairs", NO_SOURCE, "closest leg-like pairs followed per scan")
+    still_min_obs: int = param(8, "observations", NO_SOURCE,
+                               "a scan with fewer is still (the background was subtracted)")
+    still_lag: int = param(3, "scans", NO_SOURCE,
+                           "how many scans back a crowded scan is compared")
+    still_radius_m: float = param(0.05, "m", NO_SOURCE,
+                                  "an observation this near one of the earlier scan stayed")
+
+    def __post_init__(self):
+        coerce(self)
         self.max_gate_m = 1.0        # a leg unseen for a while: still no further than this
 
     def moving_pair(self, source, d_min: float, d_max: float, first_scan: int = 0,

@@ -9,12 +9,16 @@ of human gait tracking algorithms for an intelligent robotic rollator. IEEE ICRA
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from gaitval.track.init_motion import MotionCheck
+from gaitval.track.params import NO_SOURCE, coerce, declared, param
 
 
+@declared
+@dataclass(eq=False)
 class WalkingPairCheck:
     """Is there a pair of legs that walks *with* the sensor?  (For a laser that travels with
     its user: the rollator's, seed 002.)
@@ -48,16 +52,20 @@ class WalkingPairCheck:
     :class:`MotionCheck`'s 0.7 m step per 7.5 Hz scan stands for).
     """
 
-    def __init__(self, window_s: float = 1.4, m_fraction: float = 0.5,
-                 pass_leg_widths: float = 1.0, stay_leg_widths: float = 1.0,
-                 max_speed_mps: float = 5.0, max_gate_m: float = 1.0, per_scan: int = 3):
-        self.window_s = float(window_s)
-        self.m_fraction = float(m_fraction)
-        self.pass_leg_widths = float(pass_leg_widths)
-        self.stay_leg_widths = float(stay_leg_widths)
-        self.max_speed_mps = float(max_speed_mps)
-        self.max_gate_m = float(max_gate_m)
-        self.per_scan = int(per_scan)
+    window_s: float = param(1.4, "s", NO_SOURCE + " (one stride at 85 steps/min)",
+                            "the window N is counted over")
+    m_fraction: float = param(0.5, "-", NO_SOURCE + " (the people tracker's M of N)",
+                              "M = ⌈m_fraction · N⌉ scans with both legs")
+    pass_leg_widths: float = param(1.0, "leg widths", NO_SOURCE, "c_p, the legs' passing")
+    stay_leg_widths: float = param(1.0, "leg widths", NO_SOURCE,
+                                   "largest RMS of the legs' midpoint about its mean")
+    max_speed_mps: float = param(5.0, "m/s", NO_SOURCE + " (a fast swing)",
+                                 "what a leg can move per scan period")
+    max_gate_m: float = param(1.0, "m", NO_SOURCE, "largest gate of a leg unseen for a while")
+    per_scan: int = param(3, "pairs", NO_SOURCE, "closest leg-like pairs followed per scan")
+
+    def __post_init__(self):
+        coerce(self)
 
     def window_scans(self, source) -> int:
         """N: the scans of one window at the source's scan period."""

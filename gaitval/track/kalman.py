@@ -224,16 +224,9 @@ class AxisKalmanFilter(LegFilter):
     def gated(self, s, obs, g):
         px, py = s[0], s[1]
         sv = s[4] + self._r2                 # seed000 eq. (12), per axis
-        out = []
-        j = 0
-        for zx, zy in obs:
-            j += 1
-            ex = zx - px
-            ey = zy - py
-            lam2 = (ex * ex + ey * ey) / sv          # seed000 eq. (11)
-            if lam2 < g:                             # seed000 eq. (13)
-                out.append((j, lam2))
-        return out
+        lam2 = [((zx - px) * (zx - px) + (zy - py) * (zy - py)) / sv   # seed000 eq. (11)
+                for zx, zy in obs]
+        return [(j, v) for j, v in enumerate(lam2, 1) if v < g]        # seed000 eq. (13)
 
     def gated_pair(self, pl, pr, obs, g):
         lx, ly, rx, ry = pl[0], pl[1], pr[0], pr[1]

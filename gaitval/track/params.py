@@ -24,6 +24,7 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import inspect
 from typing import Any, NamedTuple
 
 NO_SOURCE = "no source"
@@ -48,12 +49,21 @@ def param(default, unit: str, source: str, doc: str):
 
 def parameters(cls) -> list[Declared]:
     """The declared parameters of a part's class (fields made with :func:`param`), in
-    constructor order."""
-    if not dataclasses.is_dataclass(cls):
+    constructor order; none for a class that is not a dataclass itself (e.g. one that
+    derives from a declared part but has a constructor of its own)."""
+    if "__dataclass_fields__" not in vars(cls):
         return []
     return [Declared(f.name, f.default, f.metadata["unit"], f.metadata["source"],
                      f.metadata["doc"])
             for f in dataclasses.fields(cls) if f.init and "unit" in f.metadata]
+
+
+def coerce(part) -> None:
+    """Convert each declared number of ``part`` to its default's type (``int``, ``float``,
+    ``bool``): a configuration may write ``1`` for ``1.0`` or ``1.0`` for ``1``."""
+    for f in dataclasses.fields(part):
+        if type(f.default) in (int, float, bool):
+            setattr(part, f.name, type(f.default)(getattr(part, f.name)))
 
 
 def declared(cls):
@@ -69,14 +79,24 @@ def declared(cls):
     return cls
 
 
+def _shown(value) -> str:
+    return f"{value:.6g}" if isinstance(value, float) else repr(value)
+
+
 def markdown_table(registries: dict[str, Any]) -> str:
     """One Markdown table of every declared parameter of the parts of ``registries``
-    (``{role key: Registry}``): role, part, parameter, default, unit, source."""
+    (``{role key: Registry}``): role, part, parameter, default, unit, source.  A part
+    without declarations gets one row saying so (its class documents its parameters)."""
     out = ["| role | part | parameter | default | unit | source |",
            "|---|---|---|---|---|---|"]
     for role, reg in registries.items():
         for name in reg.names():
-            for p in parameters(reg[name]):
-                out.append(f"| `{role}` | `{name}` | `{p.name}` | `{p.default!r}` | "
+            rows = parameters(reg[name])
+            if not rows:
+                what = ("(no parameters)" if not inspect.signature(reg[name]).parameters
+                        else f"(not declared: see `{reg[name].__qualname__}`)")
+                out.append(f"| `{role}` | `{name}` | {what} | | | |")
+            for p in rows:
+                out.append(f"| `{role}` | `{name}` | `{p.name}` | `{_shown(p.default)}` | "
                            f"{p.unit} | {p.source} |")
     return "\n".join(out) + "\n"

@@ -177,19 +177,13 @@ def _committer(run: TrackingRun, book):
 
     def commit(k, a, b, post_l, post_r, ph, obs, pats):
         Lpost[k], Rpost[k], phase[k] = post_l, post_r, ph
-        if a:
+        if a:                                   # observation a − 1 taken; H back to 0
             z = obs[a - 1]
             Lz[k], Lreal[k], Lpat[k], Lidx[k] = (z[0], z[1]), True, pats[a - 1], a - 1
-            L.n_unobserved = 0
-        else:
-            Lpat[k] = "UO"
-            L.n_unobserved += 1
+        Lpat[k], L.n_unobserved = (Lpat[k], 0) if a else ("UO", L.n_unobserved + 1)
         if b:
             z = obs[b - 1]
             Rz[k], Rreal[k], Rpat[k], Ridx[k] = (z[0], z[1]), True, pats[b - 1], b - 1
-            R.n_unobserved = 0
-        else:
-            Rpat[k] = "UO"
-            R.n_unobserved += 1
+        Rpat[k], R.n_unobserved = (Rpat[k], 0) if b else ("UO", R.n_unobserved + 1)
         book(k)
     return commit
