@@ -57,25 +57,25 @@ class Gate:
 
     def kernel(self, run):
         """The gate of one run (:class:`~gaitval.track.trackingrun.TrackingRun`, its
-        subject's w_l already bound, :meth:`for_leg_width`): ``gate(k, pl, pr, obs) ->
-        (cand_l, cand_r)`` for the predicted states ``pl``, ``pr`` at scan k."""
+        subject's w_l already bound, :meth:`for_leg_width`): ``gate(k, prior, obs) ->
+        (cand_l, cand_r)`` for the pair of predicted states ``prior`` at scan k."""
         F = run.filter
         if not self.needs_context:
             candidates = self.candidates
 
-            def gate(k, pl, pr, obs):
-                return candidates(F, pl, obs, None), candidates(F, pr, obs, None)
+            def gate(k, prior, obs):
+                return candidates(F, prior[0], obs, None), candidates(F, prior[1], obs, None)
             return gate
         at, w, dts, phase, hypot = self.candidates_at, run.leg_width_m, run.dts, run.phase, \
             math.hypot
         L, R = run.legs
         Lpost, Rpost = L.post, R.post
 
-        def gate(k, pl, pr, obs):                  # the GateContext fields as arguments
+        def gate(k, prior, obs):                   # the GateContext fields as arguments
             dt, sw = dts[k], SWINGING[phase[k - 1]]
             sl, sr = Lpost[k - 1], Rpost[k - 1]
-            return (at(F, pl, obs, w, dt, hypot(sl[2], sl[3]), sw[0], L.n_unobserved),
-                    at(F, pr, obs, w, dt, hypot(sr[2], sr[3]), sw[1], R.n_unobserved))
+            return (at(F, prior[0], obs, w, dt, hypot(sl[2], sl[3]), sw[0], L.n_unobserved),
+                    at(F, prior[1], obs, w, dt, hypot(sr[2], sr[3]), sw[1], R.n_unobserved))
         return gate
 
     def candidates_at(self, filter, prior, obs, leg_width_m: float, dt: float, speed: float,
@@ -136,8 +136,8 @@ class ChiSquareGate(Gate):
     def kernel(self, run):
         gated_pair, g = run.filter.gated_pair, self.g
 
-        def gate(k, pl, pr, obs):
-            return gated_pair(pl, pr, obs, g)       # seed000 eq. (13), both legs
+        def gate(k, prior, obs):
+            return gated_pair(prior[0], prior[1], obs, g)   # seed000 eq. (13), both legs
         return gate
 
 

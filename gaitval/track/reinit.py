@@ -11,7 +11,7 @@ of consecutive frames, we re-initialize the algorithm."
     algorithm is due for re-initialisation: from that scan on, the handler looks at each
     scan again with the detector's predefined window (no prediction, as at the first scan)
     and, at the first one with a pair of legs, restarts both legs on it at rest
-    (:meth:`~gaitval.track.tracker.TrackingRun.restart`; every restart is counted in
+    (:meth:`~gaitval.track.trackingrun.TrackingRun.restart`; every restart is counted in
     ``TrackResult.restarts``), even if the loop has meanwhile gated an observation to the
     lost leg again.
     ``n_lost`` is not given in the paper; gaitval's default is 15 scans (0.4 s at the

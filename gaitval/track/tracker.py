@@ -110,7 +110,7 @@ class Tracker:
         for k in range(run.k0 + 1, run.n):
             prior = run.predict(k)                      # seed000 eq. (7)–(8), (18)–(20)
             obs, pats = source.at(k, prior)             # detections (or a windowed detector)
-            cand_l, cand_r = gate(k, *prior, obs)       # seed000 eq. (11)–(13)
+            cand_l, cand_r = gate(k, prior, obs)        # seed000 eq. (11)–(13)
             a, b = associate(k, prior, obs, cand_l, cand_r)     # seed000 eq. (9)–(10)
             post_l, post_r, phase = update(prior, obs, a, b)    # eq. (14)–(16), (3)–(5)
             run.commit(k, a, b, post_l, post_r, phase, obs, pats)
