@@ -339,3 +339,17 @@ def test_the_parameter_table_in_the_docs_is_the_declared_one():
     assert (g.name, g.default, g.source) == ("g", 13.82, "seed000 Table 2")
     assert gate().g == 13.82 and gate(g=9.21).g == 9.21
     assert "seed000 Table 2" in gate.__doc__
+
+
+def test_every_method_s_tracker_pickles_and_tracks_the_same_afterwards():
+    """A built tracker crosses process boundaries (the workflow's job pool); its parts'
+    per-instance kernels (the phase model's bound ``identify``) are rebuilt on unpickling."""
+    import pickle
+
+    t, noisy, npats = _noisy_walk()
+    for method in ("tug_m2", "mtst_proposed"):
+        _, tracker = build_tracker(method)
+        again = pickle.loads(pickle.dumps(tracker))
+        a, b = tracker.run(t, noisy, npats, 0.1), again.run(t, noisy, npats, 0.1)
+        np.testing.assert_array_equal(a.x, b.x)
+        np.testing.assert_array_equal(a.phase, b.phase)

@@ -62,5 +62,8 @@ class SpeedThresholdPhases(PhaseModel):
         self.identify = types.FunctionType(f.__code__, f.__globals__, "identify",
                                            (self.v_st_th, self.v_sw_th))  # eq. (3)–(5)
 
+    def __reduce__(self):       # the bound copy does not pickle: rebuild it from the parameters
+        return type(self), (self.v_st_th, self.v_sw_th, self.reading)
+
     def identify(self, l, r):  # the role's method; each instance binds a copy of it (above)
         return self._of_states(l, r, self.v_st_th, self.v_sw_th)   # seed000 eq. (3)–(5)
