@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 from gaitval.registry import Registry
 from gaitval.track.init_motion import MotionCheck
-from gaitval.track.params import NO_SOURCE, declared, param
+from gaitval.track.params import NO_SOURCE, declared, param, param_of
 
 INITIALISERS = Registry("initialiser", table="gaitval.track.roles")
 
@@ -102,13 +102,9 @@ class ClosestMovingPair(ClosestPair):
     """
 
     require_motion: bool = param(True, "-", NO_SOURCE, "False gives ClosestPair exactly")
-    min_travel_m: float = param(0.5, "m", NO_SOURCE + " (empty room 0.28 m, walkers ≥ 0.5 m)",
-                                "net travel of each leg of a moving pair (over still scans, "
-                                "off the background)")
-    max_step_m: float = param(0.7, "m", NO_SOURCE + " (a 5 m/s swing at 7.5 scans/s)",
-                              "largest move of one leg between two scans")
-    max_lost_scans: int = param(8, "scans", NO_SOURCE,
-                                "a leg unseen for longer ends the pair's follow")
+    min_travel_m: float = param_of(MotionCheck, "min_travel_m")
+    max_step_m: float = param_of(MotionCheck, "max_step_m")
+    max_lost_scans: int = param_of(MotionCheck, "max_lost_scans")
     min_scans: int = param(10, "scans", NO_SOURCE,
                            "a source with fewer scans cannot show motion; its pair is kept")
 

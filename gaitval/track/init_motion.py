@@ -43,9 +43,13 @@ class MotionCheck:
     (``positive_1.bag``, every simulated TUG and MTST trial) reach 0.5 m.
     """
 
-    min_travel_m: float = param(0.5, "m", NO_SOURCE, "net travel both legs must reach")
-    max_step_m: float = param(0.7, "m", NO_SOURCE, "largest step of a leg between scans")
-    max_lost_scans: int = param(8, "scans", NO_SOURCE, "a leg lost longer ends the follow")
+    min_travel_m: float = param(0.5, "m", NO_SOURCE + " (empty room 0.28 m, walkers ≥ 0.5 m)",
+                                "net travel of each leg of a moving pair (over still scans, "
+                                "off the background)")
+    max_step_m: float = param(0.7, "m", NO_SOURCE + " (a 5 m/s swing at 7.5 scans/s)",
+                              "largest move of one leg between two scans")
+    max_lost_scans: int = param(8, "scans", NO_SOURCE,
+                                "a leg unseen for longer ends the pair's follow")
     per_scan: int = param(3, "pairs", NO_SOURCE, "closest leg-like pairs followed per scan")
     still_min_obs: int = param(8, "observations", NO_SOURCE,
                                "a scan with fewer is still (the background was subtracted)")

@@ -58,6 +58,13 @@ def parameters(cls) -> list[Declared]:
             for f in dataclasses.fields(cls) if f.init and "unit" in f.metadata]
 
 
+def param_of(cls, name: str):
+    """A field declaring the parameter ``name`` exactly as ``cls`` declares it (a part that
+    passes one of its parameters on to another part declares it once, there)."""
+    f = next(f for f in dataclasses.fields(cls) if f.name == name)
+    return dataclasses.field(default=f.default, metadata=f.metadata)
+
+
 def coerce(part) -> None:
     """Convert each declared number of ``part`` to its default's type (``int``, ``float``,
     ``bool``): a configuration may write ``1`` for ``1.0`` or ``1.0`` for ``1``."""
