@@ -104,7 +104,7 @@ def main() -> None:
     from gaitval.io.rosbag import read_rosbag_scans
     from gaitval.methods import build_method
     from gaitval.track import lifecycle as lc
-    from gaitval.track.init import principal_axis
+    from gaitval.track.init_walking import principal_axis
 
     scans = read_rosbag_scans(args.bag, args.topic)
     kind = build_method("people", {"kind__refind": args.refind} if args.refind else None)

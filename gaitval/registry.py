@@ -5,6 +5,12 @@ occlusion handler).  Each role has a small base class and a :class:`Registry` ma
 config name to an implementation.  A method (``gaitval.methods``) names one part per role
 and its parameters; :meth:`Registry.build` turns such a spec into an object.
 
+A registry is filled either by the ``register`` decorator on each class, or from a
+*table module* named when it is made (``Registry("filter", table="gaitval.track.roles")``):
+the module that lists every part of the role and adds each with :meth:`Registry.add`,
+imported the first time the registry is read, so the registry is complete whatever was
+imported before.
+
 Examples
 --------
 >>> from gaitval.registry import Registry
@@ -18,6 +24,7 @@ Examples
 """
 from __future__ import annotations
 
+import importlib
 from typing import Any, Callable
 
 from gaitval.errors import ConfigError
@@ -30,29 +37,42 @@ class Registry:
     ----------
     role : str
         The role's name, used in error messages (e.g. ``"associator"``).
+    table : str or None
+        The module that adds the role's parts (imported when the registry is first read).
     """
 
-    def __init__(self, role: str):
+    def __init__(self, role: str, table: str | None = None):
         self.role = role
         self._items: dict[str, type] = {}
+        self._table = table
+
+    def _load(self) -> None:
+        if self._table is not None:
+            table, self._table = self._table, None
+            importlib.import_module(table)
+
+    def add(self, name: str, cls: type) -> type:
+        """List ``cls`` under ``name``."""
+        if name in self._items:
+            raise ValueError(f"{self.role} {name!r} registered twice")
+        self._items[name] = cls
+        cls.registry_name = name
+        return cls
 
     def register(self, name: str) -> Callable[[type], type]:
         """Class decorator that lists the class under ``name``."""
-        def deco(cls: type) -> type:
-            if name in self._items:
-                raise ValueError(f"{self.role} {name!r} registered twice")
-            self._items[name] = cls
-            cls.registry_name = name
-            return cls
-        return deco
+        return lambda cls: self.add(name, cls)
 
     def names(self) -> list[str]:
+        self._load()
         return sorted(self._items)
 
     def __contains__(self, name: str) -> bool:
+        self._load()
         return name in self._items
 
     def __getitem__(self, name: str) -> type:
+        self._load()
         try:
             return self._items[name]
         except KeyError:

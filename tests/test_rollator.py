@@ -150,7 +150,7 @@ def test_walking_axis_is_where_the_legs_swing_not_the_longest_r():
     """r = p_L − p_R of a walker: ± 0.25 m along the walking direction (x), 0.2 m step
     width.  The principal axis is x (each leg passes the other by 0.25 m along it); along
     the longest r the far side reaches only −0.07 m, less than one leg width."""
-    from gaitval.track.init import principal_axis
+    from gaitval.track.init_walking import principal_axis
     ph = np.linspace(0, 2 * np.pi, 17)              # includes ±90°: r = (±0.25, 0.2)
     rs = [(0.25 * math.sin(a), 0.2) for a in ph]
     ux, uy = principal_axis(rs)

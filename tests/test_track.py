@@ -493,7 +493,7 @@ def test_regression_snapshot():
 
 
 def test_hypot_below_is_np_hypot_compared_even_at_the_edge():
-    from gaitval.track.init import hypot_below
+    from gaitval.track.init_motion import hypot_below
     rng = np.random.default_rng(7)
     r = 0.06
     t = rng.uniform(0, 2 * np.pi, 20000)

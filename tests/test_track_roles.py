@@ -268,46 +268,20 @@ def test_measurement_noise_in_leg_widths_is_set_per_subject():
     np.testing.assert_allclose(a.x, b.x, rtol=1e-12)          # 0.4 w_l = 0.04 m here
 
 
-def _role_by_role(tracker, t, xy, pats, leg_width_m):
-    """The tracker's loop written with one call per role and per :class:`TrackingRun`
-    step (predict, gate, associate, commit, occlusion), the readable form of
-    :meth:`Tracker.track`."""
-    from gaitval.track.leg import handedness, swap_sides
-    from gaitval.track.observations import DetectionSeries
-    from gaitval.track.tracker import Hypotheses, TrackingRun
-
-    source = DetectionSeries(xy, pats)
-    t = np.asarray(t, dtype=float)
-    start = tracker.init.find(source, leg_width_m)
-    if start is None:
-        return empty_result(t)
-    run = TrackingRun(tracker, t, source, leg_width_m, start)
-    gate, occ = tracker.gate.for_leg_width(leg_width_m), tracker.occlusion
-    state, hyp = occ.begin(run), Hypotheses(run)
-    for k in range(run.k0 + 1, run.n):
-        prior = run.predict(k)
-        obs, pk = source.at(k, prior)
-        cand = [gate.candidates(run.filter, prior[f], obs,
-                                run.gate_context(f, k) if gate.needs_context else None)
-                for f in (0, 1)]
-        hyp.reset(prior, obs)
-        a, b = tracker.associator.select(cand[0], cand[1], run.phase[k - 1], hyp.phase_of)
-        run.commit(k, a, b, hyp, obs, pk)
-        occ.after_scan(state, run, k)
-    occ.finish(state, run)
-    res = run.result()
-    if tracker.sides == "walking_direction" and handedness(res) < 0:
-        swap_sides(res)
-    return res
+def _generic(part, base):
+    """``part`` with its filter and gate kernels replaced by ``base``'s generic ones (each
+    leg on its own, through the per-leg methods)."""
+    cls = type(f"Generic{type(part).__name__}", (type(part),),
+               {name: getattr(base, name) for name in ("predict_pair", "gated_pair", "kernel")
+                if name in vars(base)})
+    out = object.__new__(cls)
+    out.__dict__.update(vars(part))
+    return out
 
 
-@pytest.mark.parametrize("method", ["tug_m1", "tug_m2", "tug_m3", "mtst_m1", "mtst_m3",
-                                    "mtst_proposed"])
-def test_the_written_out_loop_equals_the_role_by_role_loop(method):
-    """:meth:`Tracker.track` writes the roles' calls and the run's steps out for speed;
-    on a noisy walk with clutter, occlusions and a false alarm near the legs (so the
-    associators rank candidates and Method 3 re-filters) it returns exactly what the
-    role-by-role loop returns."""
+def _noisy_walk():
+    """A noisy walk with clutter, occlusions and a false alarm near the legs (so the
+    associators rank candidates and Method 3 re-filters)."""
     t, xy, pats, _ = _walk(n=240, hide=(80, 88))
     rng = np.random.default_rng(7)
     noisy, npats = [], []
@@ -320,13 +294,62 @@ def test_the_written_out_loop_equals_the_role_by_role_loop(method):
             o = o[1:]                                         # the left leg hidden too
         noisy.append(np.vstack([o, extra]))
         npats.append(["SL"] * len(noisy[-1]))
+    return t, noisy, npats
+
+
+@pytest.mark.parametrize("method", ["tug_m1", "tug_m2", "tug_m3", "mtst_m1", "mtst_m3",
+                                    "mtst_proposed"])
+def test_the_roles_fast_kernels_equal_their_generic_form(method):
+    """The filter's both-legs predict and χ² gating and the gate's per-run kernel are
+    written out for speed; the tracker returns exactly what it returns with the role
+    bases' generic forms (each leg through ``predict``, ``gated``, ``candidates``)."""
+    from gaitval.track.gate import Gate
+    from gaitval.track.kalman import LegFilter
+
+    t, noisy, npats = _noisy_walk()
     _, tracker = build_tracker(method)
     got = tracker.run(t, noisy, npats, 0.1)
-    want = _role_by_role(tracker, t, noisy, npats, 0.1)
+    tracker.filter = _generic(tracker.filter, LegFilter)
+    tracker.gate = _generic(tracker.gate, Gate)
+    assert type(tracker.filter).gated_pair is LegFilter.gated_pair
+    want = tracker.run(t, noisy, npats, 0.1)
     assert got.k_init == want.k_init >= 0
     for name in ("x", "y", "vx", "vy", "observed", "interpolated", "pattern", "phase",
                  "obs_index"):
         np.testing.assert_array_equal(getattr(got, name), getattr(want, name), err_msg=name)
     assert got.refiltered == want.refiltered and got.swapped_sides == want.swapped_sides
     if method == "tug_m3":
-        assert got.refiltered                        # the re-filtering path was exercised
+        assert got.refiltered                                 # the re-filter path ran
+
+
+def test_the_parameter_table_in_the_docs_is_the_declared_one():
+    """docs/tracking.md's table of the parts' parameters is the one drawn from their
+    declarations (gaitval/track/params.py), so the two cannot drift apart."""
+    from pathlib import Path
+
+    from gaitval.track.params import markdown_table, parameters
+    from gaitval.track.roles import ROLE_REGISTRIES
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "tracking.md").read_text()
+    begin, end = "<!-- parameters: begin (generated) -->\n", "<!-- parameters: end -->"
+    assert doc[doc.index(begin) + len(begin):doc.index(end)] == markdown_table(ROLE_REGISTRIES)
+    # the declarations are the constructors' parameters, with their defaults
+    gate = ROLE_REGISTRIES["gate"]["chi2"]
+    (g,) = parameters(gate)
+    assert (g.name, g.default, g.source) == ("g", 13.82, "seed000 Table 2")
+    assert gate().g == 13.82 and gate(g=9.21).g == 9.21
+    assert "seed000 Table 2" in gate.__doc__
+
+
+def test_every_method_s_tracker_pickles_and_tracks_the_same_afterwards():
+    """A built tracker crosses process boundaries (the workflow's job pool); its parts'
+    per-instance kernels (the phase model's bound ``identify``) are rebuilt on unpickling."""
+    import pickle
+
+    t, noisy, npats = _noisy_walk()
+    for method in ("tug_m2", "mtst_proposed"):
+        _, tracker = build_tracker(method)
+        again = pickle.loads(pickle.dumps(tracker))
+        a, b = tracker.run(t, noisy, npats, 0.1), again.run(t, noisy, npats, 0.1)
+        np.testing.assert_array_equal(a.x, b.x)
+        np.testing.assert_array_equal(a.phase, b.phase)

@@ -40,14 +40,17 @@ Global Nearest Neighbor Approach. CompSysTech 2003.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
+from dataclasses import dataclass
 from typing import Callable
 
 from gaitval.errors import ConfigError
 from gaitval.gait.phases import UNLIKELY_TRANSITIONS
 from gaitval.registry import Registry
+from gaitval.track.params import declared, param
 
-ASSOCIATORS = Registry("associator")
+ASSOCIATORS = Registry("associator", table="gaitval.track.roles")
 
 D_MAX_DEFAULT = math.sqrt(13.82)
 _NO_PHASES: frozenset = frozenset()
@@ -56,26 +59,22 @@ _NO_PHASES: frozenset = frozenset()
 _COSTS = ("mahalanobis", "mahalanobis2")
 
 
+@dataclass(eq=False)
 class Associator:
-    """Role base.
-
-    Parameters
-    ----------
-    d_max : float
-        Cost of leaving a leg without an observation (seed000 eq. (9)–(10)).
-    cost : {"mahalanobis", "mahalanobis2"}
-        d = λ (seed 000) or d = λ² (seed 001).
-    """
+    """Role base."""
 
     #: ``select`` calls ``phase_of`` (False: the tracker may pass None and skip its cache)
     uses_phase = True
+    d_max: float = param(D_MAX_DEFAULT, "λ (or λ² with cost mahalanobis2)",
+                         "seed000 eq. (9)–(10); √G, the χ² gate's edge (gaitval's choice)",
+                         "cost of leaving a leg without an observation")
+    cost: str = param("mahalanobis", "-", "seed000 eq. (10) (λ); seed001 eq. (8) (λ²)",
+                      "mahalanobis (d = λ) or mahalanobis2 (d = λ²)")
 
-    def __init__(self, d_max: float = D_MAX_DEFAULT, cost: str = "mahalanobis"):
-        if cost not in _COSTS:
-            raise ConfigError(f"unknown association cost {cost!r}",
+    def __post_init__(self):
+        if self.cost not in _COSTS:
+            raise ConfigError(f"unknown association cost {self.cost!r}",
                               hint=f"choose one of: {', '.join(_COSTS)}")
-        self.d_max = d_max
-        self.cost = cost
 
     def distances(self, cand: list[tuple[int, float]]) -> list[tuple[int, float]]:
         """``(j, d)`` from the gate's ``(j, λ²)``."""
@@ -110,6 +109,99 @@ class Associator:
                prev_phase: int, phase_of: Callable[[int, int], int]) -> tuple[int, int]:
         raise NotImplementedError
 
+    def kernel(self, run):
+        """``(associate, update)`` for one run
+        (:class:`~gaitval.track.trackingrun.TrackingRun`).
+
+        ``associate(k, prior, obs, cand_l, cand_r) -> (a, b)`` selects the association at
+        scan k (seed000 eq. (9)–(10)); ``update(prior, obs, a, b) -> (post_l, post_r,
+        phase)`` corrects both legs with it (seed000 eq. (14)–(16)) and names their gait
+        phase (seed000 eq. (3)–(5)).  An associator that compares candidates' phases
+        (``uses_phase``) computes them through one :class:`Hypotheses` per run, and
+        ``update`` reads the chosen one from it.
+        """
+        select, phase = self.select, run.phase
+        correct, identify = run.filter.correct, run.phase_model.identify
+        if not self.uses_phase:
+            def associate(k, prior, obs, cand_l, cand_r):
+                return select(cand_l, cand_r, phase[k - 1], None)
+
+            def update(prior, obs, a, b):
+                pl, pr = prior
+                if a:
+                    z = obs[a - 1]
+                    pl = correct(pl, z[0], z[1])              # seed000 eq. (14)–(16)
+                if b:
+                    z = obs[b - 1]
+                    pr = correct(pr, z[0], z[1])
+                return pl, pr, identify(pl, pr)               # seed000 eq. (3)–(5)
+            return associate, update
+        hyp = Hypotheses(correct, identify)
+        reset, phase_of, outcome = hyp.reset, hyp.phase_of, hyp.outcome
+
+        def associate(k, prior, obs, cand_l, cand_r):
+            reset(prior, obs)
+            return select(cand_l, cand_r, phase[k - 1], phase_of)
+
+        def update(prior, obs, a, b):
+            return outcome(a, b)
+        return associate, update
+
+
+class Hypotheses:
+    """Corrected states and gait phases of one scan's candidate associations, computed
+    on demand and cached (the gait-phase associator asks for several, seed 000 §5.2).
+
+    ``corrected(f, j)``: leg f corrected with observation j (0: the prediction);
+    ``phase_of(a, b)``: the phase after left ← a, right ← b (seed000 eq. (3)–(5)).
+    One object serves a whole run: :meth:`reset` starts each scan.
+    """
+
+    __slots__ = ("correct", "identify", "prior", "obs", "cache", "pcache")
+
+    def __init__(self, correct, identify):
+        self.correct, self.identify = correct, identify
+        self.cache: tuple[dict, dict] = ({}, {})
+        self.pcache: dict = {}
+
+    def reset(self, prior, obs) -> None:
+        """Start a scan: the pair of predicted states and the scan's observations."""
+        self.prior, self.obs = prior, obs
+        c0, c1 = self.cache
+        c0.clear()
+        c1.clear()
+        c0[0], c1[0] = prior
+        self.pcache.clear()
+
+    def corrected(self, f: int, j: int):
+        c = self.cache[f]
+        s = c.get(j)
+        if s is None:
+            o = self.obs[j - 1]
+            s = c[j] = self.correct(self.prior[f], o[0], o[1])   # seed000 eq. (14)–(16)
+        return s
+
+    def phase_of(self, a: int, b: int) -> int:
+        ph = self.pcache.get((a, b))
+        if ph is None:
+            # corrected(0, a), corrected(1, b) written out: this runs several times a scan
+            c0, c1 = self.cache
+            sl = c0.get(a)
+            if sl is None:
+                o = self.obs[a - 1]
+                sl = c0[a] = self.correct(self.prior[0], o[0], o[1])  # seed000 eq. (14)–(16)
+            sr = c1.get(b)
+            if sr is None:
+                o = self.obs[b - 1]
+                sr = c1[b] = self.correct(self.prior[1], o[0], o[1])
+            ph = self.pcache[(a, b)] = self.identify(sl, sr)       # seed000 eq. (3)–(5)
+        return ph
+
+    def outcome(self, a: int, b: int):
+        """``(left state, right state, phase)`` after left ← a, right ← b."""
+        ph = self.phase_of(a, b)
+        return self.cache[0][a], self.cache[1][b], ph
+
 
 def ranked_associations(cand_l, cand_r, d_max: float) -> list[tuple[float, int, int]]:
     """All joint associations as ``(c_{a,b}, a, b)``, cheapest first (seed000 eq. (9)–(10)).
@@ -129,7 +221,8 @@ def ranked_associations(cand_l, cand_r, d_max: float) -> list[tuple[float, int, 
     return out
 
 
-@ASSOCIATORS.register("gnn")
+@declared
+@dataclass(eq=False)
 class GNNAssociator(Associator):
     """Global nearest neighbour: least total cost (seed 000 Method 1, seed 001)."""
 
@@ -144,7 +237,8 @@ class GNNAssociator(Associator):
         return a, b
 
 
-@ASSOCIATORS.register("gait_phase")
+@declared
+@dataclass(eq=False)
 class GaitPhaseAssociator(Associator):
     """Least-cost association with a likely gait-phase change (seed 000 §5.2)."""
 
@@ -161,7 +255,8 @@ class GaitPhaseAssociator(Associator):
         return ranked[0][1], ranked[0][2]
 
 
-@ASSOCIATORS.register("gnn_assignment")
+@declared
+@dataclass(eq=False)
 class AssignmentGNN(Associator):
     """Seed 001's GNN: the assignment problem on the 2 × J cost matrix D (eq. (6)–(8)).
 
@@ -176,17 +271,12 @@ class AssignmentGNN(Associator):
     instead prices "none" at a finite d_max, so a leg may be left unassociated when its
     only candidate is expensive; with λ² costs that would need a d_max on the λ² scale
     that the paper does not give.)  Ties keep enumeration order (a, then b, ascending).
-
-    Parameters
-    ----------
-    cost : {"mahalanobis2", "mahalanobis"}
-        d = λ² (seed 001, default) or λ.
     """
 
     uses_phase = False
-
-    def __init__(self, cost: str = "mahalanobis2"):
-        super().__init__(d_max=math.inf, cost=cost)
+    d_max: float = dataclasses.field(default=math.inf, init=False)   # "none" has no price
+    cost: str = param("mahalanobis2", "-", "seed001 eq. (8) (\"squared, no root\")",
+                      "mahalanobis2 (d = λ²) or mahalanobis (d = λ)")
 
     def select(self, cand_l, cand_r, prev_phase, phase_of):
         if len(cand_l) <= 1 and len(cand_r) <= 1:

@@ -22,11 +22,14 @@ Table 1 and §3 (fixed radii).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import NamedTuple
 
+from gaitval.gait.phases import SWINGING
 from gaitval.registry import Registry
+from gaitval.track.params import declared, param
 
-GATES = Registry("gate")
+GATES = Registry("gate", table="gaitval.track.roles")
 
 
 class GateContext(NamedTuple):
@@ -51,6 +54,29 @@ class Gate:
 
     def admits(self, lam2: float, dist: float, ctx: GateContext | None) -> bool:
         raise NotImplementedError
+
+    def kernel(self, run):
+        """The gate of one run (:class:`~gaitval.track.trackingrun.TrackingRun`, its
+        subject's w_l already bound, :meth:`for_leg_width`): ``gate(k, prior, obs) ->
+        (cand_l, cand_r)`` for the pair of predicted states ``prior`` at scan k."""
+        F = run.filter
+        if not self.needs_context:
+            candidates = self.candidates
+
+            def gate(k, prior, obs):
+                return candidates(F, prior[0], obs, None), candidates(F, prior[1], obs, None)
+            return gate
+        at, w, dts, phase, hypot = self.candidates_at, run.leg_width_m, run.dts, run.phase, \
+            math.hypot
+        L, R = run.legs
+        Lpost, Rpost = L.post, R.post
+
+        def gate(k, prior, obs):                   # the GateContext fields as arguments
+            dt, sw = dts[k], SWINGING[phase[k - 1]]
+            sl, sr = Lpost[k - 1], Rpost[k - 1]
+            return (at(F, prior[0], obs, w, dt, hypot(sl[2], sl[3]), sw[0], L.n_unobserved),
+                    at(F, prior[1], obs, w, dt, hypot(sr[2], sr[3]), sw[1], R.n_unobserved))
+        return gate
 
     def candidates_at(self, filter, prior, obs, leg_width_m: float, dt: float, speed: float,
                       swing: bool, n_unobserved: int) -> list[tuple[int, float]]:
@@ -92,20 +118,14 @@ class Gate:
         return list(zip(inside, filter.lam2_all(prior, [obs[j - 1] for j in inside])))
 
 
-@GATES.register("chi2")
+@declared
+@dataclass(eq=False)
 class ChiSquareGate(Gate):
-    """Mahalanobis gate λ² < G, seed000 eq. (13).
-
-    Parameters
-    ----------
-    g : float
-        G; seed 000 Table 2: 13.82 (χ² with 2 degrees of freedom, P_G = 0.999).
-    """
+    """Mahalanobis gate λ² < G, seed000 eq. (13)."""
 
     needs_context = False
-
-    def __init__(self, g: float = 13.82):
-        self.g = g
+    g: float = param(13.82, "λ² (χ², 2 dof)", "seed000 Table 2",
+                     "G, the gate (P_G = 0.999)")
 
     def admits(self, lam2, dist, ctx):
         return lam2 < self.g                        # seed000 eq. (13)
@@ -113,16 +133,23 @@ class ChiSquareGate(Gate):
     def candidates(self, filter, prior, obs, ctx):
         return filter.gated(prior, obs, self.g)     # seed000 eq. (13)
 
+    def kernel(self, run):
+        gated_pair, g = run.filter.gated_pair, self.g
 
-@GATES.register("fixed_radius")
+        def gate(k, prior, obs):
+            return gated_pair(prior[0], prior[1], obs, g)   # seed000 eq. (13), both legs
+        return gate
+
+
+@declared
+@dataclass(eq=False)
 class FixedRadiusGate(Gate):
     """Circular gate ‖y − ŷ‖ < r_val, r_val = ``radius_leg_widths`` · w_l (seed001 eq. (5)).
-
-    Seed 001 uses 1.5 w_l (Methods 1 and 2) and 1.0 w_l (Method 3) for its comparisons.
     """
 
-    def __init__(self, radius_leg_widths: float = 1.5):
-        self.radius_leg_widths = radius_leg_widths
+    radius_leg_widths: float = param(1.5, "leg widths",
+                                     "seed001 §3 (1.5 in Methods 1–2, 1.0 in Method 3)",
+                                     "r_val in leg widths")
 
     def radius(self, ctx: GateContext) -> float:
         return self.radius_leg_widths * ctx.leg_width_m
@@ -153,7 +180,8 @@ class _BoundRadius(Gate):
         return self.within_radius(filter, prior, obs, self.r)             # seed001 eq. (5)
 
 
-@GATES.register("variable_region")
+@declared
+@dataclass(eq=False)
 class VariableValidationRegion(Gate):
     """Seed 001's variable validation region, r_val by gait phase and observability.
 
@@ -168,22 +196,16 @@ class VariableValidationRegion(Gate):
     ==========  ====================  ====================================
 
     The gate admits ‖y − ŷ‖ < r_val (seed001 eq. (5)).
-
-    Parameters
-    ----------
-    v_sw, v_st : float
-        1.1 and 0.55 m/s: "the assumed speed of the leg in the swing and stance phases
-        while it is hidden" (seed 001, the paragraph introducing Table 1).
-    stance_leg_widths, swing_leg_widths : float
-        The constant terms, ¾ and 1 leg widths.
     """
 
-    def __init__(self, v_sw: float = 1.1, v_st: float = 0.55,
-                 stance_leg_widths: float = 0.75, swing_leg_widths: float = 1.0):
-        self.v_sw = v_sw
-        self.v_st = v_st
-        self.stance_leg_widths = stance_leg_widths
-        self.swing_leg_widths = swing_leg_widths
+    v_sw: float = param(1.1, "m/s", "seed001, text introducing Table 1",
+                        "assumed speed of a hidden leg in swing")
+    v_st: float = param(0.55, "m/s", "seed001, text introducing Table 1",
+                        "assumed speed of a hidden leg in stance")
+    stance_leg_widths: float = param(0.75, "leg widths", "seed001 Table 1",
+                                     "constant term of r_val in stance")
+    swing_leg_widths: float = param(1.0, "leg widths", "seed001 Table 1",
+                                    "constant term of r_val in swing")
 
     def cell(self, ctx: GateContext) -> str:
         """The Table 1 cell in use: ``stance|swing`` + ``_observable|_unobservable``."""

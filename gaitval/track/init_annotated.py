@@ -34,10 +34,9 @@ from __future__ import annotations
 import math
 
 from gaitval.errors import ConfigError
-from gaitval.track.init import INITIALISERS, Initialiser, left_first, leg_pairs
+from gaitval.track.init import Initialiser, left_first, leg_pairs
 
 
-@INITIALISERS.register("annotated_pair")
 class AnnotatedPair(Initialiser):
     """The leg pair nearest an annotated person position (rule in the module notes).
 

@@ -51,10 +51,9 @@ from __future__ import annotations
 import math
 
 from gaitval.errors import ConfigError
-from gaitval.track.init import INITIALISERS, Initialiser, MotionCheck, keep_if_moving
+from gaitval.track.init import Initialiser, MotionCheck, keep_if_moving
 
 
-@INITIALISERS.register("mtst_participant")
 class MatLaneParticipant(Initialiser):
     """The participant's two legs on the mat's lane (rule in the module notes).
 

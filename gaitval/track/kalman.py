@@ -41,37 +41,26 @@ Spline-Based Interpolation during Turning Motion in Walk Tests. Sensors 2015, 15
 from __future__ import annotations
 
 import copy
+from dataclasses import dataclass
 
 import numpy as np
 
 from gaitval.registry import Registry
+from gaitval.track.params import NO_SOURCE, declared, param
 
-FILTERS = Registry("filter")
+FILTERS = Registry("filter", table="gaitval.track.roles")
 
 
+@dataclass(eq=False)
 class LegFilter:
-    """Role base: a filter for one leg's planar position and velocity.
+    """Role base: a filter for one leg's planar position and velocity (Q = diag(q², q²),
+    R = diag(r², r²))."""
 
-    Parameters
-    ----------
-    q_accel_sd_mps2 : float
-        Standard deviation of the acceleration disturbance Δx (Q = diag(q², q²)); seed 000
-        Table 2: 15.0.
-    r_sd_m : float
-        Observation noise standard deviation (R = diag(r², r²)); seed 000 Table 2: 0.04.
-    p0_pos_sd_m, p0_vel_sd_mps : float
-        Initial state uncertainty (not given in the paper).
-    r_sd_leg_widths : float or None
-        (``kf``) measurement noise in leg widths, set per subject (:meth:`for_leg_width`);
-        None keeps ``r_sd_m``.
-    """
-
-    def __init__(self, q_accel_sd_mps2: float = 15.0, r_sd_m: float = 0.04,
-                 p0_pos_sd_m: float = 0.04, p0_vel_sd_mps: float = 0.5):
-        self.q_accel_sd_mps2 = q_accel_sd_mps2
-        self.r_sd_m = r_sd_m
-        self.p0_pos_sd_m = p0_pos_sd_m
-        self.p0_vel_sd_mps = p0_vel_sd_mps
+    q_accel_sd_mps2: float = param(15.0, "m/s²", "seed000 Table 2",
+                                   "σ of the acceleration disturbance Δx")
+    r_sd_m: float = param(0.04, "m", "seed000 Table 2", "observation noise σ")
+    p0_pos_sd_m: float = param(0.04, "m", NO_SOURCE, "initial position uncertainty σ")
+    p0_vel_sd_mps: float = param(0.5, "m/s", NO_SOURCE, "initial velocity uncertainty σ")
 
     def for_leg_width(self, leg_width_m: float) -> "LegFilter":
         """The filter for one subject: itself, or a copy whose measurement noise is set from
@@ -99,6 +88,16 @@ class LegFilter:
     def correct(self, s, zx: float, zy: float):
         """A posteriori state given the observation (zx, zy) (seed000 eq. (14)–(16))."""
         raise NotImplementedError
+
+    def predict_pair(self, sl, sr, dt: float, ul, ur):
+        """Both legs' a priori states, inputs ``ul``, ``ur`` = (ux, uy) (seed000 eq.
+        (7)–(8)); one call per scan (filters override it with the arithmetic written out)."""
+        predict = self.predict
+        return predict(sl, dt, ul[0], ul[1]), predict(sr, dt, ur[0], ur[1])
+
+    def gated_pair(self, pl, pr, obs, g: float):
+        """:meth:`gated` of both legs: ``(left, right)`` lists of ``(j, λ²)``."""
+        return self.gated(pl, obs, g), self.gated(pr, obs, g)
 
     def mahalanobis2(self, s, zx: float, zy: float) -> float:
         """λ² of seed000 eq. (11) for a predicted state ``s``."""
@@ -137,7 +136,8 @@ class LegFilter:
 
 
 
-@FILTERS.register("kf")
+@declared
+@dataclass(eq=False)
 class AxisKalmanFilter(LegFilter):
     """Seed 000's Kalman filter, exact, per axis (see the module notes).
 
@@ -145,11 +145,12 @@ class AxisKalmanFilter(LegFilter):
     (position, velocity) of either axis.
     """
 
-    def __init__(self, q_accel_sd_mps2: float = 15.0, r_sd_m: float = 0.04,
-                 p0_pos_sd_m: float = 0.04, p0_vel_sd_mps: float = 0.5,
-                 r_sd_leg_widths: float | None = None):
-        super().__init__(q_accel_sd_mps2, r_sd_m, p0_pos_sd_m, p0_vel_sd_mps)
-        self.r_sd_leg_widths = r_sd_leg_widths
+    r_sd_leg_widths: float | None = param(
+        None, "leg widths", "seed001 eq. (2)–(3) (0.5: R = diag((w_l/2)², (w_l/2)²))",
+        "measurement noise σ in leg widths, set per subject (for_leg_width); None keeps "
+        "r_sd_m")
+
+    def __post_init__(self):
         self._noise_changed()
 
     def _noise_changed(self):
@@ -176,6 +177,19 @@ class AxisKalmanFilter(LegFilter):
         #   (per axis: B Q Bᵀ = q [[Δt⁴/4, Δt³/2], [Δt³/2, Δt²]])
         return (x + dt * vx + h * ux, y + dt * vy + h * uy, vx + dt * ux, vy + dt * uy,
                 a + dt * (2.0 * b + dt * c) + qaa, b + dt * c + qab, c + qbb)
+
+    def predict_pair(self, sl, sr, dt, ul, ur):
+        cst = self._cache.get(dt)
+        h, qaa, qab, qbb = cst if cst is not None else self._consts(dt)
+        x, y, vx, vy, a, b, c = sl
+        ux, uy = ul
+        # seed000 eq. (7)–(8) per leg, as predict
+        pl = (x + dt * vx + h * ux, y + dt * vy + h * uy, vx + dt * ux, vy + dt * uy,
+              a + dt * (2.0 * b + dt * c) + qaa, b + dt * c + qab, c + qbb)
+        x, y, vx, vy, a, b, c = sr
+        ux, uy = ur
+        return pl, (x + dt * vx + h * ux, y + dt * vy + h * uy, vx + dt * ux, vy + dt * uy,
+                    a + dt * (2.0 * b + dt * c) + qaa, b + dt * c + qab, c + qbb)
 
     def correct(self, s, zx, zy):
         x, y, vx, vy, a, b, c = s
@@ -210,16 +224,28 @@ class AxisKalmanFilter(LegFilter):
     def gated(self, s, obs, g):
         px, py = s[0], s[1]
         sv = s[4] + self._r2                 # seed000 eq. (12), per axis
-        out = []
+        lam2 = [((zx - px) * (zx - px) + (zy - py) * (zy - py)) / sv   # seed000 eq. (11)
+                for zx, zy in obs]
+        return [(j, v) for j, v in enumerate(lam2, 1) if v < g]        # seed000 eq. (13)
+
+    def gated_pair(self, pl, pr, obs, g):
+        lx, ly, rx, ry = pl[0], pl[1], pr[0], pr[1]
+        svl, svr = pl[4] + self._r2, pr[4] + self._r2    # seed000 eq. (12), per axis
+        cl, cr = [], []
         j = 0
         for zx, zy in obs:
             j += 1
-            ex = zx - px
-            ey = zy - py
-            lam2 = (ex * ex + ey * ey) / sv          # seed000 eq. (11)
+            ex = zx - lx
+            ey = zy - ly
+            lam2 = (ex * ex + ey * ey) / svl         # seed000 eq. (11)
             if lam2 < g:                             # seed000 eq. (13)
-                out.append((j, lam2))
-        return out
+                cl.append((j, lam2))
+            ex = zx - rx
+            ey = zy - ry
+            lam2 = (ex * ex + ey * ey) / svr
+            if lam2 < g:
+                cr.append((j, lam2))
+        return cl, cr
 
     def innovation_cov(self, s):
         v = s[4] + self._r2
@@ -228,33 +254,30 @@ class AxisKalmanFilter(LegFilter):
 
 
 
-@FILTERS.register("kf_aniso")
+@declared
+@dataclass(eq=False)
 class AnisotropicKalmanFilter(LegFilter):
     """Constant-velocity Kalman filter with per-axis noise (seed 002 §II).
-
-    Parameters
-    ----------
-    q_accel_sd_mps2 : (float, float)
-        σ_ax, σ_ay of the acceleration disturbance; seed 002: (1.63, 5.24) m/s².
-    r_sd_m : (float, float)
-        Measurement noise standard deviations in x and y; seed 002 gives 0.059 m (x) and
-        0.02 m (y), read as standard deviations (the paper does not say; gaitval's reading).
-    p0_pos_sd_m, p0_vel_sd_mps : float
-        Initial uncertainty (not given in the paper).
 
     Notes
     -----
     State tuple ``(x, y, vx, vy, ax, bx, cx, ay, by, cy)``: ``[[a, b], [b, c]]`` is the
     (position, velocity) covariance of each axis.  With Q = B diag(σ_ax², σ_ay²) Bᵀ and
     R = diag(r_x², r_y²) the two axes never couple, so the filter is exact per axis.
+    Seed 002 gives the measurement noise as 0.059 m (x) and 0.02 m (y) without saying what
+    they are; gaitval reads them as standard deviations.
     """
 
-    def __init__(self, q_accel_sd_mps2=(1.63, 5.24), r_sd_m=(0.059, 0.02),
-                 p0_pos_sd_m: float = 0.05, p0_vel_sd_mps: float = 0.5):
-        qx, qy = (float(v) for v in q_accel_sd_mps2)
-        rx, ry = (float(v) for v in r_sd_m)
-        super().__init__(q_accel_sd_mps2=(qx, qy), r_sd_m=(rx, ry),
-                         p0_pos_sd_m=p0_pos_sd_m, p0_vel_sd_mps=p0_vel_sd_mps)
+    q_accel_sd_mps2: tuple = param((1.63, 5.24), "m/s²", "seed002 §II",
+                                   "σ_ax, σ_ay of the acceleration disturbance")
+    r_sd_m: tuple = param((0.059, 0.02), "m", "seed002 §II (read as σ)",
+                          "measurement noise σ in x and y")
+    p0_pos_sd_m: float = param(0.05, "m", NO_SOURCE, "initial position uncertainty σ")
+
+    def __post_init__(self):
+        qx, qy = (float(v) for v in self.q_accel_sd_mps2)
+        rx, ry = (float(v) for v in self.r_sd_m)
+        self.q_accel_sd_mps2, self.r_sd_m = (qx, qy), (rx, ry)
         self._qx2, self._qy2 = qx * qx, qy * qy
         self._rx2, self._ry2 = rx * rx, ry * ry
 
@@ -306,19 +329,18 @@ class AnisotropicKalmanFilter(LegFilter):
 
 
 
-@FILTERS.register("kf_matrix")
 class MatrixKalmanFilter(LegFilter):
     """The textbook 4×4 matrix form (reference implementation).
 
-    ``noise=(Q_a, R, P0)`` (as returned by :meth:`LegFilter.noise`) replaces the isotropic
-    noise built from the scalar parameters, so any filter can be checked against it.
+    Its parameters are :class:`LegFilter`'s; ``noise=(Q_a, R, P0)`` (as returned by
+    :meth:`LegFilter.noise`) replaces the isotropic noise built from them, so any filter can
+    be checked against it.
     """
 
     C = np.array([[1.0, 0, 0, 0], [0, 1.0, 0, 0]])
 
-    def __init__(self, q_accel_sd_mps2: float = 15.0, r_sd_m: float = 0.04,
-                 p0_pos_sd_m: float = 0.04, p0_vel_sd_mps: float = 0.5, noise=None):
-        super().__init__(q_accel_sd_mps2, r_sd_m, p0_pos_sd_m, p0_vel_sd_mps)
+    def __init__(self, noise=None, **params):
+        super().__init__(**params)
         self._noise = (tuple(np.asarray(m, dtype=float) for m in noise) if noise is not None
                        else LegFilter.noise(self))
 

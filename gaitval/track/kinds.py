@@ -23,7 +23,7 @@ from gaitval.track.leg import TrackResult
 from gaitval.track.tracker import Tracker
 from gaitval.types import ScanSeries
 
-TRACKER_KINDS = Registry("tracker kind")
+TRACKER_KINDS = Registry("tracker kind", table="gaitval.track.roles")
 
 
 class TrackerKind:
@@ -42,7 +42,6 @@ class TrackerKind:
         raise NotImplementedError
 
 
-@TRACKER_KINDS.register("detect_then_track")
 class DetectThenTrack(TrackerKind):
     """A detector role followed by the per-scan :class:`Tracker` loop.
 

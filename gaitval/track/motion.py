@@ -34,10 +34,12 @@ Spline-Based Interpolation during Turning Motion in Walk Tests. Sensors 2015, 15
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 from gaitval.registry import Registry
+from gaitval.track.params import NO_SOURCE, declared, param
 
-MOTION_MODELS = Registry("motion model")
+MOTION_MODELS = Registry("motion model", table="gaitval.track.roles")
 
 _ZERO = (0.0, 0.0)
 
@@ -117,19 +119,19 @@ class MotionModel:
         return SwingAccelerationWindow(self.n_ac) if self.n_ac else None
 
 
-@MOTION_MODELS.register("gait_phase_accel")
+@declared
+@dataclass(eq=False)
 class GaitPhaseAcceleration(MotionModel):
-    """Acceleration input per gait phase, seed000 eq. (18)–(20).
+    """Acceleration input per gait phase, seed000 eq. (18)–(20)."""
 
-    Parameters
-    ----------
-    n_ac : int
-        N_ac, steps averaged for the acceleration function g (seed 000 Table 2: 40).
-    """
+    n_ac: int = param(40, "scans", "seed000 Table 2",
+                      "N_ac, steps averaged for the acceleration function g")
+    limit_braking: bool = param(True, "-", NO_SOURCE + " (gaitval's addition, module notes)",
+                                "a braking input may stop the leg within a step, not "
+                                "reverse it")
 
-    def __init__(self, n_ac: int = 40, limit_braking: bool = True):
-        self.n_ac = int(n_ac)
-        self.limit_braking = limit_braking
+    def __post_init__(self):
+        self.n_ac = int(self.n_ac)
 
     def inputs(self, phase, vl, vr, gl, gr, dt):
         bdt = dt if self.limit_braking else 0.0
@@ -144,7 +146,6 @@ class GaitPhaseAcceleration(MotionModel):
         return _ZERO, _ZERO                       # seed000 eq. (18); Phase 5: none
 
 
-@MOTION_MODELS.register("constant_velocity")
 class ConstantVelocity(MotionModel):
     """u = 0: the constant-velocity model of seed001 eq. (2) and seed 002 §II."""
 

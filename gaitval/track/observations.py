@@ -35,6 +35,10 @@ class DetectionSeries:
     def array(self, k: int) -> np.ndarray:
         return self._arrays[k]
 
+    def arrays(self) -> list[np.ndarray]:
+        """Every scan's :meth:`array`."""
+        return self._arrays
+
     def at(self, k: int, prior):
         return self._lists[k], self._patterns[k]
 

@@ -44,8 +44,10 @@ import numpy as np
 
 from gaitval.errors import ConfigError
 from gaitval.registry import Registry
+from gaitval.track.params import NO_SOURCE, declared, param
 
-OCCLUSION_HANDLERS = Registry("occlusion handler")
+OCCLUSION_HANDLERS = Registry("occlusion handler",
+                              table="gaitval.track.roles")
 
 #: seed000 eq. (17) basis matrix (the ½ applied separately)
 CATMULL_ROM_M = np.array([[0.0, 2.0, 0.0, 0.0],
@@ -109,7 +111,6 @@ class OcclusionHandler:
         raise NotImplementedError
 
 
-@OCCLUSION_HANDLERS.register("predict_only")
 class PredictOnly(OcclusionHandler):
     """Hidden leg = Kalman prediction (seed 000 §5.3, Methods 1 and 2)."""
 
@@ -126,26 +127,18 @@ def _steps(v, n_uo: int, max_n: int, what: str) -> int:
     return iv
 
 
-@OCCLUSION_HANDLERS.register("catmull_rom")
+@declared
+@dataclass(eq=False)
 class CatmullRomInterpolation(OcclusionHandler):
-    """Catmull–Rom virtual observations and re-filtering (seed 000 §5.4, Method 3).
+    """Catmull–Rom virtual observations and re-filtering (seed 000 §5.4, Method 3)."""
 
-    Parameters
-    ----------
-    n_bo, n_ao : int or "match"
-        N_bo, N_ao of seed000 eq. (17) (see the module notes for the default).
-    max_n : int
-        Cap of N_bo, N_ao under ``"match"``.
-    min_n_uo : int
-        Shortest occlusion (steps) that is interpolated.
-    """
-
-    def __init__(self, n_bo: int | str = "match", n_ao: int | str = "match",
-                 max_n: int = 20, min_n_uo: int = 1):
-        self.n_bo = n_bo
-        self.n_ao = n_ao
-        self.max_n = max_n
-        self.min_n_uo = min_n_uo
+    n_bo: int | str = param("match", "scans", NO_SOURCE + " (not in the paper; module notes)",
+                            "N_bo of seed000 eq. (17), or match: N_uo + 1")
+    n_ao: int | str = param("match", "scans", NO_SOURCE + " (not in the paper; module notes)",
+                            "N_ao of seed000 eq. (17), or match: N_uo + 1")
+    max_n: int = param(20, "scans", NO_SOURCE + " (about half a gait cycle at 40 Hz)",
+                       "cap of N_bo, N_ao under match")
+    min_n_uo: int = param(1, "scans", NO_SOURCE, "shortest occlusion that is interpolated")
 
     def n_before(self, n_uo):
         return _steps(self.n_bo, n_uo, self.max_n, "n_bo")

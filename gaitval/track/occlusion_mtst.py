@@ -23,10 +23,9 @@ Measurement System for the Multi-Target Stepping Task Using a Laser Range Sensor
 """
 from __future__ import annotations
 
-from gaitval.track.occlusion import OCCLUSION_HANDLERS, OcclusionHandler
+from gaitval.track.occlusion import OcclusionHandler
 
 
-@OCCLUSION_HANDLERS.register("uo_pseudo_update")
 class PseudoObservation(OcclusionHandler):
     """Correct an unobserved (UO) leg with its own prediction (seed 001 §2.4.3)."""
 

@@ -53,7 +53,7 @@ import numpy as np
 from gaitval.detect import DETECTORS
 from gaitval.errors import ConfigError
 from gaitval.track.init import INITIALISERS
-from gaitval.track.kinds import TRACKER_KINDS, RawScanTracker
+from gaitval.track.kinds import RawScanTracker
 from gaitval.track.leg import TrackResult, empty_result
 from gaitval.track.observations import WindowedDetections
 from gaitval.track.pf_likelihood import PFArrays, likelihood, sample_velocities
@@ -76,7 +76,6 @@ class _Scan:
             self.Y = scans.ranges * np.sin(a)
 
 
-@TRACKER_KINDS.register("rollator_pf")
 class ParticleFilterTracker(RawScanTracker):
     """Two particle filters, one per leg, on raw laser points (module notes).
 

@@ -13,13 +13,15 @@ Yorozu, A. et al. Sensors 2015, 15, 11151–11168 (seed 001), eq. (9)–(10).
 """
 from __future__ import annotations
 
-import functools
+import types
+from dataclasses import dataclass
 
 from gaitval.gait.phases import (check_reading, gait_phase_of_states,
                                  gait_phase_of_states_stance_first)
 from gaitval.registry import Registry
+from gaitval.track.params import declared, param
 
-PHASE_MODELS = Registry("gait phase model")
+PHASE_MODELS = Registry("gait phase model", table="gaitval.track.roles")
 
 
 class PhaseModel:
@@ -29,36 +31,39 @@ class PhaseModel:
         raise NotImplementedError
 
 
-@PHASE_MODELS.register("speed_thresholds")
+@declared
+@dataclass(eq=False)
 class SpeedThresholdPhases(PhaseModel):
     """Swing/stance per leg from its speed against two thresholds and the other leg's
     speed (seed000 eq. (3)–(4), the same form as seed001 eq. (9)–(10)), and
     accelerating/decelerating from the swing leg's velocity towards the stance leg
     (seed000 eq. (5)).
 
-    Parameters
-    ----------
-    v_st_th, v_sw_th : float
-        Stance and swing speed thresholds (m/s): seed 000 Table 2 0.47 and 0.93; seed 001
-        0.18 and 0.37.
-    reading : {"swing_first", "stance_first"}
-        Which of eq. (3)–(4) decides where both hold (:mod:`gaitval.gait.phases` notes):
-        ``swing_first`` (default) lets the absolute thresholds win, so two fast legs are
-        Phase 5; ``stance_first`` puts the slower leg in stance first, so Phase 5 is all but
-        impossible.  Set per method as ``phase__reading``; TUG Tables 3–4 report both
-        (config ``tug.phase_readings``).
+    ``reading`` says which of eq. (3)–(4) decides where both hold (:mod:`gaitval.gait.phases`
+    notes): ``swing_first`` lets the absolute thresholds win, so two fast legs are Phase 5;
+    ``stance_first`` puts the slower leg in stance first, so Phase 5 is all but impossible.
+    Set per method as ``phase__reading``; TUG Tables 3–4 report both (config
+    ``tug.phase_readings``).  Seed 001 uses 0.18 and 0.37 m/s as its thresholds.
     """
 
-    def __init__(self, v_st_th: float = 0.47, v_sw_th: float = 0.93,
-                 reading: str = "swing_first"):
-        self.v_st_th = v_st_th
-        self.v_sw_th = v_sw_th
-        self.reading = check_reading(reading)
+    v_st_th: float = param(0.47, "m/s", "seed000 Table 2", "stance speed threshold")
+    v_sw_th: float = param(0.93, "m/s", "seed000 Table 2", "swing speed threshold")
+    reading: str = param("swing_first", "-", "gaitval's reading of seed000 eq. (3)–(4)",
+                         "swing_first or stance_first")
+
+    def __post_init__(self):
+        reading = self.reading = check_reading(self.reading)
         self._of_states = (gait_phase_of_states_stance_first if reading == "stance_first"
                            else gait_phase_of_states)
-        # identify(l, r) without a Python frame of its own (called several times a scan)
-        self.identify = functools.partial(self._of_states, v_st_th=self.v_st_th,
-                                          v_sw_th=self.v_sw_th)   # seed000 eq. (3)–(5)
+        # identify(l, r): the same function with this model's thresholds as its defaults,
+        # one Python frame per call (it runs several times a scan) -- the phase model's
+        # per-run kernel
+        f = self._of_states
+        self.identify = types.FunctionType(f.__code__, f.__globals__, "identify",
+                                           (self.v_st_th, self.v_sw_th))  # eq. (3)–(5)
 
-    def identify(self, l, r):  # the role's method; each instance binds a partial of it (above)
+    def __reduce__(self):       # the bound copy does not pickle: rebuild it from the parameters
+        return type(self), (self.v_st_th, self.v_sw_th, self.reading)
+
+    def identify(self, l, r):  # the role's method; each instance binds a copy of it (above)
         return self._of_states(l, r, self.v_st_th, self.v_sw_th)   # seed000 eq. (3)–(5)

@@ -11,7 +11,7 @@ of consecutive frames, we re-initialize the algorithm."
     algorithm is due for re-initialisation: from that scan on, the handler looks at each
     scan again with the detector's predefined window (no prediction, as at the first scan)
     and, at the first one with a pair of legs, restarts both legs on it at rest
-    (:meth:`~gaitval.track.tracker.TrackingRun.restart`; every restart is counted in
+    (:meth:`~gaitval.track.trackingrun.TrackingRun.restart`; every restart is counted in
     ``TrackResult.restarts``), even if the loop has meanwhile gated an observation to the
     lost leg again.
     ``n_lost`` is not given in the paper; gaitval's default is 15 scans (0.4 s at the
@@ -32,7 +32,7 @@ of consecutive frames, we re-initialize the algorithm."
     the window on 71–94 % of its scans, and the KF and PF then tracked them to the end.
     The start is kept exactly as before (the first pair, at rest), but only when some
     pair of the trial, from that scan on, *walks with the sensor*
-    (:class:`~gaitval.track.init.WalkingPairCheck`: within 1.4 s the legs pass each other
+    (:class:`~gaitval.track.init_walking.WalkingPairCheck`: within 1.4 s the legs pass each other
     while the body stays in place w.r.t. the rollator); otherwise the run reports no
     track, as the TUG and MTST initialisers do (``keep_if_moving``).  Re-initialisation
     looks at one scan (:meth:`FacingPair.pair`) and keeps its pair.
@@ -44,12 +44,15 @@ of human gait tracking algorithms for an intelligent robotic rollator. IEEE ICRA
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from gaitval.errors import ConfigError
-from gaitval.track.init import INITIALISERS, ClosestPair, WalkingPairCheck, keep_if_moving
-from gaitval.track.occlusion import OCCLUSION_HANDLERS, OcclusionHandler
+from gaitval.track.init import INITIALISERS, ClosestPair, keep_if_moving
+from gaitval.track.init_walking import WalkingPairCheck
+from gaitval.track.occlusion import OcclusionHandler
+from gaitval.track.params import NO_SOURCE, declared, param
 
 
-@INITIALISERS.register("facing_pair")
 class FacingPair(ClosestPair):
     """The closest plausible pair, left = smaller bearing when the laser faces the user;
     None when no pair of the trial walks with the sensor (module notes).
@@ -68,7 +71,7 @@ class FacingPair(ClosestPair):
         with less than one walking window (1.4 s) from the pair's scan on, which cannot
         show a stride.
     window_s, pass_leg_widths, stay_leg_widths, max_speed_mps : float
-        :class:`~gaitval.track.init.WalkingPairCheck`.
+        :class:`~gaitval.track.init_walking.WalkingPairCheck`.
     """
 
     def __init__(self, max_pair_m: float = 0.8, min_leg_widths: float = 0.7,
@@ -113,25 +116,24 @@ class _OneScan:
         return self._obs
 
 
-@OCCLUSION_HANDLERS.register("reinit_after_lost")
+@declared
+@dataclass(eq=False)
 class ReinitialiseAfterLost(OcclusionHandler):
-    """Predict only, then restart both legs after ``n_lost`` lost scans (module notes).
+    """Predict only, then restart both legs after ``n_lost`` lost scans (module notes)."""
 
-    Parameters
-    ----------
-    n_lost : int
-        Consecutive scans without an observation (either leg) that trigger the
-        re-initialisation.
-    init : dict or str
-        The initialiser whose pair rule labels the new legs (registry spec; default
-        :class:`FacingPair`).
-    """
+    n_lost: int = param(15, "scans", NO_SOURCE + " (seed002 §II gives no number; about "
+                        "one swing, module notes)",
+                        "consecutive scans without an observation (either leg) that "
+                        "trigger the re-initialisation")
+    init: dict | str | None = param(None, "-", NO_SOURCE, "the initialiser whose pair rule "
+                                    "labels the new legs (registry spec; None: facing_pair)")
 
-    def __init__(self, n_lost: int = 15, init=None):
+    def __post_init__(self):
+        n_lost = self.n_lost
         if int(n_lost) < 1:
             raise ConfigError(f"reinit_after_lost: n_lost must be ≥ 1, got {n_lost!r}")
         self.n_lost = int(n_lost)
-        self.init = INITIALISERS.build(init if init is not None else "facing_pair")
+        self.init = INITIALISERS.build(self.init if self.init is not None else "facing_pair")
         if not hasattr(self.init, "pair"):
             raise ConfigError(f"reinit_after_lost: initialiser {self.init!r} cannot label "
                               "the legs of one scan", hint="use init: facing_pair")

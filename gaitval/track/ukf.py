@@ -70,7 +70,7 @@ N_STATE = 6
 TRACK_COLUMNS = ["t_s", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps",
                  "used_anchors", "rejected_anchors"]
 #: Trackers of one transmitter from its ranges (seed 003); config ``ultrasonic.ukf``.
-UKF_TRACKERS = Registry("ultrasonic tracker")
+UKF_TRACKERS = Registry("ultrasonic tracker", table="gaitval.track.roles")
 
 
 def ukf_weights(n: int = N_STATE, alpha: float = 1e-3, beta: float = 2.0,
@@ -282,24 +282,35 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
 
     Notes
     -----
-    Per sample: (re-)initialise by a checked trilateration when needed, predict (eq. 8, closed form),
-    update from the anchors that pass the gate (eq. 9–11), reflect a mirror state back;
-    all but the trilateration in :func:`gaitval.track.ukf_kernel.ukf_steps`.
+    Per sample (:func:`_filter`): (re-)initialise by a checked trilateration when needed,
+    predict (eq. 8, closed form), update from the anchors that pass the gate (eq. 9–11),
+    reflect a mirror state back.
     """
-    from gaitval.track.ukf_kernel import ukf_steps   # numba: only a UKF job pays it
-
     t = np.ascontiguousarray(t, dtype=float)
     d = np.ascontiguousarray(d, dtype=float)
     anchors = np.ascontiguousarray(anchors, dtype=float)
-    n_s = len(d)
     guess = anchors.mean(axis=0) if init_guess is None else np.asarray(init_guess, float)
     normal, centre = _mirror_plane(anchors, guess, mirror_guard and init_guess is not None)
     model = _model(anchors, W_sigma, V, alpha, beta, kappa, gate_sigma, max_reject,
                    min_anchors, reinit_after, normal, centre)
     P0 = np.diag([init_sigma_pos ** 2] * 3 + [init_sigma_vel ** 2] * 3)
-    finite = np.isfinite(d)
-    n_finite = finite.sum(axis=1).astype(np.int64)
-    res = ToaUkfResult.start(finite)
+    res = ToaUkfResult.start(np.isfinite(d))
+    _filter(t, d, model, P0, res,
+            lambda dk: trilaterate_checked(dk, anchors, guess,
+                                           max_residual_m=init_max_residual_m,
+                                           max_range_m=max_range_m))
+    return res
+
+
+def _filter(t, d, model, P0, res: ToaUkfResult, fix_of) -> None:
+    """The per-sample loop of :func:`run_toa_ukf` into ``res``: a checked fix
+    (``fix_of(d_k)``, :func:`trilaterate_checked`) where the filter has no state or has
+    starved, and :func:`gaitval.track.ukf_kernel.ukf_steps` (predict, update, reflect)
+    from there until it starves."""
+    from gaitval.track.ukf_kernel import ukf_steps   # numba: only a UKF job pays it
+
+    n_s = len(d)
+    n_finite = np.isfinite(d).sum(axis=1).astype(np.int64)
     out = (res.x, res.P_diag, res.used, res.rejected, res.reflected)
     x = P = None
     starved = np.zeros(1, dtype=np.int64)
@@ -307,8 +318,7 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
     while k < n_s:
         # here the filter has no state yet, or has starved for reinit_after samples
         # from the guess: its side of the array; a fix the ranges do not support is refused
-        fix = trilaterate_checked(d[k], anchors, guess, max_residual_m=init_max_residual_m,
-                                  max_range_m=max_range_m)
+        fix = fix_of(d[k])
         force = False
         if np.all(np.isfinite(fix.p)):
             res.used[k] = fix.used                  # the anchors of the fix
@@ -326,7 +336,6 @@ def run_toa_ukf(t: np.ndarray, d: np.ndarray, anchors: np.ndarray, *,
         if k < n_s:
             # per sample: predict (eq. 8), update (eq. 9-11), reflect (module notes)
             k, P = ukf_steps(k, force, t, d, n_finite, model, x, P, starved, out)
-    return res
 
 
 def _model(anchors, W_sigma, V, alpha, beta, kappa, gate_sigma, max_reject, min_anchors,
@@ -371,7 +380,6 @@ def warm_up() -> None:
                 reinit_after=10)
 
 
-@UKF_TRACKERS.register("toa_ukf")
 @dataclass
 class ToaUkf:
     """The UKF of seed 003 as a tracker role, with the parameters of :func:`run_toa_ukf`
