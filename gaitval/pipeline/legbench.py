@@ -195,7 +195,8 @@ def legbench_evaluate_step(track_parquet, annotations, out_dir, *,
                            f"track has {n} scans: not the same recording or scan topic",
                            path=annotations, trial=trial)
     if people:
-        hyp = _people_hypotheses(track)
+        from gaitval.track.people import person_hypotheses as people_hypotheses
+        hyp = people_hypotheses(track)
     else:
         hyp = person_hypotheses(x, y, meta.get("restarts") or [])
     if sector_deg is not None:
@@ -251,20 +252,6 @@ def _person_legs(track: pd.DataFrame) -> list:
             y[f, leg["k"].to_numpy()] = leg["y_m"].to_numpy(float)
         out.append((int(pid), x, y))
     return out
-
-
-def _people_hypotheses(track: pd.DataFrame) -> pd.DataFrame:
-    """Every reported person's hypothesis: the midpoint of its two legs, ``hyp_id`` = its
-    person id (:data:`gaitval.evaluate.clearmot.HYP_COLUMNS`)."""
-    from gaitval.evaluate.clearmot import HYP_COLUMNS
-    tr = track[track["person_id"] >= 0]
-    mid = tr.groupby(["k", "person_id"], sort=True)[["x_m", "y_m"]].agg(["mean", "count"])
-    ok = (mid[("x_m", "count")] == 2) & (mid[("y_m", "count")] == 2)
-    mid = mid[ok]
-    return pd.DataFrame({"k": mid.index.get_level_values(0).astype(np.int64),
-                         "hyp_id": mid.index.get_level_values(1).astype(np.int64),
-                         "x_m": mid[("x_m", "mean")].to_numpy(float),
-                         "y_m": mid[("y_m", "mean")].to_numpy(float)})[HYP_COLUMNS]
 
 
 def _people_false_legs(persons, t, positions, match_m, min_false_s) -> dict:
@@ -351,7 +338,8 @@ def legbench_tables_step(inputs, tables_dir, figures_dir, reports_dir, config_ha
 
 
 def add_legbench_verbs(sub) -> None:
-    """``legbench-track``, ``legbench-evaluate``, ``legbench-tables`` (for gaitval.cli)."""
+    """``legbench-track``, ``legbench-evaluate``, ``legbench-tables``, ``legbench-crowd``
+    (for gaitval.cli)."""
     def run(a) -> int:
         if a.verb == "legbench-track":
             legbench_track_step(a.sensor, a.method, a.out, init=a.init,
@@ -374,6 +362,9 @@ def add_legbench_verbs(sub) -> None:
                     "matches", "fn", "fp", "gt", "mota_following",
                     "false_leg_tracks_per_min"]
             print(s[cols].to_string(index=False))
+        elif a.verb == "legbench-crowd":
+            from gaitval.crowd.bench import crowd_step
+            crowd_step(a.tables_dir, a.split)
         else:
             legbench_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir,
                                  a.config_hash, methods=a.methods, inits=a.inits,
@@ -453,4 +444,11 @@ def add_legbench_verbs(sub) -> None:
     s.add_argument("--reports-dir", default="reports", help=reports)
     s.add_argument("--config-hash", default="", help="the run's config hash, written into "
                    "the provenance record (default: empty)")
+    s.set_defaults(func=run)
+    s = sub.add_parser("legbench-crowd", help="the multi-person benchmark on rendered "
+                                              "scenes (docs/crowd.md)")
+    s.add_argument("--tables-dir", required=True, help="folder the tables go to "
+                   "(legbench_crowd.csv, .md, .tex, legbench_crowd_scenes.csv)")
+    s.add_argument("--split", choices=("dev", "test", "all"), default="all",
+                   help="the development scenes, the test scenes or both (default: all)")
     s.set_defaults(func=run)

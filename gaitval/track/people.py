@@ -603,3 +603,16 @@ def people_frame_for_scoring(res: PeopleResult) -> pd.DataFrame:
     out = out.sort_values(["k", "person_id", "side"], kind="stable").reset_index(drop=True)
     return out.astype({"k": np.int64, "person_id": np.int64, "phase": np.int64,
                        "observed": bool, "swing": bool, "interpolated": bool})
+
+
+def person_hypotheses(track: pd.DataFrame) -> pd.DataFrame:
+    """Every reported person's hypothesis in a :func:`people_frame_for_scoring` track: the
+    midpoint of its two legs, ``hyp_id`` = its person id (the columns of
+    :data:`gaitval.evaluate.clearmot.HYP_COLUMNS`: ``k, hyp_id, x_m, y_m``)."""
+    tr = track[track["person_id"] >= 0]
+    mid = tr.groupby(["k", "person_id"], sort=True)[["x_m", "y_m"]].agg(["mean", "count"])
+    mid = mid[(mid[("x_m", "count")] == 2) & (mid[("y_m", "count")] == 2)]
+    return pd.DataFrame({"k": mid.index.get_level_values(0).astype(np.int64),
+                         "hyp_id": mid.index.get_level_values(1).astype(np.int64),
+                         "x_m": mid[("x_m", "mean")].to_numpy(float),
+                         "y_m": mid[("y_m", "mean")].to_numpy(float)})
