@@ -89,3 +89,28 @@ def test_benchmark_table_is_written(tmp_path):
     np.testing.assert_allclose(
         t["mota_pct"], 100 * (1 - (t["misses"] + t["fp"] + t["idsw_ref"]) / t["gt"]),
         rtol=1e-5)
+
+
+@pytest.mark.parametrize("kind", ["crossing_static", "crowd_moving", "assisted"])
+def test_no_track_outlives_the_returns_in_its_gate(kind):
+    """A reported person whose gate (``return_gate_m`` around its centre) holds no scan
+    return for longer than ``max_no_return_s`` has ended: clutter cannot coast.  (An
+    observation assigned to a leg counts as returns there; it lies within a leg's radius
+    of the returns it was made of.)"""
+    from gaitval.track.staticmap import scan_points
+    sc = make_scene(kind, 11)
+    tr = bench.tracker("people")
+    res = tr.track(sc.scans, bench.LEG_WIDTH_M)
+    limit, gate = tr.deleter.max_no_return_s, tr.deleter.return_gate_m
+    assert limit == pytest.approx(0.5) and len(res.people)
+    centres = res.people.groupby(["k", "person_id"], sort=True)[["x_m", "y_m"]].mean()
+    t = sc.scans.t
+    last: dict = {}
+    longest = 0.0
+    for (k, pid), (x, y) in centres.iterrows():
+        pts = scan_points(sc.scans, k)
+        if pid not in last or (np.hypot(pts[:, 0] - x, pts[:, 1] - y)
+                               <= gate + bench.LEG_WIDTH_M / 2).any():
+            last[pid] = t[k]
+        longest = max(longest, t[k] - last[pid])
+    assert longest <= limit + 1e-9

@@ -21,8 +21,9 @@ import pandas as pd
 
 from gaitval.crowd.scenes import CHOICES, DEV_SEEDS, KINDS, TEST_SEEDS, make_scene
 
-#: the rows of the table: leg_tracker's rules, then gaitval's online and offline trackers
-METHODS = ("leg_tracker_rules", "people", "people_offline")
+#: the rows of the table: leg_tracker's rules (with and without its leg classifier, whose
+#: forest was trained on leg_tracker's real bags), then gaitval's online and offline trackers
+METHODS = ("leg_tracker_rules", "leg_tracker_rules_no_classifier", "people", "people_offline")
 #: the scored bearings: the sensor's front half-plane, where the scenes put people
 SECTOR_DEG = (-90.0, 90.0)
 MATCH_M = 0.75                  # leg_tracker benchmark, clear_mot.py
@@ -30,15 +31,23 @@ LEG_WIDTH_M = 0.11              # the mean shank width of the scenes (2 × 0.055
 SPLITS = {"dev": DEV_SEEDS, "test": TEST_SEEDS}
 
 
+#: every method reads the sensor's motion from the scenes' odometry (the benchmark's moving
+#: robot had its wheel odometry; scan matching along a corridor has nothing to hold on to)
+ODOMETRY = {"kind__ego_motion": {"name": "odometry"}}
+
+
 def tracker(method: str, overrides: dict | None = None):
-    """A method's tracker; ``leg_tracker_rules`` is :mod:`gaitval.crowd.baseline`'s."""
-    from gaitval.methods import build_method, set_params
-    if method == "leg_tracker_rules":
+    """A method's tracker on the scenes' odometry; ``leg_tracker_rules`` is
+    :mod:`gaitval.crowd.baseline`'s."""
+    from gaitval.methods import build_method, get_method, set_params
+    over = {**ODOMETRY, **(overrides or {})}
+    if method.startswith("leg_tracker_rules"):
         from gaitval.crowd.baseline import baseline_kind
         from gaitval.track.kinds import TRACKER_KINDS
-        m = set_params({"kind": baseline_kind()}, overrides)
-        return TRACKER_KINDS.build(m["kind"])
-    return build_method(method, overrides)
+        if method.endswith("_no_classifier"):
+            over = {"kind__appearance": "none", **over}
+        return TRACKER_KINDS.build(set_params({"kind": baseline_kind()}, over)["kind"])
+    return build_method(get_method(method), over)
 
 
 def hypotheses(res) -> pd.DataFrame:
@@ -112,8 +121,11 @@ def write_crowd_table(rows: pd.DataFrame, stem) -> list[Path]:
                 "an attendant), scored as the leg_tracker benchmark scores its general "
                 f"sets: CLEAR-MOT at {MATCH_M} m inside bearings {SECTOR_DEG[0]:g}…"
                 f"{SECTOR_DEG[1]:g}°, false positives counted, MOTA from the benchmark "
-                "script's ID-switch count (py-motmetrics' count and MOTA beside). leg_tracker_rules: leg_tracker's confirmation, classifier and "
-                "deletion on gaitval's sensing; people_offline reads later scans.",
+                "script's ID-switch count (py-motmetrics' count and MOTA "
+                "beside). leg_tracker_rules: leg_tracker's confirmation, classifier and "
+                "deletion on gaitval's sensing (_no_classifier: without its classifier); "
+                "every method reads the scenes' odometry; people_offline reads later "
+                "scans.",
         notes=[f"dev seeds {', '.join(map(str, DEV_SEEDS))} (looked at while developing); "
                f"test seeds {', '.join(map(str, TEST_SEEDS))} (scored only).",
                f"free choices, drawn per scene: {free}."])

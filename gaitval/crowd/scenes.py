@@ -19,6 +19,10 @@ the stride from the speed, S = 2·(0.35 + 0.3·v) m, within 1.0–1.6 m for 0.5�
 (Grieve & Gear 1966's step length–speed line, rounded).  The ground truth of a person on
 a scan is the midpoint of its two legs, in the sensor frame, on every scan where ≥ 3
 returns fall on its legs (the benchmark's "visible": 3 points clustered on the person).
+
+The sensor's poses go with the scans as its odometry (``scans.meta["odometry"]``), as the
+benchmark's moving robot recorded its own; the trackers read them through the
+``odometry`` ego-motion role (:mod:`gaitval.crowd.bench`).
 """
 from __future__ import annotations
 
@@ -313,7 +317,7 @@ def render(walks, furn, room, pose, t, rng):
     scans = ScanSeries(t=t.copy(), ranges=m["ranges"], angle_min=spec.angle_min,
                        angle_increment=spec.angle_increment, range_min=spec.range_min,
                        range_max=spec.range_max, sensor_model=spec.model,
-                       mounting_height_m=0.3)
+                       mounting_height_m=0.3, meta={"odometry": pose.copy()})
     return scans, _truth(legs, xy, m, len(walks))
 
 
