@@ -35,7 +35,7 @@ class LegTravel(Confirmer):
     on the current scan and each has travelled more than
     ``dist_travelled_together_to_initiate_leg_pair`` = 0.5 m since the pair was formed
     (and a leg is in free space: the tracker's static-map test, :func:`gaitval.track.
-    people._on_static`).  Here each tentative person carries that filter for each leg,
+    peoplepass._on_static`).  Here each tentative person carries that filter for each leg,
     fed with the leg's observation (``person.z``), and the pair is formed at the person's
     birth::
 
