@@ -131,13 +131,17 @@ def test_a_person_who_is_no_longer_seen_ends_after_the_stated_time():
     legs = [np.vstack([left[k], right[k]]) if k < k_gone else np.zeros((0, 2))
             for k in range(n)]
     xy, pats = _observations(legs, np.random.default_rng(2))
-    res = _tracker().run(_scans(n), xy, pats, 0.10)
-    assert res.n_confirmed == 1
-    p = res.people
-    assert set(p.loc[p["k"] >= k_gone, "status"]) == {"coasting"}
-    t_last = p["t_sensor_s"].max()
-    # ended after 3.0 s without support (the deleter's max_unsupported_s)
-    assert t_last - t[k_gone - 1] == pytest.approx(3.0, abs=DT + 1e-9)
+    # the scans hold no return: ended 0.5 s after the last observation (the deleter's
+    # max_no_return_s: nothing in its gate) ...
+    for limit, deleter in ((0.5, "unsupported_time"),
+                           # ... and 3.0 s after it without that rule (max_unsupported_s)
+                           (3.0, {"name": "unsupported_time", "max_no_return_s": None})):
+        res = _tracker(deleter=deleter).run(_scans(n), xy, pats, 0.10)
+        assert res.n_confirmed == 1
+        p = res.people
+        assert set(p.loc[p["k"] >= k_gone, "status"]) == {"coasting"}
+        t_last = p["t_sensor_s"].max()
+        assert t_last - t[k_gone - 1] == pytest.approx(limit, abs=DT + 1e-9)
 
 
 def test_a_slow_walker_is_confirmed():
@@ -553,7 +557,11 @@ def test_a_coasting_person_is_taken_over_where_it_was_last_seen():
     xy, pats = _observations(legs, np.random.default_rng(7))
     area = {"name": "rectangle", "x_m": [0.0, 8.0], "y_m": [-2.0, 2.0]}
     refind = {**METHODS["people"]["kind"]["refind"], "coasting": False}
-    off = _tracker(area=area, refind=refind, motion=CV).run(_scans(n), xy, pats, 0.10)
+    # (the prediction coasts on only without the deleter's no-return rule: these scans
+    # hold no return, so with it the person ends 0.5 s into the gap and is re-found)
+    keep = {"name": "unsupported_time", "max_no_return_s": None}
+    off = _tracker(area=area, refind=refind, motion=CV, deleter=keep).run(
+        _scans(n), xy, pats, 0.10)
     assert off.n_refound == 0 and off.people["k"].max() < n - 1
     last = off.people[off.people["k"] == off.people["k"].max()]
     assert (last["x_m"] > stand[:, 0].max() + 2.0).all()       # coasted far past the person

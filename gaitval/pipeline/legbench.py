@@ -164,16 +164,14 @@ def legbench_evaluate_step(track_parquet, annotations, out_dir, *,
                            benchmark_set: str = "") -> pd.DataFrame:
     """CLEAR-MOT and false leg tracks of one track against the annotations.
 
-    Writes ``summary.parquet`` (one row: trial, method, init, the CLEAR-MOT counts and
-    rates, the benchmark's following reading and reference ID switches, false leg tracks,
-    the initial person's offset from the annotation) and ``frames.parquet`` (per scan:
-    annotated and tracked person, the CLEAR-MOT event).
+    Writes ``summary.parquet`` (one row: the CLEAR-MOT counts and rates, the benchmark's
+    following reading and reference ID switches, false leg tracks, the initial offset)
+    and ``frames.parquet`` (per scan: annotated and tracked person, the event).
 
     ``sector_deg``: ``(lo, hi)`` bearings in degrees; annotations and person hypotheses
     outside are left out of the scoring (the general-tracking sets' −80°…+12°); None: the
-    whole scan.  ``benchmark_set``: the published set the recording belongs to
-    (:data:`gaitval.tables.legbench.BENCHMARK_SETS`; its published rows stand beside this
-    one), or "".
+    whole scan.  ``benchmark_set``: the published set of the recording
+    (:data:`gaitval.tables.legbench.BENCHMARK_SETS`), or "".
     """
     from gaitval.evaluate.clearmot import (clear_mot, false_leg_tracks, following_counts,
                                            in_sector, person_hypotheses)
@@ -182,12 +180,7 @@ def legbench_evaluate_step(track_parquet, annotations, out_dir, *,
     trial = trial or meta.get("trial")
     people = "person_id" in track.columns        # a people tracker's track (issue 36)
     persons = _person_legs(track) if people else None
-    if people:
-        t = track.groupby("k", sort=True)["t_sensor_s"].first().to_numpy(float)
-    else:
-        t = track.loc[track["side"] == "L", "t_sensor_s"].to_numpy(float)
-        x = np.vstack([track.loc[track["side"] == s, "x_m"].to_numpy(float) for s in "LR"])
-        y = np.vstack([track.loc[track["side"] == s, "y_m"].to_numpy(float) for s in "LR"])
+    t, x, y = _scan_times_and_legs(track, people)
     n = len(t)
     positions, ameta = read_positions(annotations, annotation_topic, scan_topic, t, trial)
     if len(positions) and positions["k"].max() >= n:
@@ -195,32 +188,20 @@ def legbench_evaluate_step(track_parquet, annotations, out_dir, *,
                            f"track has {n} scans: not the same recording or scan topic",
                            path=annotations, trial=trial)
     if people:
-        hyp = _people_hypotheses(track)
+        from gaitval.track.people import person_hypotheses as people_hypotheses
+        hyp = people_hypotheses(track)
     else:
         hyp = person_hypotheses(x, y, meta.get("restarts") or [])
     if sector_deg is not None:
-        positions = positions[in_sector(positions["x_m"], positions["y_m"], sector_deg)]
-        hyp = hyp[in_sector(hyp["x_m"], hyp["y_m"], sector_deg)]
-        positions, hyp = positions.reset_index(drop=True), hyp.reset_index(drop=True)
+        positions, hyp = (d[in_sector(d["x_m"], d["y_m"], sector_deg)].reset_index(drop=True)
+                          for d in (positions, hyp))
     summary, events = clear_mot(positions, hyp, n, match_m=match_m)
     follow = following_counts(summary, events)
-    if people:            # every person's legs, summed (recording_min is the same for all)
-        legs = _people_false_legs(persons, t, positions, match_m, min_false_s)
-    else:
-        legs = false_leg_tracks(x, y, t, positions, match_m=match_m, min_false_s=min_false_s)
-    k0 = meta.get("k_init")
-    offset = float("nan")
-    if k0 is not None:
-        g = positions[positions["k"] == k0]
-        h = hyp[hyp["k"] == k0]
-        if len(g) and len(h):
-            offset = float(np.min(np.hypot(g["x_m"].to_numpy() - h["x_m"].iloc[0],
-                                           g["y_m"].to_numpy() - h["y_m"].iloc[0])))
-    window = _window_fraction(meta["method"], positions)
+    legs = (_people_false_legs(persons, t, positions, match_m, min_false_s) if people
+            # every person's legs, summed (recording_min is the same for all)
+            else false_leg_tracks(x, y, t, positions, match_m=match_m, min_false_s=min_false_s))
     row = {"trial": trial, "method": meta["method"], "init": meta["init"],
-           "k_init": -1 if k0 is None else int(k0),
-           "t_init_s": float(t[k0] - t[0]) if k0 is not None else float("nan"),
-           "init_offset_m": offset, **summary, **legs,
+           **_init_offset(meta.get("k_init"), t, positions, hyp), **summary, **legs,
            "idsw_ref": follow["idsw_ref"], "matched_ref": follow["matched"],
            "mota_following": follow["mota_following"],
            "sector_deg": ("" if sector_deg is None
@@ -228,7 +209,7 @@ def legbench_evaluate_step(track_parquet, annotations, out_dir, *,
            "benchmark_set": str(benchmark_set or ""),
            "tracked_fraction": float(len(hyp) / n) if n else float("nan"),
            "annotated_scans": int(positions["k"].nunique()), "n_scans": int(n),
-           "annotations_in_window": window,
+           "annotations_in_window": _window_fraction(meta["method"], positions),
            "match_m": float(match_m), "annotation_frame": str(ameta.get("frame", "")),
            "annotation_frame_source": str(ameta.get("frame_source", ""))}
     out = Path(out_dir)
@@ -236,6 +217,32 @@ def legbench_evaluate_step(track_parquet, annotations, out_dir, *,
     write_parquet(summary_df, out / SUMMARY_FILE)
     write_parquet(_frames(t, positions, hyp, events), out / FRAMES_FILE)
     return summary_df
+
+
+def _scan_times_and_legs(track: pd.DataFrame, people: bool):
+    """Per scan its time and, for a two-leg track, the legs' x and y (2, n) (None for a
+    people tracker's track, whose persons are read by :func:`_person_legs`)."""
+    if people:
+        return track.groupby("k", sort=True)["t_sensor_s"].first().to_numpy(float), None, None
+    t = track.loc[track["side"] == "L", "t_sensor_s"].to_numpy(float)
+    x = np.vstack([track.loc[track["side"] == s, "x_m"].to_numpy(float) for s in "LR"])
+    y = np.vstack([track.loc[track["side"] == s, "y_m"].to_numpy(float) for s in "LR"])
+    return t, x, y
+
+
+def _init_offset(k0, t, positions, hyp) -> dict:
+    """The scan the track started on, its time, and the started person's distance from
+    the nearest annotation on that scan."""
+    offset = float("nan")
+    if k0 is not None:
+        g = positions[positions["k"] == k0]
+        h = hyp[hyp["k"] == k0]
+        if len(g) and len(h):
+            offset = float(np.min(np.hypot(g["x_m"].to_numpy() - h["x_m"].iloc[0],
+                                           g["y_m"].to_numpy() - h["y_m"].iloc[0])))
+    return {"k_init": -1 if k0 is None else int(k0),
+            "t_init_s": float(t[k0] - t[0]) if k0 is not None else float("nan"),
+            "init_offset_m": offset}
 
 
 def _person_legs(track: pd.DataFrame) -> list:
@@ -251,20 +258,6 @@ def _person_legs(track: pd.DataFrame) -> list:
             y[f, leg["k"].to_numpy()] = leg["y_m"].to_numpy(float)
         out.append((int(pid), x, y))
     return out
-
-
-def _people_hypotheses(track: pd.DataFrame) -> pd.DataFrame:
-    """Every reported person's hypothesis: the midpoint of its two legs, ``hyp_id`` = its
-    person id (:data:`gaitval.evaluate.clearmot.HYP_COLUMNS`)."""
-    from gaitval.evaluate.clearmot import HYP_COLUMNS
-    tr = track[track["person_id"] >= 0]
-    mid = tr.groupby(["k", "person_id"], sort=True)[["x_m", "y_m"]].agg(["mean", "count"])
-    ok = (mid[("x_m", "count")] == 2) & (mid[("y_m", "count")] == 2)
-    mid = mid[ok]
-    return pd.DataFrame({"k": mid.index.get_level_values(0).astype(np.int64),
-                         "hyp_id": mid.index.get_level_values(1).astype(np.int64),
-                         "x_m": mid[("x_m", "mean")].to_numpy(float),
-                         "y_m": mid[("y_m", "mean")].to_numpy(float)})[HYP_COLUMNS]
 
 
 def _people_false_legs(persons, t, positions, match_m, min_false_s) -> dict:
@@ -350,46 +343,60 @@ def legbench_tables_step(inputs, tables_dir, figures_dir, reports_dir, config_ha
     return summary
 
 
-def add_legbench_verbs(sub) -> None:
-    """``legbench-track``, ``legbench-evaluate``, ``legbench-tables`` (for gaitval.cli)."""
-    def run(a) -> int:
-        if a.verb == "legbench-track":
-            legbench_track_step(a.sensor, a.method, a.out, init=a.init,
-                                scan_topic=a.scan_topic, annotations=a.annotations,
-                                annotation_topic=a.annotation_topic,
-                                leg_width_m=a.leg_width_m, config_json=a.config,
-                                trial=a.trial)
-        elif a.verb == "legbench-evaluate":
-            s = legbench_evaluate_step(a.track, a.annotations, a.out,
-                                       annotation_topic=a.annotation_topic,
-                                       scan_topic=a.scan_topic, match_m=a.match_m,
-                                       min_false_s=a.min_false_s, trial=a.trial,
-                                       sector_deg=a.sector_deg,
-                                       benchmark_set=a.benchmark_set or "")
-            if s.iloc[0]["gt"] == 0:
-                print(f"gaitval: warning: no annotated person in {a.annotations}"
-                      f"{' inside the sector' if a.sector_deg else ''}: nothing to score",
-                      file=sys.stderr)
-            cols = ["method", "init", "mota", "motp_m", "idsw", "idsw_ref", "idf1",
-                    "matches", "fn", "fp", "gt", "mota_following",
-                    "false_leg_tracks_per_min"]
-            print(s[cols].to_string(index=False))
-        else:
-            legbench_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir,
-                                 a.config_hash, methods=a.methods, inits=a.inits,
-                                 views_dir=a.views_dir)
-        return 0
+def _run_verb(a) -> int:
+    """Run one legbench verb from its parsed arguments."""
+    if a.verb == "legbench-track":
+        legbench_track_step(a.sensor, a.method, a.out, init=a.init,
+                            scan_topic=a.scan_topic, annotations=a.annotations,
+                            annotation_topic=a.annotation_topic,
+                            leg_width_m=a.leg_width_m, config_json=a.config,
+                            trial=a.trial)
+    elif a.verb == "legbench-evaluate":
+        s = legbench_evaluate_step(a.track, a.annotations, a.out,
+                                   annotation_topic=a.annotation_topic,
+                                   scan_topic=a.scan_topic, match_m=a.match_m,
+                                   min_false_s=a.min_false_s, trial=a.trial,
+                                   sector_deg=a.sector_deg,
+                                   benchmark_set=a.benchmark_set or "")
+        if s.iloc[0]["gt"] == 0:
+            print(f"gaitval: warning: no annotated person in {a.annotations}"
+                  f"{' inside the sector' if a.sector_deg else ''}: nothing to score",
+                  file=sys.stderr)
+        cols = ["method", "init", "mota", "motp_m", "idsw", "idsw_ref", "idf1",
+                "matches", "fn", "fp", "gt", "mota_following",
+                "false_leg_tracks_per_min"]
+        print(s[cols].to_string(index=False))
+    elif a.verb == "legbench-crowd":
+        from gaitval.crowd.bench import crowd_step
+        crowd_step(a.tables_dir, a.split)
+    else:
+        legbench_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir,
+                             a.config_hash, methods=a.methods, inits=a.inits,
+                             views_dir=a.views_dir)
+    return 0
 
-    reports = ("the report folder (reports/<run> in the workflow): the step's provenance "
-               "record goes to its provenance/ (default: reports)")
-    ann_topic = ("the bag's annotation topic, e.g. /ground_truth_people_tracks (default: "
-                 "the only one; docs/formats.md, Annotated person positions)")
-    scan_topic = "the bag's LaserScan topic (default: the only one)"
+
+_REPORTS_HELP = ("the report folder (reports/<run> in the workflow): the step's provenance "
+                 "record goes to its provenance/ (default: reports)")
+_ANN_TOPIC = ("the bag's annotation topic, e.g. /ground_truth_people_tracks (default: "
+              "the only one; docs/formats.md, Annotated person positions)")
+_SCAN_TOPIC = "the bag's LaserScan topic (default: the only one)"
+
+
+def add_legbench_verbs(sub) -> None:
+    """``legbench-track``, ``legbench-evaluate``, ``legbench-tables``, ``legbench-crowd``
+    (for gaitval.cli)."""
+    for add in (_add_track_parser, _add_evaluate_parser, _add_tables_parser,
+                _add_crowd_parser):
+        add(sub)
+
+
+def _add_track_parser(sub) -> None:
     s = sub.add_parser("legbench-track", help="track an annotated recording (bag or scan "
                                               "log, no mocap) with one method")
     s.add_argument("--sensor", required=True, help="ROS 1 *.bag, ROS 2 bag folder or "
                    "*.scan.parquet (the trial sheet's sensor_file)")
-    s.add_argument("--scan-topic", help=scan_topic)
+    s.add_argument("--scan-topic", help=_SCAN_TOPIC)
     s.add_argument("--method", required=True, help="the method's name: a built-in (e.g. "
                    "tug_m1, tug_m2, tug_m3) or one of tracking.methods (legbench.methods)")
     s.add_argument("--init", choices=INITS, default="own",
@@ -397,7 +404,7 @@ def add_legbench_verbs(sub) -> None:
                    "(default: own)")
     s.add_argument("--annotations", help="bag with the annotation topic, or *.positions.csv "
                    "(read by --init annotation)")
-    s.add_argument("--annotation-topic", help=ann_topic)
+    s.add_argument("--annotation-topic", help=_ANN_TOPIC)
     s.add_argument("--leg-width-m", type=float, default=0.10, help="the subject's shank "
                    "width (subjects.csv leg_width_m; m, default 0.10)")
     s.add_argument("--config", help="a config (view) JSON (results/<study>/config_views/all/"
@@ -408,15 +415,18 @@ def add_legbench_verbs(sub) -> None:
     s.add_argument("--out", required=True, help="the per-scan track, Parquet, sensor frame "
                    "and clock, metres (results/<study>/legbench/<method>/<init>/<trial>/"
                    "track.parquet)")
-    s.set_defaults(func=run)
+    s.set_defaults(func=_run_verb)
+
+
+def _add_evaluate_parser(sub) -> None:
     s = sub.add_parser("legbench-evaluate", help="CLEAR-MOT (0.75 m) and false leg tracks "
                                                  "of a legbench track")
     s.add_argument("--track", required=True, help="the track of legbench-track "
                    "(results/<study>/legbench/<method>/<init>/<trial>/track.parquet)")
     s.add_argument("--annotations", required=True, help="bag with the annotation topic, or "
                    "*.positions.csv")
-    s.add_argument("--annotation-topic", help=ann_topic)
-    s.add_argument("--scan-topic", help=scan_topic + ": the scan times the annotations "
+    s.add_argument("--annotation-topic", help=_ANN_TOPIC)
+    s.add_argument("--scan-topic", help=_SCAN_TOPIC + ": the scan times the annotations "
                    "are matched to")
     s.add_argument("--match-m", type=float, default=0.75, help="a tracked person (midpoint "
                    "of its two legs) matches an annotated one within this distance (m; "
@@ -434,7 +444,10 @@ def add_legbench_verbs(sub) -> None:
     s.add_argument("--trial", help="trial id (default: the one in the track)")
     s.add_argument("--out", required=True, help="folder (results/<study>/legbench_eval/"
                    "<method>/<init>/<trial>): summary.parquet, frames.parquet")
-    s.set_defaults(func=run)
+    s.set_defaults(func=_run_verb)
+
+
+def _add_tables_parser(sub) -> None:
     s = sub.add_parser("legbench-tables", help="CLEAR-MOT table and figure of legbench runs")
     s.add_argument("inputs", nargs="+", metavar="EVAL_DIR", help="legbench-evaluate output "
                    "folders (results/<study>/legbench_eval/<method>/<init>/<trial>)")
@@ -450,7 +463,17 @@ def add_legbench_verbs(sub) -> None:
                    "(legbench_clearmot.csv, .md, ...; reports/<run>/tables)")
     s.add_argument("--figures-dir", required=True, help="folder the figure goes to "
                    "(legbench_tracks.png; reports/<run>/figures)")
-    s.add_argument("--reports-dir", default="reports", help=reports)
+    s.add_argument("--reports-dir", default="reports", help=_REPORTS_HELP)
     s.add_argument("--config-hash", default="", help="the run's config hash, written into "
                    "the provenance record (default: empty)")
-    s.set_defaults(func=run)
+    s.set_defaults(func=_run_verb)
+
+
+def _add_crowd_parser(sub) -> None:
+    s = sub.add_parser("legbench-crowd", help="the multi-person benchmark on rendered "
+                                              "scenes (docs/crowd.md)")
+    s.add_argument("--tables-dir", required=True, help="folder the tables go to "
+                   "(legbench_crowd.csv, .md, .tex, legbench_crowd_scenes.csv)")
+    s.add_argument("--split", choices=("dev", "test", "all"), default="all",
+                   help="the development scenes, the test scenes or both (default: all)")
+    s.set_defaults(func=_run_verb)

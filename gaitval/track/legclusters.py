@@ -114,8 +114,7 @@ def _angle(ax, ay, bx, by):
 
 
 @njit(cache=True)
-def cluster_features(idx, ranges, angle_min, angle_increment, range_min, range_max):
-    """The 17 features of one cluster (beam indices ``idx``, increasing) of one scan."""
+def _cluster_points(idx, ranges, angle_min, angle_increment):
     n = idx.shape[0]
     x = np.empty(n)
     y = np.empty(n)
@@ -126,7 +125,14 @@ def cluster_features(idx, ranges, angle_min, angle_increment, range_min, range_m
         r[j] = ranges[i]
         x[j] = math.cos(a) * ranges[i]
         y[j] = math.sin(a) * ranges[i]
-    # mean and median (cluster_features.cpp 43-63)
+    return x, y, r
+
+
+@njit(cache=True)
+def _spread(x, y):
+    """Means, distance of the median point, std and average deviation from the median
+    (cluster_features.cpp 43-79)."""
+    n = x.shape[0]
     x_mean = x.mean()
     y_mean = y.mean()
     xs = np.sort(x)
@@ -134,15 +140,18 @@ def cluster_features(idx, ranges, angle_min, angle_increment, range_min, range_m
     x_median = 0.5 * (xs[(n - 1) // 2] + xs[n // 2])
     y_median = 0.5 * (ys[(n - 1) // 2] + ys[n // 2])
     distance = math.sqrt(x_median * x_median + y_median * y_median)        # cpp 66
-    # std and average deviation from the median (cpp 68-79)
     sum_std = 0.0
     sum_med = 0.0
     for j in range(n):
         sum_std += (x[j] - x_mean) ** 2 + (y[j] - y_mean) ** 2
         sum_med += math.sqrt((x[j] - x_median) ** 2 + (y[j] - y_median) ** 2)
-    std = math.sqrt(sum_std / (n - 1.0))
-    avg_median_dev = sum_med / n
-    # occluded left / right: the neighbouring beams (cpp 81-120)
+    return x_mean, y_mean, distance, math.sqrt(sum_std / (n - 1.0)), sum_med / n
+
+
+@njit(cache=True)
+def _occluded(idx, r, ranges, range_min, range_max):
+    """Occluded left / right: the neighbouring beams (cpp 81-120)."""
+    n = idx.shape[0]
     occ_left = 1.0
     occ_right = 1.0
     prev_i = idx[0] - 1
@@ -157,19 +166,28 @@ def cluster_features(idx, ranges, angle_min, angle_increment, range_min, range_m
         if nr > range_min and nr < range_max:
             if r[n - 1] < nr or nr < 0.01:
                 occ_right = 0.0
-    width = math.sqrt((x[0] - x[n - 1]) ** 2 + (y[0] - y[n - 1]) ** 2)       # cpp 125
-    # linearity: the squared second singular value of the centred points (cpp 128-151)
-    # (Σ over rot_points' second column² = σ₂², the smaller eigenvalue of the scatter matrix)
+    return occ_left, occ_right
+
+
+@njit(cache=True)
+def _linearity(x, y, x_mean, y_mean):
+    """The squared second singular value of the centred points (cpp 128-151): Σ over
+    rot_points' second column² = σ₂², the smaller eigenvalue of the scatter matrix."""
     sxx = 0.0
     sxy = 0.0
     syy = 0.0
-    for j in range(n):
+    for j in range(x.shape[0]):
         sxx += (x[j] - x_mean) ** 2
         sxy += (x[j] - x_mean) * (y[j] - y_mean)
         syy += (y[j] - y_mean) ** 2
     half = 0.5 * (sxx - syy)
-    linearity = max(0.5 * (sxx + syy) - math.sqrt(half * half + sxy * sxy), 0.0)
-    # circularity: least-squares circle, Σ(r_c − |p − c|)² (cpp 154-182)
+    return max(0.5 * (sxx + syy) - math.sqrt(half * half + sxy * sxy), 0.0)
+
+
+@njit(cache=True)
+def _circularity(x, y):
+    """Least-squares circle, Σ(r_c − |p − c|)² (cpp 154-182)."""
+    n = x.shape[0]
     A = np.empty((n, 3))
     B = np.empty(n)
     for j in range(n):
@@ -183,8 +201,14 @@ def cluster_features(idx, ranges, angle_min, angle_increment, range_min, range_m
     circularity = 0.0
     for j in range(n):
         circularity += (rc - math.sqrt((xc - x[j]) ** 2 + (yc - y[j]) ** 2)) ** 2
-    radius = 0.0                                                          # cpp 186
-    # boundary length / regularity, mean curvature, mean angular difference (cpp 188-249)
+    return circularity
+
+
+@njit(cache=True)
+def _boundary(x, y):
+    """Boundary length and regularity, mean curvature, mean angular difference (cpp
+    188-252)."""
+    n = x.shape[0]
     mean_curvature = 0.0
     boundary_length = 0.0
     last_seg = 0.0
@@ -216,24 +240,41 @@ def cluster_features(idx, ranges, angle_min, angle_increment, range_min, range_m
     sum_reg_sq += last_seg * last_seg
     reg = (sum_reg_sq - boundary_length ** 2 / n) / (n - 1)
     boundary_regularity = math.sqrt(reg) if reg > 0 else 0.0               # cpp 252
-    # inscribed angle: first, each middle point, last (cpp 255-290)
+    return boundary_length, boundary_regularity, mean_curvature, ang_diff
+
+
+@njit(cache=True)
+def _inscribed_angle(x, y):
+    """Inscribed angle variation: first, each middle point, last (cpp 255-290)."""
+    n = x.shape[0]
     sum_iav = 0.0
     sum_iav_sq = 0.0
     for j in range(1, n - 1):
         th = _angle(x[0] - x[j], y[0] - y[j], x[n - 1] - x[j], y[n - 1] - y[j])
         sum_iav += th
         sum_iav_sq += th * th
-    iav = sum_iav / n
     v = (sum_iav_sq - sum_iav ** 2 / n) / (n - 1)
-    std_iav = math.sqrt(v) if v > 0 else 0.0
+    return sum_iav / n, math.sqrt(v) if v > 0 else 0.0
+
+
+@njit(cache=True)
+def cluster_features(idx, ranges, angle_min, angle_increment, range_min, range_max):
+    """The 17 features of one cluster (beam indices ``idx``, increasing) of one scan."""
+    n = idx.shape[0]
+    x, y, r = _cluster_points(idx, ranges, angle_min, angle_increment)
+    x_mean, y_mean, distance, std, avg_median_dev = _spread(x, y)
+    occ_left, occ_right = _occluded(idx, r, ranges, range_min, range_max)
+    width = math.sqrt((x[0] - x[n - 1]) ** 2 + (y[0] - y[n - 1]) ** 2)       # cpp 125
+    boundary_length, boundary_regularity, mean_curvature, ang_diff = _boundary(x, y)
+    iav, std_iav = _inscribed_angle(x, y)
     out = np.empty(17)
     out[0] = n                      # cpp 296
     out[1] = std                    # cpp 297
     out[2] = avg_median_dev         # cpp 298
     out[3] = width                  # cpp 301
-    out[4] = linearity              # cpp 302
-    out[5] = circularity            # cpp 303
-    out[6] = radius                 # cpp 304
+    out[4] = _linearity(x, y, x_mean, y_mean)   # cpp 302
+    out[5] = _circularity(x, y)     # cpp 303
+    out[6] = 0.0                    # radius, cpp 186 and 304
     out[7] = boundary_length        # cpp 305
     out[8] = boundary_regularity    # cpp 306
     out[9] = mean_curvature         # cpp 307

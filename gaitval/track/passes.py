@@ -128,13 +128,34 @@ def join_passes(fwd: pd.DataFrame, bwd: pd.DataFrame, gate_m: float,
     # the scans each person is reported on
     kf = {int(p): set(g["k"].tolist()) for p, g in cf.groupby("person_id")}
     kb = {int(p): set(g["k"].tolist()) for p, g in cb.groupby("person_id")}
+    members = _groups(kf, kb, _links(cf, cb, gate_m))
+    fid = {p: min(q for s, q in m if s == "f") for m in members for s0, p in m
+           if s0 == "f"}
+    parts = [fwd.assign(person_id=fwd["person_id"].map(fid))]
+    for mem in members:
+        rows = _backward_rows(mem, fwd, bwd, kf, top, extend_only, splice_scans)
+        if rows is not None:
+            parts.append(rows)
+    res = pd.concat(parts, ignore_index=True)[cols]
+    res = res.sort_values(["k", "person_id", "side"], kind="stable").reset_index(drop=True)
+    return res.astype({"k": np.int64, "person_id": np.int64, "phase": np.int64,
+                       "observed": bool}), fid
+
+
+def _links(cf: pd.DataFrame, cb: pd.DataFrame, gate_m: float) -> list:
+    """(median centre distance, forward id, backward id) of the pairs of persons whose
+    median distance over the scans both report is within ``gate_m``, nearest first."""
     both = cf.merge(cb, on="k", suffixes=("_f", "_b"))
-    links = []
-    if len(both):
-        both["d"] = np.hypot(both["x_m_f"] - both["x_m_b"], both["y_m_f"] - both["y_m_b"])
-        med = both.groupby(["person_id_f", "person_id_b"], sort=True)["d"].median()
-        links = sorted((float(d), int(f), int(b)) for (f, b), d in med.items() if d <= gate_m)
-    # union of groups, each holding at most one person of each pass on any scan
+    if not len(both):
+        return []
+    both["d"] = np.hypot(both["x_m_f"] - both["x_m_b"], both["y_m_f"] - both["y_m_b"])
+    med = both.groupby(["person_id_f", "person_id_b"], sort=True)["d"].median()
+    return sorted((float(d), int(f), int(b)) for (f, b), d in med.items() if d <= gate_m)
+
+
+def _groups(kf: dict, kb: dict, links: list) -> list[list]:
+    """Union of the linked persons, nearest links first, each group holding at most one
+    person of each pass on any scan: the groups' members ``("f"|"b", id)``, in order."""
     group = {("f", p): ("f", p) for p in kf} | {("b", p): ("b", p) for p in kb}
     members = {g: [g] for g in group}
 
@@ -143,56 +164,40 @@ def join_passes(fwd: pd.DataFrame, bwd: pd.DataFrame, gate_m: float,
             x = group[x]
         return x
 
-    def scans_of(g, side):
-        return [kf[p] if s == "f" else kb[p] for s, p in members[g] if s == side]
+    def scans(g, side):
+        sets = [kf[p] if s == "f" else kb[p] for s, p in members[g] if s == side]
+        return set().union(*sets) if sets else set()
 
     for _, f, b in links:
         a, c = root(("f", f)), root(("b", b))
-        if a == c:
-            continue
-        ok = True
-        for side in ("f", "b"):
-            sa, sc = scans_of(a, side), scans_of(c, side)
-            ua = set().union(*sa) if sa else set()
-            if any(ua & s for s in sc):
-                ok = False
-                break
-        if not ok:
+        if a == c or any(scans(a, side) & scans(c, side) for side in ("f", "b")):
             continue
         group[c] = a
         members[a] += members.pop(c)
-    fid = {p: min(q for s, q in members[root(("f", p))] if s == "f") for p in kf}
-    out = [fwd.assign(person_id=fwd["person_id"].map(fid))]
-    bparts = []
-    for _, mem in sorted(members.items()):
-        bs = sorted(q for s, q in mem if s == "b")
-        if not bs:
-            continue
-        fs = sorted(q for s, q in mem if s == "f")
-        rows = bwd[bwd["person_id"].isin(bs)]
-        if fs:
-            covered = set().union(*(kf[q] for q in fs))
-            rows = rows[~rows["k"].isin(covered)]
-            gid = fs[0]
-        elif extend_only:
-            continue
-        else:
-            gid = top + bs[0]
-        if rows.empty:
-            continue
-        # one backward member per scan: more legs observed, then the smaller id
-        seen = rows.groupby(["k", "person_id"], sort=True)["observed"].sum().reset_index()
-        seen = seen.sort_values(["k", "observed", "person_id"], ascending=[True, False, True],
-                                kind="stable").drop_duplicates("k")
-        rows = rows.merge(seen[["k", "person_id"]], on=["k", "person_id"])
-        if fs:
-            rows = _align_sides(rows, fwd[fwd["person_id"].isin(fs)],
-                                bwd[bwd["person_id"].isin(bs)], splice_scans)
-        bparts.append(rows.assign(person_id=gid))
-    res = pd.concat(out + bparts, ignore_index=True)[cols]
-    res = res.sort_values(["k", "person_id", "side"], kind="stable").reset_index(drop=True)
-    return res.astype({"k": np.int64, "person_id": np.int64, "phase": np.int64,
-                       "observed": bool}), fid
+    return [m for _, m in sorted(members.items())]
+
+
+def _backward_rows(mem, fwd, bwd, kf, top, extend_only, splice_scans):
+    """A group's backward rows on the scans its forward members do not report (one
+    backward member per scan: more legs observed, then the smaller id), labelled with the
+    group's id and aligned with its forward legs; None when it adds nothing."""
+    bs = sorted(q for s, q in mem if s == "b")
+    fs = sorted(q for s, q in mem if s == "f")
+    if not bs or (not fs and extend_only):
+        return None
+    rows = bwd[bwd["person_id"].isin(bs)]
+    if fs:
+        rows = rows[~rows["k"].isin(set().union(*(kf[q] for q in fs)))]
+    if rows.empty:
+        return None
+    seen = rows.groupby(["k", "person_id"], sort=True)["observed"].sum().reset_index()
+    seen = seen.sort_values(["k", "observed", "person_id"], ascending=[True, False, True],
+                            kind="stable").drop_duplicates("k")
+    rows = rows.merge(seen[["k", "person_id"]], on=["k", "person_id"])
+    if fs:
+        rows = _align_sides(rows, fwd[fwd["person_id"].isin(fs)],
+                            bwd[bwd["person_id"].isin(bs)], splice_scans)
+    return rows.assign(person_id=fs[0] if fs else top + bs[0])
 
 
 def _align_sides(rows: pd.DataFrame, fwd: pd.DataFrame, bwd_all: pd.DataFrame,

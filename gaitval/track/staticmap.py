@@ -75,6 +75,20 @@ class StandingSensor(EgoMotion):
         return np.zeros((scans.n_scans, 3)), np.zeros(scans.n_scans, dtype=np.int64)
 
 
+@EGO_MOTIONS.register("odometry")
+class Odometry(EgoMotion):
+    """The sensor's poses as recorded beside the scans (``scans.meta["odometry"]``: (n, 3)
+    x, y, θ in one world frame; a robot's wheel odometry, leg_tracker's ``fixed_frame``).
+    Without them the sensor is taken to stand."""
+
+    def poses(self, scans):
+        odo = scans.meta.get("odometry") if isinstance(scans.meta, dict) else None
+        if odo is None:
+            return StandingSensor().poses(scans)
+        odo = np.asarray(odo, dtype=float).reshape(scans.n_scans, 3)
+        return odo.copy(), np.zeros(scans.n_scans, dtype=np.int64)
+
+
 @EGO_MOTIONS.register("scan_matching")
 class ScanMatching(EgoMotion):
     """Scan-to-previous-scan ICP (module notes).
