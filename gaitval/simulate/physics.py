@@ -172,11 +172,18 @@ def _swing_rows(study_dir: Path, trials: pd.DataFrame, real: dict | None,
                          f"no first swing below {SWING_BACKWARD_MPS} m/s forward",
                          "gait initiation (docs/simulator.md): hip and knee lead the first "
                          "step, the thigh carries the knee forward", group=GROUP_OF.get(proto, ""),
-                         note=f"{len(first)} first swings from standing; lowest forward speed "
-                              f"{first[:, 0].min():.2f} m/s; duration "
+                         note=f"{_n_first(first)} first swings from standing; lowest "
+                              f"forward speed {np.nanmin(first[:, 0]):.2f} m/s; duration "
                               f"{first[:, 1].min():.2f}-{first[:, 1].max():.2f} x the trial's "
                               "median swing"))
     return rows
+
+
+def _n_first(first: np.ndarray) -> str:
+    """How many first swings the row measured (a shuffle with no direction is not)."""
+    n_nan = int(np.isnan(first[:, 0]).sum())
+    shuffles = f" ({n_nan} more without a direction: the shin moved < 5 cm)" if n_nan else ""
+    return f"{len(first) - n_nan}{shuffles}"
 
 
 def _shin_rows(walkers: list | None, realdata: Path | None) -> tuple[list[dict], dict | None]:

@@ -70,5 +70,7 @@ def _first(legs: pd.DataFrame, ev: pd.DataFrame) -> tuple[float, float]:
     t = g["t_s"].to_numpy(float)
     prof = point_profile(t, g[["x_m", "y_m"]].to_numpy(float), [(a, b)],
                          1.0 / float(np.median(np.diff(t))))
-    return float(prof["fwd_min"][0]), (b - a) / float(np.median(
+    # a first step whose shin point travels < 5 cm (a shuffle) has no direction: NaN
+    fmin = float(prof["fwd_min"][0]) if len(prof["fwd_min"]) else np.nan
+    return fmin, (b - a) / float(np.median(
         [y - x for v in sw.values() for x, y in v]))
