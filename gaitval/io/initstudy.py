@@ -222,10 +222,10 @@ def _c3d_facts(path: Path) -> dict:
 
 def _bag_topics(path: Path) -> tuple[str | None, list[str], list[str]]:
     """The bag's LaserScan topic (None unless exactly one), its tracker topics
-    (:data:`gaitval.io.tracks.BAG_PEOPLE_TYPES`: a tracker recorded with the scans) and its
-    leg-detection topics (:data:`gaitval.io.tracks.BAG_LEG_DETECTIONS`)."""
+    (:data:`gaitval.io.tracks.bag.BAG_PEOPLE_TYPES`: a tracker recorded with the scans) and its
+    leg-detection topics (:data:`gaitval.io.tracks.bag.BAG_LEG_DETECTIONS`)."""
     from gaitval.io.rosbag import LASERSCAN, _open
-    from gaitval.io.tracks import BAG_LEG_DETECTIONS, BAG_PEOPLE_TYPES
+    from gaitval.io.tracks.bag import BAG_LEG_DETECTIONS, BAG_PEOPLE_TYPES
 
     reader = _open(path, None)
     try:

@@ -16,7 +16,7 @@ naming the file, the row (line number and trial id) and the column.
 
 Every call reads and validates the files again (nothing is kept between calls): a caller
 that asks for many trials' rows keeps the validated sheet itself (:func:`clean_sheet`,
-:func:`row_of`; :func:`gaitval.pipeline.steps.trial_row`).
+:func:`row_of`; :func:`gaitval.pipeline.steps.trials.trial_row`).
 """
 from __future__ import annotations
 
@@ -496,7 +496,7 @@ def clean_sheet(path, subjects) -> pd.DataFrame | None:
     """The validated sheet (:func:`sheet_problems`, its files not checked) when it, its
     subject table and study.yaml have no problem, else None.  ~35 ms for the default
     study's 127 rows: a caller asking for many trials' rows keeps it
-    (:func:`gaitval.pipeline.steps.trial_and_subject`) and picks them with
+    (:func:`gaitval.pipeline.steps.trials.trial_and_subject`) and picks them with
     :func:`row_of`."""
     df, problems = sheet_problems(Path(path).resolve(), subjects, check_files=False)
     return None if problems else df
