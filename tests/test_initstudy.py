@@ -32,7 +32,8 @@ import pytest
 import yaml
 
 from gaitval.errors import GaitvalError
-from gaitval.io.initstudy import FILL_IN, init_study
+from gaitval.io.initstudy import init_study
+from gaitval.io.initstudy_files import FILL_IN
 
 from conftest import PROFILE, SNAKEMAKE
 
