@@ -196,7 +196,8 @@ def dry_run(*args: str) -> subprocess.CompletedProcess:
 
 def test_override_keys_are_checked_against_the_methods_parameters():
     """Issue 35: a typo'd override names the key and the nearest valid one."""
-    from gaitval.methods import METHODS, check_overrides, override_problems
+    from gaitval.methods import METHODS
+    from gaitval.overrides import check_overrides, override_problems
 
     defs = {m: m for m in METHODS}
     ok = {"tug_m3": {"occlusion__max_n": 10, "gate__g": 9.21, "tracker__dt_s": 0.025,

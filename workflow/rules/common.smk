@@ -14,7 +14,8 @@ from gaitval.configcheck import (check_config, check_study_file, display_path,
 from gaitval.errors import ConfigError, GaitvalError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash, source_digest
-from gaitval.methods import METHODS, get_method, override_problems, set_params
+from gaitval.methods import METHODS, get_method, set_params
+from gaitval.overrides import override_problems
 from gaitval.pipeline.steps.config import (ALL_SCOPE, ANALYSIS_SECTIONS, PROTOCOL_SCOPE, SCOPES,
                                            STUDY_VIEW, method_definition, method_view)
 from gaitval.pipeline.steps.declarations import EXTERNAL_PROTOCOLS
