@@ -366,7 +366,8 @@ def test_init_study_external_methods_pass_validate(tiny_files, tmp_path):
     """Every trial with its track file: the study.yaml init-study writes declares the
     tracker, and `gaitval validate --deep` (schema, files, every file read) accepts it once
     the one cell the files cannot give (the leg width) is filled in; the workflow's own
-    start-up check (gaitval.pipeline.steps.declarations.external_declarations) returns the entry."""
+    start-up check (gaitval.pipeline.steps.declarations.external_declarations) returns the
+    entry."""
     from gaitval.io.tracks.write import write_tracks
     from gaitval.pipeline.steps.declarations import external_declarations
 
