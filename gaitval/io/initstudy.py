@@ -4,10 +4,10 @@ workflow config snippet from a folder of recordings (issue 37).
 The folder holds what a lab exported: C3D files, laser logs (``*.scan.parquet``, ROS bags),
 ultrasonic logs (``*.us.parquet``), rater annotations (``*.annotations.csv``,
 ``*.positions.csv``), MTST target layouts (``*.targets.csv``) and external trackers' tracks
-(``*.tracks.csv``/``*.tracks.parquet``).  :func:`scan_folder` finds them; :func:`init_study`
-pairs each sensor file with its C3D — by name (the same stem) first, then by time (the
-files' modification times, closest first, within ``max_time_gap_s``) — and reads what the
-files say about each trial:
+(``*.tracks.csv``/``*.tracks.parquet``).  :func:`~gaitval.io.initstudy_files.scan_folder`
+finds them; :func:`init_study` pairs each sensor file with its C3D — by name (the same
+stem) first, then by time (the files' modification times, closest first, within
+``max_time_gap_s``) — and reads what the files say about each trial:
 
 * protocol, subject, speed, scenario, repetition and stick from the words of the file
   name (``tug_Y01_t1``, ``rollator_P01_straight_r1``, ``us_US01_slow``; words separated by
@@ -28,13 +28,13 @@ files say about each trial:
   ``external_detections:`` entry.  The config snippet holds only what a study.yaml cannot: where the
   sheet and subject table are, and ``run``.
 
-What the files cannot say and a table needs is written as :data:`FILL_IN` — the shank
-width at the sensor's height (``leg_width_m``), a subject's height for the MTST foot model,
-whether an MTST participant walked with a stick, a study calibration such as the
-rollator's sensor mount — so that ``gaitval validate`` refuses the sheet, naming the row
-and the column, until the user has filled it in.  Nothing is guessed silently: every
-filled value's source and every cell left to the user are listed in the report
-(:class:`InitResult`).
+What the files cannot say and a table needs is written as
+:data:`~gaitval.io.initstudy_files.FILL_IN` — the shank width at the sensor's height
+(``leg_width_m``), a subject's height for the MTST foot model, whether an MTST participant
+walked with a stick, a study calibration such as the rollator's sensor mount — so that
+``gaitval validate`` refuses the sheet, naming the row and the column, until the user has
+filled it in.  Nothing is guessed silently: every filled value's source and every cell left
+to the user are listed in the report (:class:`~gaitval.io.initstudy_files.InitResult`).
 """
 from __future__ import annotations
 

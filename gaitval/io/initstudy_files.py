@@ -68,7 +68,8 @@ class Found:
 
 @dataclass
 class InitResult:
-    """What :func:`init_study` wrote and what the user must still do."""
+    """What :func:`~gaitval.io.initstudy.init_study` wrote and what the user must still
+    do."""
 
     folder: Path
     written: list[Path] = field(default_factory=list)

@@ -67,8 +67,9 @@ def check_log(log: str, *, lines: int | None = None) -> tuple[str, dict, int]:
 
 def compile_tables(paths, workdir, *, pdflatex: str = "pdflatex", timeout: float = 120
                    ) -> dict[str, Compiled]:
-    """Compile each ``.tex`` table on its own inside :data:`PREAMBLE`, as a page of an
-    article, with pdflatex, and check that it fits the page.
+    """Compile each ``.tex`` table on its own inside
+    :data:`~gaitval.tables.latex.PREAMBLE`, as a page of an article, with pdflatex, and
+    check that it fits the page.
 
     Returns ``{path: (ok, problem, n_box_problems)}`` (a :class:`Compiled` that also has
     ``.counts`` and ``.pages``).  ``ok`` is False when pdflatex fails or its log shows a

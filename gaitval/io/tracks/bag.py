@@ -91,7 +91,7 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
         Rows ``t_s, person, x, y`` (sorted by time and person, in metres; and ``msg``,
         the message's number on the topic, 1-based, which errors name) and the header
         (``format, version, units: m, frame: sensor, clock: sensor, source``), ready for
-        :func:`write_tracks`.
+        :func:`~gaitval.io.tracks.write.write_tracks`.
     """
     from gaitval.io.annotations_bag import _register_custom_types
     from gaitval.io.rosbag import _open
@@ -228,12 +228,12 @@ def read_bag_leg_detections(path: str | Path, topic: str | None = None, *,
 def people_to_legs(rows: pd.DataFrame, legs: dict, *, path=None, trial: str | None = None,
                    topic: str = "") -> pd.DataFrame:
     """People rows (``t_s, person, x, y`` in metres, :func:`read_bag_tracks`) as leg rows
-    (``t_s, side, x_m, y_m``, :func:`read_tracks`' columns, and ``msg`` when the people
-    rows have it): ``legs`` maps each side to
-    the person id that tracked it (``{"L": "1", "R": "2"}``; a PoseArray's index), for a
-    tracker that publishes each leg as a person.  Other ids are dropped.  A time stamp
-    where one leg's id is absent gets that leg without a position (not observed: the
-    tracker had no track); an id that never appears is an error naming it."""
+    (``t_s, side, x_m, y_m``, :func:`~gaitval.io.tracks.read.read_tracks`' columns, and
+    ``msg`` when the people rows have it): ``legs`` maps each side to the person id that
+    tracked it (``{"L": "1", "R": "2"}``; a PoseArray's index), for a tracker that
+    publishes each leg as a person.  Other ids are dropped.  A time stamp where one leg's
+    id is absent gets that leg without a position (not observed: the tracker had no track);
+    an id that never appears is an error naming it."""
     if set(legs) != set(SIDES):
         raise _err(path, f"legs {dict(legs)!r} must map both sides L and R to a person id",
                    trial)

@@ -37,7 +37,7 @@ def read_detections(path: str | Path, *, trial: str | None = None
         frame; ``msg`` numbers the file's distinct
         time stamps (1-based); and the header with ``source`` (default: the file name),
         ``n_messages`` and ``t_messages`` (every time stamp, detections or not) — the shape
-        of :func:`read_bag_leg_detections`'s result.
+        of :func:`~gaitval.io.tracks.bag.read_bag_leg_detections`'s result.
 
     Raises
     ------

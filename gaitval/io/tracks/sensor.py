@@ -71,12 +71,13 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
                      t_range: tuple[float, float] | None = None,
                      tolerance_s: float = 0.0, scan_t: np.ndarray | None = None,
                      max_range_m: float | None = None) -> pd.DataFrame:
-    """Exchange rows (from :func:`read_tracks`) as gaitval's per-scan leg track.
+    """Exchange rows (from :func:`~gaitval.io.tracks.read.read_tracks`) as gaitval's
+    per-scan leg track.
 
     Parameters
     ----------
     rows, meta
-        :func:`read_tracks` output.
+        :func:`~gaitval.io.tracks.read.read_tracks` output.
     registration : dict, optional
         The trial's registration record (``registration.json``: ``x_m``, ``y_m``,
         ``yaw_rad``, ``clock_offset_s``, ``clock_drift_ppm``); needed when the file's
@@ -90,21 +91,22 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
         :data:`SNAP_S` of one becomes that scan's time (:func:`snap_to_scans`).
     max_range_m : float, optional
         The laser's range: most positions (their median; in the sensor frame, after the
-        conversion) farther than this + :data:`RANGE_MARGIN_M` (a track that diverged
-        far in a few scans is a tracker's result, kept), or every position within
-        :data:`MIN_DISTANCE_M` of the laser, is an error naming the row and the header's
-        ``units`` (and ``frame``): positions in millimetres declared as metres, or the
-        reverse, or in another frame.
+        conversion) farther than this + :data:`~gaitval.io.tracks.units.RANGE_MARGIN_M` (a
+        track that diverged far in a few scans is a tracker's result, kept), or every
+        position within :data:`~gaitval.io.tracks.units.MIN_DISTANCE_M` of the laser, is an
+        error naming the row and the header's ``units`` (and ``frame``): positions in
+        millimetres declared as metres, or the reverse, or in another frame.
 
     Returns
     -------
     DataFrame
-        :data:`TRACK_COLUMNS`, sorted by time and side, on the sensor clock in the sensor
-        frame.  Columns the file lacks are filled as docs/formats.md says: ``k`` = the
-        index of the time stamp, velocities by central differences, ``observed`` = a
-        position is given, ``interpolated`` false, ``pattern`` ``UO`` where not observed
-        (else empty), ``phase`` −1, ``swing`` from the speed (hysteresis between
-        v_st_th = 0.47 and v_sw_th = 0.93 m/s, seed 000 Table 2).
+        :data:`~gaitval.io.tracks.exchange.TRACK_COLUMNS`, sorted by time and side, on the
+        sensor clock in the sensor frame.  Columns the file lacks are filled as
+        docs/formats.md says: ``k`` = the index of the time stamp, velocities by central
+        differences, ``observed`` = a position is given, ``interpolated`` false,
+        ``pattern`` ``UO`` where not observed (else empty), ``phase`` −1, ``swing`` from
+        the speed (hysteresis between v_st_th = 0.47 and v_sw_th = 0.93 m/s, seed 000
+        Table 2).
     """
     if "side" not in rows:
         raise _err(path, "the file gives people (column 'person'), not legs; the leg "
@@ -175,7 +177,8 @@ def _sensor_positions(rows: pd.DataFrame, meta: dict, reg: dict) -> tuple:
 
 def _fill_track_columns(df: pd.DataFrame, scan_t, *, has_v: bool) -> pd.DataFrame:
     """The per-scan track's columns a file lacks, filled as docs/formats.md says
-    (:func:`tracks_to_sensor`), in :data:`TRACK_COLUMNS` order and types."""
+    (:func:`tracks_to_sensor`), in :data:`~gaitval.io.tracks.exchange.TRACK_COLUMNS` order
+    and types."""
     if "k" not in df:
         tt = df["t_sensor_s"].to_numpy(float)
         idx = (np.clip(np.searchsorted(scan_t, tt), 0, len(scan_t) - 1)
@@ -221,15 +224,16 @@ def detections_to_sensor(det: pd.DataFrame, meta: dict, registration: dict | Non
                          *, path=None, trial: str | None = None,
                          scan_t: np.ndarray | None = None, tolerance_s: float = 0.0,
                          max_range_m: float | None = None) -> tuple[pd.DataFrame, list]:
-    """Detections (:func:`read_detections` or :func:`read_bag_leg_detections`) on the
-    sensor clock in the laser frame, as :func:`tracks_to_sensor` converts tracks: with
-    ``clock: mocap`` ``t_sensor = clock_offset_s + (1 + clock_drift_ppm 1e-6) t``, with
-    ``frame: mocap`` ``p_s = R(-yaw) (p - [x, y])`` (the trial's ``registration``); a
-    time within 1 µs of a scan's (``scan_t``) becomes that scan's.  With ``scan_t`` a time
-    stamp outside the recording (± ``tolerance_s``) is an error naming its row; with
-    ``max_range_m`` so are positions beyond the laser's range or all at its origin (wrong
-    units or frame).  Returns the rows (``t_s`` now on the sensor clock) and every message's
-    time on the sensor clock."""
+    """Detections (:func:`~gaitval.io.tracks.detections.read_detections` or
+    :func:`~gaitval.io.tracks.bag.read_bag_leg_detections`) on the sensor clock in the
+    laser frame, as :func:`tracks_to_sensor` converts tracks: with ``clock: mocap``
+    ``t_sensor = clock_offset_s + (1 + clock_drift_ppm 1e-6) t``, with ``frame: mocap``
+    ``p_s = R(-yaw) (p - [x, y])`` (the trial's ``registration``); a time within 1 µs of a
+    scan's (``scan_t``) becomes that scan's.  With ``scan_t`` a time stamp outside the
+    recording (± ``tolerance_s``) is an error naming its row; with ``max_range_m`` so are
+    positions beyond the laser's range or all at its origin (wrong units or frame).
+    Returns the rows (``t_s`` now on the sensor clock) and every message's time on the
+    sensor clock."""
     frame, clock = meta.get("frame", "sensor"), meta.get("clock", "sensor")
     reg = registration or {}
     _check_registration(path, trial, frame, clock, reg)

@@ -11,8 +11,9 @@ from gaitval.io.tracks.exchange import _err
 
 
 def _where(rows: pd.DataFrame, meta: dict, i: int, field: str) -> str:
-    """Row ``i`` of :func:`read_tracks` / :func:`people_to_legs` rows, as the file names
-    it: a CSV line, a Parquet data row, or a bag topic's message (``msg``), with the field."""
+    """Row ``i`` of :func:`~gaitval.io.tracks.read.read_tracks` /
+    :func:`~gaitval.io.tracks.bag.people_to_legs` rows, as the file names it: a CSV line, a
+    Parquet data row, or a bag topic's message (``msg``), with the field."""
     if "msg" in rows and np.isfinite(rows["msg"].iloc[i]):
         f = {"t_s": "header.stamp", "x": "position.x", "y": "position.y"}.get(field, field)
         return f"{meta.get('source', 'topic')}, message {int(rows['msg'].iloc[i])}, field {f}"

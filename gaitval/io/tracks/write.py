@@ -35,11 +35,11 @@ def track_to_exchange(track: pd.DataFrame) -> pd.DataFrame:
 
 def write_tracks(rows: pd.DataFrame, path: str | Path, *, units: str = "m",
                  frame: str = "sensor", clock: str = "sensor", **extra) -> Path:
-    """Write exchange-format rows (columns of :data:`COLUMNS`; positions in ``units``)
-    to ``*.tracks.csv`` or ``*.tracks.parquet``, atomically.  ``extra`` header keys (e.g.
-    ``source``) are written after the required ones.  CSV floats are written with the
-    shortest text that reads back to the same float (Python's ``repr``), so a round trip
-    through CSV is exact."""
+    """Write exchange-format rows (columns of :data:`~gaitval.io.tracks.exchange.COLUMNS`;
+    positions in ``units``) to ``*.tracks.csv`` or ``*.tracks.parquet``, atomically.
+    ``extra`` header keys (e.g. ``source``) are written after the required ones.  CSV
+    floats are written with the shortest text that reads back to the same float (Python's
+    ``repr``), so a round trip through CSV is exact."""
     p = Path(path)
     meta = _check_meta({"format": FORMAT, "version": VERSION, "units": units,
                         "frame": frame, "clock": clock}, p, None)
