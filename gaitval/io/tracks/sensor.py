@@ -71,13 +71,12 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
                      t_range: tuple[float, float] | None = None,
                      tolerance_s: float = 0.0, scan_t: np.ndarray | None = None,
                      max_range_m: float | None = None) -> pd.DataFrame:
-    """Exchange rows (from :func:`~gaitval.io.tracks.read.read_tracks`) as gaitval's
-    per-scan leg track.
+    """Exchange rows (from :func:`.read_tracks`) as gaitval's per-scan leg track.
 
     Parameters
     ----------
     rows, meta
-        :func:`~gaitval.io.tracks.read.read_tracks` output.
+        :func:`.read_tracks` output.
     registration : dict, optional
         The trial's registration record (``registration.json``: ``x_m``, ``y_m``,
         ``yaw_rad``, ``clock_offset_s``, ``clock_drift_ppm``); needed when the file's
@@ -100,13 +99,12 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
     Returns
     -------
     DataFrame
-        :data:`~gaitval.io.tracks.exchange.TRACK_COLUMNS`, sorted by time and side, on the
-        sensor clock in the sensor frame.  Columns the file lacks are filled as
-        docs/formats.md says: ``k`` = the index of the time stamp, velocities by central
-        differences, ``observed`` = a position is given, ``interpolated`` false,
-        ``pattern`` ``UO`` where not observed (else empty), ``phase`` −1, ``swing`` from
-        the speed (hysteresis between v_st_th = 0.47 and v_sw_th = 0.93 m/s, seed 000
-        Table 2).
+        :data:`.TRACK_COLUMNS`, sorted by time and side, on the sensor clock in the sensor
+        frame.  Columns the file lacks are filled as docs/formats.md says: ``k`` = the
+        index of the time stamp, velocities by central differences, ``observed`` = a
+        position is given, ``interpolated`` false, ``pattern`` ``UO`` where not observed
+        (else empty), ``phase`` −1, ``swing`` from the speed (hysteresis between
+        v_st_th = 0.47 and v_sw_th = 0.93 m/s, seed 000 Table 2).
     """
     if "side" not in rows:
         raise _err(path, "the file gives people (column 'person'), not legs; the leg "

@@ -64,13 +64,11 @@ def _units_problem(rows: pd.DataFrame, meta: dict, path, trial: str) -> None:
 def external_problems(sheet, deep: bool = False) -> list[str]:
     """What ``gaitval validate`` reports of the study's own external methods and leg
     detectors (``external_methods:``, ``external_detections:`` of the study.yaml or
-    :data:`~gaitval.pipeline.steps.declarations.STUDY_SIDE_FILE` beside ``sheet``): the
-    entries against the schema, each trial's file present and inside the folder (a
-    detector's bags: its topic), and with ``deep`` every file read
-    (:func:`~gaitval.pipeline.steps.external.read_external`,
-    :func:`~gaitval.pipeline.steps.external.read_external_detections`: header, columns,
-    rows, a bag's topic and legs; the clock and frame conversion needs the registration and
-    is checked when the run imports it).  One text per problem."""
+    :data:`.STUDY_SIDE_FILE` beside ``sheet``): the entries against the schema, each
+    trial's file present and inside the folder (a detector's bags: its topic), and with
+    ``deep`` every file read (:func:`.read_external`, :func:`.read_external_detections`:
+    header, columns, rows, a bag's topic and legs; the clock and frame conversion needs the
+    registration and is checked when the run imports it).  One text per problem."""
     from gaitval.configcheck import check_study_file
 
     out = []
