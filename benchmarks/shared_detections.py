@@ -52,7 +52,8 @@ def _runs(run: Path, study: str, family: str):
 
 
 def _track(family, run, study, sheet, trial, method, out, detections=None):
-    from gaitval.pipeline import mtst, steps
+    from gaitval.pipeline import mtst
+    from gaitval.pipeline.steps import tracking as steps
 
     res = run / "results" / study
     subjects = sheet.parent / "subjects.csv"
@@ -68,7 +69,8 @@ def _track(family, run, study, sheet, trial, method, out, detections=None):
 
 
 def _detect(family, run, study, sheet, trial, spec, out):
-    from gaitval.pipeline import mtst, steps
+    from gaitval.pipeline import mtst
+    from gaitval.pipeline.steps import tracking as steps
 
     res = run / "results" / study
     view = res / "config_views" / family / "study.json"

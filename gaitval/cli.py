@@ -36,7 +36,7 @@ def cmd_validate(a) -> int:
         problems += [p for p in deep_problems(df, a.sheet, jobs=a.jobs)
                      if not any(p.trial == t and f"column {c!r}" in str(p) for t, c in said)]
     if not a.no_file_check:        # the study's external methods and study.yaml's keys
-        from gaitval.pipeline.steps import external_problems, study_yaml_problems
+        from gaitval.pipeline.steps.checks import external_problems, study_yaml_problems
         problems += study_yaml_problems(a.sheet)
         problems += external_problems(a.sheet, deep=a.deep)
     from gaitval.io.trialsheet import sheet_warnings
@@ -57,7 +57,7 @@ def cmd_validate(a) -> int:
 
 def cmd_init_study(a) -> int:
     from gaitval.io.initstudy import init_study
-    from gaitval.pipeline.steps import external_problems
+    from gaitval.pipeline.steps.checks import external_problems
     res = init_study(a.folder, study=a.study, force=a.force, max_time_gap_s=a.max_time_gap_s)
     # the study.yaml's external_methods: as `gaitval validate` checks them (issue 37)
     res.problems += external_problems(Path(a.folder) / "trials.csv")
@@ -80,7 +80,7 @@ def cmd_simulate(a) -> int:
 
 def cmd_ingest(a) -> int:
     from gaitval.io.ingest import ingest_trial
-    from gaitval.pipeline.steps import trial_row
+    from gaitval.pipeline.steps.trials import trial_row
     s = ingest_trial(trial_row(a.sheet, a.subjects, a.trial), a.out)
     print(json.dumps(s, sort_keys=True, default=str))
     return 0
@@ -128,34 +128,34 @@ def cmd_peer(a) -> int:
 
 
 def cmd_register(a) -> int:
-    from gaitval.pipeline.steps import register_step
+    from gaitval.pipeline.steps.register import register_step
     rec = register_step(a.ingest, a.sheet, a.subjects, a.trial, a.config, a.out)
     print(json.dumps(rec, sort_keys=True, default=str))
     return 0
 
 
 def cmd_registration_summary(a) -> int:
-    from gaitval.pipeline.steps import registration_summary
+    from gaitval.pipeline.steps.register import registration_summary
     registration_summary(a.inputs, a.study, a.out_csv, a.out_stem, a.reports_dir,
                          a.config_hash)
     return 0
 
 
 def cmd_track(a) -> int:
-    from gaitval.pipeline.steps import track_step
+    from gaitval.pipeline.steps.tracking import track_step
     track_step(a.sensor, a.sheet, a.subjects, a.trial, a.method, a.config, a.out,
                detections=a.detections)
     return 0
 
 
 def cmd_detect(a) -> int:
-    from gaitval.pipeline.steps import detect_step
+    from gaitval.pipeline.steps.tracking import detect_step
     detect_step(a.sensor, a.sheet, a.subjects, a.trial, a.detector, a.config, a.out)
     return 0
 
 
 def cmd_evaluate_tug(a) -> int:
-    from gaitval.pipeline.steps import evaluate_tug_step
+    from gaitval.pipeline.steps.tug import evaluate_tug_step
     s = evaluate_tug_step(a.track, a.groundtruth, a.registration, a.trial, a.method,
                           a.config, a.out)
     print(s.to_string(index=False))
@@ -163,7 +163,7 @@ def cmd_evaluate_tug(a) -> int:
 
 
 def cmd_export_tracks(a) -> int:
-    from gaitval.pipeline.steps import export_tracks_step
+    from gaitval.pipeline.steps.external import export_tracks_step
     legs = None
     if a.legs:
         legs = dict(kv.split("=", 1) for kv in a.legs.split(",") if "=" in kv)
@@ -172,7 +172,7 @@ def cmd_export_tracks(a) -> int:
 
 
 def cmd_leg_detections(a) -> int:
-    from gaitval.pipeline.steps import leg_detections_step
+    from gaitval.pipeline.steps.external import leg_detections_step
     print(json.dumps(leg_detections_step(a.detections, a.groundtruth, a.out, topic=a.topic,
                                          trial=a.trial, gate_m=a.gate_m,
                                          registration_json=a.registration,
@@ -192,21 +192,21 @@ def cmd_leg_detections_table(a) -> int:
 
 
 def cmd_import_tracks(a) -> int:
-    from gaitval.pipeline.steps import import_tracks_step
+    from gaitval.pipeline.steps.external import import_tracks_step
     import_tracks_step(a.tracks, a.sensor, a.registration, a.trial, a.method, a.out,
                        config_json=a.config, moving_sensor=a.moving_sensor)
     return 0
 
 
 def cmd_tug_tables(a) -> int:
-    from gaitval.pipeline.steps import tug_tables_step
+    from gaitval.pipeline.steps.tug import tug_tables_step
     tug_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir, a.config_hash,
                     methods=a.methods, configs=a.configs)
     return 0
 
 
 def cmd_ultrasonic_noise(a) -> int:
-    from gaitval.pipeline.steps import ultrasonic_noise_step
+    from gaitval.pipeline.steps.ultrasonic import ultrasonic_noise_step
     n = ultrasonic_noise_step(a.ingest, a.trials, a.config, a.out, a.table_stem,
                               a.reports_dir, a.config_hash)
     print(json.dumps(n, sort_keys=True))
@@ -214,19 +214,19 @@ def cmd_ultrasonic_noise(a) -> int:
 
 
 def cmd_ultrasonic_track(a) -> int:
-    from gaitval.pipeline.steps import ultrasonic_track_step
+    from gaitval.pipeline.steps.ultrasonic import ultrasonic_track_step
     ultrasonic_track_step(a.ingest, a.trial, a.config, a.noise, a.out)
     return 0
 
 
 def cmd_gait_parameters(a) -> int:
-    from gaitval.pipeline.steps import gait_parameters_step
+    from gaitval.pipeline.steps.ultrasonic import gait_parameters_step
     gait_parameters_step(a.track, a.ingest, a.sheet, a.subjects, a.trial, a.config, a.out)
     return 0
 
 
 def cmd_ultrasonic_tables(a) -> int:
-    from gaitval.pipeline.steps import ultrasonic_tables_step
+    from gaitval.pipeline.steps.ultrasonic import ultrasonic_tables_step
     ultrasonic_tables_step(a.inputs, a.tables_dir, a.figures_dir, a.reports_dir,
                            a.config_hash, config_json=a.config)
     return 0
@@ -608,7 +608,7 @@ def _add_external_foot_verbs(sub) -> None:
     """Another system's heel trajectory on the treadmill trials (issue 37): its gait
     parameters and the agreement table of every system."""
     def run(a) -> int:
-        from gaitval.pipeline import steps as S
+        from gaitval.pipeline.steps import ultrasonic as S
         if a.verb == "external-gait-parameters":
             gp = S.external_gait_parameters_step(a.foot, a.ingest, a.sheet, a.subjects,
                                                  a.trial, a.method, a.config, a.out)

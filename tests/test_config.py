@@ -52,7 +52,7 @@ def test_simulated_study_yaml_validates(tmp_path):
 
 
 def test_every_analysis_section_is_in_both_schemas():
-    from gaitval.pipeline.steps import ANALYSIS_SECTIONS
+    from gaitval.pipeline.steps.config import ANALYSIS_SECTIONS
 
     schema = load_schema()
     for section in ANALYSIS_SECTIONS:
@@ -169,7 +169,7 @@ def test_problem_names_the_layer_that_set_the_key(cfg):
 
 
 def test_study_yaml_typo_names_the_study_yaml(cfg, tmp_path):
-    from gaitval.pipeline.steps import study_config
+    from gaitval.pipeline.steps.config import study_config
 
     (tmp_path / "study.yaml").write_text("registration:\n  pole_diamter_m: 0.06\n")
     with pytest.raises(ConfigError) as exc:
@@ -196,7 +196,8 @@ def dry_run(*args: str) -> subprocess.CompletedProcess:
 
 def test_override_keys_are_checked_against_the_methods_parameters():
     """Issue 35: a typo'd override names the key and the nearest valid one."""
-    from gaitval.methods import METHODS, check_overrides, override_problems
+    from gaitval.methods import METHODS
+    from gaitval.overrides import check_overrides, override_problems
 
     defs = {m: m for m in METHODS}
     ok = {"tug_m3": {"occlusion__max_n": 10, "gate__g": 9.21, "tracker__dt_s": 0.025,
@@ -349,7 +350,7 @@ def table2_of(monkeypatch, tmp_path):
     """Run tug_tables_step; return Table 2 built from the definitions it passed on."""
     import gaitval.report.tug_figures as figures
     import gaitval.tables.tug as tables
-    from gaitval.pipeline.steps import tug_tables_step
+    from gaitval.pipeline.steps.tug import tug_tables_step
 
     seen = {}
 
@@ -454,7 +455,7 @@ def test_table2_from_the_method_views_is_the_table_from_config_json(tmp_path, ta
     """The workflow hands tug_tables each study's method views (config_views/tug/<method>.json,
     one method's definition and override each), not config.json, so that another section's
     change does not rerun the table (issue 13): Table 2 is the same, studies still apart."""
-    from gaitval.pipeline.steps import method_view
+    from gaitval.pipeline.steps.config import method_view
 
     a = {"registration": {"sync_bin_deg": 0.5},
          "tracking": {"methods": {"my_m3": my_m3()},
@@ -479,7 +480,7 @@ def test_table2_from_the_method_views_is_the_table_from_config_json(tmp_path, ta
 def test_tug_tables_verb_hands_the_configs_it_is_given_to_the_step(monkeypatch):
     """The workflow gives `gaitval tug-tables` the method views with --configs: a run that
     asks for the TUG tables only has no config.json to fall back on (test_resume)."""
-    import gaitval.pipeline.steps as steps
+    import gaitval.pipeline.steps.tug as steps
     from gaitval.cli import main
 
     seen = {}
@@ -494,7 +495,7 @@ def test_tug_tables_verb_hands_the_configs_it_is_given_to_the_step(monkeypatch):
 
 def test_tables_steps_name_a_method_with_its_overrides_from_its_view(tmp_path):
     """Issue 35: the MTST tables step reads each method's view beside its study view."""
-    from gaitval.pipeline.steps import method_display_names, method_view
+    from gaitval.pipeline.steps.config import method_display_names, method_view
 
     cfg = {"tracking": {"methods": {}, "overrides": {"mtst_m3": {"gate__radius_leg_widths": 1.2}}}}
     for m in ("mtst_m1", "mtst_m3"):

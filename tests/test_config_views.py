@@ -1,11 +1,12 @@
-"""The per-method config views the per-trial jobs read (gaitval.pipeline.steps.method_view)."""
+"""The per-method config views the per-trial jobs read
+(gaitval.pipeline.steps.config.method_view)."""
 from __future__ import annotations
 
 import json
 
 import pytest
 
-from gaitval.pipeline.steps import STUDY_VIEW, method_definition, method_view, study_config
+from gaitval.pipeline.steps.config import STUDY_VIEW, method_definition, method_view, study_config
 
 
 CFG = {
@@ -56,7 +57,7 @@ def test_a_scoped_view_leaves_out_the_other_protocol_families_sections():
     and the shared ones, not tug:/mtst:/ultrasonic:, so a new rollator.pf_seed changes no
     TUG, MTST or ultrasonic job's view (issue 13)."""
     from gaitval.errors import ConfigError
-    from gaitval.pipeline.steps import PROTOCOL_SCOPE, SCOPES
+    from gaitval.pipeline.steps.config import PROTOCOL_SCOPE, SCOPES
 
     cfg = {**CFG, "rollator": {"pf_seed": 2017}, "tug": {"a": 1}, "mtst": {"b": 2},
            "ultrasonic": {"c": 3}, "evaluation": {"tug": {}}}

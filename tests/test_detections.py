@@ -79,7 +79,7 @@ def test_detections_of_another_detector_leg_width_or_scans_are_refused(scans, de
 
 
 def test_the_track_verb_with_detections_writes_the_same_track(scans, detections, tmp_path):
-    from gaitval.pipeline.steps import track_and_write
+    from gaitval.pipeline.steps.tracking import track_and_write
 
     a = track_and_write(scans, "tug_m2", W, None, trial="T1", method="tug_m2", source="s",
                         out_parquet=tmp_path / "a.parquet")

@@ -16,7 +16,7 @@ import yaml
 
 from gaitval.configcheck import check_study_file
 from gaitval.errors import ConfigError
-from gaitval.pipeline.steps import external_declarations, missing_external_files
+from gaitval.pipeline.steps.declarations import external_declarations, missing_external_files
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = Path(sys.executable).parent / "snakemake"
@@ -128,7 +128,7 @@ def test_the_workflow_stops_at_start_naming_the_missing_files(tmp_path):
 def test_validate_reports_the_studys_external_files(tmp_path):
     """``gaitval validate`` (the helper it calls) names a study.yaml entry's missing files,
     and with --deep each file that does not read (here: units in cm)."""
-    from gaitval.pipeline.steps import external_problems
+    from gaitval.pipeline.steps.checks import external_problems
 
     a = study(tmp_path, "a", {"mine": ENTRY})
     probs = external_problems(a)
@@ -168,7 +168,7 @@ def study_ext_run(tiny_run, tmp_path_factory):
     ``ext_csv`` (tug_m1's track as an exchange CSV); then the EXT_TARGETS run for real once
     (the ingest, the TUG registration, tug_m1 and the two external methods)."""
     from conftest import copy_run, tiny_workflow
-    from gaitval.io.tracks import track_to_exchange, write_tracks
+    from gaitval.io.tracks.write import track_to_exchange, write_tracks
     from test_workflow_external import people_bag
 
     work = tmp_path_factory.mktemp("study_ext")

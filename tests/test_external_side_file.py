@@ -12,8 +12,9 @@ import pytest
 import yaml
 
 from gaitval.errors import ConfigError
-from gaitval.pipeline.steps import (analysis_config, external_declarations, study_external,
-                                    study_side_problems)
+from gaitval.pipeline.steps.config import analysis_config
+from gaitval.pipeline.steps.declarations import (external_declarations, study_external,
+                                                 study_side_problems)
 
 ENTRY = {"path": "ext/{trial}.tracks.csv", "protocols": ["tug"]}
 
@@ -63,7 +64,7 @@ def test_a_simulated_study_declares_an_external_method_before_its_first_run(
     leaves it as it is (and its study.yaml without the entry), the run then names the
     missing track files before any job, and once they are there plans the method's job."""
     from conftest import tiny_workflow
-    from gaitval.io.tracks import track_to_exchange, write_tracks
+    from gaitval.io.tracks.write import track_to_exchange, write_tracks
 
     tiny = tmp_path / "data" / "tiny"
     tiny.mkdir(parents=True)
@@ -93,7 +94,7 @@ def test_a_simulated_study_declares_an_external_method_before_its_first_run(
 def test_validate_reports_the_side_files_detectors(tmp_path):
     """``gaitval validate`` (external_problems) names an external.yaml detector's missing
     files, and with --deep each detections file that does not read."""
-    from gaitval.pipeline.steps import external_problems
+    from gaitval.pipeline.steps.checks import external_problems
 
     sheet = study(tmp_path, None, {"external_detections": {
         "d": {"path": "det/{trial}.detections.csv", "protocols": ["tug"]}}})

@@ -113,9 +113,9 @@ def test_joint_centre_preference_and_lateral_offset():
 # ground truth at sensor timestamps (constructed walker)
 # ---------------------------------------------------------------------------------------
 def test_leg_points_computed_once_per_trial(monkeypatch):
-    """The pipeline's order (gaitval.pipeline.steps.register_step): leg points once, handed to the
-    registration and then to the ground truth, which gives the same table as computing
-    them itself."""
+    """The pipeline's order (gaitval.pipeline.steps.register.register_step): leg points
+    once, handed to the registration and then to the ground truth, which gives the same
+    table as computing them itself."""
     import gaitval.groundtruth.legs as legs_mod
     from gaitval.groundtruth import sensor_leg_points
     from gaitval.registration import register_trial

@@ -32,7 +32,8 @@ import pytest
 import yaml
 
 from gaitval.errors import GaitvalError
-from gaitval.io.initstudy import FILL_IN, init_study
+from gaitval.io.initstudy import init_study
+from gaitval.io.initstudy_files import FILL_IN
 
 from conftest import PROFILE, SNAKEMAKE
 
@@ -337,7 +338,7 @@ def test_an_empty_folder_is_one_clear_error(tmp_path):
 
 
 def test_external_tracks_named_by_trial_become_an_external_method(tiny_files, tmp_path):
-    from gaitval.io.tracks import write_tracks
+    from gaitval.io.tracks.write import write_tracks
 
     lab = tmp_path / "lab"
     lab.mkdir()
@@ -365,9 +366,10 @@ def test_init_study_external_methods_pass_validate(tiny_files, tmp_path):
     """Every trial with its track file: the study.yaml init-study writes declares the
     tracker, and `gaitval validate --deep` (schema, files, every file read) accepts it once
     the one cell the files cannot give (the leg width) is filled in; the workflow's own
-    start-up check (gaitval.pipeline.steps.external_declarations) returns the entry."""
-    from gaitval.io.tracks import write_tracks
-    from gaitval.pipeline.steps import external_declarations
+    start-up check (gaitval.pipeline.steps.declarations.external_declarations) returns the
+    entry."""
+    from gaitval.io.tracks.write import write_tracks
+    from gaitval.pipeline.steps.declarations import external_declarations
 
     lab = tmp_path / "lab"
     (lab / "tracks").mkdir(parents=True)
@@ -401,7 +403,7 @@ def test_init_study_external_methods_pass_validate(tiny_files, tmp_path):
 
 def test_a_kept_study_yaml_is_not_rewritten_its_missing_methods_are_listed(tiny_files,
                                                                           tmp_path):
-    from gaitval.io.tracks import write_tracks
+    from gaitval.io.tracks.write import write_tracks
 
     lab = tmp_path / "lab"
     (lab / "tracks").mkdir(parents=True)

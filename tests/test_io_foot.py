@@ -89,7 +89,7 @@ def test_wrong_extension_and_missing_file(tmp_path):
 @pytest.mark.parametrize("protocols, ok", [(["treadmill"], True), (["tug", "mtst"], True),
                                            (["treadmill", "tug"], False)])
 def test_treadmill_entries_cover_no_other_protocol(protocols, ok):
-    from gaitval.pipeline.steps import foot_entry_problem
+    from gaitval.pipeline.steps.declarations import foot_entry_problem
     entry = {"path": "feet/{trial}.foot.csv", "protocols": protocols}
     if ok:
         foot_entry_problem("mine", entry)
@@ -101,7 +101,7 @@ def test_treadmill_entries_cover_no_other_protocol(protocols, ok):
 def test_validate_deep_reads_heel_trajectories(tmp_path):
     """`gaitval validate --deep` on a study declaring a treadmill system reads its files:
     a missing one and a bad one are each named."""
-    from gaitval.pipeline.steps import external_problems
+    from gaitval.pipeline.steps.checks import external_problems
     sheet = tmp_path / "trials.csv"
     sheet.write_text("trial,protocol,mocap_path\nus_A_normal,treadmill,a.c3d\n"
                      "us_B_normal,treadmill,b.c3d\ntug_A,tug,c.c3d\n")

@@ -1,4 +1,4 @@
-"""Issue 37: the leg-track exchange format (gaitval/io/tracks.py, docs/formats.md "Leg
+"""Issue 37: the leg-track exchange format (gaitval/io/tracks/, docs/formats.md "Leg
 tracks"): exact round trips of gaitval's own tracks, the clock and frame conversion, and one
 clear error per kind of bad file."""
 from __future__ import annotations
@@ -11,8 +11,10 @@ import pandas as pd
 import pytest
 
 from gaitval.errors import FileFormatError
-from gaitval.io.tracks import (TRACK_COLUMNS, read_tracks, track_to_exchange,
-                               tracks_to_sensor, write_tracks)
+from gaitval.io.tracks.exchange import TRACK_COLUMNS
+from gaitval.io.tracks.read import read_tracks
+from gaitval.io.tracks.sensor import tracks_to_sensor
+from gaitval.io.tracks.write import track_to_exchange, write_tracks
 
 
 def own_track(n: int = 40, seed: int = 3) -> pd.DataFrame:
@@ -212,7 +214,7 @@ def test_people_file_reads_but_is_refused_for_legs(tmp_path):
 
 def test_external_path_stays_inside_the_sheets_folder(tmp_path):
     from gaitval.errors import ConfigError
-    from gaitval.pipeline.steps import external_track_path
+    from gaitval.pipeline.steps.declarations import external_track_path
 
     sheet = tmp_path / "study" / "trials.csv"
     sheet.parent.mkdir()
@@ -228,7 +230,7 @@ def test_import_step_empty_track_for_a_refused_registration_and_errors_by_file(t
     """A mocap-frame file of a trial whose registration was refused gives an empty track
     (its evaluation is not_registered); a file past the recording is one error naming it."""
     from gaitval.io.scanlog import write_scanlog
-    from gaitval.pipeline.steps import import_tracks_step
+    from gaitval.pipeline.steps.external import import_tracks_step
     from gaitval.types import ScanSeries
 
     scans = ScanSeries(t=np.arange(20) * 0.025, ranges=np.full((20, 5), 2.0),
@@ -250,7 +252,7 @@ def test_import_step_empty_track_for_a_refused_registration_and_errors_by_file(t
 
 
 def test_converted_times_snap_to_the_scan_they_name():
-    from gaitval.io.tracks import snap_to_scans
+    from gaitval.io.tracks.sensor import snap_to_scans
 
     scans = np.array([0.0, 0.025, 0.05, 0.075])
     t = np.array([0.025 + 4e-16, 0.05 - 2e-7, 0.0374, 0.075 + 5e-6, -1e-9])
@@ -261,7 +263,7 @@ def test_converted_times_snap_to_the_scan_they_name():
 def test_rollator_tracks_in_the_mocap_frame_are_refused(tmp_path):
     """The rollator's laser moves: a file in the mocap frame cannot be brought to it with
     one pose, and the import says so naming the file and the trial."""
-    from gaitval.pipeline.steps import import_tracks_step
+    from gaitval.pipeline.steps.external import import_tracks_step
 
     p = _csv(tmp_path, HEAD[:2] + ["# frame: mocap", HEAD[3]] + GOOD)
     with pytest.raises(FileFormatError) as exc:

@@ -9,7 +9,9 @@ import numpy as np
 import pytest
 
 from gaitval.errors import FileFormatError
-from gaitval.io.tracks import read_bag_tracks, read_tracks, write_tracks
+from gaitval.io.tracks.bag import read_bag_tracks
+from gaitval.io.tracks.read import read_tracks
+from gaitval.io.tracks.write import write_tracks
 
 DEFS = {
     "leg_tracker/msg/Person": "geometry_msgs/Pose pose\nuint32 id\n",
@@ -134,7 +136,7 @@ def test_people_as_legs_and_a_missing_leg(tmp_path):
     without one of them has that leg without a position; an id that never appears is an
     error naming the leg, the id and the ids present."""
     from gaitval.cli import main
-    from gaitval.io.tracks import people_to_legs
+    from gaitval.io.tracks.bag import people_to_legs
 
     bag = make_bag(tmp_path / "t.bag")
     rows, meta = read_bag_tracks(bag, "/people_tracked")
@@ -192,7 +194,8 @@ def test_pose_array_index_is_the_id(tmp_path):
 def test_bag_time_stamps_outside_the_recording_name_the_message(tmp_path):
     """A bag's tracks are converted like a file's: a time stamp outside the recording
     names the topic, the message and its field header.stamp."""
-    from gaitval.io.tracks import people_to_legs, tracks_to_sensor
+    from gaitval.io.tracks.bag import people_to_legs
+    from gaitval.io.tracks.sensor import tracks_to_sensor
 
     bag = make_bag(tmp_path / "t.bag")
     rows, meta = read_bag_tracks(bag, "/people_tracked", trial="T9")

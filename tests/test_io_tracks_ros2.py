@@ -13,7 +13,7 @@ import pytest
 
 from gaitval.errors import FileFormatError
 from gaitval.evaluate.leg_detections import detection_statistics
-from gaitval.io.tracks import people_to_legs, read_bag_leg_detections, read_bag_tracks
+from gaitval.io.tracks.bag import people_to_legs, read_bag_leg_detections, read_bag_tracks
 from test_io_tracks_bag import DEFS
 from test_leg_detections import SCANS, truth
 

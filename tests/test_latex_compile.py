@@ -15,8 +15,9 @@ import pandas as pd
 import pytest
 
 from gaitval.tables import write_table
-from gaitval.tables.latex import (LANDSCAPE, check_log, compile_tables, format_cell,
-                                  key_columns, latex_text, md_to_latex, to_latex)
+from gaitval.tables.latex import LANDSCAPE, key_columns, to_latex
+from gaitval.tables.latex_compile import check_log, compile_tables
+from gaitval.tables.latex_text import format_cell, latex_text, md_to_latex
 
 PDFLATEX = shutil.which("pdflatex")
 needs_pdflatex = pytest.mark.skipif(

@@ -13,7 +13,7 @@ import pytest
 
 from gaitval.errors import FileFormatError
 from gaitval.evaluate.leg_detections import detection_statistics
-from gaitval.io.tracks import read_bag_leg_detections, read_bag_tracks
+from gaitval.io.tracks.bag import read_bag_leg_detections, read_bag_tracks
 from test_io_tracks_bag import DEFS
 
 #: per scan (t = 100 s + k 25 ms) the detections; the legs stand at L (1, 0.1), R (1, -0.1)
@@ -135,7 +135,7 @@ CSV_BODY = ("t_s,x,y\n100.0,1.01,0.1\n100.0,1.0,-0.12\n100.025,1.0,0.1\n"
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
 def test_a_detections_file_scores_as_the_bag_does(tmp_path, suffix):
-    from gaitval.io.tracks import read_detections, write_detections
+    from gaitval.io.tracks.detections import read_detections, write_detections
 
     f = detections_csv(tmp_path / "d.detections.csv", CSV_BODY)
     if suffix == ".parquet":
@@ -162,7 +162,7 @@ def test_a_detections_file_scores_as_the_bag_does(tmp_path, suffix):
     ({}, "t_s,x\n100.0,1.0\n", ["column 'y' is missing"]),
 ])
 def test_a_bad_detections_file_names_the_file_field_and_line(tmp_path, head, body, words):
-    from gaitval.io.tracks import read_detections
+    from gaitval.io.tracks.detections import read_detections
 
     f = detections_csv(tmp_path / "d.detections.csv", body, **head)
     with pytest.raises(FileFormatError) as exc:
@@ -173,7 +173,8 @@ def test_a_bad_detections_file_names_the_file_field_and_line(tmp_path, head, bod
 
 
 def test_detections_in_mm_or_outside_the_recording_are_refused(tmp_path):
-    from gaitval.io.tracks import detections_to_sensor, read_detections
+    from gaitval.io.tracks.detections import read_detections
+    from gaitval.io.tracks.sensor import detections_to_sensor
 
     scan_t = 100.0 + 0.025 * np.arange(4)
     det, meta = read_detections(detections_csv(tmp_path / "a.detections.csv",
@@ -235,7 +236,7 @@ def test_rollator_detections_in_the_mocap_frame_are_refused_and_a_third_clock_is
     """On a rollator trial the laser moves: detections in the mocap frame are refused with
     one error naming the file and the header field; detections stamped on a third clock
     score like the sensor-clock file once the header gives the offset."""
-    from gaitval.pipeline.steps import leg_detections_step
+    from gaitval.pipeline.steps.external import leg_detections_step
 
     gt = tmp_path / "groundtruth.parquet"
     truth().to_parquet(gt)

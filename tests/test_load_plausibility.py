@@ -242,12 +242,12 @@ def test_rows_reusing_one_recording_are_warned_about(tmp_path, caplog):
 
 
 def test_init_study_makes_no_option_like_or_case_twin_ids(tmp_path, realdata):
-    from gaitval.io.initstudy import _as_id, _unique_id
+    from gaitval.io.initstudy_files import as_id, unique_id
 
-    assert _as_id("-rf", "trial") == "rf" and _as_id("--", "trial") == "trial"
+    assert as_id("-rf", "trial") == "rf" and as_id("--", "trial") == "trial"
     taken: set[str] = set()
-    assert _unique_id(["Walk"], taken) == "Walk"
-    assert _unique_id(["walk", "walk"], taken) == "walk_2"
+    assert unique_id(["Walk"], taken) == "Walk"
+    assert unique_id(["walk", "walk"], taken) == "walk_2"
     # a folder with a file named -rf.c3d and its sensor log: the trial id is no option
     from gaitval.io.initstudy import init_study
     folder = tmp_path / "study"

@@ -13,7 +13,8 @@ import pytest
 import yaml
 
 from gaitval.errors import ConfigError, FileFormatError
-from gaitval.pipeline.steps import ANALYSIS_SECTIONS, register_step, study_config
+from gaitval.pipeline.steps.config import ANALYSIS_SECTIONS, study_config
+from gaitval.pipeline.steps.register import register_step
 from gaitval.pipeline.mtst import (keep_every, load_targets, mtst_evaluate_step,
                                 mtst_tables_step, mtst_track_step)
 
@@ -178,7 +179,7 @@ def test_ingested_files_do_not_depend_on_where_the_study_folder_sits(tiny, tmp_p
     # the steps that have the sheet's row still name the C3D by its absolute path
     from gaitval.io.ingest import ingest_trial
     from gaitval.io.trialsheet import load_trial_sheet
-    from gaitval.pipeline.steps import load_ingested
+    from gaitval.pipeline.steps.trials import load_ingested
 
     moved = tmp_path / "elsewhere" / "tiny"
     shutil.copytree(tiny / "tiny", moved)

@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 from gaitval.errors import FileFormatError
-from gaitval.pipeline.steps import _units_problem, study_yaml_problems
+from gaitval.pipeline.steps.checks import _units_problem, study_yaml_problems
 
 
 def test_a_study_yaml_typo_is_a_validate_problem_naming_key_and_suggestion(tmp_path):

@@ -442,7 +442,7 @@ def test_the_papers_standing_laser_gives_the_people_tracker_no_scan_matching():
     """TUG and MTST (seed 000, seed 001) put the LRS on a stand: their track steps give the
     ``people`` kind ``ego_motion: none`` (issue 38), every other method nothing, and a
     config-defined method of kind ``people`` the same as the built-in one."""
-    from gaitval.pipeline.steps import fixed_sensor_overrides
+    from gaitval.pipeline.steps.tracking import fixed_sensor_overrides
 
     assert fixed_sensor_overrides("people") == {"kind__ego_motion": "none"}
     own = {**METHODS["people"], "label": "my people tracker"}

@@ -146,7 +146,7 @@ def test_the_benchmark_table_marks_offline_whatever_the_method_is_called(tmp_pat
     override, is offline; ``people`` as built in is not."""
     import json
 
-    from gaitval.pipeline.steps import offline_methods
+    from gaitval.pipeline.steps.config import offline_methods
     mine = {"label": "mine", "kind": dict(METHODS["people_offline"]["kind"])}
     views = {"mine": {"tracking": {"methods": {"mine": mine}}},
              "people": {"tracking": {"overrides": {"people": {"kind__passes": OFFLINE}}}},

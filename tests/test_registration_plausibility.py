@@ -17,7 +17,8 @@ import pytest
 
 import own_study as O
 from gaitval.io.ingest import ingest_trial
-from gaitval.pipeline.steps import register_step, trial_row
+from gaitval.pipeline.steps.register import register_step
+from gaitval.pipeline.steps.trials import trial_row
 
 #: variant -> words the refusal must contain (the probable cause named)
 CAUSES = {"mm": "millimetres", "rad": "radians", "swap": "x and y look exchanged",

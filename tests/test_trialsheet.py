@@ -70,7 +70,7 @@ def test_one_trial_job_checks_its_own_row_not_the_others(tmp_path):
     """A per-trial job (steps.trial_and_subject) validates its trial's row, its subject's
     row and the headers: a bad cell in another trial's row is the whole-sheet check's
     problem, a bad cell in its own row stops it with the row and column named."""
-    from gaitval.pipeline.steps import trial_and_subject
+    from gaitval.pipeline.steps.trials import trial_and_subject
 
     other = ROW.replace("tug_S01_1", "tug_S01_2").replace(",0.27,", ",tall,")
     sheet = make_study(tmp_path, rows=ROW + other)
@@ -91,7 +91,7 @@ def test_a_process_running_many_jobs_sees_every_edit_of_the_sheet(tmp_path):
     """A warm worker remembers validated rows by the files' contents: an edit that breaks
     the row (sheet or subject table) is caught by the next job, a fixed file passes again,
     and a job changing the dict it got does not change what the next job gets."""
-    from gaitval.pipeline.steps import trial_and_subject
+    from gaitval.pipeline.steps.trials import trial_and_subject
 
     sheet = make_study(tmp_path)
     subjects = tmp_path / "subjects.csv"

@@ -230,7 +230,7 @@ def test_every_tex_of_the_tiny_report_compiles(tiny_run, tmp_path):
     """Issue 14, scope 4: each table's .tex and verdicts.tex, alone, with pdflatex."""
     import shutil
 
-    from gaitval.tables.latex import compile_tables
+    from gaitval.tables.latex_compile import compile_tables
     if shutil.which("pdflatex") is None:
         pytest.skip("pdflatex not installed (Debian: texlive-latex-base "
                     "texlive-latex-recommended texlive-latex-extra)")

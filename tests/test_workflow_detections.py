@@ -124,7 +124,7 @@ def det_run(tiny_run, tmp_path_factory):
     the detection table run for real once.  Returns (folder, what was drawn per
     detector)."""
     from conftest import copy_run, tiny_workflow
-    from gaitval.io.tracks import write_detections
+    from gaitval.io.tracks.detections import write_detections
 
     work = tmp_path_factory.mktemp("det_run")
     copy_run(tiny_run / "data", work / "data")

@@ -24,7 +24,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from gaitval.io.tracks import track_to_exchange, write_tracks
+from gaitval.io.tracks.write import track_to_exchange, write_tracks
 
 from conftest import SNAKEMAKE, copy_run, tiny_workflow
 
@@ -387,7 +387,7 @@ def test_a_leg_tracker_bag_gives_the_rows_of_the_same_positions_as_csv(ext_run):
 @pytest.mark.slow
 def test_bag_rows_equal_the_methods_positions(ext_run):
     """Reader level: the bag's legs are the method's positions, time stamps included."""
-    from gaitval.io.tracks import people_to_legs, read_bag_tracks
+    from gaitval.io.tracks.bag import people_to_legs, read_bag_tracks
 
     work, _ = ext_run
     results = work / "results" / "tiny"

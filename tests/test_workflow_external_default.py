@@ -10,7 +10,7 @@ study and tracks it; the second runs only the external methods' jobs and the tab
 
 * ``ext_csv`` (tracking.external in a ``--configfile``): tug_m2's tracks of the TUG trials,
   mtst_proposed's of the MTST trials and rollator_kf's of the rollator trials, each
-  exported with :func:`gaitval.pipeline.steps.export_tracks_step` (what ``gaitval
+  exported with :func:`gaitval.pipeline.steps.external.export_tracks_step` (what ``gaitval
   export-tracks`` runs), CSV, sensor frame and clock.  Its rows equal the original
   method's in TUG Tables 3-5 and the failure table, MTST Tables 3-4 and rollator
   Tables I-II, value for value.
@@ -34,8 +34,8 @@ import pandas as pd
 import pytest
 import yaml
 
-from gaitval.pipeline.steps import export_tracks_step
-from gaitval.io.tracks import write_tracks
+from gaitval.pipeline.steps.external import export_tracks_step
+from gaitval.io.tracks.write import write_tracks
 from test_workflow_external import people_bag, positions_only
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -44,7 +44,7 @@ def detection_statistics(detections: pd.DataFrame, t_messages, truth: pd.DataFra
     ----------
     detections : DataFrame
         ``t_s, msg, x_m, y_m`` (sensor clock, laser frame, metres;
-        :func:`gaitval.io.tracks.read_bag_leg_detections`).
+        :func:`gaitval.io.tracks.bag.read_bag_leg_detections`).
     t_messages : sequence of float
         Every detection message's stamp (sensor clock), with legs or without.
     truth : DataFrame

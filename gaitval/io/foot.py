@@ -23,8 +23,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from gaitval.io.tracks import (UNITS, VERSION, _check_meta, _err, _floats,
-                               _on_header_clock, _write_rows, open_exchange)
+from gaitval.io.tracks.exchange import (UNITS, VERSION, _check_meta, _err, _floats,
+                                        _on_header_clock, open_exchange)
+from gaitval.io.tracks.write import _write_rows
 
 FOOT_FORMAT = "gaitval-foot"
 FOOT_META_KEY = b"gaitval:foot"

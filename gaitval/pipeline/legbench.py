@@ -33,8 +33,8 @@ import pandas as pd
 from gaitval.errors import ConfigError, GaitvalError
 from gaitval.io.atomic import write_parquet
 from gaitval.io.parquet import read_parquet
-from gaitval.pipeline.steps import (load_json, method_definition, method_display_names,
-                                    method_overrides, offline_methods)
+from gaitval.pipeline.steps.config import (load_json, method_definition, method_display_names,
+                                           method_overrides, offline_methods)
 
 INITS = ("own", "annotation")
 #: How many of the person's later clicks the annotation initialiser is given: at least its
@@ -315,7 +315,7 @@ def legbench_tables_step(inputs, tables_dir, figures_dir, reports_dir, config_ha
 
     ``views_dir``: the folder of the method config views the tracks ran with; a method run
     with ``tracking.overrides`` is then named with its changes in the tables
-    (:func:`gaitval.pipeline.steps.method_display_names`)."""
+    (:func:`gaitval.pipeline.steps.config.method_display_names`)."""
     from gaitval.report.legbench_figures import write_legbench_figure
     from gaitval.report.provenance import stamp
     from gaitval.tables.legbench import write_legbench_table

@@ -38,9 +38,10 @@ from gaitval.errors import ConfigError, FileFormatError, GaitvalError
 from gaitval.io.atomic import write_parquet
 from gaitval.pipeline.memo import FileMemo
 from gaitval.io.parquet import read_parquet
-from gaitval.pipeline.steps import (fixed_sensor_overrides, load_json, method_definition,
-                                    method_display_names, method_overrides,
-                                    track_and_write, trial_and_subject)
+from gaitval.pipeline.steps.config import (load_json, method_definition, method_display_names,
+                                           method_overrides)
+from gaitval.pipeline.steps.tracking import fixed_sensor_overrides, track_and_write
+from gaitval.pipeline.steps.trials import trial_and_subject
 
 TARGET_COLUMNS = ("target", "x_m", "y_m", "color", "assigned")
 EVAL_TABLES = ("contacts", "steps", "events", "gates", "track_field", "summary", "targets")
@@ -164,7 +165,7 @@ def mtst_track_step(sensor, sheet, subjects, trial: str, method: str, config_jso
     method's detector (:mod:`gaitval.pipeline.detections`), instead of detecting again."""
     from gaitval.methods import get_method
 
-    from gaitval.io.tracks import TRACK_COLUMNS
+    from gaitval.io.tracks.exchange import TRACK_COLUMNS
 
     cfg, s = mtst_config(config_json)
     row, subj = trial_and_subject(sheet, subjects, trial)

@@ -75,7 +75,9 @@ def _obs_of(study_dir: Path, family: str, scans_of, sheet, subjects):
         return None
     from gaitval.detect import DETECTORS
     from gaitval.pipeline.detections import method_detector
-    from gaitval.pipeline.steps import load_json, trial_and_subject, tug_leg_width
+    from gaitval.pipeline.steps.config import load_json
+    from gaitval.pipeline.steps.tracking import tug_leg_width
+    from gaitval.pipeline.steps.trials import trial_and_subject
 
     def get(trial: str, method: str):
         view = study_dir / "config_views" / family / f"{method}.json"
@@ -123,7 +125,7 @@ def mtst_figures(study_dir: Path, out: Path, config_json=None,
             for n in ("contacts", "targets", "events", "summary", "gates")}
     tracks = _concat(p for m in methods
                      for p in sorted((study_dir / "mtst_track" / m).glob("*.parquet")))
-    from gaitval.pipeline.steps import load_json
+    from gaitval.pipeline.steps.config import load_json
     s = settings(load_json(config_json) if config_json else {})
     full = _scans_of(study_dir)
     kept: dict[str, object] = {}
@@ -154,7 +156,7 @@ def rollator_figures(study_dir: Path, out: Path, kf="rollator_kf", pf="rollator_
 
 
 def ultrasonic_figures(study_dir: Path, out: Path, config_json=None):
-    from gaitval.pipeline.steps import load_json
+    from gaitval.pipeline.steps.config import load_json
     from gaitval.report.paper_figures_ultrasonic import write_ultrasonic_paper_figures
 
     gait = sorted((study_dir / "ultrasonic" / "gait").glob("*.parquet"))

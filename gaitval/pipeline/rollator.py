@@ -32,9 +32,9 @@ from gaitval.errors import GaitvalError
 from gaitval.io.atomic import write_parquet, write_text
 from gaitval.pipeline.memo import FileMemo, file_identity
 from gaitval.io.parquet import read_parquet
-from gaitval.pipeline.steps import (PROTOCOL_SCOPE, load_json, method_definition,
-                                    method_display_names, method_overrides,
-                                    trial_and_subject)
+from gaitval.pipeline.steps.config import (PROTOCOL_SCOPE, load_json, method_definition,
+                                           method_display_names, method_overrides)
+from gaitval.pipeline.steps.trials import trial_and_subject
 
 #: defaults of the ``rollator:`` keys read here
 DEFAULTS = {"kf_method": "rollator_kf", "pf_method": "rollator_pf",

@@ -7,13 +7,14 @@ does so that it does:
 
 * **Headers.** Each column's label with its unit (:mod:`gaitval.tables.labels`), never
   its machine name (the CSV keeps those).
-* **Escaping.** Every header, cell, caption and note goes through :func:`latex_text`: the
-  ten LaTeX specials (``\\ & % $ # _ { } ~ ^``) become their text commands and Unicode the
-  tables use (Δ ≥ ≤ ± ∓ − × → · √ σ ² – — … §, any Greek letter) becomes a LaTeX command
-  wrapped in ``\\ensuremath`` where it is maths, so adjacent symbols never meet as ``$$``.
-  Latin-1 letters (é, ü) are left to ``[T1]{fontenc}``; anything else is printed as
-  ``[U+XXXX]`` rather than breaking the compile.  The inline Markdown of captions and notes
-  (code, bold, italics, links) becomes ``\\texttt``, ``\\textbf``, ``\\emph`` and plain text.
+* **Escaping.** Every header, cell, caption and note goes through
+  :func:`~gaitval.tables.latex_text.latex_text`: the ten LaTeX specials (``\\ & % $ # _ { }
+  ~ ^``) become their text commands and Unicode the tables use (Δ ≥ ≤ ± ∓ − × → · √ σ ² – —
+  … §, any Greek letter) becomes a LaTeX command wrapped in ``\\ensuremath`` where it is
+  maths, so adjacent symbols never meet as ``$$``. Latin-1 letters (é, ü) are left to
+  ``[T1]{fontenc}``; anything else is printed as ``[U+XXXX]`` rather than breaking the
+  compile.  The inline Markdown of captions and notes (code, bold, italics, links) becomes
+  ``\\texttt``, ``\\textbf``, ``\\emph`` and plain text.
 * **Numbers.** The report's one number format (:func:`gaitval.tables.numbers.format_value`,
   by column and table: the same text as the Markdown and HTML, never e-notation; p-values
   as ``< 0.001``); minus signs as maths minus; numeric columns right-aligned.
@@ -32,10 +33,10 @@ does so that it does:
   height fits the page, else longtables (page breaks, repeated header) with the
   notes after them as a paragraph that may break; tables of more than :data:`LONG_ROWS`
   rows are always longtables.
-* **Checked as pages.**  :func:`compile_tables` (``python -m gaitval.tables.latex``)
-  compiles each file inside :data:`PREAMBLE`, after a paragraph of an article page, and
-  fails it on a pdflatex error, "Float too large", an overfull or underfull box, a
-  runaway argument, or a listing of fewer than :data:`MIN_LINES_PER_PAGE` lines a page.
+* **Checked as pages.**  :func:`~gaitval.tables.latex_compile.compile_tables` (``python -m
+  gaitval.tables.latex_compile``) compiles each file inside :data:`PREAMBLE`, after a
+  paragraph of an article page, and fails it on a pdflatex error, "Float too large", an
+  overfull or underfull box, a runaway argument, or a listing of too few lines a page.
 
 Same input, same bytes: nothing here depends on time or the machine.
 """
@@ -43,12 +44,13 @@ from __future__ import annotations
 
 import math
 import re
-import unicodedata
 
 import numpy as np
 import pandas as pd
 
 from gaitval.tables.labels import label
+from gaitval.tables.latex_text import cell_text, format_cell, is_missing, latex_text, md_to_latex
+
 
 #: What a document needs to \input any gaitval table (tests/test_latex_compile.py uses it).
 PREAMBLE = "\n".join([
@@ -60,9 +62,8 @@ PREAMBLE = "\n".join([
     r"\usepackage{pdflscape}",
     r"\usepackage{array}",
 ])
-#: Text set before the table in the checker's document (a table is checked as it would
-#: sit in a manuscript, after a paragraph).
-PAGE_TEXT = r"Text before the table.\par"
+
+
 #: Rows above which a table is a longtable.
 LONG_ROWS = 40
 #: Page fit (article class): text width in pt and font size in pt of a portrait table
@@ -81,113 +82,14 @@ FLEX_MARGIN_PT = 2.0
 #: A part taller than this fraction of the page's height is a longtable, not a float.
 FLOAT_FRACTION = 0.8
 
-_SPECIALS = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#",
-             "_": r"\_", "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}",
-             "^": r"\textasciicircum{}", "<": r"\textless{}", ">": r"\textgreater{}",
-             "|": r"\textbar{}"}
-_MATH = {"≥": r"\geq", "≤": r"\leq", "±": r"\pm", "∓": r"\mp", "−": "-", "×": r"\times",
-         "→": r"\rightarrow", "←": r"\leftarrow", "↔": r"\leftrightarrow",
-         "⇒": r"\Rightarrow", "·": r"\cdot", "√": r"\surd", "≈": r"\approx", "≠": r"\neq",
-         "∞": r"\infty", "∈": r"\in", "∑": r"\sum", "≡": r"\equiv", "∼": r"\sim",
-         "²": "^{2}", "³": "^{3}", "¹": "^{1}", "⁻": "^{-}", "°": r"^{\circ}",
-         "µ": r"\mu", "∆": r"\Delta", "′": r"\prime", "⋅": r"\cdot", "∝": r"\propto"}
-_TEXT = {"–": "--", "—": "---", "…": r"\dots{}", "§": r"\S{}", "‘": "`", "’": "'",
-         "“": "``", "”": "''", "\u00a0": "~", "\u2009": r"\,", "\u202f": r"\,",
-         "¶": r"\P{}", "•": r"\textbullet{}", "✓": "yes", "✗": "no"}
-_GREEK_VARIANTS = {"FINAL SIGMA": "varsigma", "EPSILON": "epsilon", "OMICRON": "o"}
-
-
-def _char(ch: str) -> str:
-    if ch in _SPECIALS:
-        return _SPECIALS[ch]
-    if ord(ch) < 128:
-        return ch
-    if ch in _MATH:
-        return rf"\ensuremath{{{_MATH[ch]}}}"
-    if ch in _TEXT:
-        return _TEXT[ch]
-    name = unicodedata.name(ch, "")
-    if name.startswith("GREEK ") and " LETTER " in name and "WITH" not in name:
-        letter = name.split(" LETTER ", 1)[1]
-        word = _GREEK_VARIANTS.get(letter, letter.lower())
-        if name.startswith("GREEK CAPITAL"):
-            word = word.capitalize()
-            if word in ("Alpha", "Beta", "Epsilon", "Zeta", "Eta", "Iota", "Kappa", "Mu",
-                        "Nu", "O", "Omicron", "Rho", "Tau", "Chi"):
-                return {"Alpha": "A", "Beta": "B", "Epsilon": "E", "Zeta": "Z", "Eta": "H",
-                        "Iota": "I", "Kappa": "K", "Mu": "M", "Nu": "N", "O": "O",
-                        "Omicron": "O", "Rho": "P", "Tau": "T", "Chi": "X"}[word]
-        return rf"\ensuremath{{\{word}}}"
-    if ord(ch) < 256 and unicodedata.category(ch).startswith("L"):
-        return ch                                   # é, ü, ß: [T1]{fontenc} + utf8
-    plain = unicodedata.normalize("NFKD", ch).encode("ascii", "ignore").decode()
-    return "".join(_char(c) for c in plain) if plain else f"[U+{ord(ch):04X}]"
-
-
-def latex_text(s: str) -> str:
-    """Plain text as LaTeX text: specials escaped, Unicode as LaTeX commands."""
-    return "".join(_char(ch) for ch in str(s))
-
-
-_MD = re.compile(r"`([^`]+)`|\*\*([^*]+)\*\*|\[([^\]]+)\]\(([^)]+)\)"
-                 r"|(?<![\w*])_([^_]+)_(?![\w])")
-
-
-def md_to_latex(s: str) -> str:
-    """The report's inline Markdown (code, bold, links, italics) as LaTeX."""
-    out, pos = [], 0
-    for m in _MD.finditer(s):
-        out.append(latex_text(s[pos:m.start()]))
-        code, bold, link, _url, em = m.groups()
-        if code is not None:
-            out.append(rf"\texttt{{{latex_text(code)}}}")
-        elif bold is not None:
-            out.append(rf"\textbf{{{latex_text(bold)}}}")
-        elif link is not None:
-            out.append(latex_text(link))
-        else:
-            out.append(rf"\emph{{{latex_text(em)}}}")
-        pos = m.end()
-    out.append(latex_text(s[pos:]))
-    return "".join(out)
-
-
-def _is_missing(v) -> bool:
-    if v is None or v is pd.NA or v is pd.NaT:
-        return True
-    return isinstance(v, (float, np.floating)) and math.isnan(v)
-
-
-def _cell_text(v, column: str, table: str | None) -> str:
-    """A cell's plain text: numbers in the report's number format, the rest as given."""
-    from gaitval.tables.numbers import format_value
-    if isinstance(v, (float, np.floating)) and math.isinf(float(v)):
-        return "-inf" if v < 0 else "inf"
-    return format_value(v, column, table)
-
-
-def format_cell(v, column: str, table: str | None = None) -> str:
-    """One cell of ``column`` (display name) of ``table`` as LaTeX (module docstring)."""
-    if _is_missing(v):
-        return ""
-    if isinstance(v, (float, np.floating)) and math.isinf(float(v)):
-        return r"\ensuremath{-\infty}" if v < 0 else r"\ensuremath{\infty}"
-    text = latex_text(_cell_text(v, column, table))
-    if isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(
-            v, (bool, np.bool_)):
-        return text.replace("-", r"\ensuremath{-}", 1) if text.startswith("-") else text
-    if any(len(w) > 16 for w in str(v).split()):    # a path or identifier may break
-        text = text.replace(r"\_", r"\_\allowbreak{}").replace("/", r"/\allowbreak{}")
-    return text
-
 
 def _plain_len(v, column: str, table: str | None) -> int:
     """Printed width of a cell in characters (for the page-fit estimate)."""
-    return 0 if _is_missing(v) else len(_cell_text(v, column, table))
+    return 0 if is_missing(v) else len(cell_text(v, column, table))
 
 
 def _numeric(col: pd.Series) -> bool:
-    vals = [v for v in col if not _is_missing(v)]
+    vals = [v for v in col if not is_missing(v)]
     return bool(vals) and all(isinstance(v, (int, float, np.integer, np.floating))
                               and not isinstance(v, (bool, np.bool_)) for v in vals)
 
@@ -279,7 +181,7 @@ def _layout(groups, info, page) -> tuple[dict[str, str], bool]:
 
 
 def _is_float_col(col: pd.Series) -> bool:
-    vals = [v for v in col if not _is_missing(v)]
+    vals = [v for v in col if not is_missing(v)]
     return any(isinstance(v, (float, np.floating)) and not float(v).is_integer()
                for v in vals)
 
@@ -409,7 +311,7 @@ def _with_prose(tex: str, df: pd.DataFrame, prose: list[str], ncols: int, page: 
     out = []
     for k, ln in enumerate(lines[:len(df)]):
         text = "; ".join(rf"\textit{{{latex_text(c)}}}: {format_cell(df[c].iloc[k], c, table)}"
-                         for c in prose if not _is_missing(df[c].iloc[k]))
+                         for c in prose if not is_missing(df[c].iloc[k]))
         out.append(ln + " \\\\\n" + rf"\multicolumn{{{ncols}}}"
                    rf"{{>{{\raggedright\arraybackslash}}p{{{width:.1f}pt}}}}"
                    rf"{{\quad {text}}} \\[2pt]" + "\n")
@@ -439,6 +341,19 @@ def to_latex(df: pd.DataFrame, *, caption: str, label: str, notes: list[str] | N
     groups = [g for g in _groups(df) if g[0] not in prose]
     keys = [k for k in (keys if keys is not None else key_columns(df.drop(columns=prose)))
             if k in df.columns]
+    page, parts, part_specs = _fit(groups, info, keys)
+    cap = md_to_latex(caption)
+    caps = [cap if len(parts) == 1 else f"{cap} (part {i + 1} of {len(parts)})"
+            for i in range(len(parts))]
+    long = _is_long(df, parts, part_specs, info, page, table=table, caps=caps, notes=notes,
+                    prose=prose)
+    return _document(df, parts, part_specs, page, prose, caps=caps, notes=notes, label=label,
+                     table=table, long=long)
+
+
+def _fit(groups, info, keys) -> tuple[dict, list, list]:
+    """The page (portrait, else landscape) and the parts the column groups are split
+    into to fit it, each part with its column specs (:func:`to_latex`)."""
     page = PORTRAIT
     specs, fits = _layout(groups, info, page)
     parts = [groups]
@@ -453,18 +368,28 @@ def to_latex(df: pd.DataFrame, *, caption: str, label: str, notes: list[str] | N
             parts = _split(key_groups, [g for g in rest if g not in text] + text, info,
                            page)
     part_specs = [specs] if len(parts) == 1 else [_layout(p, info, page)[0] for p in parts]
-    cap = md_to_latex(caption)
-    caps = [cap if len(parts) == 1 else f"{cap} (part {i + 1} of {len(parts)})"
-            for i in range(len(parts))]
+    return page, parts, part_specs
+
+
+def _is_long(df: pd.DataFrame, parts, part_specs, info, page, *, table, caps, notes,
+             prose) -> bool:
+    """A longtable rather than one float: more than :data:`LONG_ROWS` rows, or taller
+    than :data:`FLOAT_FRACTION` of the page (:func:`to_latex`)."""
     # a float must fit the page (the text height, or the text width in landscape) with
     # room for the text around it; anything taller, or long, is a longtable
     prose_lines = sum(math.ceil(1.15 * _plain_len(v, c, table) * 0.6 * page["size_pt"]
                                 / page["width_pt"]) for c in prose for v in df[c])
-    long = len(df) > LONG_ROWS or sum(
+    return len(df) > LONG_ROWS or sum(
         _height_pt(df, p, part_specs[i], info, page, table=table, caption=caps[i],
                    notes=notes if i == len(parts) - 1 else []) + 12
         for i, p in enumerate(parts)) + prose_lines * page["baseline_pt"] \
         > FLOAT_FRACTION * page["height_pt"]
+
+
+def _document(df: pd.DataFrame, parts, part_specs, page, prose, *, caps, notes, label,
+              table, long: bool) -> str:
+    """The table's LaTeX: its parts in one float (or as longtables), landscape when the
+    page is, the notes after them (:func:`to_latex`)."""
     landscape = page is LANDSCAPE
     lines = len(df) * len(parts) + sum(math.ceil(len(n) / 100) for n in notes)
     out = [f"% gaitval table {label}: {lines} lines; pdflatex with booktabs, "
@@ -502,115 +427,3 @@ def to_latex(df: pd.DataFrame, *, caption: str, label: str, notes: list[str] | N
     if landscape:
         out.append(r"\end{landscape}")
     return "\n".join(out) + "\n"
-
-
-#: What the page-fit check counts in pdflatex's log (:func:`compile_tables`).
-LOG_PROBLEMS = {"float too large": re.compile(r"Float too large for page by ([0-9.]+)pt"),
-                "overfull hbox": re.compile(r"^Overfull \\hbox", re.M),
-                "overfull vbox": re.compile(r"^Overfull \\vbox", re.M),
-                "underfull hbox": re.compile(r"^Underfull \\hbox", re.M),
-                "underfull vbox": re.compile(r"^Underfull \\vbox", re.M),
-                "runaway": re.compile(r"^Runaway (argument|definition|text|preamble)",
-                                      re.M)}
-#: A table of more than two pages must carry at least this many lines (rows, notes) a
-#: page: fewer is a listing of paragraphs, not a table (the check fails it).
-MIN_LINES_PER_PAGE = 6
-
-
-class Compiled(tuple):
-    """``(ok, problem, n_box_problems)`` of one table, plus ``.counts`` and ``.pages``."""
-
-    counts: dict
-    pages: int
-
-    def __new__(cls, ok: bool, problem: str, n_boxes: int, counts: dict, pages: int):
-        self = super().__new__(cls, (ok, problem, n_boxes))
-        self.counts, self.pages = counts, pages
-        return self
-
-
-def check_log(log: str, *, lines: int | None = None) -> tuple[str, dict, int]:
-    """The page-fit problems a pdflatex log shows: ``(first problem or '', counts,
-    pages)``.  Every count in :data:`LOG_PROBLEMS` must be 0, and a table of ``lines``
-    lines (rows of every part, and its notes at 100 characters a line) on more than two
-    pages must have :data:`MIN_LINES_PER_PAGE` lines a page."""
-    counts = {k: len(rx.findall(log)) for k, rx in LOG_PROBLEMS.items()}
-    first = re.search(r"GAITVAL-FIRST-PAGE (\d+)", log)
-    nxt = re.search(r"GAITVAL-NEXT-PAGE (\d+)", log)
-    pages = int(nxt.group(1)) - int(first.group(1)) if first and nxt else 0
-    err = next((ln for ln in log.splitlines() if ln.startswith("!")), "")
-    if err:
-        return err, counts, pages
-    too_large = LOG_PROBLEMS["float too large"].search(log)
-    if too_large:
-        return f"Float too large for page by {too_large.group(1)}pt", counts, pages
-    bad = [f"{n} {k}" for k, n in counts.items() if n]
-    if bad:
-        return ", ".join(bad), counts, pages
-    if lines is not None and pages > 2 and lines < MIN_LINES_PER_PAGE * pages:
-        return (f"{pages} pages for {lines} lines of rows and notes (fewer than "
-                f"{MIN_LINES_PER_PAGE} a page)", counts, pages)
-    return "", counts, pages
-
-
-def compile_tables(paths, workdir, *, pdflatex: str = "pdflatex", timeout: float = 120
-                   ) -> dict[str, Compiled]:
-    """Compile each ``.tex`` table on its own inside :data:`PREAMBLE`, as a page of an
-    article, with pdflatex, and check that it fits the page.
-
-    Returns ``{path: (ok, problem, n_box_problems)}`` (a :class:`Compiled` that also has
-    ``.counts`` and ``.pages``).  ``ok`` is False when pdflatex fails or its log shows a
-    float too large for the page, an overfull or underfull box, a runaway argument, or
-    (for a gaitval table, whose first line gives its lines) more than two pages with
-    fewer than :data:`MIN_LINES_PER_PAGE` lines a page.  ``workdir`` receives the wrapper documents and logs.
-    """
-    import subprocess
-    from pathlib import Path
-
-    workdir = Path(workdir)
-    workdir.mkdir(parents=True, exist_ok=True)
-    out = {}
-    for i, p in enumerate(sorted(Path(x).resolve() for x in paths)):
-        doc = workdir / f"t{i:03d}_{p.stem}.tex"
-        doc.write_text(PREAMBLE + "\n\\begin{document}\n" + PAGE_TEXT
-                       + "\n\\clearpage\\typeout{GAITVAL-FIRST-PAGE \\thepage}\n\\input{"
-                       + p.as_posix() + "}"
-                       + "\n\\clearpage\\typeout{GAITVAL-NEXT-PAGE \\thepage}\n"
-                       "\\end{document}\n", encoding="utf-8")
-        try:
-            res = subprocess.run([pdflatex, "-interaction=nonstopmode", "-halt-on-error",
-                                  "-output-directory", str(workdir), doc.name],
-                                 cwd=workdir, capture_output=True, timeout=timeout)
-            log_path = doc.with_suffix(".log")
-            log = log_path.read_text(errors="replace") if log_path.is_file() else ""
-            ok = res.returncode == 0 and doc.with_suffix(".pdf").is_file()
-        except subprocess.TimeoutExpired:
-            ok, log = False, "! pdflatex timed out"
-        m = re.match(r"% gaitval table \S+: (\d+) lines", p.read_text(errors="replace"))
-        problem, counts, pages = check_log(log, lines=int(m.group(1)) if m else None)
-        if not ok and not problem:
-            problem = "pdflatex failed"
-        n_boxes = sum(n for k, n in counts.items() if k != "float too large")
-        out[str(p)] = Compiled(ok and not problem, problem, n_boxes, counts, pages)
-    return out
-
-
-def main(argv: list[str] | None = None) -> int:
-    """``python -m gaitval.tables.latex FILE.tex ...``: compile each in a page, one line
-    per file (pages and every problem)."""
-    import sys
-    import tempfile
-
-    paths = list(sys.argv[1:] if argv is None else argv)
-    with tempfile.TemporaryDirectory() as tmp:
-        res = compile_tables(paths, tmp)
-    for p, r in res.items():
-        ok, problem, _ = r
-        print(f"{'ok  ' if ok else 'FAIL'} {p}  {r.pages} page(s)"
-              + (f"  {problem}" if problem else ""))
-    print(f"{sum(r[0] for r in res.values())}/{len(res)} fit their pages")
-    return 0 if all(r[0] for r in res.values()) else 1
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -85,7 +85,7 @@ def write_table(df: pd.DataFrame, stem: str | Path, *, caption: str,
     md = [f"**{caption}**", "", to_markdown(shown, stem.name)]
     if notes:
         md += [""] + [f"- {n}" for n in notes]
-    from gaitval.tables.latex import to_latex   # lazily: `python -m gaitval.tables.latex`
+    from gaitval.tables.latex import to_latex
 
     tex = to_latex(shown, caption=caption, notes=notes, label=stem.name)
     paths = [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".tex")]

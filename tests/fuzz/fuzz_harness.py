@@ -151,7 +151,7 @@ def judge_load(kind: str, d: dict | None, base: dict | None) -> dict:
     if d is None:
         return {"outcome": "load", "detail": ""}
     if kind == "sheet":                       # a loaded sheet: every id a safe folder name
-        from gaitval.io.trialsheet import id_problem
+        from gaitval.configcheck import id_problem
         bad = [v for v in d.get("ids", []) if id_problem(v)]
         return ({"outcome": "unsafe", "detail": f"unsafe id accepted: {bad[0][:40]!r}"}
                 if bad else {"outcome": "load", "detail": ""})
@@ -275,7 +275,7 @@ def warm_up() -> None:
     import gaitval.io.rosbag  # noqa: F401
     import gaitval.io.scanlog  # noqa: F401
     import gaitval.io.ultrasonic  # noqa: F401
-    from gaitval.io.trialsheet import load_schema
+    from gaitval.io.sheettable import load_schema
     load_schema("trials")
     load_schema("subjects")
 

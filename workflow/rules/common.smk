@@ -14,10 +14,11 @@ from gaitval.configcheck import (check_config, check_study_file, display_path,
 from gaitval.errors import ConfigError, GaitvalError
 from gaitval.io.trialsheet import load_trial_sheet
 from gaitval.report.provenance import config_hash, source_digest
-from gaitval.methods import METHODS, get_method, override_problems, set_params
-from gaitval.pipeline.steps import (ALL_SCOPE, ANALYSIS_SECTIONS, EXTERNAL_PROTOCOLS,
-                                    PROTOCOL_SCOPE, SCOPES, STUDY_VIEW,
-                                    method_definition, method_view)
+from gaitval.methods import METHODS, get_method, set_params
+from gaitval.overrides import override_problems
+from gaitval.pipeline.steps.config import (ALL_SCOPE, ANALYSIS_SECTIONS, PROTOCOL_SCOPE, SCOPES,
+                                           STUDY_VIEW, method_definition, method_view)
+from gaitval.pipeline.steps.declarations import EXTERNAL_PROTOCOLS
 from gaitval.tables.tug_evidence import method_reading
 
 
@@ -79,7 +80,7 @@ def _check_study_files(schema):
         sheet = Path(entry.get("trial_sheet") or Path(DATA) / study / "trials.csv")
         cal = sheet.parent / "study.yaml"
         # external.yaml beside it (external methods and detectors; never written by gaitval)
-        from gaitval.pipeline.steps import study_side_problems
+        from gaitval.pipeline.steps.declarations import study_side_problems
         study_side_problems(sheet, schema=schema)
         if cal.is_file():
             own = _load_config_file(cal)
@@ -104,11 +105,11 @@ UKF_SYSTEM = "ultrasonic_ukf"
 def _check_external(cfg):
     """External methods (issue 37): tracking.external of the workflow config (every study
     of run) and external_methods: of each study's study.yaml (gaitval.pipeline.steps.
-    external_declarations): a name that is not already a method, the same names in every
-    study of run, and every trial's file there, inside the study's folder, before any job
-    runs.  tracking.external in a study.yaml is refused (external_methods: is the key).
-    Returns {study: {method: entry}}."""
-    from gaitval.pipeline.steps import external_declarations, missing_external_files
+    declarations.external_declarations): a name that is not already a method, the same
+    names in every study of run, and every trial's file there, inside the study's folder,
+    before any job runs.  tracking.external in a study.yaml is refused (external_methods:
+    is the key).  Returns {study: {method: entry}}."""
+    from gaitval.pipeline.steps.declarations import external_declarations, missing_external_files
 
     names = _method_definitions(cfg)
     names.update(dict.fromkeys((cfg.get("tug") or {}).get("methods") or []))
@@ -145,8 +146,8 @@ def _check_detections(cfg, per_study_methods):
     is no method nor external method, the same names in every study of run, every trial's
     file there and inside the study's folder) and each bag's LegArray topic, before any
     job runs.  Returns {study: {detector: entry}}."""
-    from gaitval.pipeline.steps import (DETECTION_PROTOCOLS, detection_topic_problems,
-                                        external_declarations, missing_external_files)
+    from gaitval.pipeline.steps.declarations import (DETECTION_PROTOCOLS, detection_topic_problems,
+                                                     external_declarations, missing_external_files)
 
     names = _method_definitions(cfg)
     names.update(dict.fromkeys((cfg.get("tug") or {}).get("methods") or []))
@@ -169,7 +170,7 @@ def _check_detections(cfg, per_study_methods):
 
 def declared_in(sheet, key):
     """name -> the file (study.yaml or external.yaml beside the sheet) declaring it."""
-    from gaitval.pipeline.steps import declared_entries
+    from gaitval.pipeline.steps.declarations import declared_entries
 
     return {m: display_path(f) for m, (_, f) in declared_entries(sheet, key).items()}
 
@@ -313,9 +314,9 @@ SOURCE_DIGEST = source_digest()
 
 def analysis_sections_json(view=None, scope=ALL_SCOPE):
     """The analysis sections as canonical JSON (sorted keys), or one view of them
-    (gaitval.pipeline.steps.method_view): the params of rules study_config and config_view,
-    with gaitval's source digest (SOURCE_DIGEST: new code reruns the views, hence every job
-    that reads one; study_config ignores the key)."""
+    (gaitval.pipeline.steps.config.method_view): the params of rules study_config and
+    config_view, with gaitval's source digest (SOURCE_DIGEST: new code reruns the views,
+    hence every job that reads one; study_config ignores the key)."""
     sections = {k: config[k] for k in ANALYSIS_SECTIONS if k in config}
     if view is not None:
         sections = method_view(sections, view, scope)
@@ -365,7 +366,7 @@ def study_views(views, scope):
 def config_view_file(wildcards, scope=None):
     """Input function: the config view a job reads (made by the config_view rule), its
     {method}'s, or the study view for a job without a method, in the scope of its trial's
-    protocol (gaitval.pipeline.steps.PROTOCOL_SCOPE) unless `scope` is given."""
+    protocol (gaitval.pipeline.steps.config.PROTOCOL_SCOPE) unless `scope` is given."""
     view = getattr(wildcards, "method", None) or STUDY_VIEW
     if scope is None:
         protocol = trial_row(wildcards.study, wildcards.trial)["protocol"]
@@ -578,7 +579,7 @@ def external_methods(protocol=None):
 def external_tracks_file(wildcards):
     """Input function: the external method's track file of one trial (its path relative to
     the trial sheet's folder, {trial} replaced)."""
-    from gaitval.pipeline.steps import external_track_path
+    from gaitval.pipeline.steps.declarations import external_track_path
 
     entry = _EXTERNAL[wildcards.study][wildcards.method]
     return str(external_track_path(sheet_path(wildcards.study), entry, wildcards.trial,
@@ -594,7 +595,7 @@ def external_detectors():
 def detection_trials(study, detector):
     """(trial, protocol) of every trial with mocap of the detector's protocols in the
     study (a trial without mocap has no legs to score against)."""
-    from gaitval.pipeline.steps import DETECTION_PROTOCOLS
+    from gaitval.pipeline.steps.declarations import DETECTION_PROTOCOLS
 
     prots = _DETECTIONS[study][detector].get("protocols") or DETECTION_PROTOCOLS
     return [(t, p) for p in prots for t in trial_ids(study, [p]) if has_mocap(study, t)]
@@ -603,7 +604,7 @@ def detection_trials(study, detector):
 def detection_file(study, detector, trial):
     """The detector's file of one trial (its path relative to the trial sheet's folder,
     {trial} replaced)."""
-    from gaitval.pipeline.steps import external_track_path
+    from gaitval.pipeline.steps.declarations import external_track_path
 
     return str(external_track_path(sheet_path(study), _DETECTIONS[study][detector], trial,
                                    detector, field=f"external_detections.{detector}.path"))
@@ -613,7 +614,7 @@ def external_input_files(study):
     """The external trackers' and detectors' files of a study's trials (the report's
     provenance lists them with the study's other raw inputs); a ROS 2 bag folder by its
     files."""
-    from gaitval.pipeline.steps import EXTERNAL_PROTOCOLS, external_track_path
+    from gaitval.pipeline.steps.declarations import EXTERNAL_PROTOCOLS, external_track_path
 
     out = []
     for m, e in _EXTERNAL.get(study, {}).items():

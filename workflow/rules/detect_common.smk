@@ -3,7 +3,7 @@
 from collections import Counter
 
 from gaitval.pipeline.detections import canonical, detector_key, method_detector
-from gaitval.pipeline.steps import analysis_config
+from gaitval.pipeline.steps.config import analysis_config
 
 _DETECTION_PLANS = {}
 

@@ -15,18 +15,19 @@ rule study_config:
     log:
         "logs/study_config/{study}.log",
     run:
-        from gaitval.pipeline.steps import study_config
+        from gaitval.pipeline.steps.config import study_config
 
         study_config(json.loads(params.sections), input.sheet, output[0])
 
 
-# The config as the per-trial jobs of one method read it (gaitval.pipeline.steps.method_view): every
-# per-trial job takes its view (config_view_file, common.smk) instead of config.json, so a
-# change of one method's parameter reruns that method's tracking and evaluation and the
-# tables of its study section (the pooled tables read the views too: study_views), not
-# every trial's registration, every other method and the other tables.  view = a method
-# name, or "study" for the jobs without a method; scope = the protocol family whose section
-# it keeps (tug, mtst, rollator, ultrasonic; the others' left out), or "all".
+# The config as the per-trial jobs of one method read it
+# (gaitval.pipeline.steps.config.method_view): every per-trial job takes its view
+# (config_view_file, common.smk) instead of config.json, so a change of one method's
+# parameter reruns that method's tracking and evaluation and the tables of its study section
+# (the pooled tables read the views too: study_views), not every trial's registration, every
+# other method and the other tables.  view = a method name, or "study" for the jobs without
+# a method; scope = the protocol family whose section it keeps (tug, mtst, rollator,
+# ultrasonic; the others' left out), or "all".
 rule config_view:
     input:
         sheet=lambda w: sheet_path(w.study),
@@ -41,7 +42,7 @@ rule config_view:
         "logs/config_view/{study}/{scope}/{view}.log",
     priority: 200  # milliseconds each, and every job waits for its view (PRIORITIES in common.smk)
     run:
-        from gaitval.pipeline.steps import study_config
+        from gaitval.pipeline.steps.config import study_config
 
         study_config(
             json.loads(params.sections), input.sheet, output[0], view=wildcards.view,
@@ -50,7 +51,7 @@ rule config_view:
 
 
 # REGISTRATION PER PROTOCOL FAMILY.  One job per (study, family): the trials with mocap of
-# one protocol family (gaitval.pipeline.steps.PROTOCOL_SCOPE: tug, mtst, rollator,
+# one protocol family (gaitval.pipeline.steps.config.PROTOCOL_SCOPE: tug, mtst, rollator,
 # ultrasonic, or "all" for another protocol), each reading its family's study view
 # (config_views/<family>/study.json), into results/<study>/register/<family>/<trial>/.  A
 # change of one family's section (e.g. rollator.sensor_mount) thus reruns that family's
