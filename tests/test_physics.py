@@ -342,3 +342,24 @@ def test_the_study_records_its_tug_scene_and_the_marker_section_reaches_the_lase
     assert wide.loc["turning", "occluded"] > zero.loc["turning", "occluded"]
     assert wide.loc["forward", "occluded"] == zero.loc["forward", "occluded"]
     assert wide.loc["return", "occluded"] >= zero.loc["return", "occluded"]
+
+
+def test_a_first_step_that_is_a_shuffle_has_no_direction_and_does_not_crash_the_checks():
+    """A twin drawn by the robustness ensemble whose first step moves the shin point < 5 cm
+    (a shuffle) stopped the simulation's physics table with an IndexError; that swing has
+    no direction, so its forward speed is NaN and the second swing still measures."""
+    import numpy as np
+    import pandas as pd
+    from gaitval.simulate.swings import _first
+
+    t = np.arange(0.0, 4.0, 0.01)
+    x_l = np.where(t < 1.0, 0.0, np.where(t < 1.5, 0.03 * (t - 1.0) / 0.5, 0.03))  # 3 cm
+    x_r = np.where(t < 2.0, 0.0, np.where(t < 2.5, 0.6 * (t - 2.0) / 0.5, 0.6))
+    legs = pd.concat([pd.DataFrame({"t_s": t, "side": s, "x_m": x, "y_m": 0.0})
+                      for s, x in (("L", x_l), ("R", x_r))])
+    ev = pd.DataFrame({"t_s": [1.0, 1.5, 2.0, 2.5],
+                       "side": ["L", "L", "R", "R"],
+                       "event": ["foot_off", "foot_contact"] * 2})
+    fwd_min, ratio = _first(legs, ev)
+    assert np.isnan(fwd_min)
+    assert ratio == 1.0
