@@ -239,6 +239,9 @@ def cmd_compare_tables(a) -> int:
 
 def cmd_report(a) -> int:
     from gaitval.report.index import build_index
+    if a.complete is not None:     # the workflow's report job: no index over a partial report
+        from gaitval.jobs.resume import refuse_unfinished
+        refuse_unfinished(a.reports_dir, own_outputs=a.complete)
     md, html = build_index(a.reports_dir, study_names=a.studies)
     print(f"wrote {md} and {html}")
     return 0
@@ -818,6 +821,62 @@ def _add_rollator_verbs(sub) -> None:
     s.add_argument("--config-hash", default="", help=_HASH)
     common(s, tables_dir=_TABLES, figures_dir=_FIGURES)
 
+def run_verbs(argvs: list[list[str]]) -> None:
+    """A batch task (gaitval.jobs.batch): gaitval verbs one after the other, each as
+    ``gaitval ARGV`` on the command line would run it (this parser and its exit codes);
+    the first that fails stops the task.  Each verb's command line goes to the log first
+    (``$ gaitval ...``, quoted as a shell would need it): the same step, by hand."""
+    import copy
+    import shlex
+
+    from gaitval.cli_exit import run_verb
+    from gaitval.jobs.batch import VerbFailed
+
+    saved = sys.argv
+    try:
+        for argv in argvs:
+            sys.argv = ["gaitval", *argv]        # what a table's provenance records
+            print(f"$ {shlex.join(sys.argv)}", flush=True)   # the same step by hand
+            args = copy.deepcopy(parser().parse_args(list(argv)))
+            rc = run_verb(args.func, args)
+            if rc:
+                raise VerbFailed(f"gaitval {argv[0]} exited with status {rc}")
+    finally:
+        sys.argv = saved
+
+
+def cmd_stage(a) -> int:
+    """``gaitval <stage>-trials``: make the job's output folders, then run every trial's
+    verbs (:data:`gaitval.jobs.stages.STAGES`) in a pool of ``--threads`` processes forked
+    from this one, largest first by ``--sizes`` (the log: gaitval.jobs.batch.run_batch)."""
+    from pathlib import Path
+
+    from gaitval.jobs.batch import Task, by_size, run_batch
+    from gaitval.jobs.stages import STAGES, aligned, preload
+
+    for d in a.out:
+        Path(d).mkdir(parents=True, exist_ok=True)   # a batch of no trial leaves its folder
+    tasks = [Task(label, run_verbs, {"argvs": argvs}) for label, argvs in STAGES[a.verb][0](a)]
+    if a.sizes:
+        tasks = by_size(tasks, [float(s) for s in aligned(a, "sizes")])
+    if tasks:
+        preload(a.verb)
+    run_batch(tasks, a.threads, a.log, fork=True)
+    return 0
+
+
+def _add_stage_verbs(sub) -> None:
+    """The workflow's jobs: one stage's trials in a process pool (gaitval.jobs.stages)."""
+    from gaitval.jobs.stages import OPTIONS, STAGES
+
+    for name, (_, text) in STAGES.items():
+        s = sub.add_parser(name, help=f"{text} (a workflow job; the per-trial verbs in a "
+                           "pool of --threads processes)")
+        for opt, kw in OPTIONS.items():
+            s.add_argument(f"--{opt.replace('_', '-')}", **kw)
+        s.set_defaults(func=cmd_stage)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``gaitval`` argument parser: one sub-command per verb, in pipeline order."""
     p = argparse.ArgumentParser(
@@ -835,6 +894,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_external_foot_verbs(sub)
     _add_mtst_verbs(sub)
     _add_rollator_verbs(sub)
+    _add_stage_verbs(sub)
     from gaitval.pipeline.legbench import add_legbench_verbs
     add_legbench_verbs(sub)              # annotated recordings without mocap (issue 18)
     from gaitval.pipeline.paper_figures import add_paper_figure_verbs
@@ -849,6 +909,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--studies", nargs="*", default=[], metavar="STUDY",
                    help="the run's study ids (default: 'run' of <reports-dir>/provenance/"
                    "config.yaml)")
+    s.add_argument("--complete", nargs="*", default=None, metavar="OUTPUT",
+                   help="refuse (exit 1) while a table or figure a step's provenance lists "
+                   "is missing or a file of the report is marked unfinished by an "
+                   "interrupted Snakemake job; OUTPUT: the calling job's own outputs")
     s.set_defaults(func=cmd_report)
     s = sub.add_parser("compare-tables", help="two report folders' tables within a stated "
                        "tolerance (docs/numerics.md)")
@@ -874,6 +938,8 @@ def main(argv: list[str] | None = None) -> int:
     import copy
 
     from gaitval.cli_exit import configure_logging, run_verb
+    from gaitval.jobs.lifeline import verb_process
+    verb_process()      # started by a workflow's job: end with its Snakemake (jobs/lifeline.py)
     # a copy: a verb that changes a default list (--methods ...) leaves the next job's alone
     args = copy.deepcopy(parser().parse_args(argv))
     configure_logging(args.verbose, args.quiet)
