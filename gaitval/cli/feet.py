@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import json
 
-from gaitval.cli.table import (FIGURES, HASH, REPORTS, SHEET, SUBJECTS,
-                                TABLES, TRIAL, A, Verb)
+from gaitval.cli.table import (TRIAL, FIGURES_ARG, HASH_ARG, REPORTS_ARG, SHEET_ARG,
+                               SUBJECTS_ARG, TABLES_ARG, TRIAL_ARG, A, Verb)
 
 
 def cmd_ultrasonic_noise(a) -> int:
@@ -67,14 +67,14 @@ VERBS = (
          A("--table-stem", required=True,
            help="Table 1's path without suffix "
                 "(reports/<run>/tables/ultrasonic_table1; writes .csv, .md, .tex)"),
-         A("--reports-dir", default="reports", help=REPORTS),
-         A("--config-hash", default="", help=HASH)),
+         REPORTS_ARG,
+         HASH_ARG),
     Verb("ultrasonic-track", cmd_ultrasonic_track,
          "UKF track of one ultrasonic trial",
          A("--ingest", required=True, metavar="DIR",
            help="the treadmill trial's ingest folder (results/<study>/ingest/<trial>: "
                 "the ultrasonic log sensor.parquet)"),
-         A("--trial", required=True, help=TRIAL),
+         TRIAL_ARG,
          A("--config", required=True, metavar="JSON",
            help="a config (view) JSON "
                 "(results/<study>/config_views/ultrasonic/study.json): ultrasonic.ukf, "
@@ -93,9 +93,9 @@ VERBS = (
          A("--ingest", required=True, metavar="DIR",
            help="the trial's ingest folder (results/<study>/ingest/<trial>: "
                 "sensor.parquet for the anchors, mocap.parquet for the reference)"),
-         A("--sheet", required=True, help=SHEET),
-         A("--subjects", required=True, help=SUBJECTS),
-         A("--trial", required=True, help=TRIAL),
+         SHEET_ARG,
+         SUBJECTS_ARG,
+         TRIAL_ARG,
          A("--config", required=True, metavar="JSON",
            help="a config (view) JSON "
                 "(results/<study>/config_views/ultrasonic/study.json): its ultrasonic: "
@@ -108,10 +108,10 @@ VERBS = (
          A("inputs", nargs="+", metavar="GAIT_PARQUET",
            help="per-trial gait parameter files of gait-parameters "
                 "(results/<study>/ultrasonic/gait/<trial>.parquet)"),
-         A("--tables-dir", required=True, help=TABLES),
-         A("--figures-dir", required=True, help=FIGURES),
-         A("--reports-dir", default="reports", help=REPORTS),
-         A("--config-hash", default="", help=HASH),
+         TABLES_ARG,
+         FIGURES_ARG,
+         REPORTS_ARG,
+         HASH_ARG,
          A("--config",
            help="config (view) JSON: ultrasonic.tables, the strides the tables use "
                 "(default: the paper's 10 per subject)")),

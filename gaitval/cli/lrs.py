@@ -6,8 +6,8 @@ from __future__ import annotations
 import json
 import sys
 
-from gaitval.cli.table import (FIGURES, HASH, REPORTS, SHEET, SUBJECTS,
-                                TABLES, TRIAL, A, Verb)
+from gaitval.cli.table import (FIGURES_ARG, HASH_ARG, REPORTS_ARG, SHEET_ARG, SUBJECTS_ARG,
+                               TABLES_ARG, TRIAL_ARG, A, Verb)
 
 
 def cmd_register(a) -> int:
@@ -125,9 +125,9 @@ VERBS = (
          A("--ingest", required=True, metavar="DIR",
            help="the trial's ingest folder (results/<study>/ingest/<trial>: "
                 "mocap.parquet, sensor.parquet)"),
-         A("--sheet", required=True, help=SHEET),
-         A("--subjects", required=True, help=SUBJECTS),
-         A("--trial", required=True, help=TRIAL),
+         SHEET_ARG,
+         SUBJECTS_ARG,
+         TRIAL_ARG,
          A("--config", required=True, metavar="JSON",
            help="the study view of the trial's protocol family "
                 "(results/<study>/config_views/<family>/study.json) or "
@@ -149,16 +149,16 @@ VERBS = (
            help="the report table's path without suffix "
                 "(reports/<run>/tables/study_registration_<study>; writes .csv, .md, "
                 ".tex)"),
-         A("--reports-dir", default="reports", help=REPORTS),
-         A("--config-hash", default="", help=HASH)),
+         REPORTS_ARG,
+         HASH_ARG),
     Verb("track", cmd_track,
          "run one tracker method on one LRS trial",
          A("--sensor", required=True,
            help="the trial's ingested scan log "
                 "(results/<study>/ingest/<trial>/sensor.parquet)"),
-         A("--sheet", required=True, help=SHEET),
-         A("--subjects", required=True, help=SUBJECTS),
-         A("--trial", required=True, help=TRIAL),
+         SHEET_ARG,
+         SUBJECTS_ARG,
+         TRIAL_ARG,
          A("--method", required=True,
            help="the method's name: a built-in (e.g. tug_m1, tug_m2, tug_m3, people) "
                 "or one of tracking.methods"),
@@ -180,9 +180,9 @@ VERBS = (
          A("--sensor", required=True,
            help="the trial's ingested scan log "
                 "(results/<study>/ingest/<trial>/sensor.parquet)"),
-         A("--sheet", required=True, help=SHEET),
-         A("--subjects", required=True, help=SUBJECTS),
-         A("--trial", required=True, help=TRIAL),
+         SHEET_ARG,
+         SUBJECTS_ARG,
+         TRIAL_ARG,
          A("--detector", required=True,
            help='the detector spec as JSON, e.g. \'{"name": "leg_patterns", '
                 '"use_fs_u": true}\''),
@@ -311,10 +311,10 @@ VERBS = (
                 "(results/<study>/evaluate/<method>/<trial>)"),
          A("--methods", nargs="+", default=["tug_m1", "tug_m2", "tug_m3"],
            help="the methods, in table order (default: tug_m1 tug_m2 tug_m3)"),
-         A("--tables-dir", required=True, help=TABLES),
-         A("--figures-dir", required=True, help=FIGURES),
-         A("--reports-dir", default="reports", help=REPORTS),
-         A("--config-hash", default="", help=HASH),
+         TABLES_ARG,
+         FIGURES_ARG,
+         REPORTS_ARG,
+         HASH_ARG,
          A("--configs", nargs="+",
            help="each study's config.json or its method views "
                 "(config_views/tug/<method>.json) for Table 2; default: the "
@@ -400,6 +400,6 @@ LEGBENCH = (
          A("--figures-dir", required=True,
            help="folder the figure goes to (legbench_tracks.png; "
                 "reports/<run>/figures)"),
-         A("--reports-dir", default="reports", help=REPORTS),
-         A("--config-hash", default="", help=HASH)),
+         REPORTS_ARG,
+         HASH_ARG),
 )

@@ -1,8 +1,8 @@
 """Verbs of the multi-target stepping task (seed 001) and the robotic rollator (seed 002)."""
 from __future__ import annotations
 
-from gaitval.cli.table import (FIGURES, HASH, REPORTS, SHEET, SUBJECTS,
-                                TABLES, TRIAL, A, Verb)
+from gaitval.cli.table import (FIGURES_ARG, HASH_ARG, REPORTS_ARG, SHEET_ARG, SUBJECTS_ARG,
+                               TABLES_ARG, TRIAL_ARG, A, Verb)
 
 
 def cmd_mtst_track(a) -> int:
@@ -77,9 +77,9 @@ VERBS = (
            help="the trial's scan log: results/<study>/ingest/<trial>/sensor.parquet, "
                 "or for a trial without mocap the raw scan log or bag the trial sheet "
                 "names"),
-         A("--sheet", required=True, help=SHEET),
-         A("--subjects", required=True, help=SUBJECTS),
-         A("--trial", required=True, help=TRIAL),
+         SHEET_ARG,
+         SUBJECTS_ARG,
+         TRIAL_ARG,
          A("--method", required=True,
            help="the method's name: a built-in (mtst_m1, mtst_m2, mtst_m3, "
                 "mtst_proposed, people) or one of tracking.methods"),
@@ -99,9 +99,9 @@ VERBS = (
            help="the trial's scan log: results/<study>/ingest/<trial>/sensor.parquet, "
                 "or for a trial without mocap the raw scan log or bag the trial sheet "
                 "names"),
-         A("--sheet", required=True, help=SHEET),
-         A("--subjects", required=True, help=SUBJECTS),
-         A("--trial", required=True, help=TRIAL),
+         SHEET_ARG,
+         SUBJECTS_ARG,
+         TRIAL_ARG,
          A("--config", required=True,
            help="a config (view) JSON (results/<study>/config_views/mtst/study.json): "
                 "mtst.scan_period_s"),
@@ -126,8 +126,8 @@ VERBS = (
            help="the study's trial sheet, trials.csv (data/<study>/trials.csv for a "
                 "simulated study; docs/formats.md, Trial sheet); names the trial's "
                 "annotation file"),
-         A("--subjects", required=True, help=SUBJECTS),
-         A("--trial", required=True, help=TRIAL),
+         SUBJECTS_ARG,
+         TRIAL_ARG,
          A("--method", required=True, help="the method's name (its label in the tables)"),
          A("--config", required=True,
            help="the method's config view "
@@ -149,17 +149,17 @@ VERBS = (
            help="a study's config (view) JSON "
                 "(results/<study>/config_views/mtst/study.json): the mtst: section; "
                 "the method views beside it name a method run with tracking.overrides"),
-         A("--reports-dir", default="reports", help=REPORTS),
-         A("--config-hash", default="", help=HASH),
-         A("--tables-dir", required=True, help=TABLES),
-         A("--figures-dir", required=True, help=FIGURES)),
+         REPORTS_ARG,
+         HASH_ARG,
+         TABLES_ARG,
+         FIGURES_ARG),
     Verb("rollator-train", cmd_rollator_train,
          "learn the PF model for one held-out subject",
          A("--results", required=True, metavar="DIR",
            help="results/<study>: the other subjects' rollator trials' "
                 "ingest/<trial>/sensor.parquet and register/rollator/<trial>/"),
-         A("--sheet", required=True, help=SHEET),
-         A("--subjects", required=True, help=SUBJECTS),
+         SHEET_ARG,
+         SUBJECTS_ARG,
          A("--subject", required=True,
            help="the held-out subject's id: the model learns from every other "
                 "subject's rollator trials"),
@@ -177,9 +177,9 @@ VERBS = (
          A("--sensor", required=True,
            help="the trial's ingested scan log "
                 "(results/<study>/ingest/<trial>/sensor.parquet)"),
-         A("--sheet", required=True, help=SHEET),
-         A("--subjects", required=True, help=SUBJECTS),
-         A("--trial", required=True, help=TRIAL),
+         SHEET_ARG,
+         SUBJECTS_ARG,
+         TRIAL_ARG,
          A("--method", required=True,
            help="rollator_kf, rollator_pf or one of rollator.methods (e.g. people)"),
          A("--config", required=True,
@@ -204,9 +204,9 @@ VERBS = (
            help="the trial's registration.json "
                 "(results/<study>/register/rollator/<trial>/): clock offset and drift, "
                 "status"),
-         A("--sheet", required=True, help=SHEET),
-         A("--subjects", required=True, help=SUBJECTS),
-         A("--trial", required=True, help=TRIAL),
+         SHEET_ARG,
+         SUBJECTS_ARG,
+         TRIAL_ARG,
          A("--method", required=True, help="the method's name (its label in the tables)"),
          A("--config", required=True,
            help="the method's config view "
@@ -232,8 +232,8 @@ VERBS = (
                 "(results/<study>/config_views/rollator/study.json): the rollator: "
                 "section; the method views beside it name a method run with "
                 "tracking.overrides"),
-         A("--reports-dir", default="reports", help=REPORTS),
-         A("--config-hash", default="", help=HASH),
-         A("--tables-dir", required=True, help=TABLES),
-         A("--figures-dir", required=True, help=FIGURES)),
+         REPORTS_ARG,
+         HASH_ARG,
+         TABLES_ARG,
+         FIGURES_ARG),
 )

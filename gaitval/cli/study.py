@@ -8,7 +8,7 @@ import re
 import sys
 from pathlib import Path
 
-from gaitval.cli.table import HASH, REPORTS, SHEET, TRIAL, A, Verb
+from gaitval.cli.table import (SHEET, HASH_ARG, REPORTS_ARG, SHEET_ARG, TRIAL_ARG, A, Verb)
 
 
 def cmd_inspect(a) -> int:
@@ -185,9 +185,9 @@ VERBS = (
                 "study.yaml, mocap/, lrs/, annotations/, ..., truth/")),
     Verb("ingest", cmd_ingest,
          "raw files of one trial -> tidy per-trial files",
-         A("--sheet", required=True, help=SHEET),
+         SHEET_ARG,
          A("--subjects", help="subject table (default: subjects.csv beside the sheet)"),
-         A("--trial", required=True, help=TRIAL),
+         TRIAL_ARG,
          A("--out", required=True, metavar="DIR",
            help="the trial's ingest folder (results/<study>/ingest/<trial>): "
                 "mocap.parquet (metres, mocap clock), events.csv, sensor.parquet, "
@@ -200,8 +200,8 @@ VERBS = (
          A("--out-stem", required=True,
            help="the table's path without suffix "
                 "(reports/<run>/tables/study_ingest_<study>; writes .csv, .md, .tex)"),
-         A("--reports-dir", default="reports", help=REPORTS),
-         A("--config-hash", default="", help=HASH)),
+         REPORTS_ARG,
+         HASH_ARG),
     Verb("peer", cmd_peer,
          "agreement statistics (Bland-Altman, ICC, RMSE, t-test) of any system's "
          "paired results against a reference: one row per walk or stride, us_<name> / "

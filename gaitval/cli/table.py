@@ -45,3 +45,12 @@ REPORTS = ("the report folder (reports/<run> in the workflow): the step's proven
 HASH = "the run's config hash, written into the provenance record (default: empty)"
 TABLES = "folder the tables go to, each as .csv, .md, .tex (reports/<run>/tables)"
 FIGURES = "folder the figures go to, PNG (reports/<run>/figures)"
+
+#: the arguments several verbs share
+SHEET_ARG = A("--sheet", required=True, help=SHEET)
+SUBJECTS_ARG = A("--subjects", required=True, help=SUBJECTS)
+TRIAL_ARG = A("--trial", required=True, help=TRIAL)
+REPORTS_ARG = A("--reports-dir", default="reports", help=REPORTS)
+HASH_ARG = A("--config-hash", default="", help=HASH)
+TABLES_ARG = A("--tables-dir", required=True, help=TABLES)
+FIGURES_ARG = A("--figures-dir", required=True, help=FIGURES)

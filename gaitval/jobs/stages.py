@@ -94,16 +94,20 @@ def track(a) -> list[tuple[str, list[Argv]]]:
     return tasks
 
 
+def _import_tracks(a, t: str, tracks: str, out: str, *flags: str) -> Argv:
+    """An external tracker's file of trial ``t`` converted to gaitval's track (``flags``:
+    e.g. ``--moving-sensor`` on the rollator)."""
+    return ["import-tracks", "--tracks", tracks, "--sensor", f"{a.ingest}/{t}/sensor.parquet",
+            "--registration", f"{a.register}/{t}/registration.json", "--trial", t,
+            "--method", a.method, "--config", a.config, *flags, "--out", out]
+
+
 def track_external(a) -> list[tuple[str, list[Argv]]]:
     """Each TUG trial's external track (--files) converted, then evaluated."""
     tasks = []
     for t, f in zip(a.trials, aligned(a, "files")):
         out = f"{a.out[0]}/{t}.parquet"
-        tasks.append((t, [["import-tracks", "--tracks", f,
-                           "--sensor", f"{a.ingest}/{t}/sensor.parquet",
-                           "--registration", f"{a.register}/{t}/registration.json",
-                           "--trial", t, "--method", a.method, "--config", a.config,
-                           "--out", out], _evaluate_tug(a, t, out)]))
+        tasks.append((t, [_import_tracks(a, t, f, out), _evaluate_tug(a, t, out)]))
     return tasks
 
 
@@ -166,11 +170,8 @@ def rollator_external(a) -> list[tuple[str, list[Argv]]]:
     tasks = []
     for t, f in zip(a.trials, aligned(a, "files")):
         out = f"{a.out[0]}/{t}.track.parquet"
-        tasks.append((t, [["import-tracks", "--tracks", f,
-                           "--sensor", f"{a.ingest}/{t}/sensor.parquet",
-                           "--registration", f"{a.register}/{t}/registration.json",
-                           "--trial", t, "--method", a.method, "--config", a.config,
-                           "--moving-sensor", "--out", out], _rollator_evaluate(a, t, out)]))
+        tasks.append((t, [_import_tracks(a, t, f, out, "--moving-sensor"),
+                          _rollator_evaluate(a, t, out)]))
     return tasks
 
 

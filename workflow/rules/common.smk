@@ -35,16 +35,22 @@ REPORTS = f"{REPORTS_ROOT}/{RUN_NAME}"
 # stage) or (study, stage, method), not per trial: its `shell:` command is one gaitval verb
 # (`gaitval track-trials ...`, gaitval.jobs.stages) that runs each trial's per-trial verbs
 # in a process pool of the rule's `threads` and writes each trial's own files below the
-# job's `directory()` outputs; its log lists every trial's command and messages.  The
-# `gaitval` a job runs is the one beside the Python running Snakemake (its folder first on
-# PATH: a venv need not be activated); with --software-deployment-method conda, the
-# rule's environment's own (activated before the command).
+# job's `directory()` outputs; its log lists every trial's command and messages.  A job's
+# `python` is the one running Snakemake (its folder first on PATH: a venv need not be
+# activated); with --software-deployment-method conda, the rule's environment's own
+# (activated before the command).
 import os as _os
+
+from snakemake import __version__ as _SNAKEMAKE_VERSION
 
 _os.environ.update(PATH=_os.pathsep.join([str(Path(sys.executable).parent),
                                           _os.environ.get("PATH", "")]))
-#: every rule's software environment (the locked dependencies and gaitval itself)
-CONDA_ENV = "../envs/gaitval.yaml"
+# Every rule's software environment: the locked dependencies and gaitval itself.  Snakemake
+# 8 asks conda for a job's environment when it reports a failed job (`conda info`, even
+# without --software-deployment-method conda; jobs.Job.get_log_error_info), which fails
+# where conda is absent, so under Snakemake 8 the rules declare none; Snakemake 9 asks only
+# with that option.
+CONDA_ENV = "../envs/gaitval.yaml" if int(_SNAKEMAKE_VERSION.split(".")[0]) >= 9 else None
 
 
 def batch_threads():

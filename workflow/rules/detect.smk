@@ -36,7 +36,7 @@ rule detect:
     conda:
         CONDA_ENV
     shell:
-        "gaitval detect-trials --family {wildcards.family:q} --trials {params.trials:q}"
+        "python -m gaitval detect-trials --family {wildcards.family:q} --trials {params.trials:q}"
         " --sensors {params.sensors:q} --sizes {params.sizes:q} --sheet {input.sheet:q}"
         " --subjects {params.subjects:q} --detector {params.spec:q}"
         " --config {input.view:q} --out {output:q} --threads {threads:q} --log {log:q}"

@@ -29,7 +29,7 @@ rule rollator_track_external:
     conda:
         CONDA_ENV
     shell:
-        "gaitval rollator-import-trials --trials {params.trials:q} --files {input.tracks:q}"
+        "python -m gaitval rollator-import-trials --trials {params.trials:q} --files {input.tracks:q}"
         " --ingest {input.ingest:q} --register {input.register:q}"
         " --sheet {input.sheet:q} --subjects {params.subjects:q}"
         " --config {input.config:q} --method {wildcards.method:q}"
@@ -70,7 +70,7 @@ rule leg_detections:
     conda:
         CONDA_ENV
     shell:
-        "gaitval leg-detections-trials --trials {params.trial_ids:q} --files {input.files:q}"
+        "python -m gaitval leg-detections-trials --trials {params.trial_ids:q} --files {input.files:q}"
         " --protocols {params.protocols:q} --topic={params.topic:q}"
         " --ingest {input.ingest:q} --register {params.register:q}"
         " --method {wildcards.detector:q} --out {output:q} --threads {threads:q}"
@@ -101,7 +101,7 @@ rule detections_table:
     conda:
         CONDA_ENV
     shell:
-        "gaitval leg-detections-table {params.dirs:q} --out-stem {params.stem:q}"
+        "python -m gaitval leg-detections-table {params.dirs:q} --out-stem {params.stem:q}"
         " --reports-dir {params.reports:q} --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
@@ -137,7 +137,7 @@ rule ultrasonic_external:
     conda:
         CONDA_ENV
     shell:
-        "gaitval external-gait-trials --trials {params.trials:q} --files {input.feet:q}"
+        "python -m gaitval external-gait-trials --trials {params.trials:q} --files {input.feet:q}"
         " --ingest {input.ingest:q} --sheet {input.sheet:q}"
         " --subjects {params.subjects:q} --config {input.config:q}"
         " --method {wildcards.method:q} --out {output:q} --threads {threads:q}"
@@ -175,7 +175,7 @@ rule method_agreement:
     conda:
         CONDA_ENV
     shell:
-        "gaitval method-agreement {params.gait:q} --out-stem {params.stem:q}"
+        "python -m gaitval method-agreement {params.gait:q} --out-stem {params.stem:q}"
         " --config {input.config:q} --reports-dir {params.reports:q}"
         " --config-hash {params.chash:q} > {log:q} 2>&1"
 

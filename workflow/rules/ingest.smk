@@ -20,7 +20,7 @@ rule ingest:
     conda:
         CONDA_ENV
     shell:
-        "gaitval ingest-trials --trials {params.trials:q} --sizes {params.sizes:q}"
+        "python -m gaitval ingest-trials --trials {params.trials:q} --sizes {params.sizes:q}"
         " --sheet {input.sheet:q} --subjects {params.subjects:q}"
         " --out {output:q} --threads {threads:q} --log {log:q}"
 
@@ -49,7 +49,7 @@ rule ingest_summary:
     conda:
         CONDA_ENV
     shell:
-        "gaitval ingest-summary {params.summaries:q} --study {wildcards.study:q}"
+        "python -m gaitval ingest-summary {params.summaries:q} --study {wildcards.study:q}"
         " --out-stem {params.stem:q} --reports-dir {params.reports:q}"
         " --config-hash {params.chash:q} > {log:q} 2>&1"
 

@@ -27,7 +27,7 @@ rule mtst_track:
     conda:
         CONDA_ENV
     shell:
-        "gaitval mtst-trials --trials {params.trials:q} --sensors {params.sensors:q}"
+        "python -m gaitval mtst-trials --trials {params.trials:q} --sensors {params.sensors:q}"
         " --mocap-trials {params.mocap:q} --sizes {params.sizes:q}"
         " --register {params.register:q} --sheet {input.sheet:q}"
         " --subjects {params.subjects:q} --config {input.config:q}"
@@ -63,7 +63,7 @@ rule mtst_track_external:
     conda:
         CONDA_ENV
     shell:
-        "gaitval mtst-trials --trials {params.trials:q} --files {input.tracks:q}"
+        "python -m gaitval mtst-trials --trials {params.trials:q} --files {input.tracks:q}"
         " --sensors {params.sensors:q} --mocap-trials {params.mocap:q}"
         " --register {params.register:q} --sheet {input.sheet:q}"
         " --subjects {params.subjects:q} --config {input.config:q}"
@@ -107,7 +107,7 @@ rule mtst_tables:
     conda:
         CONDA_ENV
     shell:
-        "gaitval mtst-tables {params.dirs:q} --methods {params.methods:q}"
+        "python -m gaitval mtst-tables {params.dirs:q} --methods {params.methods:q}"
         " --config {params.config:q} --tables-dir {params.tables:q}"
         " --figures-dir {params.figures:q} --reports-dir {params.reports:q}"
         " --config-hash {params.chash:q} > {log:q} 2>&1"

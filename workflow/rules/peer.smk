@@ -24,7 +24,7 @@ rule peer_agreement:
     conda:
         CONDA_ENV
     shell:
-        "gaitval peer {input:q} --out-stem {params.stem:q} --reports-dir {params.reports:q}"
+        "python -m gaitval peer {input:q} --out-stem {params.stem:q} --reports-dir {params.reports:q}"
         " --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
@@ -55,7 +55,7 @@ rule agreement_file:
     conda:
         CONDA_ENV
     shell:
-        "gaitval peer {input:q} {params.opts:q} --out-stem {params.stem:q}"
+        "python -m gaitval peer {input:q} {params.opts:q} --out-stem {params.stem:q}"
         " --reports-dir {params.reports:q} --config-hash {params.chash:q} > {log:q} 2>&1"
 
 

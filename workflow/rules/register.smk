@@ -78,7 +78,7 @@ rule register:
     conda:
         CONDA_ENV
     shell:
-        "gaitval register-trials --trials {params.trials:q} --sizes {params.sizes:q}"
+        "python -m gaitval register-trials --trials {params.trials:q} --sizes {params.sizes:q}"
         " --ingest {input.ingest:q} --sheet {input.sheet:q} --subjects {params.subjects:q}"
         " --config {input.config:q} --out {output:q} --threads {threads:q} --log {log:q}"
 
@@ -111,7 +111,7 @@ rule registration_summary:
     conda:
         CONDA_ENV
     shell:
-        "gaitval registration-summary {params.registrations:q} --study {wildcards.study:q}"
+        "python -m gaitval registration-summary {params.registrations:q} --study {wildcards.study:q}"
         " --out-csv {output.csv:q} --out-stem {params.stem:q}"
         " --reports-dir {params.reports:q} --config-hash {params.chash:q} > {log:q} 2>&1"
 

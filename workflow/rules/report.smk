@@ -69,7 +69,7 @@ rule report:
     conda:
         CONDA_ENV
     shell:
-        "gaitval report --reports-dir {params.reports:q} --studies {params.studies:q}"
+        "python -m gaitval report --reports-dir {params.reports:q} --studies {params.studies:q}"
         " --complete {output:q} > {log:q} 2>&1"
 
 
@@ -93,7 +93,7 @@ rule tug_paper_figures:
     conda:
         CONDA_ENV
     shell:
-        "gaitval paper-figures {params.args:q} > {log:q} 2>&1"
+        "python -m gaitval paper-figures {params.args:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(
@@ -119,7 +119,7 @@ rule mtst_paper_figures:
     conda:
         CONDA_ENV
     shell:
-        "gaitval paper-figures {params.args:q} > {log:q} 2>&1"
+        "python -m gaitval paper-figures {params.args:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(
@@ -145,7 +145,7 @@ rule rollator_paper_figures:
     conda:
         CONDA_ENV
     shell:
-        "gaitval paper-figures {params.args:q} > {log:q} 2>&1"
+        "python -m gaitval paper-figures {params.args:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(
@@ -171,7 +171,7 @@ rule ultrasonic_paper_figures:
     conda:
         CONDA_ENV
     shell:
-        "gaitval paper-figures {params.args:q} > {log:q} 2>&1"
+        "python -m gaitval paper-figures {params.args:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(

@@ -31,7 +31,7 @@ rule rollator_train:
     conda:
         CONDA_ENV
     shell:
-        "gaitval rollator-train-subjects --trials {params.held_out:q}"
+        "python -m gaitval rollator-train-subjects --trials {params.held_out:q}"
         " --results {params.results:q} --sheet {input.sheet:q}"
         " --subjects {params.subjects:q} --config {input.config:q}"
         " --out {output:q} --threads {threads:q} --log {log:q}"
@@ -61,7 +61,7 @@ rule rollator_track:
     conda:
         CONDA_ENV
     shell:
-        "gaitval rollator-trials --trials {params.trials:q} --models {params.models:q}"
+        "python -m gaitval rollator-trials --trials {params.trials:q} --models {params.models:q}"
         " --sizes {params.sizes:q} --ingest {input.ingest:q}"
         " --register {input.register:q} --sheet {input.sheet:q}"
         " --subjects {params.subjects:q} --config {input.config:q}"
@@ -113,7 +113,7 @@ rule rollator_tables:
     conda:
         CONDA_ENV
     shell:
-        "gaitval rollator-tables {params.dirs:q} --kf {params.kf:q} --pf {params.pf:q}"
+        "python -m gaitval rollator-tables {params.dirs:q} --kf {params.kf:q} --pf {params.pf:q}"
         " --models {params.models:q} --config {input.config:q}"
         " --tables-dir {params.tables:q} --figures-dir {params.figures:q}"
         " --reports-dir {params.reports:q} --config-hash {params.chash:q} > {log:q} 2>&1"

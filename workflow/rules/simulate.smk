@@ -20,5 +20,5 @@ checkpoint simulate:
     conda:
         CONDA_ENV
     shell:
-        "gaitval simulate --preset {input.preset:q} --seed {params.seed:q} --out {params.out:q}"
+        "python -m gaitval simulate --preset {input.preset:q} --seed {params.seed:q} --out {params.out:q}"
         " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"

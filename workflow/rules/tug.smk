@@ -27,7 +27,7 @@ rule track:
     conda:
         CONDA_ENV
     shell:
-        "gaitval track-trials --trials {params.trials:q} --sizes {params.sizes:q}"
+        "python -m gaitval track-trials --trials {params.trials:q} --sizes {params.sizes:q}"
         " --ingest {input.ingest:q} --register {input.register:q} --sheet {input.sheet:q}"
         " --subjects {params.subjects:q} --config {input.config:q}"
         " --method {wildcards.method:q} --detections={params.detections:q}"
@@ -61,7 +61,7 @@ rule track_external:
     conda:
         CONDA_ENV
     shell:
-        "gaitval import-tracks-trials --trials {params.trials:q} --files {input.tracks:q}"
+        "python -m gaitval import-tracks-trials --trials {params.trials:q} --files {input.tracks:q}"
         " --ingest {input.ingest:q} --register {input.register:q}"
         " --config {input.config:q} --method {wildcards.method:q}"
         " --out {output.track:q} {output.evaluate:q} --threads {threads:q} --log {log:q}"
@@ -107,7 +107,7 @@ rule tug_tables:
     conda:
         CONDA_ENV
     shell:
-        "gaitval tug-tables {params.dirs:q} --methods {params.methods:q}"
+        "python -m gaitval tug-tables {params.dirs:q} --methods {params.methods:q}"
         " --tables-dir {params.tables:q} --figures-dir {params.figures:q}"
         " --reports-dir {params.reports:q} --config-hash {params.chash:q}"
         " --configs {input.configs:q} > {log:q} 2>&1"

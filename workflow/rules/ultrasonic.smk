@@ -38,7 +38,7 @@ rule ultrasonic_noise:
     conda:
         CONDA_ENV
     shell:
-        "gaitval ultrasonic-noise --ingest {params.dirs:q} --trials {params.trials:q}"
+        "python -m gaitval ultrasonic-noise --ingest {params.dirs:q} --trials {params.trials:q}"
         " --config {input.config:q} --out {output.noise:q} --table-stem {params.stem:q}"
         " --reports-dir {params.reports:q} --config-hash {params.chash:q} > {log:q} 2>&1"
 
@@ -64,7 +64,7 @@ rule ultrasonic_track:
     conda:
         CONDA_ENV
     shell:
-        "gaitval ultrasonic-trials --trials {params.trials:q} --sizes {params.sizes:q}"
+        "python -m gaitval ultrasonic-trials --trials {params.trials:q} --sizes {params.sizes:q}"
         " --ingest {input.ingest:q} --noise {input.noise:q} --sheet {input.sheet:q}"
         " --subjects {params.subjects:q} --config {input.config:q}"
         " --out {output:q} --threads {threads:q} --log {log:q}"
@@ -103,7 +103,7 @@ rule ultrasonic_tables:
     conda:
         CONDA_ENV
     shell:
-        "gaitval ultrasonic-tables {params.gait:q} --tables-dir {params.tables:q}"
+        "python -m gaitval ultrasonic-tables {params.gait:q} --tables-dir {params.tables:q}"
         " --figures-dir {params.figures:q} --reports-dir {params.reports:q}"
         " --config {input.config:q} --config-hash {params.chash:q} > {log:q} 2>&1"
 
