@@ -1,5 +1,5 @@
 """Verbs of a study's inputs and of the report: inspect, validate, init-study, simulate,
-ingest, ingest-summary, peer, report, compare-tables."""
+ingest, ingest-summary, peer, sensitivity, report, compare-tables."""
 from __future__ import annotations
 
 import json
@@ -131,6 +131,14 @@ def cmd_report(a) -> int:
     return 0
 
 
+def cmd_sensitivity(a) -> int:
+    from gaitval.tables.sensitivity import write_sensitivity
+    for p in write_sensitivity(a.reports, a.out,
+                               protocols=tuple(a.protocol) if a.protocol else None):
+        print(p)
+    return 0
+
+
 def cmd_compare_tables(a) -> int:
     from gaitval.report.compare import run
     return run(a)
@@ -233,6 +241,14 @@ VERBS = (
 
 #: after every other verb in ``gaitval --help``
 LAST = (
+    Verb("sensitivity", cmd_sensitivity,
+         "the verdicts of a report beside the same verdicts under the simulated "
+         "replica's alternative free choices, and which flip (docs/simulator.md)",
+         A("reports", nargs="+", type=Path,
+           help="report folders; the first is the reference"),
+         A("--out", type=Path, required=True, help="output stem (.csv, .md, .tex)"),
+         A("--protocol", action="append",
+           help="keep only these verdict groups (e.g. mtst); repeatable")),
     Verb("report", cmd_report,
          "write reports/<run>/index.md, index.html and the verdict table from the "
          "report folder's tables and figures",
