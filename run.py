@@ -207,7 +207,7 @@ def sensitivity(rest: list[str], env: dict) -> int:
         rc = subprocess.call(cmd, env=env)
         if rc:
             return rc
-    steps = [[str(PY), "-m", "gaitval.tables.sensitivity", "reports/default",
+    steps = [[str(PY), "-m", "gaitval", "sensitivity", "reports/default",
               *[f"reports/{s}" for s in SENSITIVITY_STUDIES],
               "--out", "reports/default/tables/sensitivity"],
              [str(PY), "-m", "gaitval", "report", "--reports-dir", "reports/default",

@@ -3,13 +3,12 @@
 Trial sheets come from collaborators and a reviewer runs them.  Before issue 33, rule
 ``mtst_track`` put ``{input.sensor}`` (the sheet's ``sensor_file`` for a trial without
 mocap) into its command unquoted, and a sheet naming ``lrs/y$(id>PWNED2).scan.parquet`` ran
-``id`` in the job's shell.  Since issue 38 the per-trial rules pass each value as one
-argument of a gaitval verb (``run:`` blocks, gaitval.jobs.batch: no shell at all);
-the remaining ``shell:`` rules quote.  Here:
+``id`` in the job's shell.  Every rule's ``shell:`` command quotes each value it
+interpolates, and a stage verb passes each trial's value as one argument of a gaitval verb
+(gaitval.jobs.stages, gaitval.jobs.batch: no shell at all).  Here:
 
 * every value interpolated into every rule's ``shell:`` command carries Snakemake's ``:q``
-  (static check of the rule files; ``{params.gv}`` is the command itself, quoted where it
-  is built), and no ``run:`` block starts a shell or a subprocess;
+  (static check of the rule files), and no ``run:`` block starts a shell or a subprocess;
 * a real run of an annotations-only MTST study whose file names hold spaces, quotes,
   ``$()``, backticks and ``;`` succeeds, runs none of the embedded commands, and its job
   log's command for the trial (``$ gaitval mtst-track ...``, quoted for a shell) splits
@@ -57,7 +56,7 @@ def test_every_interpolated_value_of_every_rule_is_quoted():
             fields = re.findall(r"\{([^{}]+)\}", cmd)
             commands += bool(fields)
             for field in fields:
-                assert field == "params.gv" or field.endswith(":q"), \
+                assert field.endswith(":q"), \
                     f"{path.name}: {{{field}}} reaches the shell unquoted in {cmd[:80]}..."
     assert directives >= 1 and commands == directives    # every command was read
 

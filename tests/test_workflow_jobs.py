@@ -1,6 +1,6 @@
-"""How the workflow runs its jobs (issue 38): one job per (study, stage[, method]) whose
-`run:` block runs each trial's gaitval verbs in a process pool of the rule's threads
-(gaitval.jobs.batch).  Here, on the tiny study's ingest (one job for its trials), one
+"""How the workflow runs its jobs: one job per (study, stage[, method]) whose stage verb
+(gaitval.jobs.stages) runs each trial's gaitval verbs in a process pool of the rule's
+threads (gaitval.jobs.batch).  Here, on the tiny study's ingest (one job for its trials), one
 trial with its C3D file overwritten by junk: the job fails with one message naming the
 file, the trial and the problem, its log holds every trial's messages and the command
 that reruns each by hand, and its outputs are removed."""
@@ -19,7 +19,8 @@ import pandas as pd
 import pytest
 
 from gaitval.errors import GaitvalError
-from gaitval.jobs.batch import BatchError, Task, by_size, run_batch, run_verbs
+from gaitval.cli import run_verbs
+from gaitval.jobs.batch import BatchError, Task, by_size, run_batch
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = Path(sys.executable).parent / "snakemake"

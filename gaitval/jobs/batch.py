@@ -23,12 +23,10 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import contextlib
-import copy
 import io
 import logging
 import multiprocessing
 import os
-import shlex
 import sys
 import time
 import traceback
@@ -122,29 +120,11 @@ class VerbFailed(GaitvalError):
     """A verb of :func:`run_verbs` exited with a non-zero status (its message printed)."""
 
 
-def run_verbs(argvs: list[list[str]]) -> None:
-    """A task: gaitval verbs one after the other, each as ``gaitval ARGV`` on the command
-    line would run it (:func:`gaitval.cli.main`'s parser and exit codes); the first that
-    fails stops the task.  Each verb's command line goes to the log first (``$ gaitval
-    ...``, quoted as a shell would need it): the same step, by hand."""
-    from gaitval.cli import parser
-    from gaitval.cli_exit import run_verb
-
-    saved = sys.argv
-    try:
-        for argv in argvs:
-            sys.argv = ["gaitval", *argv]        # what a table's provenance records
-            print(f"$ {shlex.join(sys.argv)}", flush=True)   # the same step by hand
-            args = copy.deepcopy(parser().parse_args(list(argv)))
-            rc = run_verb(args.func, args)
-            if rc:
-                raise VerbFailed(f"gaitval {argv[0]} exited with status {rc}")
-    finally:
-        sys.argv = saved
-
-
-def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None) -> None:
-    """Run every task, ``processes`` at a time, each in a worker process.
+def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None,
+              fork: bool = False) -> None:
+    """Run every task, ``processes`` at a time, each in a worker process: forked from the
+    preloaded forkserver (:func:`warm`), or with ``fork`` from this process itself (a
+    stage verb, :mod:`gaitval.jobs.stages`, which imports what its trials need first).
 
     The log (``log``) starts with the task count, the wall time and the tasks' CPU, then
     gives each task's output under a ``== <label>`` line, by label, ending with its CPU
@@ -167,7 +147,8 @@ def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None) 
     # each worker dies with this process (a Snakemake killed alone): gaitval/jobs/lifeline.py
     from gaitval.jobs.lifeline import pool_worker
 
-    with cf.ProcessPoolExecutor(max_workers=processes, mp_context=_context(),
+    ctx = multiprocessing.get_context("fork") if fork else _context()
+    with cf.ProcessPoolExecutor(max_workers=processes, mp_context=ctx,
                                 initializer=pool_worker, initargs=(os.getpid(),)) as pool:
         futures = {pool.submit(_call, t.func, t.kwargs): i for i, t in enumerate(tasks)}
         for fut in cf.as_completed(futures):

@@ -21,7 +21,6 @@ the step stamps what it wrote (``provenance/<protocol>_paper_figures.json``).
 """
 from __future__ import annotations
 
-import argparse
 import functools
 from pathlib import Path
 
@@ -210,30 +209,3 @@ def not_produced(path: Path, stem: str, study: str) -> Path:
             "situation\n(no tracked trial of the methods it compares, or no contact near a "
             "target)", ha="center", va="center", fontsize=9, wrap=True)
     return save_figure(fig, path)
-
-
-def add_paper_figure_verbs(sub) -> None:
-    """``paper-figures`` (for gaitval.cli)."""
-    def run(a: argparse.Namespace) -> int:
-        paper_figures_step(a.protocol, a.results, a.figures_dir, a.reports_dir,
-                           a.config_hash, a.config, a.sheet, a.subjects)
-        return 0
-
-    s = sub.add_parser("paper-figures", help="the papers' example figures of one protocol "
-                       "(Yorozu et al. 2015a Figs. 12-13, Yorozu et al. 2015b Figs. 6a, 8, 9, Chalvatzaki et al. 2017 Fig. 5, "
-                       "Qi et al. 2014 Figs. 2-4) from a run's results")
-    s.add_argument("protocol", choices=PROTOCOLS, help="which paper's figures: "
-                   + ", ".join(PROTOCOLS))
-    s.add_argument("--results", nargs="+", required=True, metavar="DIR",
-                   help="results/<study> folders; the first with the protocol's results "
-                   "is drawn")
-    s.add_argument("--config", default=None,
-                   help="a study config view (mtst: the mtst section; ultrasonic: its "
-                   "strides and symmetry window)")
-    s.add_argument("--sheet", default=None, help="the study's trial sheet (with --subjects: "
-                   "the leg widths of the TUG and MTST snapshots' observations)")
-    s.add_argument("--subjects", default=None, help="the study's subject table")
-    s.add_argument("--figures-dir", required=True, help="where the PNGs go")
-    s.add_argument("--reports-dir", default="reports", help="the report folder (provenance)")
-    s.add_argument("--config-hash", default="", help="recorded in the provenance")
-    s.set_defaults(func=run)

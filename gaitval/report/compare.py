@@ -20,7 +20,6 @@ table agrees, 1 otherwise.
 """
 from __future__ import annotations
 
-import argparse
 import fnmatch
 import math
 import re
@@ -172,22 +171,7 @@ def format_report(diffs: list[TableDiff], rtol: float, max_lines: int = 3) -> st
     return "\n".join(lines)
 
 
-def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("a", type=Path, metavar="A", help="a report folder, e.g. reports/default "
-                   "(its tables/*.csv and verdicts.csv), or its tables/ folder")
-    p.add_argument("b", type=Path, metavar="B", help="the report folder to compare it with")
-    p.add_argument("--rtol", type=float, default=1e-9, help="relative tolerance of numbers "
-                   "(default 1e-9)")
-    p.add_argument("--atol", type=float, default=0.0, help="absolute tolerance of numbers, "
-                   "in the column's unit (default 0)")
-    p.add_argument("--strict-digits", action="store_true",
-                   help="a difference of one unit in the last printed digit fails too")
-    p.add_argument("--ignore", action="append", default=[], metavar="GLOB",
-                   help="relative paths to leave out, e.g. 'tables/sensitivity.csv' "
-                   "(repeatable)")
-
-
-def run(args: argparse.Namespace) -> int:
+def run(args) -> int:
     """The verb: prints :func:`format_report`; 0 when every table agrees, else 1."""
     diffs = compare_folders(args.a, args.b, rtol=args.rtol, atol=args.atol,
                             last_digit=not args.strict_digits, ignore=args.ignore)

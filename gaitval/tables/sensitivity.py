@@ -11,7 +11,7 @@ unstated choice is reported as such, not as a finding about the methods.
 
 Usage::
 
-    python -m gaitval.tables.sensitivity reports/default reports/mtst_sensor_beside \\
+    gaitval sensitivity reports/default reports/mtst_sensor_beside \\
         reports/mtst_attendant_left reports/tug_sit_turn_right \\
         --out reports/default/tables/sensitivity
 
@@ -19,7 +19,6 @@ Usage::
 """
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 import pandas as pd
@@ -94,21 +93,3 @@ def write_sensitivity(reports: list[Path], out_stem: Path, names: list[str] | No
              "A verdict that flips depends on an unstated choice of the set-up: it is not "
              "evidence for or against a method."]
     return write_table(df, out_stem, caption=caption, notes=notes)
-
-
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("reports", nargs="+", type=Path, help="report folders; the first is the "
-                                                          "reference")
-    ap.add_argument("--out", type=Path, required=True, help="output stem")
-    ap.add_argument("--protocol", action="append", default=None,
-                    help="keep only these verdict groups (e.g. mtst); repeatable")
-    a = ap.parse_args(argv)
-    for p in write_sensitivity(a.reports, a.out,
-                               protocols=tuple(a.protocol) if a.protocol else None):
-        print(p)
-    return 0
-
-
-if __name__ == "__main__":                                    # pragma: no cover
-    raise SystemExit(main())

@@ -1,7 +1,6 @@
 # Shared by all rule files -- config validation, paths, the trial sheet, provenance.
 import re
 import json
-import shlex
 import sys
 from pathlib import Path
 
@@ -22,178 +21,7 @@ from gaitval.pipeline.steps.declarations import EXTERNAL_PROTOCOLS
 from gaitval.tables.tug_evidence import method_reading
 
 
-def _load_config_file(path):
-    """A YAML (or JSON) config file as a dict; a file that is no mapping is refused."""
-    with open(path, encoding="utf-8") as fh:
-        doc = yaml.safe_load(fh)
-    if doc is None:
-        return {}
-    if not isinstance(doc, dict):
-        raise ConfigError(f"[file {display_path(Path(path))}] a config file holds keys at "
-                          f"its top level, not a {type(doc).__name__}")
-    return doc
-
-
-def _cli_configfiles():
-    """The --configfile paths as Snakemake holds them (absolute; its ConfigSettings)."""
-    return list(workflow.config_settings.configfiles)
-
-
-def _cli_config():
-    """--config as Snakemake parsed it (Snakemake's ConfigSettings.config)."""
-    return dict(workflow.config_settings.config or {})
-
-
-def _config_layers():
-    """(name, dict) of every config source, lowest precedence first: the Snakefile's
-    configfile, each --configfile, then --config (so a problem names where its key is)."""
-    cli = [Path(f).resolve() for f in _cli_configfiles()]
-    files = [Path(f).resolve() for f in workflow.configfiles]
-    files = [f for f in files if f not in cli] + cli
-    layers = [(display_path(f), _load_config_file(f)) for f in files if f.is_file()]
-    return layers + [("--config", _command_line_config())]
-
-
-def _command_line_config():
-    """--config as Snakemake parsed it, its nested scalars typed as in a config file
-    (gaitval.configcheck.retype_command_line: {"pf_seed": "2018"} -> {"pf_seed": 2018})."""
-    return retype_command_line(_cli_config())
-
-
-def _method_definitions(cfg):
-    """Every method an override may name: the built-in ones, tracking.methods, and the
-    TUG reading variants <method>_<reading> (made from their base, _reading_variants)."""
-    defs = {m: m for m in METHODS}
-    defs.update((cfg.get("tracking") or {}).get("methods") or {})
-    for m in (cfg.get("tug") or {}).get("methods") or []:
-        for r in (cfg.get("tug") or {}).get("phase_readings") or []:
-            defs.setdefault(f"{m}_{r}", defs.get(m, m))
-    return defs
-
-
-def _check_study_files(schema):
-    """study.yaml of each study in `run` whose trial sheet is already there (a simulated
-    study's is checked again when its config is built, rule study_config), its
-    tracking.overrides too."""
-    for study in config["run"]:
-        entry = config["studies"].get(study) or {}
-        sheet = Path(entry.get("trial_sheet") or Path(DATA) / study / "trials.csv")
-        cal = sheet.parent / "study.yaml"
-        # external.yaml beside it (external methods and detectors; never written by gaitval)
-        from gaitval.pipeline.steps.declarations import study_side_problems
-        study_side_problems(sheet, schema=schema)
-        if cal.is_file():
-            own = _load_config_file(cal)
-            check_study_file(own, cal, schema=schema)
-            merged = {k: {**(config.get(k) or {}), **((own or {}).get(k) or {})}
-                      for k in ("tracking", "tug")}
-            raise_problems(with_sources(
-                override_problems((own.get("tracking") or {}).get("overrides"),
-                                  _method_definitions(merged)),
-                [(display_path(cal), own)]))
-
-
-def _sheet_of(cfg, study):
-    entry = cfg["studies"].get(study) or {}
-    return Path(entry.get("trial_sheet") or Path(DATA) / study / "trials.csv")
-
-
-#: gaitval's ultrasonic UKF as a system of the treadmill agreement table (external.smk)
-UKF_SYSTEM = "ultrasonic_ukf"
-
-
-def _check_external(cfg):
-    """External methods (issue 37): tracking.external of the workflow config (every study
-    of run) and external_methods: of each study's study.yaml (gaitval.pipeline.steps.
-    declarations.external_declarations): a name that is not already a method, the same
-    names in every study of run, and every trial's file there, inside the study's folder,
-    before any job runs.  tracking.external in a study.yaml is refused (external_methods:
-    is the key).  Returns {study: {method: entry}}."""
-    from gaitval.pipeline.steps.declarations import external_declarations, missing_external_files
-
-    names = _method_definitions(cfg)
-    names.update(dict.fromkeys((cfg.get("tug") or {}).get("methods") or []))
-    names.update(dict.fromkeys((cfg.get("mtst") or {}).get("methods") or []))
-    names[UKF_SYSTEM] = None          # gaitval's own row of the treadmill agreement table
-    config_external = (cfg.get("tracking") or {}).get("external") or {}
-    for m in config_external:
-        if m in names:
-            raise ConfigError(f"tracking.external.{m}: {m!r} is already a tracking method; "
-                              "give the external tracker another name")
-    sheets = {study: _sheet_of(cfg, study) for study in cfg["run"]}
-    for study, sheet in sheets.items():
-        cal = sheet.parent / "study.yaml"
-        if cal.is_file() and ((_load_config_file(cal) or {}).get("tracking") or {}).get(
-                "external"):
-            raise ConfigError(f"[file {display_path(cal)}] tracking.external: a study "
-                              "declares its external methods under external_methods: "
-                              "(tracking.external is declared in the workflow config, a "
-                              "--configfile; docs/formats.md, Leg tracks)")
-    per_study = external_declarations(config_external, sheets, names)
-    for study, entries in per_study.items():
-        where = declared_in(sheets[study], "external_methods")
-        for m, entry in entries.items():
-            src = ("tracking.external" if m in config_external else
-                   f"[file {where[m]}] external_methods")
-            missing_external_files(sheets[study], {m: entry}, f"study {study}: {src}",
-                                   key=None if m in config_external else "external_methods")
-    return per_study
-
-
-def _check_detections(cfg, per_study_methods):
-    """External leg detectors (issue 37): external_detections: of each study's study.yaml
-    or external.yaml, checked as _check_external checks the external methods (a name that
-    is no method nor external method, the same names in every study of run, every trial's
-    file there and inside the study's folder) and each bag's LegArray topic, before any
-    job runs.  Returns {study: {detector: entry}}."""
-    from gaitval.pipeline.steps.declarations import (DETECTION_PROTOCOLS, detection_topic_problems,
-                                                     external_declarations, missing_external_files)
-
-    names = _method_definitions(cfg)
-    names.update(dict.fromkeys((cfg.get("tug") or {}).get("methods") or []))
-    names.update(dict.fromkeys((cfg.get("mtst") or {}).get("methods") or []))
-    for entries in per_study_methods.values():
-        names.update(dict.fromkeys(entries))
-    sheets = {study: _sheet_of(cfg, study) for study in cfg["run"]}
-    per_study = external_declarations({}, sheets, names, key="external_detections",
-                                      protocols=DETECTION_PROTOCOLS)
-    for study, entries in per_study.items():
-        where = declared_in(sheets[study], "external_detections")
-        for m, entry in entries.items():
-            src = f"study {study}: [file {where[m]}] external_detections"
-            missing_external_files(sheets[study], {m: entry}, src,
-                                   protocols=DETECTION_PROTOCOLS, what="detection files",
-                                   key="external_detections", mocap_only=True)
-            detection_topic_problems(sheets[study], {m: entry}, src)
-    return per_study
-
-
-def declared_in(sheet, key):
-    """name -> the file (study.yaml or external.yaml beside the sheet) declaring it."""
-    from gaitval.pipeline.steps.declarations import declared_entries
-
-    return {m: display_path(f) for m, (_, f) in declared_entries(sheet, key).items()}
-
-
-DATA = config.get("data_dir", "data")
-# Numbers nested in a --config value as numbers (Snakemake leaves them strings).
-update_config(config, _command_line_config())
-# Every key against workflow/schemas/config.schema.yaml, then the studies' study.yaml: a
-# typo stops the run here with the file, the key's path and the nearest valid key
-# (gaitval.configcheck), as one message.
-try:
-    _SCHEMA = load_schema(Path(workflow.basedir) / "workflow/schemas/config.schema.yaml")
-    check_config(config, _config_layers(), schema=_SCHEMA)
-    raise_problems(with_sources(run_problems(config), _config_layers()))   # run: [studies]
-    # tracking.overrides: each key a role and parameter of its method (gaitval.methods)
-    raise_problems(with_sources(
-        override_problems((config.get("tracking") or {}).get("overrides"),
-                          _method_definitions(config)), _config_layers()))
-    _check_study_files(_SCHEMA)
-    _EXTERNAL = _check_external(config)
-    _DETECTIONS = _check_detections(config, _EXTERNAL)
-except ConfigError as exc:
-    sys.exit(f"ConfigError: {exc}")
+include: "config_common.smk"
 
 RESULTS = config.get("results_dir", "results")
 PRESETS = Path(workflow.basedir) / "config" / "studies"
@@ -204,16 +32,26 @@ PRESETS = Path(workflow.basedir) / "config" / "studies"
 RUN_NAME = "+".join(config["run"])
 REPORTS_ROOT = config.get("reports_dir", "reports")
 REPORTS = f"{REPORTS_ROOT}/{RUN_NAME}"
-# HOW JOBS RUN (issue 38; docs/speed.md).  One Snakemake job per (study, stage) or
-# (study, stage, method), not per trial: its `run:` block hands the trials to
-# gaitval.jobs.batch.run_batch, which runs each trial's gaitval verbs (the CLI's, with
-# the same arguments as `python -m gaitval VERB ...` by hand) in a process pool of the
-# rule's `threads`, forked from the standard library's forkserver that imported numpy,
-# pandas, scipy and gaitval once.  Every trial still writes its own files, in the same
-# places; a job's outputs are the stage's folders (`directory()`), and its log lists every
-# trial's messages.  The simulation runs through Snakemake's `shell:`, with GV, the
-# interpreter running Snakemake (so a venv's bin/ need not be on PATH).
-GV = f"{shlex.quote(sys.executable)} -m gaitval"   # a checkout path with a space
+# HOW JOBS RUN (docs/architecture.md, "How a job runs").  One Snakemake job per (study,
+# stage) or (study, stage, method), not per trial: its `shell:` command is one gaitval verb
+# (`gaitval track-trials ...`, gaitval.jobs.stages) that runs each trial's per-trial verbs
+# in a process pool of the rule's `threads` and writes each trial's own files below the
+# job's `directory()` outputs; its log lists every trial's command and messages.  A job's
+# `python` is the one running Snakemake (its folder first on PATH: a venv need not be
+# activated); with --software-deployment-method conda, the rule's environment's own
+# (activated before the command).
+import os as _os
+
+from snakemake import __version__ as _SNAKEMAKE_VERSION
+
+_os.environ.update(PATH=_os.pathsep.join([str(Path(sys.executable).parent),
+                                          _os.environ.get("PATH", "")]))
+# Every rule's software environment: the locked dependencies and gaitval itself.  Snakemake
+# 8 asks conda for a job's environment when it reports a failed job (`conda info`, even
+# without --software-deployment-method conda; jobs.Job.get_log_error_info), which fails
+# where conda is absent, so under Snakemake 8 the rules declare none; Snakemake 9 asks only
+# with that option.
+CONDA_ENV = "../envs/gaitval.yaml" if int(_SNAKEMAKE_VERSION.split(".")[0]) >= 9 else None
 
 
 def batch_threads():
@@ -239,26 +77,13 @@ if workflow.is_main_process and not {"-n", "--dry-run", "--dryrun"} & set(sys.ar
         print(f"gaitval: removed {len(_removed)} output(s) an interrupted run left "
               f"unfinished; their jobs run again: {', '.join(_removed[:6])}"
               + (", ..." if len(_removed) > 6 else ""), file=sys.stderr)
-# The jobs' processes end with this Snakemake (gaitval/jobs/lifeline.py): a shell job's
-# `python -m gaitval` watches this pid, as the batch pool's workers do.
-import os as _os
-
+# The jobs' processes end with this Snakemake (gaitval/jobs/lifeline.py): a job's `gaitval`
+# verb and its pool's workers watch this pid.
 _os.environ.update(GAITVAL_RUN_PID=str(_os.getpid()))
 
 
-# The batch jobs' pool: its forkserver imports numpy, pandas, scipy and gaitval (~2 CPU-s)
-# once per run.  Started when Snakemake begins to run jobs (not on a dry run, nor when
-# nothing is to be done), it imports beside the first jobs (the simulation's own start-up
-# leaves a core free) instead of inside the first batch job with one core idle
-# (docs/speed.md).  Only where the jobs run in this process: on a cluster each job is a
-# process of its own (Snakemake's `local_exec`, False for a cluster executor).
-onstart:
-    if getattr(workflow, "local_exec", True):
-        from gaitval.jobs.batch import warm
-
-        warm()
-
-
+# verb, run_trials, run_verb_job: for the rules whose trials still run inside Snakemake's
+# own process (`run:` blocks: the legbench rules); every other rule is one `gaitval` verb.
 def verb(*words):
     """One gaitval verb's command line, as a list of words (nested lists flattened, so an
     optional ``[flag, value]`` param goes in as is)."""
@@ -277,7 +102,8 @@ def run_trials(tasks, threads, log, sizes=None, outdirs=()):
     outputs, made first (a batch of no trial still leaves its folder).  A job killed
     half-way leaves them marked incomplete by Snakemake, and the next run removes and
     redoes them (gaitval.jobs.resume)."""
-    from gaitval.jobs.batch import Task, by_size, run_batch, run_verbs
+    from gaitval.cli import run_verbs
+    from gaitval.jobs.batch import Task, by_size, run_batch
 
     for d in outdirs:
         Path(d).mkdir(parents=True, exist_ok=True)
@@ -290,6 +116,18 @@ def run_trials(tasks, threads, log, sizes=None, outdirs=()):
 def run_verb_job(argv, log):
     """A job of one verb (a table, the report): in one process of the pool."""
     run_trials([(argv[0], [argv])], 1, log)
+
+
+def first_or_empty(name):
+    """Param function: input `name`'s first path, or "" when the job has none (an
+    optional folder, e.g. the shared detections)."""
+
+    def first(wildcards, input):
+        paths = getattr(input, name, None) or []
+        paths = [paths] if isinstance(paths, str) else list(paths)
+        return paths[0] if paths else ""
+
+    return first
 
 
 def size_of(path):
@@ -383,28 +221,10 @@ def config_view_in(scope):
     return view_in_scope
 
 
-# PRIORITIES.  Snakemake starts ready jobs by priority (default 0), not by how much waits
-# on them.  The default report's critical path (benchmarks/report_end_to_end.py, the run's
-# Snakemake log) was the ultrasonic chain: the noise identification (one ~30 CPU-s job)
-# started only when every other trial was done, then its 30 tracks, gait parameters and
-# tables ran alone for ~90 s; the rollator PF likewise waited for its trained models.  So:
-# ultrasonic_noise and rollator_train 100, ultrasonic_track (with the gait parameters) 50,
-# ingest, register and detect (everything's inputs) 20.  The tables are one process each
-# (tug 2.4, mtst 2.3, rollator 1.1, ultrasonic 5.8 CPU-s), and a batch job takes every
-# core, so a table started while batch jobs wait ran with the other core idle (~7 core-s
-# in a default run, benchmarks/batch_tails.py and the run's Snakemake log); at -10 they
-# wait until no batch job is left and then run two at a time, ultrasonic_tables (-5, the
-# longest) beside the three others in turn: 5.8 against 5.8 CPU-s.  registration_summary
-# (0.1 s) is at -10 too: at 0 it started, for its large input, as soon as the last MTST
-# track ended, on one core, a table took the other, and the TUG tracks, which need both,
-# waited 4.6 s (the run's Snakemake log, issue 38).
-# config_view 200: the views take milliseconds each, but at priority 0 they ran only when
-# a core was free of batch jobs, so the jobs that read them waited -- the ultrasonic chain
-# (noise 100, tracks 50) started only after every MTST track, and its table then ran alone
-# with a core idle (benchmarks/report_end_to_end.py, the run's Snakemake log).  (With the
-# per-trial jobs of before issue 38 the same priority made every registration ready at
-# once and cost Snakemake ~5 CPU-s of scheduling rounds; with ~50 jobs it costs nothing.)
-# Order only: same jobs, same files.
+# PRIORITIES (a rule's `priority:`) only order ready jobs, never change a file: what reads
+# everything first (ingest, register, detect 20; the config views 200), the long chains
+# early (ultrasonic_noise, rollator_train 100; ultrasonic_track 50), the one-process
+# tables last (-10; ultrasonic_tables -5).  Measured reasons: docs/speed.md.
 
 # Rule files add functions study -> [report items] here; rule `report` collects them.
 REPORT_ITEM_FUNCS = []
@@ -516,6 +336,11 @@ def trial_bytes(study, trial):
     starts the largest trials first)."""
     row = trial_row(study, trial)
     return sum(size_of(p) for p in (row["mocap_path"], row["sensor_path"]) if p)
+
+
+def trial_sizes(study, trials):
+    """trial_bytes of each trial: a stage verb's --sizes."""
+    return [trial_bytes(study, t) for t in trials]
 
 
 def report_items(wildcards):

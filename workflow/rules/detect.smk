@@ -27,16 +27,16 @@ rule detect:
         spec=detector_spec_json,
         subjects=lambda w: subjects_path(w.study),
         trials=lambda w: trial_ids(w.study, [w.family]),
+        sensors=lambda w: [detect_sensor(w.study, w.family, t)
+                           for t in trial_ids(w.study, [w.family])],
+        sizes=lambda w, input: [size_of(detect_sensor(w.study, w.family, t))
+                                for t in trial_ids(w.study, [w.family])],
     log:
         "logs/detect/{study}/{family}/{detector}.log",
-    run:
-        sensors = [detect_sensor(wildcards.study, wildcards.family, t) for t in params.trials]
-        run_trials(
-            [(t, [verb("detect" if wildcards.family == "tug" else "mtst-detect",
-                       "--sensor", sensor, "--sheet", input.sheet,
-                       "--subjects", params.subjects, "--trial", t,
-                       "--detector", params.spec, "--config", input.view,
-                       "--out", f"{output[0]}/{t}.parquet")])
-             for t, sensor in zip(params.trials, sensors)],
-            threads, log[0], outdirs=output, sizes=[size_of(s) for s in sensors],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval detect-trials --family {wildcards.family:q} --trials {params.trials:q}"
+        " --sensors {params.sensors:q} --sizes {params.sizes:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --detector {params.spec:q}"
+        " --config {input.view:q} --out {output:q} --threads {threads:q} --log {log:q}"

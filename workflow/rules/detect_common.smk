@@ -38,14 +38,6 @@ def detections_dir(family):
     return shared_detections
 
 
-def detections_arg(input, trial):
-    """``--detections <folder>/<trial>.parquet`` of a track verb, when its job reads a
-    detect job's folder (input ``detections``)."""
-    folders = getattr(input, "detections", None) or []
-    folders = [folders] if isinstance(folders, str) else list(folders)
-    return ["--detections", f"{folders[0]}/{trial}.parquet"] if folders else []
-
-
 def detect_inputs(wildcards):
     """What a detect job reads: the sheet, the family's study view (leg width default, scan
     period), the ingest folder, and an MTST trial's raw scan log when it has no mocap."""

@@ -26,23 +26,14 @@ rule rollator_track_external:
         trials=lambda w: trial_ids(w.study, ["rollator"]),
     log:
         "logs/rollator_track/{study}/{method}.log",
-    run:
-        run_trials(
-            [(t, [verb("import-tracks", "--tracks", tracks,
-                       "--sensor", f"{input.ingest}/{t}/sensor.parquet",
-                       "--registration", f"{input.register}/{t}/registration.json",
-                       "--trial", t, "--method", wildcards.method, "--config", input.config,
-                       "--moving-sensor", "--out", f"{output[0]}/{t}.track.parquet"),
-                  verb("rollator-evaluate", "--track", f"{output[0]}/{t}.track.parquet",
-                       "--groundtruth", f"{input.register}/{t}/groundtruth.parquet",
-                       "--registration", f"{input.register}/{t}/registration.json",
-                       "--ingest", f"{input.ingest}/{t}", "--sheet", input.sheet,
-                       "--subjects", params.subjects, "--trial", t,
-                       "--method", wildcards.method, "--config", input.config,
-                       "--out", f"{output[0]}/{t}")])
-             for t, tracks in zip(params.trials, input.tracks)],
-            threads, log[0], outdirs=output,
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval rollator-import-trials --trials {params.trials:q} --files {input.tracks:q}"
+        " --ingest {input.ingest:q} --register {input.register:q}"
+        " --sheet {input.sheet:q} --subjects {params.subjects:q}"
+        " --config {input.config:q} --method {wildcards.method:q}"
+        " --out {output:q} --threads {threads:q} --log {log:q}"
 
 
 # External leg detectors (external_detections: of a study's study.yaml or external.yaml,
@@ -71,22 +62,19 @@ rule leg_detections:
         trials=lambda w: detection_trials(w.study, w.detector),
         entry=lambda w: json.dumps(_DETECTIONS[w.study][w.detector], sort_keys=True),
         topic=lambda w: _DETECTIONS[w.study][w.detector].get("topic") or "",
+        trial_ids=lambda w: [t for t, _ in detection_trials(w.study, w.detector)],
+        protocols=lambda w: [p for _, p in detection_trials(w.study, w.detector)],
+        register=lambda w: f"{RESULTS}/{w.study}/register",
     log:
         "logs/leg_detections/{study}/{detector}.log",
-    run:
-        reg = f"{RESULTS}/{wildcards.study}/register"
-        run_trials(
-            [(t, [verb("leg-detections", "--detections", f,
-                       *(["--topic", params.topic] if params.topic else []),
-                       "--groundtruth", f"{reg}/{p}/{t}/groundtruth.parquet",
-                       "--registration", f"{reg}/{p}/{t}/registration.json",
-                       "--sensor", f"{input.ingest}/{t}/sensor.parquet",
-                       "--trial", t, "--method", wildcards.detector, "--protocol", p,
-                       ["--moving-sensor"] if p == "rollator" else [],
-                       "--out", f"{output[0]}/{t}")])
-             for (t, p), f in zip(params.trials, input.files)],
-            threads, log[0], outdirs=output,
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval leg-detections-trials --trials {params.trial_ids:q} --files {input.files:q}"
+        " --protocols {params.protocols:q} --topic={params.topic:q}"
+        " --ingest {input.ingest:q} --register {params.register:q}"
+        " --method {wildcards.detector:q} --out {output:q} --threads {threads:q}"
+        " --log {log:q}"
 
 
 rule detections_table:
@@ -110,12 +98,11 @@ rule detections_table:
     priority: -10  # after the jobs it pools, beside the other tables (PRIORITIES in common.smk)
     log:
         "logs/detections_table.log",
-    run:
-        run_verb_job(
-            verb("leg-detections-table", params.dirs, "--out-stem", params.stem,
-                 "--reports-dir", params.reports, "--config-hash", params.chash),
-            log[0],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval leg-detections-table {params.dirs:q} --out-stem {params.stem:q}"
+        " --reports-dir {params.reports:q} --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(
@@ -147,16 +134,14 @@ rule ultrasonic_external:
         trials=lambda w: trial_ids(w.study, ["treadmill"]),
     log:
         "logs/ultrasonic_external/{study}/{method}.log",
-    run:
-        run_trials(
-            [(t, [verb("external-gait-parameters", "--foot", foot,
-                       "--ingest", f"{input.ingest}/{t}", "--sheet", input.sheet,
-                       "--subjects", params.subjects, "--trial", t,
-                       "--method", wildcards.method, "--config", input.config,
-                       "--out", f"{output[0]}/{t}.parquet")])
-             for t, foot in zip(params.trials, input.feet)],
-            threads, log[0], outdirs=output,
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval external-gait-trials --trials {params.trials:q} --files {input.feet:q}"
+        " --ingest {input.ingest:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --config {input.config:q}"
+        " --method {wildcards.method:q} --out {output:q} --threads {threads:q}"
+        " --log {log:q}"
 
 
 rule method_agreement:
@@ -187,13 +172,12 @@ rule method_agreement:
     priority: -10  # after the jobs it pools, beside the other tables (PRIORITIES in common.smk)
     log:
         "logs/method_agreement.log",
-    run:
-        run_verb_job(
-            verb("method-agreement", params.gait, "--out-stem", params.stem,
-                 "--config", input.config, "--reports-dir", params.reports,
-                 "--config-hash", params.chash),
-            log[0],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval method-agreement {params.gait:q} --out-stem {params.stem:q}"
+        " --config {input.config:q} --reports-dir {params.reports:q}"
+        " --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(

@@ -14,16 +14,15 @@ rule ingest:
     params:
         subjects=lambda w: subjects_path(w.study),
         trials=lambda w: mocap_trial_ids(w.study),
+        sizes=lambda w, input: trial_sizes(w.study, mocap_trial_ids(w.study)),
     log:
         "logs/ingest/{study}.log",
-    run:
-        run_trials(
-            [(t, [verb("ingest", "--sheet", input.sheet, "--subjects", params.subjects,
-                       "--trial", t, "--out", f"{output[0]}/{t}")])
-             for t in params.trials],
-            threads, log[0], outdirs=output,
-            sizes=[trial_bytes(wildcards.study, t) for t in params.trials],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval ingest-trials --trials {params.trials:q} --sizes {params.sizes:q}"
+        " --sheet {input.sheet:q} --subjects {params.subjects:q}"
+        " --out {output:q} --threads {threads:q} --log {log:q}"
 
 
 rule ingest_summary:
@@ -40,18 +39,19 @@ rule ingest_summary:
         tex=f"{REPORTS}/tables/study_ingest_{{study}}.tex",
     params:
         trials=lambda w: mocap_trial_ids(w.study),
+        summaries=lambda w, input: [f"{input[0]}/{t}/ingest.json"
+                                    for t in mocap_trial_ids(w.study)],
         stem=lambda w, output: output.csv[: -len(".csv")],
         reports=parent_of("csv", up=1),
         chash=config_hash_when_run,
     log:
         "logs/ingest_summary/{study}.log",
-    run:
-        run_verb_job(
-            verb("ingest-summary", [f"{input[0]}/{t}/ingest.json" for t in params.trials],
-                 "--study", wildcards.study, "--out-stem", params.stem,
-                 "--reports-dir", params.reports, "--config-hash", params.chash),
-            log[0],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval ingest-summary {params.summaries:q} --study {wildcards.study:q}"
+        " --out-stem {params.stem:q} --reports-dir {params.reports:q}"
+        " --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
 # Ingest reads mocap: a study whose trials all have annotations only has no ingest table.

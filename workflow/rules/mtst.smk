@@ -17,11 +17,22 @@ rule mtst_track:
     params:
         subjects=lambda w: subjects_path(w.study),
         trials=lambda w: trial_ids(w.study, ["mtst"]),
+        sensors=mtst_sensors,
+        mocap=lambda w: [t for t in trial_ids(w.study, ["mtst"]) if has_mocap(w.study, t)],
+        sizes=lambda w, input: [size_of(s) for s in mtst_sensors(w)],
+        detections=first_or_empty("detections"),
+        register=lambda w: register_dir(w.study, "mtst"),
     log:
         "logs/mtst_track/{study}/{method}.log",
-    run:
-        run_trials(mtst_tasks(wildcards, input, output, params), threads, log[0],
-                   outdirs=output, sizes=mtst_sizes(wildcards, params.trials))
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval mtst-trials --trials {params.trials:q} --sensors {params.sensors:q}"
+        " --mocap-trials {params.mocap:q} --sizes {params.sizes:q}"
+        " --register {params.register:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --config {input.config:q}"
+        " --method {wildcards.method:q} --detections={params.detections:q}"
+        " --out {output.track:q} {output.evaluate:q} --threads {threads:q} --log {log:q}"
 
 
 # An external method (tracking.external, issue 37): the other tracker's file of each trial,
@@ -44,11 +55,20 @@ rule mtst_track_external:
     params:
         subjects=lambda w: subjects_path(w.study),
         trials=lambda w: trial_ids(w.study, ["mtst"]),
+        sensors=mtst_sensors,
+        mocap=lambda w: [t for t in trial_ids(w.study, ["mtst"]) if has_mocap(w.study, t)],
+        register=lambda w: register_dir(w.study, "mtst"),
     log:
         "logs/mtst_track/{study}/{method}.log",
-    run:
-        run_trials(mtst_tasks(wildcards, input, output, params, external=True), threads,
-                   log[0], outdirs=output)
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval mtst-trials --trials {params.trials:q} --files {input.tracks:q}"
+        " --sensors {params.sensors:q} --mocap-trials {params.mocap:q}"
+        " --register {params.register:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --config {input.config:q}"
+        " --method {wildcards.method:q}"
+        " --out {output.track:q} {output.evaluate:q} --threads {threads:q} --log {log:q}"
 
 
 rule mtst_tables:
@@ -76,6 +96,7 @@ rule mtst_tables:
     params:
         dirs=lambda w: [str(Path(p).parent) for p in mtst_summaries(w)],
         methods=mtst_methods() + external_methods("mtst"),
+        config=lambda w, input: input.configs[0],
         tables=parent_of("t3"),
         figures=parent_of("fig"),
         reports=parent_of("t3", up=1),
@@ -83,14 +104,13 @@ rule mtst_tables:
     priority: -10  # after every track job, beside the other tables (PRIORITIES in common.smk)
     log:
         "logs/mtst_tables.log",
-    run:
-        run_verb_job(
-            verb("mtst-tables", params.dirs, "--methods", params.methods,
-                 "--config", input.configs[0], "--tables-dir", params.tables,
-                 "--figures-dir", params.figures, "--reports-dir", params.reports,
-                 "--config-hash", params.chash),
-            log[0],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval mtst-tables {params.dirs:q} --methods {params.methods:q}"
+        " --config {params.config:q} --tables-dir {params.tables:q}"
+        " --figures-dir {params.figures:q} --reports-dir {params.reports:q}"
+        " --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(

@@ -90,30 +90,10 @@ def mtst_batch_inputs(wildcards):
     return files
 
 
-def mtst_tasks(wildcards, input, output, params, external=False):
-    """A (study, method) job's tasks: per trial, its tracking (or, for an external method,
-    the conversion of the other tracker's file) and then its evaluation."""
-    tasks = []
-    for i, t in enumerate(params.trials):
-        f = mtst_trial_files(wildcards.study, t)
-        track = f"{output.track}/{t}.parquet"
-        common = ["--sheet", input.sheet, "--subjects", params.subjects, "--trial", t,
-                  "--method", wildcards.method, "--config", input.config, f["reg"]]
-        if external:
-            first = verb("import-tracks", "--tracks", input.tracks[i], "--sensor",
-                         f["sensor"], f["reg"], "--trial", t, "--method", wildcards.method,
-                         "--config", input.config, "--out", track)
-        else:
-            first = verb("mtst-track", "--sensor", f["sensor"], common,
-                         detections_arg(input, t), "--out", track)
-        tasks.append((t, [first, verb("mtst-evaluate", "--track", track, common, f["gt"],
-                                      "--out", f"{output.evaluate}/{t}")]))
-    return tasks
-
-
-def mtst_sizes(wildcards, trials):
-    """Each trial's scan log bytes (a batch starts the largest first)."""
-    return [size_of(mtst_trial_files(wildcards.study, t)["sensor"]) for t in trials]
+def mtst_sensors(wildcards):
+    """Param function: each MTST trial's scan log (ingested, or raw without mocap)."""
+    return [mtst_trial_files(wildcards.study, t)["sensor"]
+            for t in trial_ids(wildcards.study, ["mtst"])]
 
 
 def mtst_summaries(wildcards):

@@ -21,12 +21,11 @@ rule peer_agreement:
         chash=config_hash_when_run,
     log:
         "logs/peer_agreement.log",
-    run:
-        run_verb_job(
-            verb("peer", input[0], "--out-stem", params.stem, "--reports-dir", params.reports,
-                 "--config-hash", params.chash),
-            log[0],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval peer {input:q} --out-stem {params.stem:q} --reports-dir {params.reports:q}"
+        " --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(
@@ -53,12 +52,11 @@ rule agreement_file:
         chash=config_hash_when_run,
     log:
         "logs/agreement_file/{name}.log",
-    run:
-        run_verb_job(
-            verb("peer", input[0], params.opts, "--out-stem", params.stem,
-                 "--reports-dir", params.reports, "--config-hash", params.chash),
-            log[0],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval peer {input:q} {params.opts:q} --out-stem {params.stem:q}"
+        " --reports-dir {params.reports:q} --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(

@@ -73,17 +73,15 @@ rule register:
     params:
         subjects=lambda w: subjects_path(w.study),
         trials=lambda w: family_mocap_trials(w.study, w.family),
+        sizes=lambda w, input: trial_sizes(w.study, family_mocap_trials(w.study, w.family)),
     log:
         "logs/register/{study}/{family}.log",
-    run:
-        run_trials(
-            [(t, [verb("register", "--ingest", f"{input.ingest}/{t}", "--sheet", input.sheet,
-                       "--subjects", params.subjects, "--trial", t,
-                       "--config", input.config, "--out", f"{output[0]}/{t}")])
-             for t in params.trials],
-            threads, log[0], outdirs=output,
-            sizes=[trial_bytes(wildcards.study, t) for t in params.trials],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval register-trials --trials {params.trials:q} --sizes {params.sizes:q}"
+        " --ingest {input.ingest:q} --sheet {input.sheet:q} --subjects {params.subjects:q}"
+        " --config {input.config:q} --out {output:q} --threads {threads:q} --log {log:q}"
 
 
 rule registration_summary:
@@ -111,15 +109,12 @@ rule registration_summary:
     priority: -10
     log:
         "logs/registration_summary/{study}.log",
-    run:
-        run_verb_job(
-            verb("registration-summary",
-                 params.registrations,
-                 "--study", wildcards.study, "--out-csv", output.csv,
-                 "--out-stem", params.stem, "--reports-dir", params.reports,
-                 "--config-hash", params.chash),
-            log[0],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval registration-summary {params.registrations:q} --study {wildcards.study:q}"
+        " --out-csv {output.csv:q} --out-stem {params.stem:q}"
+        " --reports-dir {params.reports:q} --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
 # Registration needs mocap: likewise absent for a study without any.

@@ -63,14 +63,14 @@ rule report:
         studies=list(config["run"]),
     log:
         f"logs/report/{RUN_NAME}.log",
-    run:
-        # no index over a partial report: every item a step's provenance lists is there,
-        # no file of the report is left unfinished by an interrupted job (jobs/resume.py)
-        from gaitval.jobs.resume import refuse_unfinished
-
-        refuse_unfinished(params.reports, own_outputs=list(output))
-        run_verb_job(verb("report", "--reports-dir", params.reports, "--studies",
-                          params.studies), log[0])
+    # no index over a partial report (--complete): every item a step's provenance lists
+    # is there, no file of the report is left unfinished by an interrupted job
+    # (gaitval/jobs/resume.py)
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval report --reports-dir {params.reports:q} --studies {params.studies:q}"
+        " --complete {output:q} > {log:q} 2>&1"
 
 
 include: "report_common.smk"
@@ -86,11 +86,14 @@ rule tug_paper_figures:
         study=lambda w: paper_figure_study("tug"),
         config=lambda w, input: [f for f in input if str(f).endswith(".json")],
         chash=config_hash_when_run,
+        args=paper_figures_args("tug"),
     priority: -10  # after the track jobs, beside the tables (PRIORITIES in common.smk)
     log:
         "logs/paper_figures/tug.log",
-    run:
-        run_verb_job(paper_figures_verb("tug", params, output), log[0])
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval paper-figures {params.args:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(
@@ -109,11 +112,14 @@ rule mtst_paper_figures:
         study=lambda w: paper_figure_study("mtst"),
         config=lambda w, input: [f for f in input if str(f).endswith(".json")],
         chash=config_hash_when_run,
+        args=paper_figures_args("mtst"),
     priority: -10  # after the track jobs, beside the tables (PRIORITIES in common.smk)
     log:
         "logs/paper_figures/mtst.log",
-    run:
-        run_verb_job(paper_figures_verb("mtst", params, output), log[0])
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval paper-figures {params.args:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(
@@ -132,11 +138,14 @@ rule rollator_paper_figures:
         study=lambda w: paper_figure_study("rollator"),
         config=lambda w, input: [f for f in input if str(f).endswith(".json")],
         chash=config_hash_when_run,
+        args=paper_figures_args("rollator"),
     priority: -10  # after the track jobs, beside the tables (PRIORITIES in common.smk)
     log:
         "logs/paper_figures/rollator.log",
-    run:
-        run_verb_job(paper_figures_verb("rollator", params, output), log[0])
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval paper-figures {params.args:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(
@@ -155,11 +164,14 @@ rule ultrasonic_paper_figures:
         study=lambda w: paper_figure_study("ultrasonic"),
         config=lambda w, input: [f for f in input if str(f).endswith(".json")],
         chash=config_hash_when_run,
+        args=paper_figures_args("ultrasonic"),
     priority: -10  # after the track jobs, beside the tables (PRIORITIES in common.smk)
     log:
         "logs/paper_figures/ultrasonic.log",
-    run:
-        run_verb_job(paper_figures_verb("ultrasonic", params, output), log[0])
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval paper-figures {params.args:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(

@@ -48,12 +48,18 @@ def paper_figure_inputs(protocol):
                                                                 rc["pf_method"])]
     return [f"{r}/ultrasonic", f"{r}/config_views/ultrasonic/{STUDY_VIEW}.json"]
 
-def paper_figures_verb(protocol, params, output):
-    """`gaitval paper-figures` of one protocol, for its rule's `run:` block."""
-    study = params.study
-    return verb("paper-figures", protocol, "--results", f"{RESULTS}/{study}",
-                *(["--config", params.config[0]] if params.config else []),
+def paper_figures_args(protocol):
+    """Param function: the arguments of `gaitval paper-figures` of one protocol (its
+    rule's shell command).  It takes `input`, so it is no rerun trigger (the inputs are)."""
+
+    def args(wildcards, input, output):
+        study = paper_figure_study(protocol)
+        config = [f for f in input if str(f).endswith(".json")]
+        return [protocol, "--results", f"{RESULTS}/{study}",
+                *(["--config", config[0]] if config else []),
                 "--sheet", sheet_path(study), "--subjects", subjects_path(study),
                 "--figures-dir", str(Path(output[0]).parent),
                 "--reports-dir", str(Path(output[0]).parents[1]),
-                "--config-hash", params.chash)
+                "--config-hash", CONFIG_HASH]
+
+    return args

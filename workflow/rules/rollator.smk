@@ -28,14 +28,13 @@ rule rollator_train:
         held_out=lambda w: rollator_subjects(w.study),
     log:
         "logs/rollator_train/{study}.log",
-    run:
-        run_trials(
-            [(s, [verb("rollator-train", "--results", params.results, "--sheet", input.sheet,
-                       "--subjects", params.subjects, "--subject", s,
-                       "--config", input.config, "--out", f"{output[0]}/{s}.json")])
-             for s in params.held_out],
-            threads, log[0], outdirs=output,
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval rollator-train-subjects --trials {params.held_out:q}"
+        " --results {params.results:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --config {input.config:q}"
+        " --out {output:q} --threads {threads:q} --log {log:q}"
 
 
 rule rollator_track:
@@ -55,12 +54,19 @@ rule rollator_track:
     params:
         subjects=lambda w: subjects_path(w.study),
         trials=lambda w: trial_ids(w.study, ["rollator"]),
+        models=rollator_trial_models,
+        sizes=lambda w, input: trial_sizes(w.study, trial_ids(w.study, ["rollator"])),
     log:
         "logs/rollator_track/{study}/{method}.log",
-    run:
-        run_trials(rollator_tasks(wildcards, input, output, params), threads, log[0],
-                   outdirs=output,
-                   sizes=[trial_bytes(wildcards.study, t) for t in params.trials])
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval rollator-trials --trials {params.trials:q} --models {params.models:q}"
+        " --sizes {params.sizes:q} --ingest {input.ingest:q}"
+        " --register {input.register:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --config {input.config:q}"
+        " --method {wildcards.method:q} --out {output:q} --threads {threads:q}"
+        " --log {log:q}"
 
 
 rule rollator_tables:
@@ -104,14 +110,13 @@ rule rollator_tables:
     priority: -10  # after every track job, beside the other tables (PRIORITIES in common.smk)
     log:
         "logs/rollator_tables.log",
-    run:
-        run_verb_job(
-            verb("rollator-tables", params.dirs, "--kf", params.kf, "--pf", params.pf,
-                 "--models", params.models, "--config", input.config,
-                 "--tables-dir", params.tables, "--figures-dir", params.figures,
-                 "--reports-dir", params.reports, "--config-hash", params.chash),
-            log[0],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval rollator-tables {params.dirs:q} --kf {params.kf:q} --pf {params.pf:q}"
+        " --models {params.models:q} --config {input.config:q}"
+        " --tables-dir {params.tables:q} --figures-dir {params.figures:q}"
+        " --reports-dir {params.reports:q} --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(

@@ -37,21 +37,8 @@ def rollator_model(w):
     return [f"{RESULTS}/{w.study}/rollator/model/{subject}.json"]
 
 
-def rollator_tasks(wildcards, input, output, params):
-    """A (study, method) job's tasks: per trial, its track (the PF with its held-out
-    subject's model) and then its evaluation."""
-    tasks = []
-    for t in params.trials:
-        model = rollator_model(trial_wildcards(wildcards.study, t, wildcards.method))
-        common = ["--sheet", input.sheet, "--subjects", params.subjects, "--trial", t,
-                  "--method", wildcards.method, "--config", input.config]
-        track = f"{output[0]}/{t}.track.parquet"
-        tasks.append((t, [
-            verb("rollator-track", "--sensor", f"{input.ingest}/{t}/sensor.parquet", common,
-                 ["--model", model[0]] if model else [], "--out", track),
-            verb("rollator-evaluate", "--track", track,
-                 "--groundtruth", f"{input.register}/{t}/groundtruth.parquet",
-                 "--registration", f"{input.register}/{t}/registration.json",
-                 "--ingest", f"{input.ingest}/{t}", common, "--out", f"{output[0]}/{t}"),
-        ]))
-    return tasks
+def rollator_trial_models(w):
+    """Param function: each rollator trial's PF model (its held-out subject's), "-" (none)
+    for a method other than the PF."""
+    return [(rollator_model(trial_wildcards(w.study, t, w.method)) or ["-"])[0]
+            for t in trial_ids(w.study, ["rollator"])]

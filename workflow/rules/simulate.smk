@@ -3,11 +3,6 @@
 # (gaitval/simulate/), so a new twin regenerates the study on the next run instead of
 # leaving a report of the old twin's data under the new code (Snakemake reruns a job whose
 # params changed; a study folder copied without .snakemake/ metadata is taken as it is).
-# No conda: directive (snakemake --lint asks for one): Snakemake 8.30 runs `conda info` for
-# it even without --use-conda, which fails where conda is absent, and the batch rules'
-# run: blocks cannot use conda at all; the software is pinned by requirements.lock,
-# which run.py installs into .venv/ (README, docs/speed.md).
-
 
 checkpoint simulate:
     input:
@@ -17,12 +12,13 @@ checkpoint simulate:
         subjects=f"{DATA}/{{study}}/subjects.csv",
         realism=f"{DATA}/{{study}}/realism.csv",
     params:
-        gv=GV,
         seed=lambda w: study_cfg(w.study)["simulate"].get("seed", 0),
         twin=TWIN,
         out=parent_of("sheet"),
     log:
         "logs/simulate/{study}.log",
+    conda:
+        CONDA_ENV
     shell:
-        "{params.gv} simulate --preset {input.preset:q} --seed {params.seed:q} --out {params.out:q}"
+        "python -m gaitval simulate --preset {input.preset:q} --seed {params.seed:q} --out {params.out:q}"
         " > {log:q} 2>&1 || (cat {log:q} >&2; exit 1)"

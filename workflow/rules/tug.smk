@@ -20,23 +20,18 @@ rule track:
     params:
         subjects=lambda w: subjects_path(w.study),
         trials=lambda w: trial_ids(w.study, ["tug"]),
+        sizes=lambda w, input: trial_sizes(w.study, trial_ids(w.study, ["tug"])),
+        detections=first_or_empty("detections"),
     log:
         "logs/track/{study}/{method}.log",
-    run:
-        run_trials(
-            [(t, [verb("track", "--sensor", f"{input.ingest}/{t}/sensor.parquet",
-                       "--sheet", input.sheet, "--subjects", params.subjects, "--trial", t,
-                       "--method", wildcards.method, "--config", input.config,
-                       detections_arg(input, t), "--out", f"{output.track}/{t}.parquet"),
-                  verb("evaluate-tug", "--track", f"{output.track}/{t}.parquet",
-                       "--groundtruth", f"{input.register}/{t}/groundtruth.parquet",
-                       "--registration", f"{input.register}/{t}/registration.json",
-                       "--trial", t, "--method", wildcards.method, "--config", input.config,
-                       "--out", f"{output.evaluate}/{t}")])
-             for t in params.trials],
-            threads, log[0], outdirs=output,
-            sizes=[trial_bytes(wildcards.study, t) for t in params.trials],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval track-trials --trials {params.trials:q} --sizes {params.sizes:q}"
+        " --ingest {input.ingest:q} --register {input.register:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --config {input.config:q}"
+        " --method {wildcards.method:q} --detections={params.detections:q}"
+        " --out {output.track:q} {output.evaluate:q} --threads {threads:q} --log {log:q}"
 
 
 # An external method (tracking.external, issue 37): the other tracker's file of each trial,
@@ -63,21 +58,13 @@ rule track_external:
         trials=lambda w: trial_ids(w.study, ["tug"]),
     log:
         "logs/track/{study}/{method}.log",
-    run:
-        run_trials(
-            [(t, [verb("import-tracks", "--tracks", tracks,
-                       "--sensor", f"{input.ingest}/{t}/sensor.parquet",
-                       "--registration", f"{input.register}/{t}/registration.json",
-                       "--trial", t, "--method", wildcards.method, "--config", input.config,
-                       "--out", f"{output.track}/{t}.parquet"),
-                  verb("evaluate-tug", "--track", f"{output.track}/{t}.parquet",
-                       "--groundtruth", f"{input.register}/{t}/groundtruth.parquet",
-                       "--registration", f"{input.register}/{t}/registration.json",
-                       "--trial", t, "--method", wildcards.method, "--config", input.config,
-                       "--out", f"{output.evaluate}/{t}")])
-             for t, tracks in zip(params.trials, input.tracks)],
-            threads, log[0], outdirs=output,
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval import-tracks-trials --trials {params.trials:q} --files {input.tracks:q}"
+        " --ingest {input.ingest:q} --register {input.register:q}"
+        " --config {input.config:q} --method {wildcards.method:q}"
+        " --out {output.track:q} {output.evaluate:q} --threads {threads:q} --log {log:q}"
 
 
 rule tug_tables:
@@ -117,14 +104,13 @@ rule tug_tables:
     priority: -10  # after every track job, beside the other tables (PRIORITIES in common.smk)
     log:
         "logs/tug_tables.log",
-    run:
-        run_verb_job(
-            verb("tug-tables", params.dirs, "--methods", params.methods,
-                 "--tables-dir", params.tables, "--figures-dir", params.figures,
-                 "--reports-dir", params.reports, "--config-hash", params.chash,
-                 "--configs", input.configs),
-            log[0],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval tug-tables {params.dirs:q} --methods {params.methods:q}"
+        " --tables-dir {params.tables:q} --figures-dir {params.figures:q}"
+        " --reports-dir {params.reports:q} --config-hash {params.chash:q}"
+        " --configs {input.configs:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(

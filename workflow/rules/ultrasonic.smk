@@ -35,14 +35,12 @@ rule ultrasonic_noise:
         chash=config_hash_when_run,
     log:
         f"logs/ultrasonic_noise/{RUN_NAME}.log",
-    run:
-        run_verb_job(
-            verb("ultrasonic-noise", "--ingest", params.dirs, "--trials", params.trials,
-                 "--config", input.config, "--out", output.noise,
-                 "--table-stem", params.stem, "--reports-dir", params.reports,
-                 "--config-hash", params.chash),
-            log[0],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval ultrasonic-noise --ingest {params.dirs:q} --trials {params.trials:q}"
+        " --config {input.config:q} --out {output.noise:q} --table-stem {params.stem:q}"
+        " --reports-dir {params.reports:q} --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
 rule ultrasonic_track:
@@ -60,21 +58,16 @@ rule ultrasonic_track:
     params:
         subjects=lambda w: subjects_path(w.study),
         trials=lambda w: trial_ids(w.study, ["treadmill"]),
+        sizes=lambda w, input: trial_sizes(w.study, trial_ids(w.study, ["treadmill"])),
     log:
         "logs/ultrasonic_track/{study}.log",
-    run:
-        run_trials(
-            [(t, [verb("ultrasonic-track", "--ingest", f"{input.ingest}/{t}", "--trial", t,
-                       "--config", input.config, "--noise", input.noise,
-                       "--out", f"{output[0]}/track/{t}.parquet"),
-                  verb("gait-parameters", "--track", f"{output[0]}/track/{t}.parquet",
-                       "--ingest", f"{input.ingest}/{t}", "--sheet", input.sheet,
-                       "--subjects", params.subjects, "--trial", t, "--config", input.config,
-                       "--out", f"{output[0]}/gait/{t}.parquet")])
-             for t in params.trials],
-            threads, log[0], outdirs=output,
-            sizes=[trial_bytes(wildcards.study, t) for t in params.trials],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval ultrasonic-trials --trials {params.trials:q} --sizes {params.sizes:q}"
+        " --ingest {input.ingest:q} --noise {input.noise:q} --sheet {input.sheet:q}"
+        " --subjects {params.subjects:q} --config {input.config:q}"
+        " --out {output:q} --threads {threads:q} --log {log:q}"
 
 
 rule ultrasonic_tables:
@@ -107,13 +100,12 @@ rule ultrasonic_tables:
     priority: -5  # the longest table job: the first of the tables (PRIORITIES, common.smk)
     log:
         "logs/ultrasonic_tables.log",
-    run:
-        run_verb_job(
-            verb("ultrasonic-tables", params.gait, "--tables-dir", params.tables,
-                 "--figures-dir", params.figures, "--reports-dir", params.reports,
-                 "--config", input.config, "--config-hash", params.chash),
-            log[0],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval ultrasonic-tables {params.gait:q} --tables-dir {params.tables:q}"
+        " --figures-dir {params.figures:q} --reports-dir {params.reports:q}"
+        " --config {input.config:q} --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(

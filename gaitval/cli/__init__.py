@@ -1,0 +1,74 @@
+"""``gaitval <verb>``: the pipeline's steps by hand, one verb per step.
+
+Run ``gaitval --help`` or ``gaitval <verb> --help``.  Every verb reads files and writes
+files; a data error prints one line ``gaitval: error: ...`` naming the file, the trial and
+the problem, and exits with status 1; a usage error exits with 2
+(:mod:`gaitval.cli_exit`).  ``-v``/``-q`` before or after the verb: more or less progress.
+
+The verbs are one table, :data:`VERBS` (name, handler, help, arguments;
+:class:`gaitval.cli.table.Verb`), gathered from the modules of this package by concern:
+a study's inputs and the report (:mod:`.study`), the laser range sensor studies
+(:mod:`.lrs`), the ultrasonic study (:mod:`.feet`), the MTST and rollator studies
+(:mod:`.mtst_rollator`) and the workflow's jobs (:mod:`.jobs`).  Every verb is dispatched
+the same way: ``handler(args)`` returns the exit code.
+"""
+from __future__ import annotations
+
+import argparse
+import functools
+import sys
+
+from gaitval.cli import feet, jobs, lrs, mtst_rollator, study
+from gaitval.cli.jobs import run_verbs  # noqa: F401  (a batch task: gaitval.cli.run_verbs)
+from gaitval.cli.table import Verb
+
+#: every verb, in pipeline order (the order of ``gaitval --help``)
+VERBS: tuple[Verb, ...] = (study.VERBS + lrs.VERBS + feet.VERBS + mtst_rollator.VERBS
+                           + jobs.STAGE_VERBS + lrs.LEGBENCH + jobs.FIGURES + study.LAST)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``gaitval`` argument parser: one sub-command per entry of :data:`VERBS`."""
+    from gaitval import __version__
+    from gaitval.cli_exit import add_verbosity
+
+    p = argparse.ArgumentParser(
+        prog="gaitval", description=__doc__.splitlines()[0].replace("``", ""),
+        epilog="'gaitval VERB --help': what the verb reads and writes (the paths the "
+               "workflow uses, formats, units, defaults). Exit codes: 0 done, 1 a data "
+               "error, 2 a usage error (README, 'When something goes wrong').")
+    p.add_argument("--version", action="version", version=f"gaitval {__version__}")
+    sub = p.add_subparsers(dest="verb", required=True, metavar="VERB",
+                           title="verbs (in pipeline order)")
+    for verb in VERBS:
+        # `gaitval VERB --help` opens with what the verb does
+        s = sub.add_parser(verb.name, help=verb.help, description=verb.help)
+        for arg in verb.args:
+            s.add_argument(*arg.flags, **arg.options)
+        s.set_defaults(func=verb.handler)
+    add_verbosity(p, sub)
+    return p
+
+
+@functools.cache
+def parser() -> argparse.ArgumentParser:
+    """:func:`build_parser`, built once per process (~12 ms; a batch job's worker runs
+    the verbs of many trials, gaitval.jobs.batch)."""
+    return build_parser()
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run one verb; exit codes 0 ok, 1 data/analysis error, 2 usage (gaitval.cli_exit)."""
+    import copy
+
+    from gaitval.cli_exit import configure_logging, run_verb
+    from gaitval.jobs.lifeline import verb_process
+    verb_process()      # started by a workflow's job: end with its Snakemake (jobs/lifeline.py)
+    # a copy: a verb that changes a default list (--methods ...) leaves the next job's alone
+    args = copy.deepcopy(parser().parse_args(argv))
+    configure_logging(args.verbose, args.quiet)
+    return run_verb(args.func, args)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

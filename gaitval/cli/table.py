@@ -1,0 +1,56 @@
+"""The shape of a verb: name, handler, help and arguments (one entry of a ``VERBS`` table),
+and the help texts several verbs share (the paths are those the workflow passes,
+workflow/rules/)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+
+@dataclass(frozen=True)
+class Arg:
+    """One argument: ``add_argument(*flags, **options)``."""
+
+    flags: tuple[str, ...]
+    options: dict
+
+
+def A(*flags: str, **options) -> Arg:
+    return Arg(flags, options)
+
+
+@dataclass(frozen=True)
+class Verb:
+    """``gaitval NAME``: ``handler(args)`` returns the exit code; ``help`` opens its
+    ``--help`` and is its line in ``gaitval --help``."""
+
+    name: str
+    handler: Callable[..., int]
+    help: str
+    args: tuple[Arg, ...]
+
+    def __init__(self, name, handler, help, *args):
+        object.__setattr__(self, "name", name)
+        object.__setattr__(self, "handler", handler)
+        object.__setattr__(self, "help", help)
+        object.__setattr__(self, "args", args)
+
+
+SHEET = ("the study's trial sheet, trials.csv (data/<study>/trials.csv for a simulated "
+         "study; docs/formats.md, Trial sheet)")
+SUBJECTS = "the study's subject table, subjects.csv (leg width, height; docs/formats.md)"
+TRIAL = "trial id: a row of the trial sheet (named in errors and outputs)"
+REPORTS = ("the report folder (reports/<run> in the workflow): the step's provenance record "
+           "goes to its provenance/ (default: reports)")
+HASH = "the run's config hash, written into the provenance record (default: empty)"
+TABLES = "folder the tables go to, each as .csv, .md, .tex (reports/<run>/tables)"
+FIGURES = "folder the figures go to, PNG (reports/<run>/figures)"
+
+#: the arguments several verbs share
+SHEET_ARG = A("--sheet", required=True, help=SHEET)
+SUBJECTS_ARG = A("--subjects", required=True, help=SUBJECTS)
+TRIAL_ARG = A("--trial", required=True, help=TRIAL)
+REPORTS_ARG = A("--reports-dir", default="reports", help=REPORTS)
+HASH_ARG = A("--config-hash", default="", help=HASH)
+TABLES_ARG = A("--tables-dir", required=True, help=TABLES)
+FIGURES_ARG = A("--figures-dir", required=True, help=FIGURES)
