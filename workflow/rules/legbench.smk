@@ -93,8 +93,10 @@ rule legbench_crowd:
         tables=parent_of("table"),
     log:
         "logs/legbench_crowd.log",
-    run:
-        run_verb_job(verb("legbench-crowd", "--tables-dir", params.tables), log[0])
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval legbench-crowd --tables-dir {params.tables:q} > {log:q} 2>&1"
 
 
 REPORT_ITEM_FUNCS.append(
