@@ -86,6 +86,16 @@ def tiny_workflow(work: Path, *extra: str, snakemake: Path = SNAKEMAKE, targets=
     return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
 
 
+@pytest.fixture(scope="session")
+def replay_simulated(realdata, tmp_path_factory) -> Path:
+    """The replay preset (real walks replayed into a simulated study,
+    ``tests/own_study.py``) generated once per test run; tests build their own studies
+    from it and only read it."""
+    from own_study import replay_study
+
+    return built_once(tmp_path_factory, "replay_simulated", replay_study)
+
+
 def _report_tiny(work: Path, snakemake: Path = SNAKEMAKE) -> None:
     res = tiny_workflow(work, snakemake=snakemake)
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-4000:]
