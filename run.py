@@ -310,7 +310,7 @@ def main(argv: list[str]) -> int:
     elif verb == "test":
         ensure_env("test")
         ensure_pdflatex_on_ci()
-        cmd = [str(PY), "-m", "pytest", *rest]
+        cmd = [str(PY), "-m", "pytest", *xdist_args(rest), *rest]
     else:
         ensure_env("test,bench")
         cmd = [str(PY), *rest]
@@ -327,6 +327,18 @@ def main(argv: list[str]) -> int:
             rc = closing_summary(target, accept_refusals)
     return rc
 
+
+
+def xdist_args(rest: list[str]) -> list[str]:
+    """pytest-xdist's options ``test`` adds: one worker per core, each test file on one
+    worker (a module's fixture, e.g. a workflow run, is built once), unless the arguments
+    choose (``-n``, ``--numprocesses``, ``--dist``, ``-p no:xdist``) or ask for a debugger
+    or a listing, which want one process."""
+    own = ("-n", "--numprocesses", "--dist", "--pdb", "--trace", "--co", "--collect-only",
+           "--setup-plan", "--setup-only", "no:xdist")
+    if any(a in own or a.startswith(("-n", "--numprocesses=", "--dist=")) for a in rest):
+        return []
+    return ["-n", "auto", "--dist", "loadfile"]
 
 #: ``run.py report``'s exit code when the report was built but trials were refused.
 EXIT_REFUSED = 3

@@ -1,7 +1,9 @@
 """Shared fixtures: where the real data lives, and skipping cleanly when it does not; the
-tiny study's workflow run, built once per session and shared read-only."""
+tiny study's workflow run, built once per test run and shared read-only (by every
+pytest-xdist worker too: :func:`built_once`)."""
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import sys
@@ -34,16 +36,39 @@ def repo_root() -> Path:
     return ROOT
 
 
+def built_once(tmp_path_factory, name: str, build) -> Path:
+    """Folder ``name``, made by ``build(folder)`` once per test run and only read after.
+
+    Under pytest-xdist each worker has its own session, so a session fixture would build
+    once per worker: the workers share the run's temporary folder (the parent of each
+    one's own), the first to ask builds there while the others wait on a file lock, and
+    all of them read the same folder.  A build that failed is tried again by the next
+    worker that asks (and fails its tests the same way)."""
+    from filelock import FileLock
+
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent
+    out, done = root / name, root / f"{name}.built"
+    with FileLock(str(root / f"{name}.lock")):
+        if not done.exists():
+            if out.exists():
+                shutil.rmtree(out)                      # a failed build's leftovers
+            out.mkdir()
+            build(out)
+            done.touch()
+    return out
+
+
 @pytest.fixture(scope="session")
 def tiny_simulated(tmp_path_factory) -> Path:
-    """``generate_study(folder, "tiny")`` once per session: the tiny preset's files, read
+    """``generate_study(folder, "tiny")`` once per test run: the tiny preset's files, read
     only by the tests (tests/test_simulate.py, test_physics.py, test_registration.py,
     test_mtst_steps.py); a test that changes files copies them."""
     from gaitval.simulate import generate_study
 
-    out = tmp_path_factory.mktemp("tiny_simulated")
-    generate_study(out, "tiny")
-    return out
+    return built_once(tmp_path_factory, "tiny_simulated",
+                      lambda out: generate_study(out, "tiny"))
 
 
 def tiny_workflow(work: Path, *extra: str, snakemake: Path = SNAKEMAKE, targets=(),
@@ -62,16 +87,30 @@ def tiny_workflow(work: Path, *extra: str, snakemake: Path = SNAKEMAKE, targets=
 
 
 @pytest.fixture(scope="session")
-def tiny_run(tmp_path_factory) -> Path:
-    """The tiny study simulated and reported once per session, with this venv's Snakemake,
-    in a scratch folder that tests only read (dry runs included).  A test that runs the
-    workflow for real builds its own folder, from a copy of this one's ``data``
-    (:func:`copy_run`; a copy of the whole folder is not up to date where it lands: the
-    ingest job's inputs are the raw files' absolute paths)."""
-    work = tmp_path_factory.mktemp("tiny_run")
-    res = tiny_workflow(work)
+def replay_simulated(realdata, tmp_path_factory) -> Path:
+    """The replay preset (real walks replayed into a simulated study,
+    ``tests/own_study.py``) generated once per test run; tests build their own studies
+    from it and only read it."""
+    from own_study import replay_study
+
+    return built_once(tmp_path_factory, "replay_simulated", replay_study)
+
+
+def _report_tiny(work: Path, snakemake: Path = SNAKEMAKE) -> None:
+    res = tiny_workflow(work, snakemake=snakemake)
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-4000:]
-    return work
+
+
+@pytest.fixture(scope="session")
+def tiny_run(tmp_path_factory) -> Path:
+    """The tiny study simulated and reported once per test run, with this venv's
+    Snakemake, in a scratch folder that tests only read (dry runs included).  A test that
+    runs the workflow for real builds its own folder, from a copy of this one's ``data``
+    (:func:`copy_run`; a copy of the whole folder is not up to date where it lands: the
+    ingest job's inputs are the raw files' absolute paths).  It is the suite's most
+    expensive fixture (a whole report): a test that needs a workflow's outputs reads
+    these rather than running Snakemake again."""
+    return built_once(tmp_path_factory, "tiny_run", _report_tiny)
 
 
 @pytest.fixture(scope="session")
@@ -80,10 +119,8 @@ def tiny_run_snakemake8(tmp_path_factory) -> Path:
     the newest Snakemake 8.x (tests/test_snakemake_releases.py, ``.venv-snakemake8``)."""
     from test_snakemake_releases import snakemake_8
 
-    work = tmp_path_factory.mktemp("tiny_run_snakemake8")
-    res = tiny_workflow(work, snakemake=snakemake_8())
-    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-4000:]
-    return work
+    return built_once(tmp_path_factory, "tiny_run_snakemake8",
+                      lambda work: _report_tiny(work, snakemake_8()))
 
 
 def copy_run(run: Path, dst: Path) -> Path:

@@ -40,15 +40,13 @@ def test_shipped_config_validates(cfg):
     check_config(cfg)
 
 
-@pytest.mark.slow
-def test_simulated_study_yaml_validates(tmp_path):
-    """The study.yaml the simulator writes beside a generated trial sheet."""
-    simulate = pytest.importorskip("gaitval.simulate")
-    simulate.generate_study(tmp_path, "tiny")
-    with open(tmp_path / "study.yaml", encoding="utf-8") as fh:
+def test_simulated_study_yaml_validates(tiny_simulated):
+    """The study.yaml the simulator writes beside a generated trial sheet (the session's
+    tiny preset, tests/conftest.py: generated once for every test that reads it)."""
+    with open(tiny_simulated / "study.yaml", encoding="utf-8") as fh:
         study = yaml.safe_load(fh)
     assert "rollator" in study and "registration" in study
-    check_study_file(study, tmp_path / "study.yaml")
+    check_study_file(study, tiny_simulated / "study.yaml")
 
 
 def test_every_analysis_section_is_in_both_schemas():

@@ -96,6 +96,7 @@ def test_the_workflow_declares_every_new_paper_figure(repo_root):
     assert {s for v in FIGURES.values() for s in v} <= listed
 
 
+@pytest.mark.slow
 def test_the_tiny_report_draws_every_data_figure(tiny_run):
     """Every listed figure is a drawn PNG of the tiny report and its index shows it with
     its caption."""
@@ -115,6 +116,7 @@ def test_the_tiny_report_draws_every_data_figure(tiny_run):
         assert (prov / f"{proto}_paper_figures.json").is_file(), proto
 
 
+@pytest.mark.slow
 def test_paper_figures_are_deterministic(tiny_run, tmp_path):
     """The same results give the same PNG bytes (no time stamps in the files), and the
     report's: the workflow's job is the step."""

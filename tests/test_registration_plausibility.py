@@ -27,8 +27,8 @@ CAUSES = {"mm": "millimetres", "rad": "radians", "swap": "x and y look exchanged
 
 
 @pytest.fixture(scope="module")
-def replay(realdata, tmp_path_factory) -> Path:
-    return O.replay_study(tmp_path_factory.mktemp("replay"))
+def replay(replay_simulated) -> Path:
+    return replay_simulated
 
 
 def _register(replay: Path, out: Path, variant, trial: str) -> dict:

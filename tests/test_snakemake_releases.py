@@ -23,7 +23,19 @@ VENV_8 = ROOT / ".venv-snakemake8"
 
 
 def snakemake_8() -> Path:
-    """``.venv-snakemake8/bin/snakemake`` at :data:`SNAKEMAKE_8`, made if missing."""
+    """``.venv-snakemake8/bin/snakemake`` at :data:`SNAKEMAKE_8`, made if missing (by one
+    process at a time: pytest-xdist's workers may both ask)."""
+    import hashlib
+    import tempfile
+
+    from filelock import FileLock
+
+    key = hashlib.sha256(str(VENV_8).encode()).hexdigest()[:12]
+    with FileLock(str(Path(tempfile.gettempdir()) / f"gaitval-venv-snakemake8-{key}.lock")):
+        return _snakemake_8()
+
+
+def _snakemake_8() -> Path:
     py = VENV_8 / "bin" / "python"
     check = [str(py), "-c", "import snakemake, gaitval; print(snakemake.__version__)"]
     # (from another folder than the checkout: gaitval must come from the venv, not cwd)

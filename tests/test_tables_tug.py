@@ -108,11 +108,9 @@ def test_write_tug_tables(tmp_path, data):
 
 # -- end to end on the tiny simulated study ----------------------------------------------------
 @pytest.fixture(scope="module")
-def tiny_study(tmp_path_factory):
-    simulate = pytest.importorskip("gaitval.simulate")
-    out = tmp_path_factory.mktemp("tiny")
-    simulate.generate_study(out, "tiny")
-    return out
+def tiny_study(tiny_simulated):
+    """The session's tiny preset (tests/conftest.py), read only here."""
+    return tiny_simulated
 
 
 @pytest.mark.slow

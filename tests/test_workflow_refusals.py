@@ -35,8 +35,8 @@ def run_report(work: Path, sheet: Path, *extra: str) -> subprocess.CompletedProc
 
 
 @pytest.mark.slow
-def test_refused_trials_are_loud(realdata, tmp_path):
-    sim = O.replay_study(tmp_path / "replay")
+def test_refused_trials_are_loud(replay_simulated, tmp_path):
+    sim = replay_simulated
     sheet = O.build_mixed(sim, tmp_path / "data" / O.STUDY)
     res = run_report(tmp_path, sheet)
     out = res.stdout + res.stderr
@@ -63,8 +63,8 @@ def test_refused_trials_are_loud(realdata, tmp_path):
 
 
 @pytest.mark.slow
-def test_the_correct_study_exits_0_with_every_trial_analysed(realdata, tmp_path):
-    sim = O.replay_study(tmp_path / "replay")
+def test_the_correct_study_exits_0_with_every_trial_analysed(replay_simulated, tmp_path):
+    sim = replay_simulated
     sheet = O.build(sim, tmp_path / "data" / O.STUDY, None)
     res = run_report(tmp_path, sheet)
     assert res.returncode == 0, (res.stdout + res.stderr)[-4000:]
