@@ -223,7 +223,7 @@ def sensitivity(rest: list[str], env: dict) -> int:
 
 def robustness(rest: list[str], env: dict) -> int:
     """The robustness ensemble (docs/simulator.md, "Robustness ensemble";
-    ``gaitval.robustness``): twins drawn from ``--ensemble FILE`` (default
+    ``gaitval robustness``): twins drawn from ``--ensemble FILE`` (default
     config/robustness.yaml), each twin's report built by the workflow as any study's
     (reports/robustness/twins/), the table reports/robustness/robustness.*, then the base
     study's report again so its verdicts show the shares.  Other arguments go to Snakemake
@@ -236,7 +236,7 @@ def robustness(rest: list[str], env: dict) -> int:
         i = rest.index("--ensemble")
         pick, rest = ["--config", rest[i + 1]], rest[:i] + rest[i + 2:]
     rest, logger = console_args(rest, env)
-    cmd = [str(PY), "-m", "gaitval.robustness", "run", *pick, "--",
+    cmd = [str(PY), "-m", "gaitval", "robustness", "run", *pick, "--snakemake",
            "--profile", "workflow/profiles/default", *logger, *rest]
     print("[run.py] " + " ".join(cmd), flush=True)
     plain = [str(BIN / "snakemake"), "--profile", "workflow/profiles/default", *rest]

@@ -2,6 +2,8 @@
 ingest, ingest-summary, peer, sensitivity, report, compare-tables."""
 from __future__ import annotations
 
+import argparse
+
 import json
 import logging
 import re
@@ -139,6 +141,11 @@ def cmd_sensitivity(a) -> int:
     return 0
 
 
+def cmd_robustness(a) -> int:
+    from gaitval.robustness.runner import robustness_step
+    return robustness_step(a.step, a.config, a.out, a.reports_dir, a.workdir, a.snakemake)
+
+
 def cmd_compare_tables(a) -> int:
     from gaitval.report.compare import run
     return run(a)
@@ -241,6 +248,23 @@ VERBS = (
 
 #: after every other verb in ``gaitval --help``
 LAST = (
+    Verb("robustness", cmd_robustness,
+         "the robustness ensemble of the simulated replica (python3 run.py robustness; "
+         "docs/simulator.md): design the twins, write the table, or run both with every "
+         "twin's report between them",
+         A("step", choices=["design", "table", "run"],
+           help="design: the twins' presets, design.csv, ensemble.yaml; table: "
+                "robustness.* from the twins' verdicts; run: both, the twins' reports "
+                "built by the workflow between them"),
+         A("--config", type=Path,
+           help="the ensemble's configuration (default config/robustness.yaml)"),
+         A("--out", type=Path, help="output folder of design and table"),
+         A("--reports-dir", type=Path,
+           help="the twins' report folders (table; default OUT/twins)"),
+         A("--workdir", type=Path, default=Path("."),
+           help="the checkout the run step works in (default: here)"),
+         A("--snakemake", nargs=argparse.REMAINDER, default=[], metavar="ARG",
+           help="last: everything after it goes to each twin's Snakemake run (run)")),
     Verb("sensitivity", cmd_sensitivity,
          "the verdicts of a report beside the same verdicts under the simulated "
          "replica's alternative free choices, and which flip (docs/simulator.md)",

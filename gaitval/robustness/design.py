@@ -154,7 +154,7 @@ def read_design(out_dir: str | Path) -> pd.DataFrame:
     f = Path(out_dir) / "design.csv"
     if not f.is_file():
         raise ConfigError("no design of a robustness ensemble here", path=f,
-                          hint="python -m gaitval.robustness design --out DIR writes it")
+                          hint="gaitval robustness design --out DIR writes it")
     return pd.read_csv(f, index_col="twin")
 
 

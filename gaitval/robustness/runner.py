@@ -2,7 +2,7 @@
 workflow (one Snakemake run per twin, ``run=[<twin>]``, so each twin is an ordinary study
 and its jobs run wherever the given profile sends them), then the robustness table.
 
-``python -m gaitval.robustness run [--config FILE] [--workdir DIR] [-- SNAKEMAKE ARGS]``;
+``gaitval robustness run [--config FILE] [--workdir DIR] [--snakemake ARGS...]``;
 ``python3 run.py robustness`` calls it and then rebuilds the base study's report so its
 verdicts show the shares.
 """
@@ -52,4 +52,35 @@ def run_ensemble(config: str | Path | None = None, workdir: str | Path = ".",
     for p in write_robustness(read_design(out),
                               out / "twins", cfg, out):
         print(p, flush=True)
+    return 0
+
+
+def robustness_step(step: str, config=None, out=None, reports_dir=None, workdir=".",
+                    extra: list[str] | None = None) -> int:
+    """``gaitval robustness design|table|run`` (the verb's handler, gaitval/cli/study.py).
+
+    ``design --out DIR`` writes the twins' presets, ``DIR/design.csv`` and
+    ``DIR/ensemble.yaml`` (the Snakemake config file declaring the twins as studies) and
+    prints its path, the twins' names and the base study; ``run [--workdir DIR]
+    [--snakemake ARGS...]`` does all three in DIR; ``table --out DIR --reports-dir TWINS`` writes
+    ``DIR/robustness.*`` from each twin's ``TWINS/<twin>/verdicts.csv``."""
+    from gaitval.errors import ConfigError
+
+    if step == "run":
+        return run_ensemble(config, workdir, list(extra or []))
+    if out is None:
+        raise ConfigError(f"gaitval robustness {step} needs --out")
+    out = Path(out)
+    cfg = load_config(config)
+    if step == "design":
+        table, conf = write_ensemble(cfg, out)
+        print(conf)
+        print(" ".join(table.index))
+        print(cfg.get("base_study", "default"))
+        return 0
+    from gaitval.robustness.summary import write_robustness
+
+    design = read_design(out)
+    for p in write_robustness(design, reports_dir or out / "twins", cfg, out):
+        print(p)
     return 0
