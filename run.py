@@ -222,7 +222,7 @@ def sensitivity(rest: list[str], env: dict) -> int:
 
 
 def robustness(rest: list[str], env: dict) -> int:
-    """The robustness ensemble (docs/simulator.md, "Robustness ensemble";
+    """The robustness ensemble (docs/robustness.md;
     ``gaitval robustness``): twins drawn from ``--ensemble FILE`` (default
     config/robustness.yaml), each twin's report built by the workflow as any study's
     (reports/robustness/twins/), the table reports/robustness/robustness.*, then the base

@@ -1,4 +1,4 @@
-"""The robustness ensemble of the twin (gaitval.robustness; docs/simulator.md, "Robustness ensemble"):
+"""The robustness ensemble of the twin (gaitval.robustness; docs/robustness.md):
 the seeded design, the twins' presets, the share table and its class by the stated
 criterion, the share beside the report's verdicts, and (slow) two twins at the tiny sizes
 run end to end through the workflow."""

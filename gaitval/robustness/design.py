@@ -2,8 +2,8 @@
 plausible ranges by a seeded Latin hypercube (``scipy.stats.qmc.LatinHypercube``), each
 twin written as a study preset and declared as a study of the workflow.
 
-``config/robustness.yaml`` names the factors (docs/simulator.md, "Plausible ranges" and
-"Robustness ensemble"); :func:`design` draws the table of twins, :func:`twin_presets`
+``config/robustness.yaml`` names the factors (docs/robustness.md, "Plausible ranges" and
+"The ensemble"); :func:`design` draws the table of twins, :func:`twin_presets`
 turns each row into the base preset with those choices, :func:`write_ensemble` writes
 the presets (``config/studies/<ensemble>/<twin>.yaml``) and a Snakemake config file that
 declares every twin as a simulated study (``--configfile``), so a twin is an ordinary
@@ -29,7 +29,7 @@ CONFIG = ROOT / "config" / "robustness.yaml"
 PRESET_DIR = ROOT / "config" / "studies"
 #: The MTST mat's goal end and half width (m; gaitval.simulate.mtst).
 MTST_GOAL_X_M, MTST_HALF_WIDTH_M = 5.85, 0.575
-#: The MTST sensor's plausible places (docs/simulator.md): on the walking line 0.5-1.5 m
+#: The MTST sensor's plausible places (docs/robustness.md): on the walking line 0.5-1.5 m
 #: beyond the goal facing the walker, or beside the mat 0.8-1.5 m from its edge at
 #: x = 2.0 m looking across it.
 MTST_PLACES = {"line": (0.5, 1.5), "beside": (0.8, 1.5)}

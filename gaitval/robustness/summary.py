@@ -1,7 +1,7 @@
 """The robustness table: per verdict, the share of twins that reproduce it, its Wilson
 95 % interval, the criterion's class and the free choices that move it most.
 
-The criterion was stated before any ensemble ran (docs/simulator.md, "Robustness
+The criterion was stated before any ensemble ran (docs/robustness.md, "The
 ensemble"): robust (reproduced) when the Wilson lower bound of the share is at least
 :data:`ROBUST_SHARE`, robust (not reproduced) when the upper bound is at most
 ``1 - ROBUST_SHARE``, otherwise the verdict hinges on the set-up.  The choices that move
@@ -25,7 +25,7 @@ from gaitval.report.robustness_share import KEY, config_digest
 from gaitval.robustness.design import coded
 from gaitval.tables.render import write_table
 
-#: The stated criterion (docs/simulator.md): robust when the Wilson 95 % lower bound of
+#: The stated criterion (docs/robustness.md): robust when the Wilson 95 % lower bound of
 #: the share of reproducing twins is at least this.
 ROBUST_SHARE = 0.8
 #: How many choices each verdict names.
@@ -167,7 +167,7 @@ def write_robustness(design: pd.DataFrame, reports_dir: str | Path, cfg: dict,
     caption = (f"Robustness of every verdict over {n} twins of the {cfg['base_preset']} study "
                "drawn jointly "
                "over the plausible ranges of the twin's free choices (Latin hypercube; "
-               "docs/simulator.md, 'Robustness ensemble'): share of twins reproducing it, "
+               "docs/robustness.md): share of twins reproducing it, "
                "Wilson 95 % interval, class by the stated criterion, and the choices that "
                "move it most (Spearman's ρ between the choice and the verdict).")
     notes = [f"Robust: the Wilson 95 % lower bound of the share ≥ {ROBUST_SHARE} (robust: not "

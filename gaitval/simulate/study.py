@@ -207,7 +207,7 @@ def _subject_choices(study_cfg: dict, proto: str, subj: dict, gp: GaitParams
     their draws (so every other draw is unchanged): ``leg_width_scale`` (top level)
     scales the leg width at the scan height, ``tug.turn_step_factor`` replaces the turning
     step length factor, ``mtst.step_width_scale`` scales the step width.  Absent keys
-    change nothing (docs/simulator.md, "Plausible ranges")."""
+    change nothing (docs/robustness.md, "Plausible ranges")."""
     from dataclasses import replace
 
     c = study_cfg.get(proto) or {}
