@@ -69,14 +69,13 @@ rule legbench_tables:
         chash=LEGBENCH_HASH,
     log:
         "logs/legbench_tables.log",
-    run:
-        run_verb_job(
-            verb("legbench-tables", params.dirs, "--methods", params.methods,
-                 "--inits", params.inits, "--views-dir", params.views,
-                 "--tables-dir", params.tables, "--figures-dir", params.figures,
-                 "--reports-dir", params.reports, "--config-hash", params.chash),
-            log[0],
-        )
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval legbench-tables {params.dirs:q} --methods {params.methods:q}"
+        " --inits {params.inits:q} --views-dir {params.views:q}"
+        " --tables-dir {params.tables:q} --figures-dir {params.figures:q}"
+        " --reports-dir {params.reports:q} --config-hash {params.chash:q} > {log:q} 2>&1"
 
 
 rule legbench_crowd:
