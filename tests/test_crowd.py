@@ -114,3 +114,17 @@ def test_no_track_outlives_the_returns_in_its_gate(kind):
             last[pid] = t[k]
         longest = max(longest, t[k] - last[pid])
     assert longest <= limit + 1e-9
+
+
+@pytest.mark.slow
+def test_the_crowd_tables_are_byte_identical_run_to_run(tmp_path):
+    """Same seeds, same machine: the same bytes (no CPU time or other run-to-run figure
+    in the tables; the CPU seconds stay in :func:`gaitval.crowd.bench.run`'s rows)."""
+    from gaitval.crowd.bench import crowd_step
+
+    for d in ("a", "b"):
+        crowd_step(tmp_path / d, "dev")
+    names = sorted(p.name for p in (tmp_path / "a").iterdir())
+    assert names and names == sorted(p.name for p in (tmp_path / "b").iterdir())
+    for n in names:
+        assert (tmp_path / "a" / n).read_bytes() == (tmp_path / "b" / n).read_bytes(), n
