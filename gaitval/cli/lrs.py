@@ -6,8 +6,9 @@ from __future__ import annotations
 import json
 import sys
 
-from gaitval.cli.table import (FIGURES_ARG, HASH_ARG, REPORTS_ARG, SHEET_ARG, SUBJECTS_ARG,
-                               TABLES_ARG, TRIAL_ARG, A, Verb)
+from gaitval.cli.table import (FIGURES_ARG, HASH_ARG, LABEL_METHOD_ARG, REPORTS_ARG,
+                               SCAN_LOG_ARG, SHEET_ARG, SUBJECTS_ARG, TABLES_ARG, TRIAL_ARG,
+                               A, Verb)
 
 
 def cmd_register(a) -> int:
@@ -159,9 +160,7 @@ VERBS = (
          HASH_ARG),
     Verb("track", cmd_track,
          "run one tracker method on one LRS trial",
-         A("--sensor", required=True,
-           help="the trial's ingested scan log "
-                "(results/<study>/ingest/<trial>/sensor.parquet)"),
+         SCAN_LOG_ARG,
          SHEET_ARG,
          SUBJECTS_ARG,
          TRIAL_ARG,
@@ -183,9 +182,7 @@ VERBS = (
     Verb("detect", cmd_detect,
          "one TUG trial's leg observations by one detector, for every method with that "
          "detector",
-         A("--sensor", required=True,
-           help="the trial's ingested scan log "
-                "(results/<study>/ingest/<trial>/sensor.parquet)"),
+         SCAN_LOG_ARG,
          SHEET_ARG,
          SUBJECTS_ARG,
          TRIAL_ARG,
@@ -215,7 +212,7 @@ VERBS = (
            help="the trial's registration.json (results/<study>/register/tug/<trial>/; "
                 "a refused registration: the trial is counted as not registered)"),
          A("--trial", required=True, help="trial id (named in errors and outputs)"),
-         A("--method", required=True, help="the method's name (its label in the tables)"),
+         LABEL_METHOD_ARG,
          A("--config", required=True,
            help="the method's config view "
                 "(results/<study>/config_views/tug/<method>.json): its evaluation.tug "

@@ -1,8 +1,9 @@
 """Verbs of the multi-target stepping task (seed 001) and the robotic rollator (seed 002)."""
 from __future__ import annotations
 
-from gaitval.cli.table import (FIGURES_ARG, HASH_ARG, REPORTS_ARG, SHEET_ARG, SUBJECTS_ARG,
-                               TABLES_ARG, TRIAL_ARG, A, Verb)
+from gaitval.cli.table import (FIGURES_ARG, HASH_ARG, LABEL_METHOD_ARG, REPORTS_ARG,
+                               SCAN_LOG_ARG, SHEET_ARG, SUBJECTS_ARG, TABLES_ARG, TRIAL_ARG,
+                               A, Verb)
 
 
 def cmd_mtst_track(a) -> int:
@@ -128,7 +129,7 @@ VERBS = (
                 "annotation file"),
          SUBJECTS_ARG,
          TRIAL_ARG,
-         A("--method", required=True, help="the method's name (its label in the tables)"),
+         LABEL_METHOD_ARG,
          A("--config", required=True,
            help="the method's config view "
                 "(results/<study>/config_views/mtst/<method>.json): the mtst: section "
@@ -174,9 +175,7 @@ VERBS = (
          A("--model",
            help="the held-out subject's PF model of rollator-train "
                 "(results/<study>/rollator/model/<subject>.json; PF methods)"),
-         A("--sensor", required=True,
-           help="the trial's ingested scan log "
-                "(results/<study>/ingest/<trial>/sensor.parquet)"),
+         SCAN_LOG_ARG,
          SHEET_ARG,
          SUBJECTS_ARG,
          TRIAL_ARG,
@@ -207,7 +206,7 @@ VERBS = (
          SHEET_ARG,
          SUBJECTS_ARG,
          TRIAL_ARG,
-         A("--method", required=True, help="the method's name (its label in the tables)"),
+         LABEL_METHOD_ARG,
          A("--config", required=True,
            help="the method's config view "
                 "(results/<study>/config_views/rollator/<method>.json): the rollator: "

@@ -54,3 +54,10 @@ REPORTS_ARG = A("--reports-dir", default="reports", help=REPORTS)
 HASH_ARG = A("--config-hash", default="", help=HASH)
 TABLES_ARG = A("--tables-dir", required=True, help=TABLES)
 FIGURES_ARG = A("--figures-dir", required=True, help=FIGURES)
+#: one LRS trial's ingested scan log, the input of its per-trial steps
+SCAN_LOG_ARG = A("--sensor", required=True,
+                 help="the trial's ingested scan log "
+                      "(results/<study>/ingest/<trial>/sensor.parquet)")
+#: a method's name where it only labels the rows of the tables
+LABEL_METHOD_ARG = A("--method", required=True,
+                     help="the method's name (its label in the tables)")
