@@ -75,12 +75,12 @@ def ensure_env(extras: str) -> None:
               flush=True)
         subprocess.run([*pip, "-e", f"{ROOT}[{extras}]" if extras else str(ROOT)],
                        check=True)
-    # the particle filter's and the UKF's numba kernels, compiled into their cache now
-    # (~15 s CPU) rather than by each worker of the first report (warm_up in
-    # gaitval/track/pf.py and gaitval/track/ukf.py)
+    # the particle filter's, the UKF's and the motion check's numba kernels, compiled into
+    # their cache now (~15 s CPU) rather than by each worker of the first report (warm_up
+    # in gaitval/track/pf.py, ukf.py and init_motion_kernel.py)
     print("[run.py] compiling the trackers' kernels (first run only) ...", flush=True)
-    subprocess.run([str(PY), "-c", "from gaitval.track import pf, ukf; pf.warm_up(); "
-                    "ukf.warm_up()"], check=False)
+    subprocess.run([str(PY), "-c", "from gaitval.track import init_motion_kernel, pf, ukf; "
+                    "pf.warm_up(); ukf.warm_up(); init_motion_kernel.warm_up()"], check=False)
     stamp.write_text(key)
 
 

@@ -492,14 +492,67 @@ def test_regression_snapshot():
     assert got == want
 
 
-def test_hypot_below_is_np_hypot_compared_even_at_the_edge():
-    from gaitval.track.init_motion import hypot_below
+def test_motion_kernel_radius_test_is_np_hypot_compared_even_at_the_edge():
+    from gaitval.track.init_motion_kernel import _below
     rng = np.random.default_rng(7)
     r = 0.06
-    t = rng.uniform(0, 2 * np.pi, 20000)
+    t = rng.uniform(0, 2 * np.pi, 5000)
     rr = r * (1 + rng.integers(-4, 5, t.size) * np.finfo(float).eps)    # within ulps of r
-    dx = np.concatenate([rng.normal(0, 0.05, 20000), rr * np.cos(t), [np.nan, np.inf, 1e9]])
-    dy = np.concatenate([rng.normal(0, 0.05, 20000), rr * np.sin(t), [0.0, np.nan, 1e9]])
+    dx = np.concatenate([rng.normal(0, 0.05, 5000), rr * np.cos(t), [np.nan, np.inf, 1e9]])
+    dy = np.concatenate([rng.normal(0, 0.05, 5000), rr * np.sin(t), [0.0, np.nan, 1e9]])
     expected = np.hypot(dx, dy) < r
     assert 0 < expected.sum() < expected.size
-    assert np.array_equal(hypot_below(dx, dy, r), expected)
+    assert [_below(x, y, r) for x, y in zip(dx.tolist(), dy.tolist())] == expected.tolist()
+
+
+def _walkers_and_clutter(n=80, clutter_step_m=0.0, rail=False):
+    """Scans at 7.5 /s: a pair of legs walking 0.02 m per scan away from the sensor, and
+    ten clutter points that shift ``clutter_step_m`` per scan (a sensor that moves makes
+    the whole background move); with ``rail``, a railing of posts 5 cm apart, seen on
+    every scan, runs 3 cm beside the right leg's path."""
+    clutter = np.column_stack([np.full(10, 4.0), np.linspace(-2, 2, 10)])
+    if rail:
+        posts = np.arange(0.9, 2.8, 0.05)
+        clutter = np.vstack([clutter, np.column_stack([posts, np.full(posts.size, -0.13)])])
+    return [np.vstack([[[1.0 + 0.02 * k, 0.1], [1.0 + 0.02 * k, -0.1]],
+                       clutter + [clutter_step_m * k, 0.0]]) for k in range(n)]
+
+
+@pytest.mark.parametrize("clutter_step_m,rail,moves", [
+    (0.0, False, True),         # both legs walk 1.6 m in a still scene
+    (0.1, False, False),        # the scene moves: no step can be told from the sensor's
+    (0.0, True, False),         # one leg's every step lands by a place seen all the time
+])
+def test_motion_check_counts_steps_off_the_background_in_a_still_scene(
+        clutter_step_m, rail, moves):
+    from gaitval.track.init_motion import MotionCheck
+    from gaitval.track.observations import DetectionSeries
+    xy = _walkers_and_clutter(clutter_step_m=clutter_step_m, rail=rail)
+    src = DetectionSeries(xy, [["SL"] * len(o) for o in xy])
+    found = MotionCheck(per_scan=10_000).moving_pair(src, 0.1, 0.8)   # every leg-like pair
+    assert (found is not None) == moves
+    if moves:
+        assert found[0] == 0 and {found[1], found[2]} == {0, 1}
+
+
+@pytest.mark.slow
+def test_motion_kernel_warm_up_compiles_what_a_check_then_uses(tmp_path):
+    """gaitval.track.init_motion_kernel.warm_up (a batch job's pool's and run.py's) gives
+    the follow the specialisation a motion check needs: a check afterwards compiles
+    nothing new.  In a fresh process, so that no other test has compiled it first."""
+    from fresh_process import run_fresh
+
+    code = (
+        "from gaitval.track import init_motion_kernel as K\n"
+        "from gaitval.track.init import INITIALISERS\n"
+        "from gaitval.track.observations import DetectionSeries\n"
+        "from test_track import _walkers_and_clutter\n"
+        "K.warm_up()\n"
+        "before = list(K.follow.signatures)\n"
+        "assert before\n"
+        "xy = _walkers_and_clutter()\n"
+        "src = DetectionSeries(xy, [['SL'] * len(o) for o in xy])\n"
+        "assert INITIALISERS.build('closest_pair').find(src, 0.1) is not None\n"
+        "after = list(K.follow.signatures)\n"
+        "assert after == before, (before, after)\n")
+    run_fresh(code, tmp_path)

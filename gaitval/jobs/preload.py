@@ -37,7 +37,7 @@ def _load() -> None:
             importlib.import_module(mod.name)
         except Exception:
             FAILED.append(mod.name)
-    for name in ("gaitval.track.pf", "gaitval.track.ukf"):
+    for name in ("gaitval.track.pf", "gaitval.track.ukf", "gaitval.track.init_motion_kernel"):
         try:                           # the compiled kernels, loaded from numba's cache
             importlib.import_module(name).warm_up()
         except Exception:

@@ -258,10 +258,11 @@ def preload(stage: str) -> None:
     for name in ("gaitval.pipeline.steps", *IMPORTS.get(stage, ())):
         importlib.import_module(name)
     if stage in KERNELS:
-        from gaitval.track import pf, ukf
+        from gaitval.track import init_motion_kernel, pf, ukf
 
         pf.warm_up()
         ukf.warm_up()
+        init_motion_kernel.warm_up()
 
 
 #: the options of every stage verb: name -> (argparse keywords, help)
