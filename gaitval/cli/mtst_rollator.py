@@ -1,9 +1,9 @@
 """Verbs of the multi-target stepping task (seed 001) and the robotic rollator (seed 002)."""
 from __future__ import annotations
 
-from gaitval.cli.table import (FIGURES_ARG, HASH_ARG, LABEL_METHOD_ARG, REPORTS_ARG,
-                               SCAN_LOG_ARG, SHEET_ARG, SUBJECTS_ARG, TABLES_ARG, TRIAL_ARG,
-                               A, Verb)
+from gaitval.cli.table import (SCAN_LOG_ARG, SHEET_ARG, SUBJECTS_ARG, TABLE_OUTPUT_ARGS,
+                               TRIAL_ARG, A, Verb, eval_dirs_arg, labelled_eval_args,
+                               view_arg)
 
 
 def cmd_mtst_track(a) -> int:
@@ -63,6 +63,13 @@ def cmd_rollator_tables(a) -> int:
     return 0
 
 
+#: an MTST step's scan log (ingested, or raw without mocap) and the trial it belongs to
+MTST_TRIAL_ARGS = (
+    A("--sensor", required=True,
+      help="the trial's scan log: results/<study>/ingest/<trial>/sensor.parquet, or for a "
+           "trial without mocap the raw scan log or bag the trial sheet names"),
+    SHEET_ARG, SUBJECTS_ARG, TRIAL_ARG)
+
 VERBS = (
     Verb("mtst-track", cmd_mtst_track,
          "track one MTST trial (every scan at Δt = 0.05 s)",
@@ -74,20 +81,12 @@ VERBS = (
            help="the trial's observations by this method's detector (gaitval "
                 "mtst-detect: results/<study>/detect/mtst/<detector>/<trial>.parquet), "
                 "used instead of detecting again (default: none, the step detects)"),
-         A("--sensor", required=True,
-           help="the trial's scan log: results/<study>/ingest/<trial>/sensor.parquet, "
-                "or for a trial without mocap the raw scan log or bag the trial sheet "
-                "names"),
-         SHEET_ARG,
-         SUBJECTS_ARG,
-         TRIAL_ARG,
+         *MTST_TRIAL_ARGS,
          A("--method", required=True,
            help="the method's name: a built-in (mtst_m1, mtst_m2, mtst_m3, "
                 "mtst_proposed, people) or one of tracking.methods"),
-         A("--config", required=True,
-           help="the method's config view "
-                "(results/<study>/config_views/mtst/<method>.json): the mtst: section "
-                "(scan_period_s, mat), tracking.methods and tracking.overrides"),
+         view_arg("mtst", "the mtst: section (scan_period_s, mat), tracking.methods and "
+                  "tracking.overrides"),
          A("--out", required=True,
            help="the per-scan track, Parquet, sensor frame and clock, metres, every "
                 "scan at mtst.scan_period_s "
@@ -96,13 +95,7 @@ VERBS = (
          "one MTST trial's leg observations by one detector, for every method with "
          "that detector",
          A("--detector", required=True, help="the detector spec as JSON"),
-         A("--sensor", required=True,
-           help="the trial's scan log: results/<study>/ingest/<trial>/sensor.parquet, "
-                "or for a trial without mocap the raw scan log or bag the trial sheet "
-                "names"),
-         SHEET_ARG,
-         SUBJECTS_ARG,
-         TRIAL_ARG,
+         *MTST_TRIAL_ARGS,
          A("--config", required=True,
            help="a config (view) JSON (results/<study>/config_views/mtst/study.json): "
                 "mtst.scan_period_s"),
@@ -127,21 +120,14 @@ VERBS = (
            help="the study's trial sheet, trials.csv (data/<study>/trials.csv for a "
                 "simulated study; docs/formats.md, Trial sheet); names the trial's "
                 "annotation file"),
-         SUBJECTS_ARG,
-         TRIAL_ARG,
-         LABEL_METHOD_ARG,
-         A("--config", required=True,
-           help="the method's config view "
-                "(results/<study>/config_views/mtst/<method>.json): the mtst: section "
-                "(targets, mat, gates)"),
-         A("--out", required=True,
-           help="folder (results/<study>/mtst_eval/<method>/<trial>): contacts, steps, "
-                "events, gates, track_field, summary, targets (.parquet)")),
+         *labelled_eval_args(
+             "mtst", "the mtst: section (targets, mat, gates)",
+             "folder (results/<study>/mtst_eval/<method>/<trial>): contacts, steps, "
+             "events, gates, track_field, summary, targets (.parquet)")),
     Verb("mtst-tables", cmd_mtst_tables,
          "Yorozu et al. 2015b Tables 1, 3, 4 and the trial figure",
-         A("inputs", nargs="+", metavar="EVAL_DIR",
-           help="per-(trial, method) evaluation folders of mtst-evaluate "
-                "(results/<study>/mtst_eval/<method>/<trial>)"),
+         eval_dirs_arg("per-(trial, method) evaluation folders of mtst-evaluate "
+                       "(results/<study>/mtst_eval/<method>/<trial>)"),
          A("--methods", nargs="+",
            help="the methods, in table order; one not in mtst.methods is shown as an "
                 "external tracker (default: mtst.methods of --config, else mtst_m1 "
@@ -150,10 +136,7 @@ VERBS = (
            help="a study's config (view) JSON "
                 "(results/<study>/config_views/mtst/study.json): the mtst: section; "
                 "the method views beside it name a method run with tracking.overrides"),
-         REPORTS_ARG,
-         HASH_ARG,
-         TABLES_ARG,
-         FIGURES_ARG),
+         *TABLE_OUTPUT_ARGS),
     Verb("rollator-train", cmd_rollator_train,
          "learn the PF model for one held-out subject",
          A("--results", required=True, metavar="DIR",
@@ -181,10 +164,8 @@ VERBS = (
          TRIAL_ARG,
          A("--method", required=True,
            help="rollator_kf, rollator_pf or one of rollator.methods (e.g. people)"),
-         A("--config", required=True,
-           help="the method's config view "
-                "(results/<study>/config_views/rollator/<method>.json): the rollator: "
-                "section, tracking.methods and tracking.overrides"),
+         view_arg("rollator", "the rollator: section, tracking.methods and "
+                  "tracking.overrides"),
          A("--out", required=True,
            help="the per-scan track, Parquet, in the laser's (moving) frame, metres "
                 "(results/<study>/rollator/<method>/<trial>.track.parquet)")),
@@ -204,21 +185,14 @@ VERBS = (
                 "(results/<study>/register/rollator/<trial>/): clock offset and drift, "
                 "status"),
          SHEET_ARG,
-         SUBJECTS_ARG,
-         TRIAL_ARG,
-         LABEL_METHOD_ARG,
-         A("--config", required=True,
-           help="the method's config view "
-                "(results/<study>/config_views/rollator/<method>.json): the rollator: "
-                "section, tracking.methods and tracking.overrides"),
-         A("--out", required=True,
-           help="folder (results/<study>/rollator/<method>/<trial>): frames.parquet, "
-                "summary.parquet")),
+         *labelled_eval_args(
+             "rollator", "the rollator: section, tracking.methods and tracking.overrides",
+             "folder (results/<study>/rollator/<method>/<trial>): frames.parquet, "
+             "summary.parquet")),
     Verb("rollator-tables", cmd_rollator_tables,
          "Chalvatzaki et al. 2017 Tables I, II and the figure",
-         A("inputs", nargs="+", metavar="EVAL_DIR",
-           help="per-(trial, method) evaluation folders of rollator-evaluate "
-                "(results/<study>/rollator/<method>/<trial>)"),
+         eval_dirs_arg("per-(trial, method) evaluation folders of rollator-evaluate "
+                       "(results/<study>/rollator/<method>/<trial>)"),
          A("--kf", default="rollator_kf",
            help="the KF method's name (rollator.kf_method; default rollator_kf)"),
          A("--pf", default="rollator_pf",
@@ -231,8 +205,5 @@ VERBS = (
                 "(results/<study>/config_views/rollator/study.json): the rollator: "
                 "section; the method views beside it name a method run with "
                 "tracking.overrides"),
-         REPORTS_ARG,
-         HASH_ARG,
-         TABLES_ARG,
-         FIGURES_ARG),
+         *TABLE_OUTPUT_ARGS),
 )

@@ -61,3 +61,29 @@ SCAN_LOG_ARG = A("--sensor", required=True,
 #: a method's name where it only labels the rows of the tables
 LABEL_METHOD_ARG = A("--method", required=True,
                      help="the method's name (its label in the tables)")
+#: the arguments closing a table verb: provenance, config hash, where tables and figures go
+TABLE_OUTPUT_ARGS = (REPORTS_ARG, HASH_ARG, TABLES_ARG, FIGURES_ARG)
+
+
+def view_arg(family: str, contents: str) -> Arg:
+    """``--config``: the method's config view of a per-trial step of ``family``."""
+    return A("--config", required=True,
+             help=f"the method's config view (results/<study>/config_views/{family}/"
+                  f"<method>.json): {contents}")
+
+
+def out_arg(help: str) -> Arg:
+    """``--out``: what a per-trial step writes."""
+    return A("--out", required=True, help=help)
+
+
+def eval_dirs_arg(help: str) -> Arg:
+    """The positional evaluation folders a table verb reads."""
+    return A("inputs", nargs="+", metavar="EVAL_DIR", help=help)
+
+
+def labelled_eval_args(family: str, contents: str, out: str) -> tuple[Arg, ...]:
+    """The closing arguments of an evaluation verb: subjects, trial, the method's label,
+    its config view and the output folder."""
+    return (SUBJECTS_ARG, TRIAL_ARG, LABEL_METHOD_ARG, view_arg(family, contents),
+            out_arg(out))

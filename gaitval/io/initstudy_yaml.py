@@ -99,8 +99,6 @@ def bag_detection_entries(trials: list[dict], bag_detectors: dict[str, list[str]
     ``external_detections:`` entry per topic whose bags are the trials' sensor bags, named
     by trial id in one folder (the TUG and MTST trials'; nothing for the user to fill in:
     detections have no legs to map), each checked against the schema."""
-    from gaitval.configcheck import check_study_file
-
     out = {}
     by_file = {r["sensor_file"]: r["trial"] for r in trials}
     for topic, bags in sorted(bag_detectors.items()):
@@ -115,15 +113,37 @@ def bag_detection_entries(trials: list[dict], bag_detectors: dict[str, list[str]
         name = "det_" + (_ID_BAD.sub("_", topic.strip("/")) or "bag")
         entry = {"path": f"{d}/{{trial}}.bag" if d != "." else "{trial}.bag",
                  "topic": topic, "protocols": protos}
-        try:
-            check_study_file({"external_detections": {name: entry}}, yaml_path)
-        except GaitvalError as exc:
-            res.todo.append(f"study.yaml external_detections.{name}: {exc}")
-            continue
-        out[name] = entry
-        res.notes.append(f"study.yaml external_detections.{name}: leg detections "
-                         f"{topic} of the sensor bags, scored in the detection table")
+        problem = _schema_problem("external_detections", name, entry, yaml_path)
+        _declare(out, name, entry, res.todo, f"study.yaml external_detections.{name}: "
+                 f"{problem}" if problem else None, res.notes,
+                 f"study.yaml external_detections.{name}: leg detections {topic} of the "
+                 "sensor bags, scored in the detection table")
     return out
+
+
+def _schema_problem(section: str, name: str, entry: dict, yaml_path: Path) -> str | None:
+    """What is wrong with study.yaml's ``section: {name: entry}`` by the schema a
+    hand-written entry is checked against (:func:`gaitval.configcheck.check_study_file`),
+    or None."""
+    from gaitval.configcheck import check_study_file
+
+    try:
+        check_study_file({section: {name: entry}}, yaml_path)
+    except GaitvalError as exc:
+        return str(exc)
+    return None
+
+
+def _declare(out: dict, name: str, entry: dict, problems: list, problem: str | None,
+             notes: list, note: str) -> bool:
+    """``out[name] = entry`` with ``note`` in ``notes``, or, when ``problem``, that into
+    ``problems`` and nothing declared; True when declared."""
+    if problem:
+        problems.append(problem)
+        return False
+    out[name] = entry
+    notes.append(note)
+    return True
 
 
 def external_method_entries(trials: list[dict], files: list[Found], res: InitResult,
@@ -134,8 +154,6 @@ def external_method_entries(trials: list[dict], files: list[Found], res: InitRes
     protocols those of its trials (:data:`EXTERNAL_KINDS`) (docs/formats.md, *External methods*): the
     study.yaml's ``external_methods:``, each entry checked against the schema a
     hand-written one is (:func:`gaitval.configcheck.check_study_file`)."""
-    from gaitval.configcheck import check_study_file
-
     proto = {r["trial"]: r.get("protocol") for r in trials}
     groups: dict[tuple[str, str, str], list[str]] = {}
     for f in files:
@@ -160,14 +178,12 @@ def external_method_entries(trials: list[dict], files: list[Found], res: InitRes
         if not protos:
             continue
         entry = {"path": path, "protocols": protos}
-        try:
-            check_study_file({"external_methods": {name: entry}}, yaml_path)
-        except GaitvalError as exc:
-            res.unpaired.append(f"{parent}/*{suffix}: not declared ({exc})")
+        problem = _schema_problem("external_methods", name, entry, yaml_path)
+        if not _declare(out, name, entry, res.unpaired, f"{parent}/*{suffix}: not declared "
+                        f"({problem})" if problem else None, res.notes,
+                        f"study.yaml external_methods.{name}: {path} "
+                        f"({', '.join(protos)} trials)"):
             continue
-        out[name] = entry
-        res.notes.append(f"study.yaml external_methods.{name}: {path} "
-                         f"({', '.join(protos)} trials)")
         if missing:
             res.todo.append(f"study.yaml external_methods.{name}: no file for trial(s) "
                             f"{', '.join(missing[:5])}{' ...' if len(missing) > 5 else ''} "

@@ -93,20 +93,10 @@ def read_bag_tracks(path: str | Path, topic: str | None = None, *,
         (``format, version, units: m, frame: sensor, clock: sensor, source``), ready for
         :func:`~gaitval.io.tracks.write.write_tracks`.
     """
-    from gaitval.io.annotations_bag import _register_custom_types
-    from gaitval.io.rosbag import _open
-
     p = Path(path)
-    reader = _open(p, trial)
-    try:
-        _register_custom_types(reader)
-        conns = _bag_topic(reader, topic, BAG_PEOPLE_TYPES + (BAG_LEG_DETECTIONS,), p, trial)
-        msgtype, name = conns[0].msgtype, conns[0].topic
-        _check_people_type(p, name, msgtype, trial)
-        scan_frames = _scan_frames(reader)
-        rows, frames = _people_rows(reader, conns, msgtype)
-    finally:
-        reader.close()
+    rows, frames, scan_frames, msgtype, name = _read_topic(
+        p, topic, BAG_PEOPLE_TYPES + (BAG_LEG_DETECTIONS,), trial, _check_people_type,
+        _people_rows)
     if not rows:
         raise _err(p, f"topic {name} holds no person", trial)
     _check_frames(p, name, frames, scan_frames, trial)
@@ -131,7 +121,29 @@ def _check_people_type(p: Path, name: str, msgtype: str, trial) -> None:
                    f"{', '.join(BAG_PEOPLE_TYPES)}", trial)
 
 
-def _people_rows(reader, conns, msgtype: str) -> tuple[list, set]:
+def _read_topic(p: Path, topic, known: tuple, trial, check_type, read_rows):
+    """Open the bag, pick its topic (:func:`_bag_topic` among the types ``known``), check
+    the topic's type (``check_type(p, name, msgtype, trial)``) and read it
+    (``read_rows(reader, conns, msgtype, p, name, trial) -> (rows, frames)``):
+    ``(rows, frames, scan_frames, msgtype, name)``, the frames of the topic's messages
+    and of the bag's LaserScans for :func:`_check_frames`."""
+    from gaitval.io.annotations_bag import _register_custom_types
+    from gaitval.io.rosbag import _open
+
+    reader = _open(p, trial)
+    try:
+        _register_custom_types(reader)
+        conns = _bag_topic(reader, topic, known, p, trial)
+        msgtype, name = conns[0].msgtype, conns[0].topic
+        check_type(p, name, msgtype, trial)
+        scan_frames = _scan_frames(reader)
+        rows, frames = read_rows(reader, conns, msgtype, p, name, trial)
+    finally:
+        reader.close()
+    return rows, frames, scan_frames, msgtype, name
+
+
+def _people_rows(reader, conns, msgtype: str, *_) -> tuple[list, set]:
     """``(t, person, x, y, message number)`` of every person of every message on the
     topic, and the messages' header frames."""
     rows, frames = [], set()
@@ -191,38 +203,38 @@ def read_bag_leg_detections(path: str | Path, topic: str | None = None, *,
         laser's frame, no LaserScan to check that against, a non-finite position (naming
         the message).
     """
-    from gaitval.io.annotations_bag import _register_custom_types
-    from gaitval.io.rosbag import _open
-
     p = Path(path)
-    reader = _open(p, trial)
-    try:
-        _register_custom_types(reader)
-        conns = _bag_topic(reader, topic, (BAG_LEG_DETECTIONS,), p, trial)
-        msgtype, name = conns[0].msgtype, conns[0].topic
-        if msgtype != BAG_LEG_DETECTIONS:
-            raise _err(p, f"topic {name} holds {msgtype}, not {BAG_LEG_DETECTIONS}", trial)
-        scan_frames = _scan_frames(reader)
-        rows, frames, stamps = [], set(), []
-        for n, (con, _, raw) in enumerate(reader.messages(connections=conns)):
-            m = reader.deserialize(raw, con.msgtype)
-            t = _stamp(m)
-            stamps.append(t)
-            frames.add(str(m.header.frame_id))
-            for leg in m.legs:
-                x, y = float(leg.position.x), float(leg.position.y)
-                if not (math.isfinite(x) and math.isfinite(y)):
-                    raise _err(p, f"topic {name}, message {n + 1}: a leg has a non-finite "
-                               "position", trial)
-                rows.append((t, n + 1, x, y, float(leg.confidence)))
-    finally:
-        reader.close()
+    (rows, stamps), frames, scan_frames, msgtype, name = _read_topic(
+        p, topic, (BAG_LEG_DETECTIONS,), trial, _check_legs_type, _leg_rows)
     if not stamps:
         raise _err(p, f"topic {name} has no message", trial)
     _check_frames(p, name, frames, scan_frames, trial)
     df = pd.DataFrame(rows, columns=["t_s", "msg", "x_m", "y_m", "confidence"])
     return df, {"source": f"{msgtype} on {name}", "n_messages": len(stamps),
                 "t_messages": stamps}
+
+
+def _check_legs_type(p: Path, name: str, msgtype: str, trial) -> None:
+    if msgtype != BAG_LEG_DETECTIONS:
+        raise _err(p, f"topic {name} holds {msgtype}, not {BAG_LEG_DETECTIONS}", trial)
+
+
+def _leg_rows(reader, conns, msgtype, p, name, trial) -> tuple[tuple[list, list], set]:
+    """``((rows, stamps), frames)``: ``(t, message number, x, y, confidence)`` of every
+    leg of every message, every message's stamp, and the messages' header frames."""
+    rows, frames, stamps = [], set(), []
+    for n, (con, _, raw) in enumerate(reader.messages(connections=conns)):
+        m = reader.deserialize(raw, con.msgtype)
+        t = _stamp(m)
+        stamps.append(t)
+        frames.add(str(m.header.frame_id))
+        for leg in m.legs:
+            x, y = float(leg.position.x), float(leg.position.y)
+            if not (math.isfinite(x) and math.isfinite(y)):
+                raise _err(p, f"topic {name}, message {n + 1}: a leg has a non-finite "
+                           "position", trial)
+            rows.append((t, n + 1, x, y, float(leg.confidence)))
+    return (rows, stamps), frames
 
 
 def people_to_legs(rows: pd.DataFrame, legs: dict, *, path=None, trial: str | None = None,
