@@ -49,7 +49,7 @@ def cmd_stage(a) -> int:
         tasks = by_size(tasks, [float(s) for s in aligned(a, "sizes")])
     if tasks:
         preload(a.verb)
-    run_batch(tasks, a.threads, a.log, fork=True)
+    run_batch(tasks, a.threads, a.log)
     return 0
 
 

@@ -1,19 +1,14 @@
 """One job, many trials: a rule's per-trial steps in a process pool (issue 38).
 
 The workflow runs one Snakemake job per (study, stage) or (study, stage, method) instead
-of one per trial.  The job's ``run:`` block hands its trials to :func:`run_batch`, which
-calls the step function of each trial in a :class:`concurrent.futures.ProcessPoolExecutor`
-of the rule's ``threads`` processes and writes every trial's output files as before (one
-file, or folder, per trial).  Why, and what it costs: docs/speed.md.
-
-The pool's processes start from the standard library's *forkserver*
-(:mod:`multiprocessing`, ``forkserver`` start method): one clean process, started by
-:func:`warm` when the workflow begins to run jobs (else the first time a batch runs in
-this Python process), that has already imported the modules in
-:data:`PRELOAD` (numpy, pandas, scipy, the trackers' compiled kernels: ~1 CPU-s) and forks
-each worker from there.  So a batch's workers pay no import, and the Snakemake process
-that waits on them imports none of the analysis.  Each batch has its own workers; they
-exit when the batch ends, and nothing a worker holds outlives its batch.
+of one per trial.  The job's stage verb (:mod:`gaitval.jobs.stages`) imports what its
+trials need (and loads the trackers' compiled kernels) once, then hands its trials to
+:func:`run_batch`, which runs each trial's task in a
+:class:`concurrent.futures.ProcessPoolExecutor` of the rule's ``threads`` processes forked
+from that process (so a worker pays no import) and writes every trial's output files (one
+file, or folder, per trial).  Each batch has its own workers; they exit when the batch
+ends, and nothing a worker holds outlives its batch.  Why, and what it costs:
+docs/speed.md.
 
 Determinism: a trial's files depend on its inputs only, not on which worker ran it or
 in which order; the job's log lists the trials in the order given, whatever the order they
@@ -36,11 +31,6 @@ from typing import Any, Callable
 
 from gaitval.errors import GaitvalError
 
-#: what the forkserver imports once before it forks a worker: every step module and what
-#: they import (a module not listed is imported by the worker that needs it)
-PRELOAD = ("gaitval.jobs.preload",)
-
-
 @dataclass
 class Task:
     """One trial's call: ``func(**kwargs)``; ``label`` names it in the log and errors."""
@@ -52,24 +42,6 @@ class Task:
 
 class BatchError(GaitvalError):
     """A task of a batch failed; the message is the task's own error, its label first."""
-
-
-def _context():
-    ctx = multiprocessing.get_context("forkserver")
-    ctx.set_forkserver_preload(list(PRELOAD))
-    return ctx
-
-
-def warm() -> None:
-    """Start the pool's forkserver now, without waiting for it: it imports :data:`PRELOAD`
-    (~2 CPU-s) in its own process while this one goes on, so the first batch does not
-    wait for the imports with one core busy and the others idle.  The workflow calls it
-    when Snakemake starts running jobs (``onstart``, workflow/rules/common.smk), where the
-    simulation's start-up leaves a core free.  The forkserver ends with this process."""
-    from multiprocessing import forkserver
-
-    _context()
-    forkserver.ensure_running()
 
 
 def _call(func, kwargs) -> tuple[bool, str, str, float]:
@@ -120,11 +92,9 @@ class VerbFailed(GaitvalError):
     """A verb of :func:`run_verbs` exited with a non-zero status (its message printed)."""
 
 
-def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None,
-              fork: bool = False) -> None:
-    """Run every task, ``processes`` at a time, each in a worker process: forked from the
-    preloaded forkserver (:func:`warm`), or with ``fork`` from this process itself (a
-    stage verb, :mod:`gaitval.jobs.stages`, which imports what its trials need first).
+def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None) -> None:
+    """Run every task, ``processes`` at a time, each in a worker process forked from this
+    one (a stage verb, :mod:`gaitval.jobs.stages`, imports what its trials need first).
 
     The log (``log``) starts with the task count, the wall time and the tasks' CPU, then
     gives each task's output under a ``== <label>`` line, by label, ending with its CPU
@@ -147,7 +117,7 @@ def run_batch(tasks: list[Task], processes: int, log: str | Path | None = None,
     # each worker dies with this process (a Snakemake killed alone): gaitval/jobs/lifeline.py
     from gaitval.jobs.lifeline import pool_worker
 
-    ctx = multiprocessing.get_context("fork") if fork else _context()
+    ctx = multiprocessing.get_context("fork")
     with cf.ProcessPoolExecutor(max_workers=processes, mp_context=ctx,
                                 initializer=pool_worker, initargs=(os.getpid(),)) as pool:
         futures = {pool.submit(_call, t.func, t.kwargs): i for i, t in enumerate(tasks)}

@@ -213,6 +213,50 @@ def ultrasonic_external(a) -> list[tuple[str, list[Argv]]]:
             for t, f in zip(a.trials, aligned(a, "files"))]
 
 
+def _legbench_score(row: dict) -> Argv:
+    """A recording's scoring options: its published benchmark set (trial sheet
+    ``scenario``, one of :data:`gaitval.tables.legbench.BENCHMARK_SETS`) and bearing sector
+    (``sector_min_deg``, ``sector_max_deg``; else the set's own, e.g. -80..12 for the
+    general-tracking sets)."""
+    from gaitval.tables.legbench import BENCHMARK_SETS
+
+    bset = row.get("scenario") or ""
+    args = ["--benchmark-set", bset] if bset in BENCHMARK_SETS else []
+    sector = [row.get("sector_min_deg"), row.get("sector_max_deg")]
+    sector = [float(v) for v in sector if v is not None and float(v) == float(v)]  # not NaN
+    if len(sector) < 2 and bset in BENCHMARK_SETS:
+        sector = list(BENCHMARK_SETS[bset]["sector_deg"] or ())
+    if len(sector) == 2:
+        args += ["--sector-deg", f"{sector[0]:g}", f"{sector[1]:g}"]
+    return args
+
+
+def legbench(a) -> list[tuple[str, list[Argv]]]:
+    """Each annotated recording tracked by one method and initialisation (--init), then
+    scored with CLEAR-MOT against its annotations (--out TRACK EVALUATE); the recording,
+    its annotations (the annotation file, else the bag), topics, benchmark set, sector and
+    the subject's leg width are the trial sheet's."""
+    from gaitval.io.trialsheet import load_subjects, load_trial_row
+
+    widths = load_subjects(a.subjects)["leg_width_m"]
+    tasks = []
+    for t in a.trials:
+        row = load_trial_row(a.sheet, a.subjects, t)
+        ann = row["annotation_path"] or row["sensor_path"]
+        topics = (_opt("--scan-topic", row["sensor_topic"])
+                  + _opt("--annotation-topic", row["annotation_topic"]))
+        track = f"{a.out[0]}/{t}/track.parquet"
+        tasks.append((t, [
+            ["legbench-track", "--sensor", row["sensor_path"], "--annotations", ann, *topics,
+             "--method", a.method, "--init", a.init,
+             "--leg-width-m", str(float(widths.loc[row["subject"]])), "--config", a.config,
+             "--trial", t, "--out", track],
+            ["legbench-evaluate", "--track", track, "--annotations", ann, *topics,
+             *_legbench_score(row), "--match-m", str(a.match_m),
+             "--min-false-s", str(a.min_false_s), "--trial", t, "--out", f"{a.out[1]}/{t}"]]))
+    return tasks
+
+
 #: verb name -> (the tasks of its trials, help)
 STAGES: dict[str, tuple[Callable, str]] = {
     "ingest-trials": (ingest, "ingest every trial of a study (one folder per trial)"),
@@ -233,6 +277,8 @@ STAGES: dict[str, tuple[Callable, str]] = {
                           "parameters"),
     "external-gait-trials": (ultrasonic_external, "an external system's gait parameters "
                              "on every treadmill trial"),
+    "legbench-trials": (legbench, "every annotated recording tracked by one method and "
+                        "initialisation, then scored with CLEAR-MOT"),
 }
 
 
@@ -241,15 +287,16 @@ STAGES: dict[str, tuple[Callable, str]] = {
 IMPORTS = {"mtst-trials": ("gaitval.pipeline.mtst",), "detect-trials": ("gaitval.pipeline.mtst",),
            "rollator-train-subjects": ("gaitval.pipeline.rollator",),
            "rollator-trials": ("gaitval.pipeline.rollator",),
-           "rollator-import-trials": ("gaitval.pipeline.rollator",)}
-KERNELS = ("track-trials", "mtst-trials", "rollator-trials", "ultrasonic-trials")
+           "rollator-import-trials": ("gaitval.pipeline.rollator",),
+           "legbench-trials": ("gaitval.pipeline.legbench",)}
+KERNELS = ("track-trials", "mtst-trials", "rollator-trials", "ultrasonic-trials",
+           "legbench-trials")
 
 
 def preload(stage: str) -> None:
     """Import the stage's modules (and load its trackers' compiled kernels) in this process,
     so that the workers forked from it start with them: ~1 CPU-s once per job instead of
-    once per worker (the whole package's preload, :data:`gaitval.jobs.batch.PRELOAD`, is
-    ~5 CPU-s)."""
+    once per worker."""
     import importlib
 
     import matplotlib
@@ -294,4 +341,10 @@ OPTIONS: dict[str, dict] = {
     "results": dict(help="results/<study> (rollator-train-subjects)"),
     "noise": dict(help="the noise identification JSON (ultrasonic-trials)"),
     "topic": dict(default="", help="the bag topic of the detections (leg-detections)"),
+    "init": dict(default="own", choices=["own", "annotation"],
+                 help="legbench-trials: the tracks' initialisation"),
+    "match_m": dict(type=float, default=0.75, help="legbench-trials: CLEAR-MOT's match "
+                    "distance (m)"),
+    "min_false_s": dict(type=float, default=0.5, help="legbench-trials: the shortest "
+                        "false leg track counted (s)"),
 }

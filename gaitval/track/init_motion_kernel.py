@@ -5,8 +5,8 @@ legs of a leg-like pair travel ``min_travel_m`` (the rules are in
 :class:`~gaitval.track.init_motion.MotionCheck`); :func:`follow` is that follow over the
 trial's scans held as one padded array, with the background test
 (:class:`~gaitval.track.init_motion.Background`) done step by step and remembered per
-observation.  numba is imported only when a motion check runs (the tracking jobs' process
-pool loads the compiled kernel once, ``gaitval/jobs/preload.py``).
+observation.  numba is imported only when a motion check runs (a tracking job loads the
+compiled kernel once before its pool forks, :func:`gaitval.jobs.stages.preload`).
 
 Every comparison is the one of the rules: the nearest observation is the first of equals,
 a distance below a radius is ``hypot(dx, dy) < r`` (decided on dx² + dy² against r² except
@@ -131,7 +131,7 @@ def warm_up() -> None:
     """Compile :func:`follow` (or load it from numba's cache) on a tiny problem with the
     argument types :meth:`~gaitval.track.init_motion.MotionCheck.moving_pair` passes:
     two legs walking away over twelve still scans.  Called where
-    :func:`gaitval.track.pf.warm_up` is (a batch job's pool before it forks its workers;
+    :func:`gaitval.track.pf.warm_up` is (a stage verb before its pool forks its workers;
     ``run.py`` after installing); tests/test_track.py checks that a motion check
     afterwards adds no specialisation."""
     n = 12

@@ -222,9 +222,9 @@ def warm_up() -> None:
     numba's cache, on a tiny problem (two scans of an arc, eight particles per leg,
     resampling forced).
 
-    A batch job's process pool calls it once before forking its workers
-    (``gaitval/jobs/preload.py``), so that a report loads it once instead of once per worker; ``run.py`` calls it after installing.  The arguments have
-    the types and layouts of :meth:`ParticleFilterTracker.step`'s (tests/test_pf_kernel.py
+    A stage verb calls it once before its process pool forks its workers
+    (:func:`gaitval.jobs.stages.preload`), so that a job loads it once instead of once per
+    worker; ``run.py`` calls it after installing.  The arguments have the types and layouts of :meth:`ParticleFilterTracker.step`'s (tests/test_pf_kernel.py
     checks that a track afterwards adds no specialisation).
     """
     tracker = ParticleFilterTracker(n_particles=8, resample_fraction=1.0)

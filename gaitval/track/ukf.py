@@ -366,9 +366,9 @@ def warm_up() -> None:
     numba's cache, on a tiny problem: a transmitter in front of four coplanar receivers,
     one range missing.
 
-    Called where :func:`gaitval.track.pf.warm_up` is (a batch job's pool before it forks
-    its workers, ``gaitval/jobs/preload.py``; ``run.py`` after installing), with the argument types of :meth:`ToaUkf.track`,
-    so a track afterwards finds its specialisation (tests/test_ukf.py checks it adds none).
+    Called where :func:`gaitval.track.pf.warm_up` is (a stage verb before its pool forks
+    its workers, :func:`gaitval.jobs.stages.preload`; ``run.py`` after installing), with
+    the argument types of :meth:`ToaUkf.track`, so a track afterwards finds its specialisation (tests/test_ukf.py checks it adds none).
     """
     anchors = np.array([[0.0, 0.0, 0.0], [0.3, 0.0, 0.0], [0.0, 0.2, 0.0], [0.3, 0.2, 0.0]])
     t = np.arange(12) / 100.0

@@ -82,42 +82,6 @@ if workflow.is_main_process and not {"-n", "--dry-run", "--dryrun"} & set(sys.ar
 _os.environ.update(GAITVAL_RUN_PID=str(_os.getpid()))
 
 
-# verb, run_trials, run_verb_job: for the rules whose trials still run inside Snakemake's
-# own process (`run:` blocks: the legbench rules); every other rule is one `gaitval` verb.
-def verb(*words):
-    """One gaitval verb's command line, as a list of words (nested lists flattened, so an
-    optional ``[flag, value]`` param goes in as is)."""
-    out = []
-    for w in words:
-        if isinstance(w, (list, tuple)):
-            out.extend(verb(*w))
-        else:
-            out.append(str(w))
-    return out
-
-
-def run_trials(tasks, threads, log, sizes=None, outdirs=()):
-    """Run a batch job's tasks (label, [verb, ...]) in the pool (gaitval.jobs.batch),
-    largest first when their ``sizes`` are given.  ``outdirs``: the job's `directory()`
-    outputs, made first (a batch of no trial still leaves its folder).  A job killed
-    half-way leaves them marked incomplete by Snakemake, and the next run removes and
-    redoes them (gaitval.jobs.resume)."""
-    from gaitval.cli import run_verbs
-    from gaitval.jobs.batch import Task, by_size, run_batch
-
-    for d in outdirs:
-        Path(d).mkdir(parents=True, exist_ok=True)
-    tasks = [Task(label, run_verbs, {"argvs": argvs}) for label, argvs in tasks]
-    if sizes is not None:
-        tasks = by_size(tasks, sizes)
-    run_batch(tasks, threads, log)
-
-
-def run_verb_job(argv, log):
-    """A job of one verb (a table, the report): in one process of the pool."""
-    run_trials([(argv[0], [argv])], 1, log)
-
-
 def first_or_empty(name):
     """Param function: input `name`'s first path, or "" when the job has none (an
     optional folder, e.g. the shared detections)."""

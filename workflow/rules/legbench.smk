@@ -7,11 +7,13 @@ include: "legbench_common.smk"
 
 rule legbench_track:
     # one job per (study, method, init): each trial tracked, then scored with CLEAR-MOT
-    # against its annotations (two verbs of one task; HOW JOBS RUN in common.smk)
+    # against its annotations (two verbs of one task; HOW JOBS RUN in common.smk); the
+    # topics, benchmark set, sector and leg width are read from the trial sheet
     input:
         sensors=lambda w: [trial_row(w.study, t)["sensor_path"] for t in legbench_trials(w.study)],
         annotations=lambda w: [legbench_annotations(w.study, t) for t in legbench_trials(w.study)],
         config=f"{RESULTS}/{{study}}/config_views/{ALL_SCOPE}/{{method}}.json",
+        sheet=lambda w: sheet_path(w.study),
     output:
         track=directory(f"{RESULTS}/{{study}}/legbench/{{method}}/{{init}}"),
         evaluate=directory(f"{RESULTS}/{{study}}/legbench_eval/{{method}}/{{init}}"),
@@ -19,20 +21,21 @@ rule legbench_track:
         **LEGBENCH_WC,
     threads: BATCH_THREADS
     params:
+        subjects=lambda w: subjects_path(w.study),
         trials=lambda w: legbench_trials(w.study),
-        topics=lambda w: [legbench_args(trial_wildcards(w.study, t))
-                          for t in legbench_trials(w.study)],
-        score=lambda w: [legbench_score_args(trial_wildcards(w.study, t))
-                         for t in legbench_trials(w.study)],
-        leg_width=lambda w: [legbench_leg_width(trial_wildcards(w.study, t))
-                             for t in legbench_trials(w.study)],
+        sizes=lambda w, input: [size_of(p) for p in input.sensors],
         match_m=legbench_cfg()["match_m"],
         min_false_s=legbench_cfg()["min_false_s"],
     log:
         "logs/legbench_track/{study}/{method}/{init}.log",
-    run:
-        run_trials(legbench_tasks(wildcards, input, output, params), threads, log[0],
-                   outdirs=output, sizes=[size_of(p) for p in input.sensors])
+    conda:
+        CONDA_ENV
+    shell:
+        "python -m gaitval legbench-trials --trials {params.trials:q} --sizes {params.sizes:q}"
+        " --sheet {input.sheet:q} --subjects {params.subjects:q} --config {input.config:q}"
+        " --method {wildcards.method:q} --init {wildcards.init:q}"
+        " --match-m {params.match_m:q} --min-false-s {params.min_false_s:q}"
+        " --out {output.track:q} {output.evaluate:q} --threads {threads:q} --log {log:q}"
 
 
 rule legbench_tables:
