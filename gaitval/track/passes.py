@@ -155,7 +155,9 @@ def _links(cf: pd.DataFrame, cb: pd.DataFrame, gate_m: float) -> list:
 
 def _groups(kf: dict, kb: dict, links: list) -> list[list]:
     """Union of the linked persons, nearest links first, each group holding at most one
-    person of each pass on any scan: the groups' members ``("f"|"b", id)``, in order."""
+    forward person on any scan, and at most one backward person on any scan unless the
+    backward person joins it alone (linked to no forward person yet): the groups' members
+    ``("f"|"b", id)``, in order."""
     group = {("f", p): ("f", p) for p in kf} | {("b", p): ("b", p) for p in kb}
     members = {g: [g] for g in group}
 
@@ -170,7 +172,11 @@ def _groups(kf: dict, kb: dict, links: list) -> list[list]:
 
     for _, f, b in links:
         a, c = root(("f", f)), root(("b", b))
-        if a == c or any(scans(a, side) & scans(c, side) for side in ("f", "b")):
+        # a backward person no forward person has taken may share scans with the group's
+        # backward members: the group reports one of them per scan (_backward_rows)
+        lone = all(s == "b" for s, _ in members[c])
+        sides = ("f",) if lone else ("f", "b")
+        if a == c or any(scans(a, side) & scans(c, side) for side in sides):
             continue
         group[c] = a
         members[a] += members.pop(c)
