@@ -28,8 +28,11 @@ The join (per pair of persons, forward f and backward b, reported on common scan
                                     lifecycle.leg_tracker_person_gate; 0.83 m at 10 Hz and 7.5 Hz)
 
 Links are taken nearest first (smallest d, then the forward id, then the backward id);
-two groups are joined only if the result holds at most one person of each pass on any
-scan.  A group is reported with the smallest forward id it holds (a backward-only person
+two groups are joined only if the result holds at most one forward person on any scan,
+and at most one backward person on any scan unless the backward person joins alone
+(linked to no forward person yet: the outdoor bag's backward pass holds its followed
+person twice for a while, and only the earlier track reaches back before the forward
+pass confirmed them).  A group is reported with the smallest forward id it holds (a backward-only person
 gets an id after every forward id); on each scan it takes the forward pass's rows where a
 forward member is reported, otherwise the backward pass's (the member with more legs
 observed on that scan, then the smaller id).  A backward member's left/right labels are
