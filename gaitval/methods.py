@@ -354,10 +354,12 @@ METHODS["people"] = {
              "tentative_gate": {"name": "variable_region", "v_sw": 1.1, "v_st": 0.55},
              "birth": {"name": "unexplained_pairs", "max_pair_m": 0.8,
                        "min_leg_widths": 0.7},
-             # M of N scans with a leg pair that walks (docs/people.md)
+             # M of N scans with a leg pair that walks (docs/people.md); a scan counts
+             # only when no surface runs through both legs (separate_legs)
              "confirmer": {"name": "m_of_n_moving", "window_s": 1.4, "m_fraction": 0.5,
                            "min_relative_travel_m": 0.5, "pass_leg_widths": 1.0,
-                           "min_travel_m": 0.5, "evidence": "observations"},
+                           "min_travel_m": 0.5, "evidence": "observations",
+                           "separate_legs": True},
              "deleter": {"name": "unsupported_time", "max_unsupported_s": 3.0,
                          "tentative_unsupported_s": 0.2},
              "area": {"name": "field_of_view", "margin_m": 0.25},

@@ -125,6 +125,27 @@ def test_two_people_at_once_are_never_joined_into_one():
     assert abs(early[1] - 0.35) < 1e-9 and abs(early[2] + 0.15) < 1e-9
 
 
+def test_a_backward_person_that_overlaps_another_backward_member_still_extends_alone():
+    """The outdoor bag's first 10.7 s: the backward pass holds the person twice for a while
+    (an early backward track that drifts off at times, and a later one that follows the
+    forward track), and only the early one covers the scans before the forward person is
+    confirmed.  The later one joins first (nearer); the early one, joined to no forward
+    person, still joins that group and reports the scans before it, one backward member
+    per scan."""
+    walk = lambda k: (1.0 + 0.05 * k, 0.1)                        # noqa: E731
+    other = lambda k: (1.0 + 0.05 * k, -0.1)                      # noqa: E731
+    fwd = _rows(5, range(10, 40), walk, other)
+    # the early one reaches before scan 10 and runs 0.3 m beside the person (the farther link)
+    early = _rows(1, range(0, 25), lambda k: (walk(k)[0], 0.4), lambda k: (other(k)[0], 0.2))
+    # the later backward track follows the forward one exactly (the nearer link)
+    late = _rows(2, range(15, 40), walk, other)
+    bwd = pd.concat([early, late])
+    out, ids = join_passes(fwd, bwd, 0.84, extend_only=True, splice_scans=5)
+    assert ids == {5: 5} and set(out["person_id"]) == {5}
+    assert sorted(out["k"].unique()) == list(range(40))          # scans 0-9 from `early`
+    assert out.groupby("k").size().max() == 2                     # one person, two legs
+
+
 def test_reverse_rows_maps_scans_times_and_velocities_back():
     t = np.arange(5) * DT + 100.0
     r = _rows(1, [0, 1], lambda k: (1.0, 0.0), lambda k: (1.0, 0.2)).assign(vx_mps=0.5)

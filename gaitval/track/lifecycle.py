@@ -241,13 +241,19 @@ class MOfNMoving(Confirmer):
         legs pass, r spans d_c); where it is not known, the gait tests alone decide, as
         before.  False (default): every test is asked; True confirms furniture in the
         empty room (experiments/people_gate.py).
+    separate_legs : bool
+        A scan counts as one with both legs observed only when no return lies on the line
+        between the two observations, beyond one leg width of each
+        (:func:`gaitval.track.peoplepass.joined_by_surface`): between a person's legs the
+        beams pass through.  False (default): not asked.
     """
 
     def __init__(self, window_s: float = 1.4, m_fraction: float = 0.5,
                  min_relative_travel_m: float = 0.5, pass_leg_widths: float = 1.0,
                  min_travel_m: float = 0.0, evidence: str = "estimates",
-                 walk_suffices: bool = False):
+                 walk_suffices: bool = False, separate_legs: bool = False):
         self.walk_suffices = bool(walk_suffices)
+        self.separate_legs = bool(separate_legs)
         if evidence not in ("estimates", "observations"):
             raise ValueError(f"m_of_n_moving: evidence must be 'estimates' or "
                              f"'observations', not {evidence!r}")
@@ -264,7 +270,7 @@ class MOfNMoving(Confirmer):
     def bind(self, dt, leg_width_m: float = 0.10):
         out = MOfNMoving(self.window_s, self.m_fraction, self.min_relative_travel_m,
                          self.pass_leg_widths, self.min_travel_m, self.evidence,
-                         self.walk_suffices)
+                         self.walk_suffices, self.separate_legs)
         out.n = max(1, int(round(self.window_s / dt)))
         out.m = max(1, math.ceil(self.m_fraction * out.n))
         out.leg_width_m = leg_width_m
@@ -277,7 +283,7 @@ class MOfNMoving(Confirmer):
 
     def step(self, person, k):
         mem = person.confirm_memory
-        both = person.seen[0] and person.seen[1]
+        both = person.seen[0] and person.seen[1] and (not self.separate_legs or person.apart)
         if both:
             (xl, yl), (xr, yr) = ((person.z[0], person.z[1]) if self.evidence == "observations"
                                   else (person.pos(0), person.pos(1)))

@@ -28,8 +28,11 @@ The join (per pair of persons, forward f and backward b, reported on common scan
                                     lifecycle.leg_tracker_person_gate; 0.83 m at 10 Hz and 7.5 Hz)
 
 Links are taken nearest first (smallest d, then the forward id, then the backward id);
-two groups are joined only if the result holds at most one person of each pass on any
-scan.  A group is reported with the smallest forward id it holds (a backward-only person
+two groups are joined only if the result holds at most one forward person on any scan,
+and at most one backward person on any scan unless the backward person joins alone
+(linked to no forward person yet: the outdoor bag's backward pass holds its followed
+person twice for a while, and only the earlier track reaches back before the forward
+pass confirmed them).  A group is reported with the smallest forward id it holds (a backward-only person
 gets an id after every forward id); on each scan it takes the forward pass's rows where a
 forward member is reported, otherwise the backward pass's (the member with more legs
 observed on that scan, then the smaller id).  A backward member's left/right labels are
@@ -155,7 +158,9 @@ def _links(cf: pd.DataFrame, cb: pd.DataFrame, gate_m: float) -> list:
 
 def _groups(kf: dict, kb: dict, links: list) -> list[list]:
     """Union of the linked persons, nearest links first, each group holding at most one
-    person of each pass on any scan: the groups' members ``("f"|"b", id)``, in order."""
+    forward person on any scan, and at most one backward person on any scan unless the
+    backward person joins it alone (linked to no forward person yet): the groups' members
+    ``("f"|"b", id)``, in order."""
     group = {("f", p): ("f", p) for p in kf} | {("b", p): ("b", p) for p in kb}
     members = {g: [g] for g in group}
 
@@ -170,7 +175,11 @@ def _groups(kf: dict, kb: dict, links: list) -> list[list]:
 
     for _, f, b in links:
         a, c = root(("f", f)), root(("b", b))
-        if a == c or any(scans(a, side) & scans(c, side) for side in ("f", "b")):
+        # a backward person no forward person has taken may share scans with the group's
+        # backward members: the group reports one of them per scan (_backward_rows)
+        lone = all(s == "b" for s, _ in members[c])
+        sides = ("f",) if lone else ("f", "b")
+        if a == c or any(scans(a, side) & scans(c, side) for side in sides):
             continue
         group[c] = a
         members[a] += members.pop(c)

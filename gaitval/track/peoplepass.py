@@ -36,7 +36,8 @@ class Person:
 
     __slots__ = ("pid", "status", "post", "prior", "seen", "pattern", "obs_j", "phase",
                  "windows", "t_last_seen", "confirm_memory", "n_unobs", "k_born", "n_obs",
-                 "world_centre", "seen_centre", "z", "zp", "look", "n_both", "t_last_return")
+                 "world_centre", "seen_centre", "z", "zp", "look", "n_both", "t_last_return",
+                 "apart")
 
     def __init__(self, pid, filter, zl, zr, pl, pr, jl, jr, k, t, windows, memory,
                  status=TENTATIVE, scores=(1.0, 1.0), look=None):
@@ -62,6 +63,7 @@ class Person:
         self.look = look                       # the appearance role's memory
         self.n_both = 1                        # scans with both legs observed since birth
         self.t_last_return = t                 # the last scan with support in its gate
+        self.apart = True                      # no surface joins the two observations
 
     def pos(self, f: int) -> tuple[float, float]:
         s = self.post[f]
@@ -109,6 +111,32 @@ def _relative(a, b) -> tuple[float, float, float]:
     c, s = math.cos(a[2]), math.sin(a[2])
     dx, dy = b[0] - a[0], b[1] - a[1]
     return c * dx + s * dy, -s * dx + c * dy, b[2] - a[2]
+
+
+def joined_by_surface(zl, zr, pts: np.ndarray, leg_width_m: float) -> bool:
+    """Is the pair of observations ``zl``, ``zr`` part of one surface: a scan return
+    (``pts``, sensor frame) farther than one leg width from both, within half a leg width
+    of the line through them, between them or up to two leg widths beyond either?
+    Between a person's legs the beams pass through to the background, and along the line
+    of the legs lies the space the person walks through; a return there is a surface that
+    runs through both "legs" (a wall or a piece of furniture seen at a grazing angle,
+    broken into leg-sized pieces by range steps and dropouts:
+    experiments/people_empty_backwards.py)."""
+    if not len(pts):
+        return False
+    a = np.array(zl, dtype=float)
+    d = np.array(zr, dtype=float) - a
+    n = float(np.hypot(*d))
+    if n <= 0.0:
+        return False
+    u = d / n
+    q = pts - a
+    along = q @ u
+    off = np.abs(q[:, 0] * u[1] - q[:, 1] * u[0])
+    far = (np.hypot(*q.T) > leg_width_m) & (np.hypot(*(q - d).T) > leg_width_m)
+    on_line = (off <= 0.5 * leg_width_m) & (along >= -2.0 * leg_width_m) \
+        & (along <= n + 2.0 * leg_width_m)
+    return bool(np.any(far & on_line))
 
 
 def _on_static(p: Person, pose, smap) -> bool:
@@ -165,6 +193,7 @@ class PeoplePass:
         """Scan k's observations, pose and static flags (the map as learned up to the
         previous scan: leg_tracker's local map is the one published after it)."""
         self.k, self.dt, self.tk = k, self.dts[k], float(self.t[k])
+        self.pts = None                          # the scan's returns, when asked for
         self.obs = [(float(p[0]), float(p[1])) for p in self.xy[k]]
         self.pose = self.poses[k]
         if self.segment[k] != self.seg:          # the sensor's motion was lost: a new map
@@ -325,6 +354,7 @@ class PeoplePass:
         if not self.look.keeps(p):                  # no longer looks like two legs
             p.status = ENDED
             return
+        self._apart(p)
         p.world_centre = (self.seg, *to_world(self.pose, np.array([p.evidence_centre(
             confirmer.evidence)]))[0].tolist())
         if (confirmer.step(p, self.k) or self.arrived.confirms(p, self.pose, self.tk)) \
@@ -334,6 +364,16 @@ class PeoplePass:
             self.n_conf += 1
         elif confirmer.failed(p):
             p.status = ENDED
+
+    def _apart(self, p: Person) -> None:
+        """Whether a tentative person's two observations on this scan are two separate
+        objects (:func:`joined_by_surface`), for a confirmer that asks it."""
+        if not getattr(self.confirmer, "separate_legs", False):
+            return
+        if self.pts is None:
+            self.pts = scan_points(self.scans, self.k)
+        p.apart = not (p.seen[0] and p.seen[1]) or not joined_by_surface(
+            p.z[0], p.z[1], self.pts, self.w)
 
     def births(self) -> None:
         """Tentative persons from the pairs of observations nobody explains (the
@@ -369,6 +409,7 @@ class PeoplePass:
         self.n_born += 1
         self.n_conf += start == CONFIRMED
         if start == TENTATIVE:
+            self._apart(p)
             p.world_centre = (self.seg, *to_world(self.pose,
                                                   np.array([p.centre()]))[0].tolist())
             self.confirmer.step(p, k)
