@@ -1,0 +1,121 @@
+"""Where the twin's pendulum error SD per axis comes from (seed 003 Table 1).
+
+Usage: ``.venv/bin/python experiments/pendulum_error_decomposition.py [N_TRIALS] [SEED]``
+(defaults: the default study's 5 pendulum trials, its seed 20150904).
+
+The default study's ``pendulum_error_sd`` rows read X / Y / Z 2.95 / 3.35 / 1.91 mm against
+seed 003 Table 1's 4.08 / 0.72 / 1.08 mm (tolerance: a factor 1.5 either way).  This script
+simulates the default study's pendulum trials in memory and takes the pipeline's Table 1
+(V by eq. 23 and W by the minimum-RMSE search on the same trials, then the UKF minus the
+camera) with one error source of the twin switched off at a time, cumulatively:
+
+1. ``full``       the twin as it is;
+2. ``no_noise``   the Gaussian range noise V set to 0;
+3. ``no_detect``  also no threshold-detection delay (no directivity, no amplitude jitter);
+4. ``no_marker``  also the camera marker exactly on the transducer head, no camera noise,
+                  no multipath, no dropouts: what is left is the filter's dynamic error
+                  (lag on the swing), the 1 us counter tick and eq. (2)'s speed of sound.
+
+Each variant runs twice: W identified on the variant's own trials (what the pipeline does)
+and W fixed at the ``full`` twin's identified W (so the difference isolates the source, not
+a re-tuned filter).  It also prints the static geometry: the per-axis SD a 1 mm range error
+gives at the swing's mean position, independent per receiver vs common to all four
+(the first-order least-squares solution, no filtering).
+
+Question it decides (written before the first run): which share of each axis's SD is range
+noise, detection delay, marker/camera, and filter dynamics; whether Y's excess over 1.08 mm
+(the row's upper bound) is noise carried by the board's geometry (then ``no_noise`` puts Y
+under 1.08 mm) or the filter's dynamics (then ``no_marker`` keeps Y above 1.08 mm).
+"""
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from gaitval.config import deep_merge
+from gaitval.evaluate.pendulum import pendulum_errors
+from gaitval.evaluate.ultrasonic_config import resolve_cfg
+from gaitval.simulate import us_pendulum
+from gaitval.simulate import ultrasonic as U
+from gaitval.stats.noise import identify_noise
+from gaitval.types import MocapTrial
+
+N_TRIALS = int(sys.argv[1]) if len(sys.argv) > 1 else 5
+SEED = int(sys.argv[2]) if len(sys.argv) > 2 else 20150904
+
+
+def _trials(overrides: dict, detection: bool):
+    plan = U.plan_ultrasonic({"n_subjects": 1, "n_pendulum_trials": N_TRIALS,
+                              **overrides}, SEED)
+    orig = us_pendulum._ranges_to_tof
+    if not detection:
+        def no_det(*a, amplitude=None, **k):
+            return orig(*a, amplitude=None, **k)
+        us_pendulum._ranges_to_tof = no_det
+    try:
+        out = []
+        for kind, trial, ts, _ in plan.tasks:
+            if kind != "pendulum":
+                continue
+            labels, xyz, log, truth, meta = us_pendulum.simulate_pendulum_trial(
+                np.random.default_rng(ts), plan.cfg, plan.R, plan.o)
+            out.append((log, MocapTrial(path=f"{trial}.c3d", rate_hz=plan.cfg["mocap_rate_hz"],
+                                        first_frame=1, labels=labels, xyz=xyz), meta, truth))
+    finally:
+        us_pendulum._ranges_to_tof = orig
+    return out
+
+
+def _table1(trials, W=None):
+    pairs = [(lg, mo) for lg, mo, _, _ in trials]
+    res = identify_noise(pairs, None)
+    w = res["W_sigma_mps2"] if W is None else W
+    cfg = deep_merge(resolve_cfg(None), {"ukf": {"W_sigma_mps2": w, "V_m2": res["V_m2"]}})
+    err = pendulum_errors(pairs, cfg, aligned=res["_aligned"])
+    sd = [1e3 * float(err[c].std(ddof=1)) for c in ("ex_m", "ey_m", "ez_m")]
+    mean = [1e3 * float(err[c].mean()) for c in ("ex_m", "ey_m", "ez_m")]
+    return sd, mean, res["W_sigma_mps2"], [1e3 * np.sqrt(v) for v in res["V_m2"]]
+
+
+def _geometry(trials):
+    """Per-axis SD (mm) per 1 mm range error at the swing's mean position (first order)."""
+    p = np.concatenate([t[3][["xu_m", "yu_m", "zu_m"]].to_numpy() for t in trials]).mean(0)
+    A = U.PAPER_ANCHORS
+    H = (p[None] - A) / np.linalg.norm(p[None] - A, axis=1)[:, None]
+    Hp = np.linalg.pinv(H)
+    indep = np.sqrt(np.diag(Hp @ Hp.T))
+    common = np.abs(Hp @ np.ones(4))
+    return p, indep, common
+
+
+def main():
+    variants = [("full", {}, True), ("no_noise", {"noise_V_m2": [0.0] * 4}, True),
+                ("no_detect", {"noise_V_m2": [0.0] * 4}, False),
+                ("no_marker", {"noise_V_m2": [0.0] * 4, "pendulum_marker_offset_m": 0.0,
+                               "mocap_noise_m": 0.0, "multipath_prob": 0.0,
+                               "dropout_prob": 0.0}, False)]
+    W_full = None
+    print(f"{N_TRIALS} pendulum trials, seed {SEED}; paper X/Y/Z 4.08 / 0.72 / 1.08 mm")
+    for name, ov, det in variants:
+        tr = _trials(ov, det)
+        if name == "full":
+            p, indep, common = _geometry(tr)
+            print(f"mean TX position (ultrasonic frame) {np.round(p, 3)} m; per 1 mm range "
+                  f"error, independent: {np.round(indep, 2)}, common: {np.round(common, 2)}")
+            L = [m["pendulum_length_m"] for _, _, m, _ in tr]
+            th = [np.rad2deg(m["theta0_rad"]) for _, _, m, _ in tr]
+            print(f"lengths {np.round(L, 3)} m, release angles {np.round(th, 1)} deg")
+        sd, mean, w_id, v_sd = _table1(tr)
+        line = (f"{name:10s} own W {w_id}: SD {np.round(sd, 2)} mean {np.round(mean, 2)}"
+                f" | eq.23 sd {np.round(v_sd, 2)} mm")
+        if name == "full":
+            W_full = w_id
+        else:
+            sd2, _, _, _ = _table1(tr, W_full)
+            line += f" | at full's W {W_full}: SD {np.round(sd2, 2)}"
+        print(line, flush=True)
+
+
+if __name__ == "__main__":
+    main()
