@@ -1,6 +1,6 @@
 """Where the twin's pendulum error SD per axis comes from (seed 003 Table 1).
 
-Usage: ``.venv/bin/python experiments/pendulum_error_decomposition.py [N_TRIALS] [SEED]``
+Usage: ``.venv/bin/python experiments/pendulum_error_decomposition.py [N_TRIALS] [SEED] [sweep]``
 (defaults: the default study's 5 pendulum trials, its seed 20150904).
 
 The default study's ``pendulum_error_sd`` rows read X / Y / Z 2.95 / 3.35 / 1.91 mm against
@@ -26,6 +26,16 @@ Question it decides (written before the first run): which share of each axis's S
 noise, detection delay, marker/camera, and filter dynamics; whether Y's excess over 1.08 mm
 (the row's upper bound) is noise carried by the board's geometry (then ``no_noise`` puts Y
 under 1.08 mm) or the filter's dynamics (then ``no_marker`` keeps Y above 1.08 mm).
+
+``sweep`` (second step, criteria written before its first run): the range noise split into
+a part common to the four anchors (the transmitter's trigger-to-RF latency) and an
+independent part, per-anchor total still the paper's V (``noise_common_fraction`` f of the
+smallest V, :func:`gaitval.simulate.us_sensor.range_noise`), f on the grid 0, 0.25, 0.5,
+0.75, 0.9, 1.0.  The paper gives no split (it *assumes* independence, §4.3.2), so a value
+picked here is a calibration on Table 1's SDs: f would be the smallest grid value whose
+three ``pendulum_error_sd`` rows all pass (factor 1.5); if none passes, f stays 0 (the
+paper's assumption) and the figures are reported.  Also printed, not used to pick anything:
+the same with the pendulum's camera marker within 1 mm instead of 2 mm of the transducer.
 """
 from __future__ import annotations
 
@@ -89,6 +99,19 @@ def _geometry(trials):
     return p, indep, common
 
 
+def sweep():
+    print(f"{N_TRIALS} pendulum trials, seed {SEED}; rows pass inside "
+          "X 2.72-6.12, Y 0.48-1.08, Z 0.72-1.62 mm")
+    for mo in (0.002, 0.001):
+        for f in (0.0, 0.25, 0.5, 0.75, 0.9, 1.0):
+            tr = _trials({"noise_common_fraction": f, "pendulum_marker_offset_m": mo}, True)
+            sd, mean, w_id, v_sd = _table1(tr)
+            ok = [lo <= v <= hi for v, lo, hi in zip(sd, (2.72, 0.48, 0.72),
+                                                      (6.12, 1.08, 1.62))]
+            print(f"marker {1e3 * mo:.0f} mm f {f:4.2f}: W {w_id} SD {np.round(sd, 2)} "
+                  f"pass {ok} | eq.23 sd {np.round(v_sd, 2)}", flush=True)
+
+
 def main():
     variants = [("full", {}, True), ("no_noise", {"noise_V_m2": [0.0] * 4}, True),
                 ("no_detect", {"noise_V_m2": [0.0] * 4}, False),
@@ -118,4 +141,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sweep() if "sweep" in sys.argv[3:] else main()

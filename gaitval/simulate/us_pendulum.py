@@ -84,7 +84,8 @@ def simulate_pendulum_trial(rng: np.random.Generator, cfg: dict, R: np.ndarray,
     amp = received_amplitude(d_true, cos_tx, cos_tx)
     temp_true, temp_log = _temperature(rng, t_us)
     tof, counts = _ranges_to_tof(d_true, temp_true, rng, np.asarray(cfg["noise_V_m2"]),
-                                 cfg["multipath_prob"], cfg["dropout_prob"], amplitude=amp)
+                                 cfg["multipath_prob"], cfg["dropout_prob"], amplitude=amp,
+                                 common_fraction=float(cfg.get("noise_common_fraction", 0.0)))
     truth_tx = pd.DataFrame({"t_s": t_m, "x_m": tx_f[:, 0], "y_m": tx_f[:, 1],
                              "z_m": tx_f[:, 2], "xu_m": tx_u[:, 0], "yu_m": tx_u[:, 1],
                              "zu_m": tx_u[:, 2]})
