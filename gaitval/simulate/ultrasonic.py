@@ -125,6 +125,10 @@ DEFAULTS: dict = {
     "mocap_noise_m": 0.0004,
     "stride_cv": 0.02,
     "pendulum_marker_offset_m": 0.002,
+    "pendulum_release_deg": [25.0, 35.0],
+    "pendulum_board_distance_m": 0.30,
+    "pendulum_damping_ratio": 0.03,
+    "noise_common_fraction": 0.0,
     "folder": "ultrasonic",
 }
 

@@ -42,10 +42,13 @@ def simulate_pendulum_trial(rng: np.random.Generator, cfg: dict, R: np.ndarray,
     """One pendulum trial (seed 003 §4.3) in memory."""
     dur, rate, us_rate = cfg["pendulum_duration_s"], cfg["mocap_rate_hz"], cfg["us_rate_hz"]
     L = rng.uniform(0.50, 0.60)
+    dist = float(cfg.get("pendulum_board_distance_m", 0.30))
     pivot_u = np.array([0.162 + rng.uniform(-0.02, 0.02), L + rng.uniform(0.10, 0.14),
-                        -0.30 + rng.uniform(-0.02, 0.02)])
+                        -dist + rng.uniform(-0.02, 0.02)])
     tilt = np.deg2rad(rng.uniform(-3, 3))                   # swing plane vs the board
-    theta0 = np.deg2rad(rng.uniform(25, 35)) * (1 if rng.random() < 0.5 else -1)
+    lo, hi = cfg.get("pendulum_release_deg", (25.0, 35.0))
+    theta0 = np.deg2rad(rng.uniform(lo, hi)) * (1 if rng.random() < 0.5 else -1)
+    zeta = float(cfg.get("pendulum_damping_ratio", 0.03))
     t_rel = 1.0
 
     def tx_at(th):
@@ -57,7 +60,7 @@ def simulate_pendulum_trial(rng: np.random.Generator, cfg: dict, R: np.ndarray,
     t_m = np.arange(int(round(dur * rate))) / rate
     t_us, t_true, offset, drift = _clock(rng, dur, us_rate)
     # one integration of the swing for both clocks' sample instants
-    th_all = _pendulum_theta(np.concatenate([t_m, t_true]), L, theta0, 0.03, t_rel)
+    th_all = _pendulum_theta(np.concatenate([t_m, t_true]), L, theta0, zeta, t_rel)
     th_m = th_all[:len(t_m)]
     tx_u = tx_at(th_m)
     # marker within 2 mm of the transducer head, fixed on the arm (radial, tangential, z)
