@@ -44,7 +44,9 @@ head to within 2 mm, as the paper built that experiment to do.)
 *Ranging*: time of flight with the speed of sound of dry air ``331.3 sqrt(1 + T/273.15)``
 (the physics; the pipeline uses the paper's linear eq. (2), ``331.5 + 0.6 T``, whose
 0.1 % error at room temperature is part of what it must live with), Gaussian noise with the
-paper's ``V = diag(11, 9.3, 9, 9) mm^2`` converted to seconds, the threshold detector's
+paper's ``V = diag(11, 9.3, 9, 9) mm^2`` per anchor, independent between anchors as the
+paper assumes (``noise_common_fraction`` > 0 makes that share of the smallest V common to
+the four: :func:`gaitval.simulate.us_sensor.range_noise`), the threshold detector's
 delay (the burst's amplitude falls off both transducers' axes and with distance: later
 detection, cycle slips of one wavelength or missed echoes; :mod:`gaitval.simulate.us_sensor`),
 a 1 us counter tick, occasional multipath (a late echo: path longer by 0.05-0.5 m, probability
@@ -61,8 +63,9 @@ temperature drifts slowly around 22-26 degC and is logged with 0.0625 degC resol
 
 *Pendulum trials* (seed 003 §4.3): the transmitter (with a marker on it) at the end of a
 0.50-0.60 m wooden pendulum pivoting about a horizontal axis, swinging in a plane parallel
-to the board about 0.3 m in front of it; held at 25-35 degrees, released after 1 s and left
-to swing (nonlinear pendulum, damping ratio 0.03) for ``pendulum_duration_s``.
+to the board ``pendulum_board_distance_m`` (0.3 m) in front of it; held at
+``pendulum_release_deg`` (25-35 degrees), released after 1 s and left to swing (nonlinear
+pendulum, damping ratio ``pendulum_damping_ratio``, 0.03) for ``pendulum_duration_s``.
 
 Truth (for tests only, never read by the pipeline) goes to ``out_dir/truth/<trial>/``:
 ``tx.parquet`` (true transmitter path in field and ultrasonic frames on the mocap clock,
@@ -309,7 +312,10 @@ def generate_ultrasonic(out_dir: Path, cfg: dict | None = None, seed: int = 0
         ``us_rate_hz`` (50), ``noise_V_m2`` (the paper's V), ``multipath_prob`` (0.005),
         ``dropout_prob`` (0.002), ``mocap_noise_m`` (0.0004), ``stride_cv`` (0.02),
         ``pendulum_marker_offset_m`` (0.002: largest per-axis offset of the pendulum's
-        camera marker from the transducer head), ``folder`` ("ultrasonic").
+        camera marker from the transducer head), ``pendulum_release_deg`` ([25, 35]:
+        range of the release angle), ``pendulum_board_distance_m`` (0.30),
+        ``pendulum_damping_ratio`` (0.03), ``noise_common_fraction`` (0: share of the
+        smallest V common to the four anchors), ``folder`` ("ultrasonic").
     seed : int
         Seed of ``np.random.default_rng``; each trial gets its own child stream, so the
         same seed gives byte-identical files.
