@@ -86,7 +86,7 @@ N_TRIALS = int(sys.argv[1]) if len(sys.argv) > 1 else 5
 SEED = int(sys.argv[2]) if len(sys.argv) > 2 else 20150904
 
 
-def _trials(overrides: dict, detection: bool):
+def _trials(overrides: dict, detection: bool, shared: bool = True):
     plan = U.plan_ultrasonic({"n_subjects": 1, "n_pendulum_trials": N_TRIALS,
                               **overrides}, SEED)
     orig = us_pendulum._ranges_to_tof
@@ -100,7 +100,8 @@ def _trials(overrides: dict, detection: bool):
             if kind != "pendulum":
                 continue
             labels, xyz, log, truth, meta = us_pendulum.simulate_pendulum_trial(
-                np.random.default_rng(ts), plan.cfg, plan.R, plan.o)
+                np.random.default_rng(ts), plan.cfg, plan.R, plan.o,
+                plan.pendulum if shared else None)
             out.append((log, MocapTrial(path=f"{trial}.c3d", rate_hz=plan.cfg["mocap_rate_hz"],
                                         first_frame=1, labels=labels, xyz=xyz), meta, truth))
     finally:
@@ -199,7 +200,22 @@ def release():
         print(f"release {band} deg: W {w_id} SD {np.round(sd, 2)} pass {ok}", flush=True)
 
 
+def apparatus():
+    print(f"{N_TRIALS} pendulum trials, seed {SEED}; rows pass inside "
+          "X 2.72-6.12, Y 0.48-1.08, Z 0.72-1.62 mm")
+    for name, shared in (("a pendulum per trial", False), ("one pendulum per study", True)):
+        for ov, label in (({}, "twin"), ({"noise_V_m2": [0.0] * 4}, "no range noise")):
+            sd, mean, w_id, v_sd = _table1(_trials(ov, True, shared))
+            ok = [lo <= v <= hi for v, lo, hi in zip(sd, (2.72, 0.48, 0.72),
+                                                      (6.12, 1.08, 1.62))]
+            print(f"{name:22s} {label:15s}: W {w_id} SD {np.round(sd, 2)} mean "
+                  f"{np.round(mean, 2)} pass {ok} | eq.23 sd {np.round(v_sd, 2)}", flush=True)
+
+
 if __name__ == "__main__":
+    if "apparatus" in sys.argv[3:]:
+        apparatus()
+        sys.exit()
     if "release" in sys.argv[3:]:
         release()
         sys.exit()
