@@ -94,3 +94,20 @@ def test_pendulum_physics_rows(tmp_path):
         assert r.value == pytest.approx(err[col].std(ddof=1))
         assert 0.0005 < r.value < 0.01               # mm-scale, as the ranging noise gives
         assert r.passed == (r.lower <= r.value <= r.upper)
+
+
+def test_a_study_releases_one_pendulum(tmp_path):
+    # seed 003 §4.3: one pendulum with one marker, released M times; only the release varies
+    plan = S.plan_ultrasonic({"n_subjects": 1, "speeds": {"normal": 0.99},
+                              "n_pendulum_trials": 2, "pendulum_duration_s": 6.0}, seed=4)
+    metas = []
+    for task in [t for t in plan.tasks if t[0] == "pendulum"]:
+        rng = np.random.default_rng(task[2])
+        *_, meta = S.simulate_pendulum_trial(rng, plan.cfg, plan.R, plan.o, plan.pendulum)
+        metas.append(meta)
+    assert metas[0]["pendulum_length_m"] == metas[1]["pendulum_length_m"]
+    assert metas[0]["marker_offset_m"] == metas[1]["marker_offset_m"]
+    assert np.max(np.abs(metas[0]["marker_offset_m"])) <= plan.cfg["pendulum_marker_offset_m"]
+    assert metas[0]["theta0_rad"] != metas[1]["theta0_rad"]
+    lo, hi = np.deg2rad(plan.cfg["pendulum_release_deg"])
+    assert all(lo <= abs(m["theta0_rad"]) <= hi for m in metas)
