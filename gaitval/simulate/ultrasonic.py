@@ -44,7 +44,9 @@ head to within 2 mm, as the paper built that experiment to do.)
 *Ranging*: time of flight with the speed of sound of dry air ``331.3 sqrt(1 + T/273.15)``
 (the physics; the pipeline uses the paper's linear eq. (2), ``331.5 + 0.6 T``, whose
 0.1 % error at room temperature is part of what it must live with), Gaussian noise with the
-paper's ``V = diag(11, 9.3, 9, 9) mm^2`` converted to seconds, the threshold detector's
+paper's ``V = diag(11, 9.3, 9, 9) mm^2`` per anchor, independent between anchors as the
+paper assumes (``noise_common_fraction`` > 0 makes that share of the smallest V common to
+the four: :func:`gaitval.simulate.us_sensor.range_noise`), the threshold detector's
 delay (the burst's amplitude falls off both transducers' axes and with distance: later
 detection, cycle slips of one wavelength or missed echoes; :mod:`gaitval.simulate.us_sensor`),
 a 1 us counter tick, occasional multipath (a late echo: path longer by 0.05-0.5 m, probability
@@ -61,8 +63,11 @@ temperature drifts slowly around 22-26 degC and is logged with 0.0625 degC resol
 
 *Pendulum trials* (seed 003 §4.3): the transmitter (with a marker on it) at the end of a
 0.50-0.60 m wooden pendulum pivoting about a horizontal axis, swinging in a plane parallel
-to the board about 0.3 m in front of it; held at 25-35 degrees, released after 1 s and left
-to swing (nonlinear pendulum, damping ratio 0.03) for ``pendulum_duration_s``.
+to the board ``pendulum_board_distance_m`` (0.3 m) in front of it; held at
+``pendulum_release_deg`` (25-35 degrees), released after 1 s and left to swing (nonlinear
+pendulum, damping ratio ``pendulum_damping_ratio``, 0.03) for ``pendulum_duration_s``.
+One pendulum (length, pivot, swing plane, marker) serves all of a study's pendulum trials,
+as the paper built one and released it M times.
 
 Truth (for tests only, never read by the pipeline) goes to ``out_dir/truth/<trial>/``:
 ``tx.parquet`` (true transmitter path in field and ultrasonic frames on the mocap clock,
@@ -95,7 +100,7 @@ from gaitval.errors import ConfigError
 from gaitval.io.atomic import write_csv, write_parquet, write_text
 from gaitval.io.c3d import write_c3d
 from gaitval.io.ultrasonic import write_ultrasonic
-from gaitval.simulate.us_pendulum import simulate_pendulum_trial
+from gaitval.simulate.us_pendulum import pendulum_apparatus, simulate_pendulum_trial
 from gaitval.simulate.us_sensor import (ANCHOR_IDS, PAPER_ANCHORS, PAPER_V_M2, board_pose,
                                         speed_of_sound_true)
 from gaitval.simulate.us_treadmill import (foot_points, heel_path, simulate_treadmill_trial,
@@ -103,6 +108,7 @@ from gaitval.simulate.us_treadmill import (foot_points, heel_path, simulate_trea
 
 __all__ = ["ANCHOR_IDS", "DEFAULTS", "PAPER_ANCHORS", "PAPER_V_M2", "UltrasonicPlan",
            "board_pose", "finish_ultrasonic", "foot_points", "generate_ultrasonic",
+           "pendulum_apparatus",
            "heel_path", "plan_ultrasonic", "simulate_pendulum_trial",
            "simulate_treadmill_trial", "simulate_ultrasonic_trial", "speed_of_sound_true",
            "stride_plan"]
@@ -125,6 +131,10 @@ DEFAULTS: dict = {
     "mocap_noise_m": 0.0004,
     "stride_cv": 0.02,
     "pendulum_marker_offset_m": 0.002,
+    "pendulum_release_deg": [25.0, 35.0],
+    "pendulum_board_distance_m": 0.30,
+    "pendulum_damping_ratio": 0.03,
+    "noise_common_fraction": 0.0,
     "folder": "ultrasonic",
 }
 
@@ -209,14 +219,17 @@ def _pendulum_tasks(pend_seeds) -> list[tuple]:
 @dataclass
 class UltrasonicPlan:
     """What :func:`plan_ultrasonic` draws before any trial: the full config, the
-    participants, the receiver board's pose in the field (``R``, ``o``) and one task per
-    trial, each with its own seed, so the trials can be simulated in any order or process."""
+    participants, the receiver board's pose in the field (``R``, ``o``), one task per
+    trial, each with its own seed, so the trials can be simulated in any order or process,
+    and the pendulum all pendulum trials release (``pendulum``,
+    :func:`gaitval.simulate.us_pendulum.pendulum_apparatus`)."""
 
     cfg: dict
     subjects: pd.DataFrame
     R: np.ndarray
     o: np.ndarray
     tasks: list = field(default_factory=list)
+    pendulum: dict | None = None
 
 
 def plan_ultrasonic(cfg: dict | None = None, seed: int = 0) -> UltrasonicPlan:
@@ -229,7 +242,7 @@ def plan_ultrasonic(cfg: dict | None = None, seed: int = 0) -> UltrasonicPlan:
             raise ConfigError(f"ultrasonic.{key} is {cfg[key]!r} s; the simulated trials "
                               f"need at least {MIN_TRIAL_S:g} s")
     root = np.random.SeedSequence(seed)
-    s_subj, s_board, s_trials, s_pend = root.spawn(4)
+    s_subj, s_board, s_trials, s_pend, s_app = root.spawn(5)
     subjects = _subjects(np.random.default_rng(s_subj), int(cfg["n_subjects"]))
     R, o = board_pose(np.random.default_rng(s_board))
     # each subject's own stride duration at a given speed, beyond leg length: with the
@@ -242,7 +255,9 @@ def plan_ultrasonic(cfg: dict | None = None, seed: int = 0) -> UltrasonicPlan:
     tasks = _treadmill_tasks(subjects, speeds, t_factor,
                              s_trials.spawn(len(subjects) * len(speeds)))
     tasks += _pendulum_tasks(s_pend.spawn(int(cfg["n_pendulum_trials"])))
-    return UltrasonicPlan(cfg, subjects, R, o, tasks)
+    # one pendulum with one marker, released n_pendulum_trials times (seed 003 §4.3)
+    app = pendulum_apparatus(np.random.default_rng(s_app), cfg)
+    return UltrasonicPlan(cfg, subjects, R, o, tasks, app)
 
 
 def simulate_ultrasonic_trial(out_dir: Path, plan: UltrasonicPlan, task: tuple
@@ -257,7 +272,8 @@ def simulate_ultrasonic_trial(out_dir: Path, plan: UltrasonicPlan, task: tuple
         labels, xyz, log, truth_tx, meta, strides = simulate_treadmill_trial(
             rng, cfg, sub, v, plan.R, plan.o)
     else:
-        labels, xyz, log, truth_tx, meta = simulate_pendulum_trial(rng, cfg, plan.R, plan.o)
+        labels, xyz, log, truth_tx, meta = simulate_pendulum_trial(rng, cfg, plan.R, plan.o,
+                                                                   plan.pendulum)
         strides = None
     log.meta["trial"] = trial
     c3d_rel, us_rel = _write_trial(out_dir, cfg["folder"], trial, labels, xyz,
@@ -305,7 +321,10 @@ def generate_ultrasonic(out_dir: Path, cfg: dict | None = None, seed: int = 0
         ``us_rate_hz`` (50), ``noise_V_m2`` (the paper's V), ``multipath_prob`` (0.005),
         ``dropout_prob`` (0.002), ``mocap_noise_m`` (0.0004), ``stride_cv`` (0.02),
         ``pendulum_marker_offset_m`` (0.002: largest per-axis offset of the pendulum's
-        camera marker from the transducer head), ``folder`` ("ultrasonic").
+        camera marker from the transducer head), ``pendulum_release_deg`` ([25, 35]:
+        range of the release angle), ``pendulum_board_distance_m`` (0.30),
+        ``pendulum_damping_ratio`` (0.03), ``noise_common_fraction`` (0: share of the
+        smallest V common to the four anchors), ``folder`` ("ultrasonic").
     seed : int
         Seed of ``np.random.default_rng``; each trial gets its own child stream, so the
         same seed gives byte-identical files.

@@ -2,8 +2,9 @@
 
 The transmitter (with a marker on it) at the end of a wooden pendulum swinging in a plane
 parallel to the receiver board, as described in the notes of
-:mod:`gaitval.simulate.ultrasonic`: the nonlinear damped swing (:func:`_pendulum_theta`)
-and one whole trial in memory (:func:`simulate_pendulum_trial`).
+:mod:`gaitval.simulate.ultrasonic`: the pendulum with its marker, built once per study
+(:func:`pendulum_apparatus`), the nonlinear damped swing (:func:`_pendulum_theta`) and one
+release as a whole trial in memory (:func:`simulate_pendulum_trial`).
 
 References
 ----------
@@ -37,15 +38,39 @@ def _pendulum_theta(t: np.ndarray, L: float, theta0: float, zeta: float, t_relea
     return sol.sol(tau)[0]
 
 
-def simulate_pendulum_trial(rng: np.random.Generator, cfg: dict, R: np.ndarray,
-                            o: np.ndarray):
-    """One pendulum trial (seed 003 §4.3) in memory."""
-    dur, rate, us_rate = cfg["pendulum_duration_s"], cfg["mocap_rate_hz"], cfg["us_rate_hz"]
+def pendulum_apparatus(rng: np.random.Generator, cfg: dict) -> dict:
+    """The pendulum and its camera marker, built once (seed 003 §4.3: "A wooden pendulum was
+    constructed ... a reflective marker was also located approximately in alignment with the
+    ultrasonic transmitter head ... This action was repeated M times").
+
+    Returns ``length_m``, ``pivot_u`` (pivot in the ultrasonic frame, m), ``tilt_rad`` (swing
+    plane against the board) and ``marker_offset_m`` (radial, tangential, lateral offset of
+    the marker from the transducer head, within ``pendulum_marker_offset_m`` per axis).
+    """
     L = rng.uniform(0.50, 0.60)
+    dist = float(cfg.get("pendulum_board_distance_m", 0.30))
     pivot_u = np.array([0.162 + rng.uniform(-0.02, 0.02), L + rng.uniform(0.10, 0.14),
-                        -0.30 + rng.uniform(-0.02, 0.02)])
+                        -dist + rng.uniform(-0.02, 0.02)])
     tilt = np.deg2rad(rng.uniform(-3, 3))                   # swing plane vs the board
-    theta0 = np.deg2rad(rng.uniform(25, 35)) * (1 if rng.random() < 0.5 else -1)
+    mo = rng.uniform(-1.0, 1.0, 3) * float(cfg["pendulum_marker_offset_m"])
+    return {"length_m": float(L), "pivot_u": pivot_u, "tilt_rad": float(tilt),
+            "marker_offset_m": mo}
+
+
+def simulate_pendulum_trial(rng: np.random.Generator, cfg: dict, R: np.ndarray,
+                            o: np.ndarray, apparatus: dict | None = None):
+    """One release of the pendulum (seed 003 §4.3) in memory.
+
+    ``apparatus`` (:func:`pendulum_apparatus`) is the study's pendulum, shared by its
+    trials; without it the trial builds its own from ``rng``.
+    """
+    dur, rate, us_rate = cfg["pendulum_duration_s"], cfg["mocap_rate_hz"], cfg["us_rate_hz"]
+    app = pendulum_apparatus(rng, cfg) if apparatus is None else apparatus
+    L, pivot_u, tilt = app["length_m"], np.asarray(app["pivot_u"]), app["tilt_rad"]
+    mo = np.asarray(app["marker_offset_m"], dtype=float)
+    lo, hi = cfg.get("pendulum_release_deg", (25.0, 35.0))
+    theta0 = np.deg2rad(rng.uniform(lo, hi)) * (1 if rng.random() < 0.5 else -1)
+    zeta = float(cfg.get("pendulum_damping_ratio", 0.03))
     t_rel = 1.0
 
     def tx_at(th):
@@ -57,11 +82,10 @@ def simulate_pendulum_trial(rng: np.random.Generator, cfg: dict, R: np.ndarray,
     t_m = np.arange(int(round(dur * rate))) / rate
     t_us, t_true, offset, drift = _clock(rng, dur, us_rate)
     # one integration of the swing for both clocks' sample instants
-    th_all = _pendulum_theta(np.concatenate([t_m, t_true]), L, theta0, 0.03, t_rel)
+    th_all = _pendulum_theta(np.concatenate([t_m, t_true]), L, theta0, zeta, t_rel)
     th_m = th_all[:len(t_m)]
     tx_u = tx_at(th_m)
-    # marker within 2 mm of the transducer head, fixed on the arm (radial, tangential, z)
-    mo = rng.uniform(-1.0, 1.0, 3) * float(cfg["pendulum_marker_offset_m"])
+    # the marker sits fixed on the arm near the transducer head (radial, tangential, z)
     radial = np.column_stack([np.sin(th_m) * np.cos(tilt), -np.cos(th_m),
                               np.sin(th_m) * np.sin(tilt)])
     tangential = np.column_stack([np.cos(th_m) * np.cos(tilt), np.sin(th_m),
@@ -84,7 +108,8 @@ def simulate_pendulum_trial(rng: np.random.Generator, cfg: dict, R: np.ndarray,
     amp = received_amplitude(d_true, cos_tx, cos_tx)
     temp_true, temp_log = _temperature(rng, t_us)
     tof, counts = _ranges_to_tof(d_true, temp_true, rng, np.asarray(cfg["noise_V_m2"]),
-                                 cfg["multipath_prob"], cfg["dropout_prob"], amplitude=amp)
+                                 cfg["multipath_prob"], cfg["dropout_prob"], amplitude=amp,
+                                 common_fraction=float(cfg.get("noise_common_fraction", 0.0)))
     truth_tx = pd.DataFrame({"t_s": t_m, "x_m": tx_f[:, 0], "y_m": tx_f[:, 1],
                              "z_m": tx_f[:, 2], "xu_m": tx_u[:, 0], "yu_m": tx_u[:, 1],
                              "zu_m": tx_u[:, 2]})

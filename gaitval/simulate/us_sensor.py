@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from gaitval import consts as C
+from gaitval.errors import ConfigError
 from gaitval.io.ultrasonic import distance_to_tof
 from gaitval.types import UltrasonicLog
 
@@ -125,18 +126,42 @@ def detection_delay_m(amplitude: np.ndarray, wavelength_m) -> np.ndarray:
     return (_crossing_cycles(amplitude, h) - t_cal) * np.asarray(wavelength_m, dtype=float)
 
 
+def range_noise(rng: np.random.Generator, n: int, V_m2: np.ndarray,
+                common_fraction: float = 0.0) -> np.ndarray:
+    """Gaussian range errors (n, m) whose variance per anchor is ``V_m2`` (seed 003's V).
+
+    A share ``common_fraction`` of the smallest anchor variance is one draw per ping shared
+    by every anchor (the transmitter's trigger-to-RF latency starts all counters late or
+    early together); the rest is independent per anchor (each anchor's own detection and
+    counter start).  Per anchor the total variance is ``V_m2`` either way, which is all
+    eq. (23) measures.  With ``common_fraction`` 0 no common draw is made.
+    """
+    V = np.asarray(V_m2, dtype=float)
+    m = V.size
+    if not 0.0 <= common_fraction <= 1.0:
+        raise ConfigError(f"ultrasonic.noise_common_fraction is {common_fraction!r}; it "
+                          "must be in [0, 1]")
+    common = common_fraction * float(V.min())
+    e = rng.standard_normal((n, m)) * np.sqrt(V - common)[None, :]
+    if common > 0.0:
+        e = e + rng.standard_normal((n, 1)) * np.sqrt(common)
+    return e
+
+
 def _ranges_to_tof(d_true: np.ndarray, temp_c: np.ndarray, rng: np.random.Generator,
                    V_m2: np.ndarray, multipath_prob: float, dropout_prob: float,
-                   amplitude: np.ndarray | None = None) -> tuple[np.ndarray, dict]:
+                   amplitude: np.ndarray | None = None, common_fraction: float = 0.0
+                   ) -> tuple[np.ndarray, dict]:
     """True ranges -> logged times of flight (noise, multipath, dropouts, 1 us tick).
 
-    ``amplitude`` (n, m): the bursts' relative amplitudes (:func:`received_amplitude`);
-    when given, each range also carries the threshold detector's delay
-    (:func:`detection_delay_m`, amplitude fluctuating by :data:`AMPLITUDE_SD` per ping) and
-    a burst below the threshold is a missed echo.
+    The range noise is :func:`range_noise` (``common_fraction`` of it shared by the
+    anchors).  ``amplitude`` (n, m): the bursts' relative amplitudes
+    (:func:`received_amplitude`); when given, each range also carries the threshold
+    detector's delay (:func:`detection_delay_m`, amplitude fluctuating by
+    :data:`AMPLITUDE_SD` per ping) and a burst below the threshold is a missed echo.
     """
     n, m = d_true.shape
-    d = d_true + rng.standard_normal((n, m)) * np.sqrt(V_m2)[None, :]
+    d = d_true + range_noise(rng, n, V_m2, common_fraction)
     mp = rng.random((n, m)) < multipath_prob
     d = d + mp * rng.uniform(0.05, 0.5, size=(n, m))
     counts = {}

@@ -300,7 +300,8 @@ def simulate_treadmill_trial(rng: np.random.Generator, cfg: dict, subject: dict,
                             plan_r["z_h"])
     temp_true, temp_log = _temperature(rng, t_us)
     tof, counts = _ranges_to_tof(d_true, temp_true, rng, np.asarray(cfg["noise_V_m2"]),
-                                 cfg["multipath_prob"], cfg["dropout_prob"], amplitude=amp)
+                                 cfg["multipath_prob"], cfg["dropout_prob"], amplitude=amp,
+                                 common_fraction=float(cfg.get("noise_common_fraction", 0.0)))
 
     t_hs = plan_r["t_hs"]
     keep = (t_hs[:-1] >= 0) & (t_hs[1:] <= dur)
