@@ -105,9 +105,9 @@ def _report_tiny(work: Path, snakemake: Path = SNAKEMAKE) -> None:
 def tiny_run(tmp_path_factory) -> Path:
     """The tiny study simulated and reported once per test run, with this venv's
     Snakemake, in a scratch folder that tests only read (dry runs included).  A test that
-    runs the workflow for real builds its own folder, from a copy of this one's ``data``
-    (:func:`copy_run`; a copy of the whole folder is not up to date where it lands: the
-    ingest job's inputs are the raw files' absolute paths).  It is the suite's most
+    runs the workflow for real builds its own folder from a copy of this one
+    (:func:`copy_run`: its ``data`` to run from the simulation on, or the whole folder to
+    run only what the test adds).  It is the suite's most
     expensive fixture (a whole report): a test that needs a workflow's outputs reads
     these rather than running Snakemake again."""
     return built_once(tmp_path_factory, "tiny_run", _report_tiny)
@@ -124,9 +124,12 @@ def tiny_run_snakemake8(tmp_path_factory) -> Path:
 
 
 def copy_run(run: Path, dst: Path) -> Path:
-    """A copy of a run's folder (e.g. its ``data``: the simulated study), times kept, so
-    that a run reading it finds the simulation up to date and does not simulate again."""
-    shutil.copytree(run, dst, symlinks=True)
+    """A copy of a run's folder (its ``data``: the simulated study; or the whole run, with
+    ``results``, ``reports`` and Snakemake's ``.snakemake`` records), times kept, so that a
+    run there finds what was copied up to date (the raw files are the jobs' inputs by paths
+    relative to the workflow's folder: workflow/rules/common.smk, ``in_workdir``) and runs
+    only what the test adds."""
+    shutil.copytree(run, dst, symlinks=True, dirs_exist_ok=True)
     return dst
 
 

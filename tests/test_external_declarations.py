@@ -172,7 +172,7 @@ def study_ext_run(tiny_run, tmp_path_factory):
     from test_workflow_external import people_bag
 
     work = tmp_path_factory.mktemp("study_ext")
-    copy_run(tiny_run / "data", work / "data")
+    copy_run(tiny_run, work)
     study, done = work / "data" / "tiny", tiny_run / "results" / "tiny"
     trials = sorted(p.stem for p in (done / "track" / "tug_m2").glob("*.parquet"))
     assert trials

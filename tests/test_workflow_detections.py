@@ -127,7 +127,7 @@ def det_run(tiny_run, tmp_path_factory):
     from gaitval.io.tracks.detections import write_detections
 
     work = tmp_path_factory.mktemp("det_run")
-    copy_run(tiny_run / "data", work / "data")
+    copy_run(tiny_run, work)
     study, done = work / "data" / "tiny", tiny_run / "results" / "tiny"
     trials = sorted(p.name for p in (done / "register" / "tug").iterdir()
                     if (p / "groundtruth.parquet").is_file())

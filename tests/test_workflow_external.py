@@ -180,10 +180,9 @@ def feet_from_the_marker(study: Path, results: Path) -> None:
 def ext_run(tiny_run, tmp_path_factory):
     """The tables TARGETS in a folder of their own (this module writes into its data
     folder and runs it again with external methods declared), on a copy of the session's
-    tiny data.  (Not a copy of the whole run: the ingest job's inputs are the raw files'
-    absolute paths, so a copied run is out of date where it lands.)"""
+    tiny run, whose tracks it reads (the first run finds them up to date)."""
     work = tmp_path_factory.mktemp("ext")
-    copy_run(tiny_run / "data", work / "data")
+    copy_run(tiny_run, work)
     res = tiny_workflow(work, targets=TARGETS)
     assert res.returncode == 0, res.stderr[-4000:]
     study = work / "data" / "tiny"

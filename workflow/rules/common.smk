@@ -231,16 +231,34 @@ def subjects_path(study):
 
 
 _SHEETS = {}
+_WORKDIR = Path.cwd().resolve()
+
+
+def in_workdir(path):
+    """A file below the workflow's directory as a path relative to it (the sheet gives
+    absolute ones), anything else as given: Snakemake compares a job's input paths with
+    the ones it last ran with, so a study folder copied or moved together with its
+    results stays up to date."""
+    if not path:
+        return path
+    try:
+        return str(Path(path).relative_to(_WORKDIR))
+    except ValueError:
+        return path
 
 
 def trials(study):
-    """The validated trial sheet of a study (DataFrame indexed by trial id)."""
+    """The validated trial sheet of a study (DataFrame indexed by trial id), its raw files'
+    paths relative to the workflow's directory where they lie below it (in_workdir)."""
     path = sheet_path(study)
     if path not in _SHEETS:
         try:
-            _SHEETS[path] = load_trial_sheet(path, subjects_path(study))
+            df = load_trial_sheet(path, subjects_path(study))
         except GaitvalError as exc:   # a file gone since the start: one line, no traceback
             sys.exit(f"gaitval: error: {exc}")
+        for col in ("mocap_path", "sensor_path", "annotation_path"):
+            df[col] = [in_workdir(p) for p in df[col]]
+        _SHEETS[path] = df
     return _SHEETS[path]
 
 
