@@ -444,14 +444,17 @@ def test_external_heel_trajectories_get_the_ukfs_agreement_rows(ext_run, ext, ex
     assert {"bias", "loa_low", "loa_high", "icc_a1", "bias_rm", "icc_agreement_rm"} <= set(stats)
     # the CSV has 6 significant digits: a last-digit flip is a relative 1e-5 at most (the
     # REML fits behind the *_rm and prop_bias columns are stable to ~2e-6, docs/numerics.md)
-    # except the proportional-bias p: where it is near 1 the slope's t is near 0, and the
-    # REML fit's own precision (~2e-6 in the slope) moves p by up to ~1e-2 there (dp/dt =
-    # -0.8 at t = 0): compared on that scale
+    # except the proportional-bias p: its slope agrees to 1e-5 (compared with the rest), but
+    # where p is near 1 the slope's standard error comes from a REML fit whose subject
+    # variance sits near its boundary (two subjects at the tiny size), and inputs equal to
+    # 1e-9 move p in its second digit (0.982 / 0.999 for a slope of 0.4537 both): p is
+    # compared by the decision it gives at 0.05, and to 0.05
     pv = [c for c in stats if c.startswith("prop_bias_p")]
     rest = [c for c in stats if c not in pv]
     pd.testing.assert_frame_equal(a[rest], b[rest], check_exact=exact, rtol=1e-5,
                                   atol=1e-12)
-    pd.testing.assert_frame_equal(a[pv], b[pv], check_exact=exact, rtol=0, atol=1e-2)
+    pd.testing.assert_frame_equal(a[pv], b[pv], check_exact=exact, rtol=0, atol=5e-2)
+    assert ((a[pv] < 0.05).to_numpy() == (b[pv] < 0.05).to_numpy()).all()
     gait = work / "results" / "tiny" / "ultrasonic_external" / ext
     for p in sorted((work / "results" / "tiny" / "ultrasonic" / "gait").glob("*.parquet")):
         own, other = pd.read_parquet(p), pd.read_parquet(gait / p.name)
