@@ -359,7 +359,7 @@ METHODS["people"] = {
              "confirmer": {"name": "m_of_n_moving", "window_s": 1.4, "m_fraction": 0.5,
                            "min_relative_travel_m": 0.5, "pass_leg_widths": 1.0,
                            "min_travel_m": 0.5, "evidence": "observations",
-                           "separate_legs": True},
+                           "separate_legs": True, "min_apart_leg_widths": 1.0},
              "deleter": {"name": "unsupported_time", "max_unsupported_s": 3.0,
                          "tentative_unsupported_s": 0.2},
              "area": {"name": "field_of_view", "margin_m": 0.25},
@@ -378,6 +378,9 @@ METHODS["people"] = {
              # no confirmation by arrival in free space (it confirmed furniture from a
              # moving robot; docs/history/people.md); written out, not left to the default
              "arrival": {"name": "none"},
+             # a tentative pair's legs associated as a pair: beside a standing leg the
+             # other swings ahead at up to twice a brisk walker's body speed (2 x 1.5 m/s)
+             "pair_swing_mps": 3.0,
              "init": None, "max_leg_separation_m": 0.8, "person_points_m": 0.13, "dt_s": None,
              "sides": "walking_direction"},
 }

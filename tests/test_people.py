@@ -289,11 +289,20 @@ def test_a_person_whose_track_ended_is_found_again_and_kept_while_standing():
     assert alone.people["k"].max() < 25                      # ended, and never again
     # the people method's own motion (seed 000's gait input once confirmed, v13) stops the
     # legs of the walker that stopped: its track never leaves the area, so the person
-    # coasts and keeps its id, with nothing to re-find
-    own = _tracker(area=area).run(_scans(n), xy, pats, 0.10)
+    # coasts and keeps its id, with nothing to re-find (the walker confirmed at k 20, its
+    # legs associated leg by leg)
+    own = _tracker(area=area, pair_swing_mps=None).run(_scans(n), xy, pats, 0.10)
     assert own.n_confirmed == 1 and own.n_refound == 0
     assert own.people["person_id"].nunique() == 1 and own.people["k"].max() == n - 1
     assert set(own.people.loc[own.people["k"] >= 25, "status"]) == {"confirmed"}
+    # with the pair rule (the method's) it is confirmed 7 scans earlier, with a gait state
+    # that carries its prediction out of the area while unseen: it ends and is re-found,
+    # with its id, where it stands
+    pair = _tracker(area=area).run(_scans(n), xy, pats, 0.10)
+    assert pair.people["k"].min() < own.people["k"].min()
+    assert pair.n_confirmed == 1 and pair.n_refound == 1
+    assert pair.people["person_id"].nunique() == 1 and pair.people["k"].max() == n - 1
+    assert set(pair.people.loc[pair.people["k"] >= 25, "status"]) == {"confirmed"}
 
 
 def test_a_hypothesis_beyond_the_gate_or_too_late_is_not_the_ended_person():
@@ -560,13 +569,17 @@ def test_a_coasting_person_is_taken_over_where_it_was_last_seen():
     # (the prediction coasts on only without the deleter's no-return rule: these scans
     # hold no return, so with it the person ends 0.5 s into the gap and is re-found)
     keep = {"name": "unsupported_time", "max_no_return_s": None}
-    off = _tracker(area=area, refind=refind, motion=CV, deleter=keep).run(
+    # (legs associated leg by leg: with the pair rule the walker is confirmed at k 13, not
+    # 20, and the coasting person's grown χ² gate takes the standing legs back itself at
+    # k 30, 0.7 m behind its prediction: no take-over is needed to test)
+    leg_by_leg = {"pair_swing_mps": None}
+    off = _tracker(area=area, refind=refind, motion=CV, deleter=keep, **leg_by_leg).run(
         _scans(n), xy, pats, 0.10)
     assert off.n_refound == 0 and off.people["k"].max() < n - 1
     last = off.people[off.people["k"] == off.people["k"].max()]
     assert (last["x_m"] > stand[:, 0].max() + 2.0).all()       # coasted far past the person
-    on = _tracker(area=area, refind={**refind, "coasting": True}, motion=CV).run(
-        _scans(n), xy, pats, 0.10)
+    on = _tracker(area=area, refind={**refind, "coasting": True}, motion=CV,
+                  **leg_by_leg).run(_scans(n), xy, pats, 0.10)
     p = on.people
     assert on.n_confirmed == 1 and on.n_refound == 1
     assert p["person_id"].nunique() == 1 and p["k"].max() == n - 1
@@ -723,3 +736,98 @@ def test_the_walk_alone_confirms_a_side_stepper_only_when_asked_and_the_world_is
     assert not confirmed(False, lambda k: 0)
     assert confirmed(True, lambda k: 0)
     assert not confirmed(True, lambda k: k % 2)          # the world frame keeps breaking
+
+
+def _stance_swing_walker(c0, v, t, beta=0.6, step_width_m=0.16):
+    """Two legs that walk as the crowd scenes' walkers do (docs/crowd.md): each foot stands
+    for β of the stride and then swings to its next foothold, S = 2·(0.35 + 0.3·v) m, so
+    the swinging leg moves at about 2.5 times the body speed while the other stands."""
+    c0, v = np.asarray(c0, float), np.asarray(v, float)
+    speed = float(np.hypot(*v))
+    u, stride = v / speed, 2.0 * (0.35 + 0.3 * speed)
+    nrm = np.array([-u[1], u[0]])
+    s = speed * t
+    legs = []
+    for offset, side in ((0.0, 1.0), (0.5, -1.0)):
+        ph = (s / stride + offset) % 1.0
+        x = np.clip((ph - beta) / (1.0 - beta), 0.0, 1.0)
+        rel = np.where(ph < beta, stride * beta * (0.5 - ph / beta),
+                       stride * beta * (-0.5 + x * x * (3.0 - 2.0 * x)))
+        legs.append(c0 + (s + rel)[:, None] * u + side * 0.5 * step_width_m * nrm)
+    return legs
+
+
+@pytest.mark.parametrize("speed", [1.0, 1.5])
+def test_a_tentative_pair_keeps_its_swinging_leg(speed):
+    """A walker whose swinging leg moves 0.25-0.4 m per scan while the other stands: leg by
+    leg, the newborn hypothesis loses the swinging leg (seed 001's gate of a leg seen once
+    is w_l + Δt·v_sw = 0.22 m) and is never confirmed; with the legs associated as a pair
+    (``pair_swing_mps``, the people method's 3.0 m/s) the swinging leg is kept beside the
+    standing one and the walker is confirmed."""
+    assert METHODS["people"]["kind"]["pair_swing_mps"] == 3.0
+    n = 60
+    t = np.arange(n) * DT
+    left, right = _stance_swing_walker((2.0, -1.5), (0.0, speed), t)
+    xy, pats = _observations([np.vstack([left[k], right[k]]) for k in range(n)],
+                             np.random.default_rng(5))
+    assert _tracker(pair_swing_mps=None).run(_scans(n), xy, pats, 0.11).n_confirmed == 0
+    res = _tracker().run(_scans(n), xy, pats, 0.11)
+    assert res.n_confirmed == 1
+    mid = res.people.groupby("k")[["x_m", "y_m"]].mean()
+    k = mid.index.to_numpy()
+    centre = 0.5 * (left + right)
+    assert np.hypot(mid["x_m"] - centre[k, 0], mid["y_m"] - centre[k, 1]).max() < 0.3
+
+
+def test_a_pair_that_stood_a_window_does_not_take_a_far_observation_as_a_swing():
+    """Two still objects 0.25 m apart, then one of them is not seen for three scans and an
+    observation appears 0.8 m from where it was, within the pairing distance of the other:
+    a swinging leg could reach it (w_l + 4·Δt·3.0 m/s).  A pair born a few scans earlier
+    takes it as its swinging leg; a pair that stood through a whole confirmation window
+    (1.4 s) is not mid-walk and does not (outside the pair rule the leg-by-leg gate does
+    not take it either)."""
+    from gaitval.track.peoplepass import PeoplePass
+
+    a, b, far = (2.28, 0.94), (2.03, 1.01), (1.57, 1.30)
+
+    def takes_far(n_still, **kw):
+        legs = [[a, b]] * n_still + [[b]] * 3 + [[far, b]]
+        xy, pats = _observations(legs, np.random.default_rng(7), sd=0.005)
+        run = PeoplePass(_tracker(ego_motion="none", static_map="none", **kw),
+                         _scans(len(xy)), xy, pats, 0.11, None)
+        for k in range(run.n):
+            run.scan(k)
+        (p,) = run.persons
+        return p.k_born == 0 and p.seen == [True, True] and \
+            math.dist(p.z[0], far) < 0.05
+    assert takes_far(4)
+    assert not takes_far(4, pair_swing_mps=None)
+    assert not takes_far(30)
+
+
+def test_observations_closer_than_a_leg_width_are_not_two_legs():
+    """``min_apart_leg_widths`` (the people method's 1.0): two shanks are solid, so a scan
+    whose two observations are closer than one leg width (one object split in two) does
+    not count as both legs seen; a walker whose observations are split so on two scans in
+    three is not confirmed with the test and is without it."""
+    from types import SimpleNamespace
+
+    assert METHODS["people"]["kind"]["confirmer"]["min_apart_leg_widths"] == 1.0
+    n = 20
+    t = np.arange(n) * DT
+    c, left, right = _walker((2.0, -1.0), (0.0, 1.0), t, step_m=0.6)
+
+    def confirmed(apart):
+        conf = CONFIRMERS.build({**METHODS["people"]["kind"]["confirmer"],
+                                 "min_apart_leg_widths": apart}).bind(DT, 0.10)
+        p = SimpleNamespace(seen=[True, True], confirm_memory=conf.new_memory(), apart=True)
+        out = []
+        for k in range(n):
+            split = k % 3 != 0
+            p.z = [tuple(left[k]), tuple(left[k] + (0.06, 0.0) if split else right[k])]
+            p.world_centre = (0, float(c[k, 0]), float(c[k, 1]))
+            out.append(conf.step(p, k))
+        return any(out)
+
+    assert not confirmed(1.0)
+    assert confirmed(0.0)

@@ -155,7 +155,8 @@ def baseline_kind() -> dict:
     filter, ego-motion, static map) with leg_tracker's rules (module notes)."""
     from gaitval.methods import METHODS
     kind = copy.deepcopy(METHODS["people"]["kind"])
-    kind.update({"confirmer": LegTravel(), "refind": "none",
+    # legs associated one by one, as leg_tracker's GNN does (not gaitval's pair rule)
+    kind.update({"confirmer": LegTravel(), "refind": "none", "pair_swing_mps": None,
                  "motion": {"name": "constant_velocity"},
                  "appearance": {"name": "leg_forest"},
                  "deleter": {"name": "unsupported_time", "max_unsupported_s": 3.0,

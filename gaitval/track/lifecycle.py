@@ -246,12 +246,19 @@ class MOfNMoving(Confirmer):
         between the two observations, beyond one leg width of each
         (:func:`gaitval.track.peoplepass.joined_by_surface`): between a person's legs the
         beams pass through.  False (default): not asked.
+    min_apart_leg_widths : float
+        A scan counts as one with both legs observed only when the two observations are
+        at least this many leg widths apart (1.0: two solid shanks' centres are a leg
+        width apart when they touch; closer, it is one object seen as two).  0 (default):
+        not asked.
     """
 
     def __init__(self, window_s: float = 1.4, m_fraction: float = 0.5,
                  min_relative_travel_m: float = 0.5, pass_leg_widths: float = 1.0,
                  min_travel_m: float = 0.0, evidence: str = "estimates",
-                 walk_suffices: bool = False, separate_legs: bool = False):
+                 walk_suffices: bool = False, separate_legs: bool = False,
+                 min_apart_leg_widths: float = 0.0):
+        self.min_apart_leg_widths = float(min_apart_leg_widths)
         self.walk_suffices = bool(walk_suffices)
         self.separate_legs = bool(separate_legs)
         if evidence not in ("estimates", "observations"):
@@ -270,7 +277,8 @@ class MOfNMoving(Confirmer):
     def bind(self, dt, leg_width_m: float = 0.10):
         out = MOfNMoving(self.window_s, self.m_fraction, self.min_relative_travel_m,
                          self.pass_leg_widths, self.min_travel_m, self.evidence,
-                         self.walk_suffices, self.separate_legs)
+                         self.walk_suffices, self.separate_legs,
+                         self.min_apart_leg_widths)
         out.n = max(1, int(round(self.window_s / dt)))
         out.m = max(1, math.ceil(self.m_fraction * out.n))
         out.leg_width_m = leg_width_m
@@ -284,6 +292,9 @@ class MOfNMoving(Confirmer):
     def step(self, person, k):
         mem = person.confirm_memory
         both = person.seen[0] and person.seen[1] and (not self.separate_legs or person.apart)
+        if both and self.min_apart_leg_widths > 0:      # two solid shanks do not overlap
+            both = math.dist(person.z[0], person.z[1]) >= \
+                self.min_apart_leg_widths * self.leg_width_m
         if both:
             (xl, yl), (xr, yr) = ((person.z[0], person.z[1]) if self.evidence == "observations"
                                   else (person.pos(0), person.pos(1)))

@@ -125,6 +125,12 @@ class PeopleTracker(TrackerKind):
         Scan returns within this distance of an observation assigned to a reported person
         are that person's leg and are not learned by the static map (leg_tracker's cluster
         distance ``cluster_dist_euclid``, 0.13 m).
+    pair_swing_mps : float or None
+        A tentative person's legs associated as a pair (:meth:`~gaitval.track.peoplepass.
+        PeoplePass._pair_swing`): beside a leg assigned on the scan, the other leg takes a
+        free observation within the pairing distance of it and within w_l + (H + 1)·Δt·
+        ``pair_swing_mps`` of its prediction — a swinging leg moves ahead while the other
+        stands.  None (default): leg by leg only.
     dt_s : float or None
         Scan period (None: the median timestamp difference).
     sides : {"walking_direction", "as_initialised"}
@@ -139,7 +145,8 @@ class PeopleTracker(TrackerKind):
                  refind="leg_tracker_gate",
                  appearance="none", arrival="none", passes="forward",
                  max_leg_separation_m: float = 0.8, person_points_m: float = 0.13,
-                 dt_s: float | None = None, sides: str = "walking_direction"):
+                 pair_swing_mps: float | None = None, dt_s: float | None = None,
+                 sides: str = "walking_direction"):
         self.detector = DETECTORS.build(detector)
         self.filter = FILTERS.build(filter)
         self.motion = MOTION_MODELS.build(motion)
@@ -161,6 +168,8 @@ class PeopleTracker(TrackerKind):
         self.init = INITIALISERS.build(init) if init else None
         self.max_leg_separation_m = max_leg_separation_m
         self.person_points_m = person_points_m
+        self.pair_swing_mps = None if pair_swing_mps is None else float(pair_swing_mps)
+        self.birth_min_leg_widths = float(getattr(self.birth, "min_leg_widths", 0.7))
         self.dt_s = dt_s
         self.sides = sides
 

@@ -29,6 +29,11 @@ from gaitval.track.staticmap import scan_points, to_world
 from gaitval.track.tracker import _SWING, step_durations
 
 _NO = 1.0e12            # cost of a pair outside the gate (never chosen)
+# a standing leg's reach in one scan: seed 001 Table 1's stance cell with its assumed
+# stance speed (¾ w_l + Δt·v_st, v_st = 0.55 m/s): the leg beside which the other swings
+STAND_LEG_WIDTHS = 0.75
+STAND_MPS = 0.55
+
 
 
 class Person:
@@ -243,6 +248,50 @@ class PeoplePass:
                     i, f = legs[r]
                     self.assigned[(id(group[i]), f)] = c
                     self.taken[c] = True
+        if self.tk_.pair_swing_mps is not None:
+            self._pair_swing()
+
+    def _pair_swing(self) -> None:
+        """The pair rule (docs/people.md): a tentative person with one leg assigned takes,
+        for its other leg, a free observation that a swinging leg can have reached while
+        the assigned leg stood — within the pairing distance of the assigned leg (0.7 w_l
+        … ``max_leg_separation_m``, the birth's bounds) and within w_l + (H + 1)·Δt·v_pair
+        of the other leg's prediction (H: its unobserved scans, v_pair the tracker's
+        ``pair_swing_mps``), the nearest to that prediction.  Only when the assigned leg
+        stood (observed on the previous scan too, within seed 001's stance reach of its
+        prediction) and the person is younger than the confirmer's window (a pair that
+        stood through a whole window is not mid-walk); a lone leg keeps its own gate."""
+        lo, hi = self.tk_.birth_min_leg_widths * self.w, self.tk_.max_leg_separation_m
+        v = self.tk_.pair_swing_mps
+        stay = STAND_LEG_WIDTHS * self.w + self.dt * STAND_MPS
+        young = getattr(self.confirmer, "n", None)
+        for p in self.persons:
+            if p.status != TENTATIVE:
+                continue
+            a = [self.assigned.get((id(p), f)) for f in (0, 1)]
+            if (a[0] is None) == (a[1] is None):
+                continue
+            seen = 0 if a[0] is not None else 1
+            zx, zy = self.obs[a[seen]]
+            sx, sy = p.prior[seen][0], p.prior[seen][1]
+            if p.n_unobs[seen] > 0 or math.hypot(zx - sx, zy - sy) > stay:
+                continue                # the seen leg was not seen standing there
+            if young is not None and self.k - p.k_born >= young:
+                continue                # stood through a whole window: not mid-walk
+            px, py = p.prior[1 - seen][0], p.prior[1 - seen][1]
+            reach = self.w + (p.n_unobs[1 - seen] + 1) * self.dt * v
+            best, bd = None, reach
+            for j, (ox, oy) in enumerate(self.obs):
+                if self.taken[j] or self.explained[j] or self.static[j]:
+                    continue
+                if not lo <= math.hypot(ox - zx, oy - zy) <= hi:
+                    continue
+                d = math.hypot(ox - px, oy - py)
+                if d <= bd:
+                    best, bd = j, d
+            if best is not None:
+                self.assigned[(id(p), 1 - seen)] = best
+                self.taken[best] = True
 
     def _gate_context(self, p: Person, f: int):
         s = p.post[f]
