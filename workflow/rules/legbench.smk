@@ -93,6 +93,8 @@ rule legbench_crowd:
         scenes=f"{REPORTS}/tables/legbench_crowd_scenes.csv",
     params:
         tables=parent_of("table"),
+        # no file input: gaitval's source digest makes new tracker code rerun the scenes
+        source=SOURCE_DIGEST,
     log:
         "logs/legbench_crowd.log",
     conda:
