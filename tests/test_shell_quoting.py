@@ -117,5 +117,6 @@ def test_a_real_run_of_a_hostile_sheet_runs_no_embedded_command(hostile):
     assert len(printed) == 1, log[-3000:]
     argv = shlex.split(printed[0])
     sheet_dir = work / "data" / STUDY
-    assert argv[argv.index("--sensor") + 1] == str((sheet_dir / sensor).resolve())
+    # the raw file, one argument, relative to the workflow's folder (common.smk in_workdir)
+    assert (work / argv[argv.index("--sensor") + 1]).resolve() == (sheet_dir / sensor).resolve()
     assert argv[argv.index("--trial") + 1] == trial
