@@ -87,3 +87,20 @@ def test_captions_and_notes_name_columns_by_their_headers(tmp_path):
     assert "- _Difference mean (m)_ is system minus reference for tug_m1" in text
     assert "ft_forward" not in tex.read_text() and "diff" not in tex.read_text().lower() \
         .replace("difference", "")
+
+
+def test_a_report_with_the_crowd_table_says_its_scenes_are_simulated(tmp_path):
+    """The legbench run's data are real recordings, but its crowd table's scenes are
+    rendered by the twin: the data lines at the top say so, and only when that table is
+    there."""
+    rd = tmp_path / "reports" / "legbench"
+    write_table(pd.DataFrame({"kind": ["crossing_static"], "mota_pct": [40.0]}),
+                rd / "tables" / "legbench_clearmot", caption="CLEAR-MOT")
+    build_index(rd, study_names=["legbench"])
+    assert "simulated scenes" not in (rd / "index.md").read_text()
+    write_table(pd.DataFrame({"kind": ["crossing_static"], "mota_pct": [40.0]}),
+                rd / "tables" / "legbench_crowd", caption="Crowd")
+    build_index(rd, study_names=["legbench"])
+    for name in ("index.md", "index.html"):
+        text = (rd / name).read_text()
+        assert "legbench_crowd" in text and "simulated scenes" in text, name

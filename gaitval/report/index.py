@@ -287,6 +287,13 @@ def _md_table(header: list[str], rows: list[list[str]]) -> str:
     return "\n".join(lines)
 
 
+#: the data line of a report that holds the crowd benchmark's table: its scenes are not the
+#: study's recordings but rendered by the twin (docs/crowd.md)
+RENDERED_SCENES = ("**legbench_crowd**: simulated scenes (several people rendered by the "
+                   "twin's laser model, ground truth per person), not recordings: its rows "
+                   "test the people trackers on scenes of other kinds than the recordings'.")
+
+
 def collect(reports_dir: str | Path, study_names: list[str] | None = None,
             report_prov: dict | None = None) -> dict:
     """The report's content model, shared by the Markdown and the HTML."""
@@ -333,7 +340,9 @@ def collect(reports_dir: str | Path, study_names: list[str] | None = None,
                              "missing": miss})
     vd = verdicts.astype(str)
     return {"version": __version__, "studies": ", ".join(study_names or []) or "-",
-            "data": headline(studies), "verdict_summary": summary_lines(verdicts),
+            "data": headline(studies) + ([RENDERED_SCENES] if "legbench_crowd" in present
+                                         else []),
+            "verdict_summary": summary_lines(verdicts),
             "verdicts": verdicts,
             "verdict_header": list(VERDICT_COLUMNS), "verdict_rows": vd.values.tolist(),
             "sections": sections, "provenance": _provenance(rd, report_prov),
