@@ -72,11 +72,6 @@ def view_arg(family: str, contents: str) -> Arg:
                   f"<method>.json): {contents}")
 
 
-def out_arg(help: str) -> Arg:
-    """``--out``: what a per-trial step writes."""
-    return A("--out", required=True, help=help)
-
-
 def eval_dirs_arg(help: str) -> Arg:
     """The positional evaluation folders a table verb reads."""
     return A("inputs", nargs="+", metavar="EVAL_DIR", help=help)
@@ -86,4 +81,4 @@ def labelled_eval_args(family: str, contents: str, out: str) -> tuple[Arg, ...]:
     """The closing arguments of an evaluation verb: subjects, trial, the method's label,
     its config view and the output folder."""
     return (SUBJECTS_ARG, TRIAL_ARG, LABEL_METHOD_ARG, view_arg(family, contents),
-            out_arg(out))
+            A("--out", required=True, help=out))

@@ -114,10 +114,12 @@ def bag_detection_entries(trials: list[dict], bag_detectors: dict[str, list[str]
         entry = {"path": f"{d}/{{trial}}.bag" if d != "." else "{trial}.bag",
                  "topic": topic, "protocols": protos}
         problem = _schema_problem("external_detections", name, entry, yaml_path)
-        _declare(out, name, entry, res.todo, f"study.yaml external_detections.{name}: "
-                 f"{problem}" if problem else None, res.notes,
-                 f"study.yaml external_detections.{name}: leg detections {topic} of the "
-                 "sensor bags, scored in the detection table")
+        if problem:
+            res.todo.append(f"study.yaml external_detections.{name}: {problem}")
+            continue
+        out[name] = entry
+        res.notes.append(f"study.yaml external_detections.{name}: leg detections "
+                         f"{topic} of the sensor bags, scored in the detection table")
     return out
 
 
@@ -132,18 +134,6 @@ def _schema_problem(section: str, name: str, entry: dict, yaml_path: Path) -> st
     except GaitvalError as exc:
         return str(exc)
     return None
-
-
-def _declare(out: dict, name: str, entry: dict, problems: list, problem: str | None,
-             notes: list, note: str) -> bool:
-    """``out[name] = entry`` with ``note`` in ``notes``, or, when ``problem``, that into
-    ``problems`` and nothing declared; True when declared."""
-    if problem:
-        problems.append(problem)
-        return False
-    out[name] = entry
-    notes.append(note)
-    return True
 
 
 def external_method_entries(trials: list[dict], files: list[Found], res: InitResult,
@@ -179,11 +169,12 @@ def external_method_entries(trials: list[dict], files: list[Found], res: InitRes
             continue
         entry = {"path": path, "protocols": protos}
         problem = _schema_problem("external_methods", name, entry, yaml_path)
-        if not _declare(out, name, entry, res.unpaired, f"{parent}/*{suffix}: not declared "
-                        f"({problem})" if problem else None, res.notes,
-                        f"study.yaml external_methods.{name}: {path} "
-                        f"({', '.join(protos)} trials)"):
+        if problem:
+            res.unpaired.append(f"{parent}/*{suffix}: not declared ({problem})")
             continue
+        out[name] = entry
+        res.notes.append(f"study.yaml external_methods.{name}: {path} "
+                         f"({', '.join(protos)} trials)")
         if missing:
             res.todo.append(f"study.yaml external_methods.{name}: no file for trial(s) "
                             f"{', '.join(missing[:5])}{' ...' if len(missing) > 5 else ''} "

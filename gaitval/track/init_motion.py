@@ -130,10 +130,9 @@ class MotionCheck:
 
 
 class Background:
-    """Places observed again and again.
-
-    ``occupied(k, z)``: an observation lies within ``radius_m`` of ``z`` in at least
-    ``fraction`` of the scans ``k - window .. k + window``.  The scans are held as one
+    """Places observed again and again: an observation lies within ``radius_m`` of a
+    position in at least ``fraction`` of the scans ``k - window .. k + window`` (the test is
+    :func:`gaitval.track.init_motion_kernel._occupied`).  The scans are held as one
     padded ``(n, J_max, 2)`` array ``P`` (padding far from everything) with ``sizes``, the
     layout the compiled follow (:mod:`gaitval.track.init_motion_kernel`) reads.
     """
@@ -146,9 +145,3 @@ class Background:
         self.P = np.full((self.n, max(jmax, 1), 2), 1e9)
         if jmax:
             self.P[np.arange(jmax)[None, :] < self.sizes[:, None]] = np.concatenate(arrays)
-
-    def occupied(self, k: int, z) -> bool:
-        from gaitval.track.init_motion_kernel import _occupied
-
-        return bool(_occupied(self.P, self.sizes, int(k), float(z[0]), float(z[1]), self.r,
-                              self.window, self.fraction))
