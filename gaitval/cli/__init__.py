@@ -5,9 +5,9 @@ files; a data error prints one line ``gaitval: error: ...`` naming the file, the
 the problem, and exits with status 1; a usage error exits with 2
 (:mod:`gaitval.cli_exit`).  ``-v``/``-q`` before or after the verb: more or less progress.
 
-The verbs are one table, :data:`VERBS` (name, handler, help, arguments;
-:class:`gaitval.cli.table.Verb`), gathered from the modules of this package by concern:
-a study's inputs and the report (:mod:`.study`), the laser range sensor studies
+The verbs are one table, ``gaitval/cli/verbs.toml`` (name, handler, help, arguments;
+read by :mod:`gaitval.cli.table`); their handlers live in the modules of this package by
+concern: a study's inputs and the report (:mod:`.study`), the laser range sensor studies
 (:mod:`.lrs`), the ultrasonic study (:mod:`.feet`), the MTST and rollator studies
 (:mod:`.mtst_rollator`) and the workflow's jobs (:mod:`.jobs`).  Every verb is dispatched
 the same way: ``handler(args)`` returns the exit code.
@@ -18,17 +18,13 @@ import argparse
 import functools
 import sys
 
-from gaitval.cli import feet, jobs, lrs, mtst_rollator, study
 from gaitval.cli.jobs import run_verbs  # noqa: F401  (a batch task: gaitval.cli.run_verbs)
-from gaitval.cli.table import Verb
-
-#: every verb, in pipeline order (the order of ``gaitval --help``)
-VERBS: tuple[Verb, ...] = (study.VERBS + lrs.VERBS + feet.VERBS + mtst_rollator.VERBS
-                           + jobs.STAGE_VERBS + lrs.LEGBENCH + jobs.FIGURES + study.LAST)
+from gaitval.cli.table import add_verbs, read_table
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The ``gaitval`` argument parser: one sub-command per entry of :data:`VERBS`."""
+    """The ``gaitval`` argument parser: one sub-command per verb of the verb table
+    (``gaitval/cli/verbs.toml``)."""
     from gaitval import __version__
     from gaitval.cli_exit import add_verbosity
 
@@ -40,12 +36,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"gaitval {__version__}")
     sub = p.add_subparsers(dest="verb", required=True, metavar="VERB",
                            title="verbs (in pipeline order)")
-    for verb in VERBS:
-        # `gaitval VERB --help` opens with what the verb does
-        s = sub.add_parser(verb.name, help=verb.help, description=verb.help)
-        for arg in verb.args:
-            s.add_argument(*arg.flags, **arg.options)
-        s.set_defaults(func=verb.handler)
+    add_verbs(sub, read_table())
     add_verbosity(p, sub)
     return p
 

@@ -4,9 +4,6 @@ from __future__ import annotations
 
 import sys
 
-from gaitval.cli.table import A, Verb
-from gaitval.jobs.stages import OPTIONS, STAGES
-
 
 def run_verbs(argvs: list[list[str]]) -> None:
     """A batch task (gaitval.jobs.batch): gaitval verbs one after the other, each as
@@ -51,40 +48,3 @@ def cmd_stage(a) -> int:
         preload(a.verb)
     run_batch(tasks, a.threads, a.log)
     return 0
-
-
-def cmd_paper_figures(a) -> int:
-    from gaitval.pipeline.paper_figures import paper_figures_step
-    paper_figures_step(a.protocol, a.results, a.figures_dir, a.reports_dir, a.config_hash,
-                       a.config, a.sheet, a.subjects)
-    return 0
-
-
-#: the stage verbs, every one with the options of :data:`gaitval.jobs.stages.OPTIONS`
-STAGE_VERBS = tuple(
-    Verb(name, cmd_stage, f"{text} (a workflow job: the per-trial verbs in a pool of "
-         "--threads processes)",
-         *(A(f"--{opt.replace('_', '-')}", **kw) for opt, kw in OPTIONS.items()))
-    for name, (_, text) in STAGES.items())
-
-FIGURES = (
-    Verb("paper-figures", cmd_paper_figures,
-         "the papers' example figures of one protocol (Yorozu et al. 2015a Figs. "
-         "12-13, Yorozu et al. 2015b Figs. 6a, 8, 9, Chalvatzaki et al. 2017 Fig. 5, "
-         "Qi et al. 2014 Figs. 2-4) from a run's results",
-         A("protocol", choices=["tug", "mtst", "rollator", "ultrasonic"],
-           help="which paper's figures: tug, mtst, rollator, ultrasonic"),
-         A("--results", nargs="+", required=True, metavar="DIR",
-           help="results/<study> folders; the first with the protocol's results is "
-                "drawn"),
-         A("--config",
-           help="a study config view (mtst: the mtst section; ultrasonic: its strides "
-                "and symmetry window)"),
-         A("--sheet",
-           help="the study's trial sheet (with --subjects: the leg widths of the TUG "
-                "and MTST snapshots' observations)"),
-         A("--subjects", help="the study's subject table"),
-         A("--figures-dir", required=True, help="where the PNGs go"),
-         A("--reports-dir", default="reports", help="the report folder (provenance)"),
-         A("--config-hash", default="", help="recorded in the provenance")),
-)

@@ -1,84 +1,92 @@
-"""The shape of a verb: name, handler, help and arguments (one entry of a ``VERBS`` table),
-and the help texts several verbs share (the paths are those the workflow passes,
-workflow/rules/)."""
+"""The verb table, ``gaitval/cli/verbs.toml``, read into argparse.
+
+The table lists every verb in pipeline order: its name, what it runs, its help and its
+arguments.  What it runs is either ``handler`` (``module:function`` in this package,
+called with the parsed arguments) or, for a verb that only passes its arguments on,
+``step`` (``module:function`` in gaitval) with ``call``, the arguments in the step's
+order (``"name"``: positional; ``"key=name"``: keyword ``key``, ``"key="`` when both are
+the same); either module is imported when the verb runs.  Each argument is written as
+``add_argument(*flags, **keywords)`` would take it (``type``: ``path``, ``float`` or
+``int``).  An argument several verbs share is written once under ``[args.NAME]`` and
+named by a verb as ``use = "NAME"``.  ``stages = true`` stands for the workflow's stage
+verbs, one per :data:`gaitval.jobs.stages.STAGES` entry with the options of
+:data:`gaitval.jobs.stages.OPTIONS`."""
 from __future__ import annotations
 
+import argparse
+import tomllib
 from dataclasses import dataclass
-from typing import Callable
+from importlib import import_module
+from pathlib import Path
+
+#: the table
+TABLE = Path(__file__).with_name("verbs.toml")
+#: the table's ``type`` names
+TYPES = {"path": Path, "float": float, "int": int}
 
 
 @dataclass(frozen=True)
-class Arg:
-    """One argument: ``add_argument(*flags, **options)``."""
+class Handler:
+    """A verb's handler, ``gaitval.cli.<module>.<function>(args)`` returning the exit
+    code; the module is imported when the verb runs, not when the parser is built."""
 
-    flags: tuple[str, ...]
-    options: dict
+    ref: str
 
-
-def A(*flags: str, **options) -> Arg:
-    return Arg(flags, options)
+    def __call__(self, args: argparse.Namespace) -> int:
+        return _resolve(f"gaitval.cli.{self.ref}")(args)
 
 
 @dataclass(frozen=True)
-class Verb:
-    """``gaitval NAME``: ``handler(args)`` returns the exit code; ``help`` opens its
-    ``--help`` and is its line in ``gaitval --help``."""
+class Step:
+    """A verb that passes its arguments on: ``gaitval.<module>.<function>`` called with
+    ``call``'s arguments in order (``"name"`` positional, ``"key=name"`` keyword); exit
+    code 0 when it returns."""
 
-    name: str
-    handler: Callable[..., int]
-    help: str
-    args: tuple[Arg, ...]
+    ref: str
+    call: tuple[str, ...]
 
-    def __init__(self, name, handler, help, *args):
-        object.__setattr__(self, "name", name)
-        object.__setattr__(self, "handler", handler)
-        object.__setattr__(self, "help", help)
-        object.__setattr__(self, "args", args)
-
-
-SHEET = ("the study's trial sheet, trials.csv (data/<study>/trials.csv for a simulated "
-         "study; docs/formats.md, Trial sheet)")
-SUBJECTS = "the study's subject table, subjects.csv (leg width, height; docs/formats.md)"
-TRIAL = "trial id: a row of the trial sheet (named in errors and outputs)"
-REPORTS = ("the report folder (reports/<run> in the workflow): the step's provenance record "
-           "goes to its provenance/ (default: reports)")
-HASH = "the run's config hash, written into the provenance record (default: empty)"
-TABLES = "folder the tables go to, each as .csv, .md, .tex (reports/<run>/tables)"
-FIGURES = "folder the figures go to, PNG (reports/<run>/figures)"
-
-#: the arguments several verbs share
-SHEET_ARG = A("--sheet", required=True, help=SHEET)
-SUBJECTS_ARG = A("--subjects", required=True, help=SUBJECTS)
-TRIAL_ARG = A("--trial", required=True, help=TRIAL)
-REPORTS_ARG = A("--reports-dir", default="reports", help=REPORTS)
-HASH_ARG = A("--config-hash", default="", help=HASH)
-TABLES_ARG = A("--tables-dir", required=True, help=TABLES)
-FIGURES_ARG = A("--figures-dir", required=True, help=FIGURES)
-#: one LRS trial's ingested scan log, the input of its per-trial steps
-SCAN_LOG_ARG = A("--sensor", required=True,
-                 help="the trial's ingested scan log "
-                      "(results/<study>/ingest/<trial>/sensor.parquet)")
-#: a method's name where it only labels the rows of the tables
-LABEL_METHOD_ARG = A("--method", required=True,
-                     help="the method's name (its label in the tables)")
-#: the arguments closing a table verb: provenance, config hash, where tables and figures go
-TABLE_OUTPUT_ARGS = (REPORTS_ARG, HASH_ARG, TABLES_ARG, FIGURES_ARG)
+    def __call__(self, args: argparse.Namespace) -> int:
+        pos = [getattr(args, c) for c in self.call if "=" not in c]
+        kw = {k: getattr(args, v or k)
+              for k, _, v in (c.partition("=") for c in self.call if "=" in c)}
+        _resolve(f"gaitval.{self.ref}")(*pos, **kw)
+        return 0
 
 
-def view_arg(family: str, contents: str) -> Arg:
-    """``--config``: the method's config view of a per-trial step of ``family``."""
-    return A("--config", required=True,
-             help=f"the method's config view (results/<study>/config_views/{family}/"
-                  f"<method>.json): {contents}")
+def _resolve(ref: str):
+    module, name = ref.split(":")
+    return getattr(import_module(module), name)
 
 
-def eval_dirs_arg(help: str) -> Arg:
-    """The positional evaluation folders a table verb reads."""
-    return A("inputs", nargs="+", metavar="EVAL_DIR", help=help)
+def read_table(path: Path = TABLE) -> dict:
+    """The verb table as a dict: ``args`` (the shared arguments) and ``verbs``."""
+    with open(path, "rb") as f:
+        return tomllib.load(f)
 
 
-def labelled_eval_args(family: str, contents: str, out: str) -> tuple[Arg, ...]:
-    """The closing arguments of an evaluation verb: subjects, trial, the method's label,
-    its config view and the output folder."""
-    return (SUBJECTS_ARG, TRIAL_ARG, LABEL_METHOD_ARG, view_arg(family, contents),
-            A("--out", required=True, help=out))
+def add_verbs(sub: argparse._SubParsersAction, table: dict) -> None:
+    """One sub-parser per verb of ``table``; ``gaitval VERB --help`` opens with what the
+    verb does (its help)."""
+    from gaitval.jobs.stages import OPTIONS, STAGES
+
+    for verb in table["verbs"]:
+        if verb.get("stages"):
+            for name, (_, text) in STAGES.items():
+                s = sub.add_parser(name, help=_stage_help(text), description=_stage_help(text))
+                for opt, kw in OPTIONS.items():
+                    s.add_argument(f"--{opt.replace('_', '-')}", **kw)
+                s.set_defaults(func=Handler("jobs:cmd_stage"))
+            continue
+        s = sub.add_parser(verb["name"], help=verb["help"], description=verb["help"])
+        for arg in verb.get("args", ()):
+            spec = dict(table["args"][arg["use"]] if "use" in arg else arg)
+            flags = spec.pop("flags")
+            if "type" in spec:
+                spec["type"] = TYPES[spec["type"]]
+            s.add_argument(*flags, **spec)
+        s.set_defaults(func=Handler(verb["handler"]) if "handler" in verb
+                       else Step(verb["step"], tuple(verb["call"])))
+
+
+def _stage_help(text: str) -> str:
+    return f"{text} (a workflow job: the per-trial verbs in a pool of --threads processes)"

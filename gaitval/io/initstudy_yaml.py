@@ -113,26 +113,27 @@ def bag_detection_entries(trials: list[dict], bag_detectors: dict[str, list[str]
         name = "det_" + (_ID_BAD.sub("_", topic.strip("/")) or "bag")
         entry = {"path": f"{d}/{{trial}}.bag" if d != "." else "{trial}.bag",
                  "topic": topic, "protocols": protos}
-        problem = _schema_problem("external_detections", name, entry, yaml_path)
+        problem = _add_checked(out, "external_detections", name, entry, yaml_path)
         if problem:
             res.todo.append(f"study.yaml external_detections.{name}: {problem}")
-            continue
-        out[name] = entry
-        res.notes.append(f"study.yaml external_detections.{name}: leg detections "
-                         f"{topic} of the sensor bags, scored in the detection table")
+        else:
+            res.notes.append(f"study.yaml external_detections.{name}: leg detections "
+                             f"{topic} of the sensor bags, scored in the detection table")
     return out
 
 
-def _schema_problem(section: str, name: str, entry: dict, yaml_path: Path) -> str | None:
-    """What is wrong with study.yaml's ``section: {name: entry}`` by the schema a
-    hand-written entry is checked against (:func:`gaitval.configcheck.check_study_file`),
-    or None."""
+def _add_checked(out: dict, section: str, name: str, entry: dict,
+                 yaml_path: Path) -> str | None:
+    """``out[name] = entry`` when study.yaml's ``section: {name: entry}`` passes the schema
+    a hand-written entry is checked against (:func:`gaitval.configcheck.check_study_file`);
+    otherwise what is wrong with it (``out`` unchanged)."""
     from gaitval.configcheck import check_study_file
 
     try:
         check_study_file({section: {name: entry}}, yaml_path)
     except GaitvalError as exc:
         return str(exc)
+    out[name] = entry
     return None
 
 
@@ -168,11 +169,10 @@ def external_method_entries(trials: list[dict], files: list[Found], res: InitRes
         if not protos:
             continue
         entry = {"path": path, "protocols": protos}
-        problem = _schema_problem("external_methods", name, entry, yaml_path)
+        problem = _add_checked(out, "external_methods", name, entry, yaml_path)
         if problem:
             res.unpaired.append(f"{parent}/*{suffix}: not declared ({problem})")
             continue
-        out[name] = entry
         res.notes.append(f"study.yaml external_methods.{name}: {path} "
                          f"({', '.join(protos)} trials)")
         if missing:
