@@ -34,7 +34,6 @@ import numpy as np
 
 from gaitval import methods as M
 from gaitval.track import peoplepass as pp
-from gaitval.track.lifecycle import TENTATIVE
 
 REAL = Path(__file__).resolve().parents[1] / ".." / "shared" / "realdata" / "lrs"
 _associate = pp.PeoplePass.associate
@@ -44,14 +43,8 @@ def _reacquire(run) -> None:
     """The pass's association, then the other leg of a half-seen tentative person."""
     _associate(run)
     lo, hi = 0.7 * run.w, 0.8
-    for p in run.persons:
-        if p.status != TENTATIVE:
-            continue
-        a = [run.assigned.get((id(p), f)) for f in (0, 1)]
-        if (a[0] is None) == (a[1] is None):
-            continue
-        seen = 0 if a[0] is not None else 1
-        zx, zy = run.obs[a[seen]]
+    for p, seen in run.half_seen():
+        zx, zy = run.obs[run.assigned[(id(p), seen)]]
         px, py = p.prior[1 - seen][0], p.prior[1 - seen][1]
         free = [j for j, (ox, oy) in enumerate(run.obs)
                 if not (run.taken[j] or run.explained[j] or run.static[j])

@@ -18,6 +18,7 @@ The confirmer is handed to the tracker as a built part, not registered: no metho
 from __future__ import annotations
 
 import copy
+import copy
 import math
 
 from gaitval.track.lifecycle import Confirmer
@@ -84,8 +85,7 @@ class LegTravel(Confirmer):
         self._motion = None
 
     def bind(self, dt, leg_width_m: float = 0.10):
-        out = LegTravel(self.min_travel_m, self.min_step_m, self.std_obs_m, self.p0,
-                        self.process_std_per_s, self.percentile, self.assoc_extra_m)
+        out = copy.copy(self)          # the declared values; dt for this run
         out.dt = float(dt)
         return out
 

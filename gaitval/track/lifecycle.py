@@ -63,8 +63,10 @@ deletion defaults).
 """
 from __future__ import annotations
 
+import copy
 import math
 from collections import deque
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -206,6 +208,7 @@ class Confirmer:
 
 
 @CONFIRMERS.register("m_of_n_moving")
+@dataclass(eq=False)
 class MOfNMoving(Confirmer):
     """M of N scans with both legs observed and a leg pair that walks (module notes).
 
@@ -253,32 +256,29 @@ class MOfNMoving(Confirmer):
         not asked.
     """
 
-    def __init__(self, window_s: float = 1.4, m_fraction: float = 0.5,
-                 min_relative_travel_m: float = 0.5, pass_leg_widths: float = 1.0,
-                 min_travel_m: float = 0.0, evidence: str = "estimates",
-                 walk_suffices: bool = False, separate_legs: bool = False,
-                 min_apart_leg_widths: float = 0.0):
-        self.min_apart_leg_widths = float(min_apart_leg_widths)
-        self.walk_suffices = bool(walk_suffices)
-        self.separate_legs = bool(separate_legs)
-        if evidence not in ("estimates", "observations"):
+    window_s: float = 1.4
+    m_fraction: float = 0.5
+    min_relative_travel_m: float = 0.5
+    pass_leg_widths: float = 1.0
+    min_travel_m: float = 0.0
+    evidence: str = "estimates"
+    walk_suffices: bool = False
+    separate_legs: bool = False
+    min_apart_leg_widths: float = 0.0
+    # bound to a run (bind): the window in scans, M of it, the leg width
+    n: int = field(default=1, init=False)
+    m: int = field(default=1, init=False)
+    leg_width_m: float = field(default=0.10, init=False)
+
+    def __post_init__(self):
+        self.min_apart_leg_widths = float(self.min_apart_leg_widths)
+        self.walk_suffices, self.separate_legs = bool(self.walk_suffices), bool(self.separate_legs)
+        if self.evidence not in ("estimates", "observations"):
             raise ValueError(f"m_of_n_moving: evidence must be 'estimates' or "
-                             f"'observations', not {evidence!r}")
-        self.evidence = evidence
-        self.window_s = window_s
-        self.m_fraction = m_fraction
-        self.min_relative_travel_m = min_relative_travel_m
-        self.pass_leg_widths = pass_leg_widths
-        self.min_travel_m = min_travel_m
-        self.n = 1
-        self.m = 1
-        self.leg_width_m = 0.10
+                             f"'observations', not {self.evidence!r}")
 
     def bind(self, dt, leg_width_m: float = 0.10):
-        out = MOfNMoving(self.window_s, self.m_fraction, self.min_relative_travel_m,
-                         self.pass_leg_widths, self.min_travel_m, self.evidence,
-                         self.walk_suffices, self.separate_legs,
-                         self.min_apart_leg_widths)
+        out = copy.copy(self)          # the declared values; n, m, w_l for this run
         out.n = max(1, int(round(self.window_s / dt)))
         out.m = max(1, math.ceil(self.m_fraction * out.n))
         out.leg_width_m = leg_width_m

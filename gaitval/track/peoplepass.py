@@ -251,6 +251,16 @@ class PeoplePass:
         if self.tk_.pair_swing_mps is not None:
             self._pair_swing()
 
+    def half_seen(self):
+        """(person, seen leg) of each tentative person with exactly one leg assigned an
+        observation on this scan."""
+        for p in self.persons:
+            if p.status != TENTATIVE:
+                continue
+            a = [self.assigned.get((id(p), f)) is not None for f in (0, 1)]
+            if a[0] != a[1]:
+                yield p, 0 if a[0] else 1
+
     def _pair_swing(self) -> None:
         """The pair rule (docs/people.md): a tentative person with one leg assigned takes,
         for its other leg, a free observation that a swinging leg can have reached while
@@ -265,14 +275,8 @@ class PeoplePass:
         v = self.tk_.pair_swing_mps
         stay = STAND_LEG_WIDTHS * self.w + self.dt * STAND_MPS
         young = getattr(self.confirmer, "n", None)
-        for p in self.persons:
-            if p.status != TENTATIVE:
-                continue
-            a = [self.assigned.get((id(p), f)) for f in (0, 1)]
-            if (a[0] is None) == (a[1] is None):
-                continue
-            seen = 0 if a[0] is not None else 1
-            zx, zy = self.obs[a[seen]]
+        for p, seen in self.half_seen():
+            zx, zy = self.obs[self.assigned[(id(p), seen)]]
             sx, sy = p.prior[seen][0], p.prior[seen][1]
             if p.n_unobs[seen] > 0 or math.hypot(zx - sx, zy - sy) > stay:
                 continue                # the seen leg was not seen standing there
