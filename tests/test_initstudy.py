@@ -461,7 +461,7 @@ def test_a_tracker_recorded_in_the_sensor_bags_is_offered_commented(tiny_files, 
 
 def test_heel_trajectories_named_by_trial_become_a_treadmill_method(tiny_files, tmp_path):
     """A foot-tracking system's *.foot.csv beside treadmill recordings: init-study declares
-    it with protocols [treadmill] (docs/formats.md, Foot trajectories)."""
+    it with protocols [treadmill] (docs/formats_external.md, Foot trajectories)."""
     from gaitval.io.foot import write_foot
 
     lab = tmp_path / "lab"

@@ -1,4 +1,4 @@
-"""Issue 37: another system's heel trajectory (gaitval/io/foot.py, docs/formats.md "Foot
+"""Issue 37: another system's heel trajectory (gaitval/io/foot.py, docs/formats_external.md "Foot
 trajectories"): an exact round trip, the header's units and third-clock offset, one clear
 error per kind of bad file, and a declaration that mixes the treadmill with leg
 protocols refused."""

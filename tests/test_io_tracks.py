@@ -1,4 +1,4 @@
-"""Issue 37: the leg-track exchange format (gaitval/io/tracks/, docs/formats.md "Leg
+"""Issue 37: the leg-track exchange format (gaitval/io/tracks/, docs/formats_external.md "Leg
 tracks"): exact round trips of gaitval's own tracks, the clock and frame conversion, and one
 clear error per kind of bad file."""
 from __future__ import annotations

@@ -102,7 +102,7 @@ def legarray_bag(path: Path, rows: pd.DataFrame, scan_t) -> Path:
 
 def to_mocap(rows: pd.DataFrame, reg: dict) -> pd.DataFrame:
     """Sensor-frame, sensor-clock rows in the mocap field and on the mocap clock (the
-    inverse of docs/formats.md's conversion)."""
+    inverse of docs/formats_external.md's conversion)."""
     c, s = math.cos(reg["yaw_rad"]), math.sin(reg["yaw_rad"])
     drift = 1.0 + float(reg.get("clock_drift_ppm") or 0.0) * 1e-6
     return pd.DataFrame({"t_s": (rows["t_s"] - reg["clock_offset_s"]) / drift,

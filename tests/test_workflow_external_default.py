@@ -207,7 +207,7 @@ def test_person_array_bag_has_tug_m2s_tracking_results_not_its_occlusion(default
     in this study, the one failure that reads the swing flags a bag lacks -- the success
     trials, and Table 4's steps and RMSEs per TUG phase.  The occlusion count does not:
     the bag gives a position wherever leg_tracker had a track and says nothing of where
-    the laser saw the leg (docs/formats.md, From a ROS bag)."""
+    the laser saw the leg (docs/formats_external.md, From a ROS bag)."""
     work, _ = default_ext
     t3 = _table(work, "tug_table3")
     a, b = _rows(t3, "tug_m2"), _rows(t3, "ext_bag")

@@ -7,7 +7,7 @@ previous scan.  gaitval does not pair them into left and right tracks — that p
 be a tracker (gaitval's, not the external system's), and its errors would be charged to
 the detector — so they enter none of the protocol tables (which score tracks: success,
 identity swaps, RMSE of a leg's track).  They are scored as what they are, a detector's
-output, scan by scan (docs/formats.md, *Leg detections*):
+output, scan by scan (docs/formats_external.md, *Leg detections*):
 
 * each scan with a detection message and both mocap legs known (``valid``) is matched
   one-to-one, detections to the two legs, minimising the summed distance

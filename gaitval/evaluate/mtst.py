@@ -63,7 +63,7 @@ def check_annotations(ann: pd.DataFrame, *, path, trial: str) -> None:
     if bad:
         raise FileFormatError(f"unknown annotation event type(s) {bad}; an MTST annotation "
                               f"file holds only {', '.join(EVENTS)}", path=path, trial=trial,
-                              hint="see docs/formats.md, rater annotations")
+                              hint="see docs/formats_recordings.md, rater annotations")
     ts = ann[ann["event"] == "target_step"]
     odd = ts[~ts["value"].isin(["hit", "miss"])]
     if len(odd):

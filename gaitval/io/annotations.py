@@ -1,6 +1,6 @@
 """Rater annotations (``*.annotations.csv``): events scored by a person from video.
 
-Format (version 1), documented in full in ``docs/formats.md``
+Format (version 1), documented in full in ``docs/formats_recordings.md``
 ------------------------------------------------------------
 A UTF-8 CSV file.  Leading lines starting with ``#`` are ``key: value`` metadata; the
 first must be ``# gaitval-annotations v1``.  Recognised keys:
@@ -80,11 +80,11 @@ def _read_annotations(path: Path, trial: str | None) -> tuple[pd.DataFrame, dict
     except UnicodeDecodeError as exc:
         raise FileFormatError(f"not UTF-8 text (byte 0x{exc.object[exc.start]:02X} at "
                               f"position {exc.start})", path=path, trial=trial,
-                              hint="save it as CSV (UTF-8); see docs/formats.md") from None
+                              hint="save it as CSV (UTF-8); see docs/formats_recordings.md") from None
     lines = text.splitlines()
     if not lines or lines[0].strip() != MAGIC:
         raise FileFormatError(f"first line must be '{MAGIC}'", path=path, trial=trial,
-                              hint="see docs/formats.md")
+                              hint="see docs/formats_recordings.md")
     meta: dict[str, str] = {}
     n_head = 0
     for line in lines:

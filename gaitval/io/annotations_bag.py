@@ -12,7 +12,7 @@ Bag topic (:func:`read_bag_annotations`)
 CSV (:func:`read_position_csv`)
     ``# gaitval-positions v1`` on the first line, then columns ``t_s, x_m, y_m, id`` and an
     optional ``frame``: ``t_s`` on the sensor clock (the scans' header stamps), positions in
-    metres in the laser frame (docs/formats.md).
+    metres in the laser frame (docs/formats_recordings.md).
 
 Which scan an annotation belongs to (bag topics)
     The leg_tracker annotation tool (angusleigh/leg_tracker_benchmarks,
@@ -241,7 +241,7 @@ def read_position_csv(path: str | Path, *, trial: str | None = None) -> pd.DataF
     lines = text.splitlines()
     if not lines or lines[0].strip() != POSITIONS_MAGIC:
         raise FileFormatError(f"first line must be '{POSITIONS_MAGIC}'", path=path,
-                              trial=trial, hint="see docs/formats.md")
+                              trial=trial, hint="see docs/formats_recordings.md")
     body = "\n".join(ln for ln in lines[1:] if not ln.startswith("#"))
     try:
         df = pd.read_csv(io.StringIO(body), dtype={"id": str, "frame": str},

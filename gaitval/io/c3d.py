@@ -10,7 +10,7 @@ ezc3d opens a file :mod:`gaitval.io.c3d_format` (header, data size) and
 gaitval.  Their public names are re-exported here,
 so ``from gaitval.io.c3d import read_c3d, write_c3d`` is the way to use them.
 
-Conventions (also in ``docs/formats.md``)
+Conventions (also in ``docs/formats_recordings.md``)
 -----------------------------------------
 Units
     ``POINT:UNITS`` ``mm``, ``cm`` or ``m`` is converted to metres.  A file without

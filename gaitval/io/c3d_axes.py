@@ -1,7 +1,7 @@
 """Which axis of a C3D file points up, read from the markers themselves.
 
 Part of :mod:`gaitval.io.c3d`.  gaitval's field frame has z up and the floor at z = 0
-(``docs/formats.md``), but some labs export y up (OpenSim, some Motion Analysis set-ups);
+(``docs/formats_recordings.md``), but some labs export y up (OpenSim, some Motion Analysis set-ups);
 read as z-up, such a walk leaves every leg point below the sensor's plane and ground truth
 finds no valid frame, silently.  C3D has no reliable field for it (``POINT:X_SCREEN`` /
 ``Y_SCREEN`` describe the display, and are often left at their defaults), so

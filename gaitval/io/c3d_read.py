@@ -200,7 +200,7 @@ def read_c3d(path: str | Path, *, trial: str | None = None, duplicates: str = "s
     Notes
     -----
     The conventions (units, gaps, prefixes, duplicates, first frame, events) are in the
-    module docstring and ``docs/formats.md``.
+    module docstring and ``docs/formats_recordings.md``.
     """
     path = Path(path)
     if duplicates not in ("suffix", "error"):

@@ -3,7 +3,7 @@
 The treadmill protocol (seed 003) validates a foot-mounted system's 3-D trajectory of one
 heel against the heel marker, stride by stride.  Another system's heel trajectory (a
 vendor's ultrasonic or inertial system, a depth camera's) enters the same gait-parameter
-extraction and agreement statistics through this format (issue 37; docs/formats.md,
+extraction and agreement statistics through this format (issue 37; docs/formats_external.md,
 section *Foot trajectories*): one row per time stamp, columns ``t_s``, ``x``, ``y``,
 ``z``.  The header is that of the leg-track format (:mod:`gaitval.io.tracks`): ``units``
 (``m``/``mm``), ``frame`` (``sensor``: the ultrasonic receivers' frame, that of the

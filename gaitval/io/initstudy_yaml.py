@@ -15,7 +15,7 @@ from gaitval.io.initstudy_files import _ID_BAD, FILL_IN, Found, InitResult
 
 
 #: the protocols an external file of each kind can cover (leg tracks: a fixed or moving
-#: laser; heel trajectories: the treadmill, docs/formats.md "Foot trajectories")
+#: laser; heel trajectories: the treadmill, docs/formats_external.md "Foot trajectories")
 EXTERNAL_KINDS = {"tracks": {"tug", "mtst", "rollator"}, "foot": {"treadmill"}}
 
 
@@ -57,14 +57,14 @@ def study_yaml_text(trials: list[dict], files: list[Found], res: InitResult,
     body = yaml.safe_dump(doc, sort_keys=True) if doc else ""
     tail = []
     if bag_lines:
-        tail += ["# A tracker recorded in the sensor bags (docs/formats.md, 'External "
+        tail += ["# A tracker recorded in the sensor bags (docs/formats_external.md, 'External "
                  "methods'):", "# to validate it, fill in each leg's person id and "
                  "uncomment its entry"]
         tail += ["# external_methods:"] * (not external) + list(bag_lines)
     tracks = sorted({f.rel for f in files if f.kind == "tracks"})
     if tracks and not external:
         tail += ["# External trackers' tracks were found, not named by trial ids "
-                 "(docs/formats.md, 'External methods'); declare each as a method, e.g.",
+                 "(docs/formats_external.md, 'External methods'); declare each as a method, e.g.",
                  "# external_methods:",
                  f"#   my_tracker: {{path: \"{tracks[0]}\"}}   # {{trial}} for the trial id"]
     return "\n".join(lines) + "\n" + body + "".join(f"{t}\n" for t in tail)
@@ -142,7 +142,7 @@ def external_method_entries(trials: list[dict], files: list[Found], res: InitRes
     """External trackers' files (``<folder>/<trial>.tracks.csv`` or ``.parquet``, and
     foot-tracking systems' ``<folder>/<trial>.foot.csv`` or ``.parquet``): one method per
     folder and suffix whose files are named by trial ids, named after the folder; its
-    protocols those of its trials (:data:`EXTERNAL_KINDS`) (docs/formats.md, *External methods*): the
+    protocols those of its trials (:data:`EXTERNAL_KINDS`) (docs/formats_external.md, *External methods*): the
     study.yaml's ``external_methods:``, each entry checked against the schema a
     hand-written one is (:func:`gaitval.configcheck.check_study_file`)."""
     proto = {r["trial"]: r.get("protocol") for r in trials}

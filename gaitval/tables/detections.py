@@ -1,7 +1,7 @@
 """The detection table: external leg *detectors* scored per scan against the mocap legs.
 
 A detector's output (leg_tracker's ``/detected_leg_clusters``, ``leg_tracker/LegArray``, or
-a ``*.detections.csv``; docs/formats.md, *Leg detections*) has no identity and no side, so
+a ``*.detections.csv``; docs/formats_external.md, *Leg detections*) has no identity and no side, so
 it is no track and gets no row in the protocol tables (TUG Tables 3–5, MTST Tables 3–4,
 rollator Tables I–II score tracks: success, swaps, a leg's RMSE).  This table scores it as
 what it is (:func:`gaitval.evaluate.leg_detections.detection_statistics`, run per trial by

@@ -109,7 +109,7 @@ def _check_external(cfg):
             raise ConfigError(f"[file {display_path(cal)}] tracking.external: a study "
                               "declares its external methods under external_methods: "
                               "(tracking.external is declared in the workflow config, a "
-                              "--configfile; docs/formats.md, Leg tracks)")
+                              "--configfile; docs/formats_external.md, Leg tracks)")
     per_study = external_declarations(config_external, sheets, names)
     for study, entries in per_study.items():
         where = declared_in(sheets[study], "external_methods")

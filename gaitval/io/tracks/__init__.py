@@ -2,7 +2,7 @@
 
 Any tracker's output — gaitval's own (``gaitval export-tracks``), a vendor's export, a
 ROS node's topics converted — enters gaitval's tables through this one format
-(issue 37; docs/formats.md, section *Leg tracks*).  One row per time stamp and leg
+(issue 37; docs/formats_external.md, section *Leg tracks*).  One row per time stamp and leg
 (``side`` ``L``/``R``) or, for a tracker that gives only people, per time stamp and
 person (``person``).  Positions ``x``, ``y`` (velocities ``vx``, ``vy``) are in the
 header's ``units`` (``m`` or ``mm``; per second for velocities) and ``frame`` (``sensor``:

@@ -1,4 +1,4 @@
-"""Leg detections without identity as a file (docs/formats.md, "Leg detections"):
+"""Leg detections without identity as a file (docs/formats_external.md, "Leg detections"):
 ``*.detections.csv`` and ``*.detections.parquet``.
 """
 from __future__ import annotations

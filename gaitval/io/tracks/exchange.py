@@ -1,4 +1,4 @@
-"""The exchange format's header and columns (docs/formats.md, *Leg tracks*), shared by leg
+"""The exchange format's header and columns (docs/formats_external.md, *Leg tracks*), shared by leg
 tracks, leg detections (:mod:`gaitval.io.tracks.detections`) and heel trajectories
 (:mod:`gaitval.io.foot`): the header checked, the columns read from CSV or Parquet and
 parsed, each problem naming the file, the field or column and the row.

@@ -1,6 +1,6 @@
 """Exchange rows into gaitval's per-scan track (and detections onto the scans): the clock and
 frame conversion with the trial's registration, time stamps snapped to the scans, the
-columns a file lacks filled as docs/formats.md says.
+columns a file lacks filled as docs/formats_external.md says.
 """
 from __future__ import annotations
 
@@ -100,7 +100,7 @@ def tracks_to_sensor(rows: pd.DataFrame, meta: dict, registration: dict | None =
     -------
     DataFrame
         :data:`.TRACK_COLUMNS`, sorted by time and side, on the sensor clock in the sensor
-        frame.  Columns the file lacks are filled as docs/formats.md says: ``k`` = the
+        frame.  Columns the file lacks are filled as docs/formats_external.md says: ``k`` = the
         index of the time stamp, velocities by central differences, ``observed`` = a
         position is given, ``interpolated`` false, ``pattern`` ``UO`` where not observed
         (else empty), ``phase`` −1, ``swing`` from the speed (hysteresis between
@@ -174,7 +174,7 @@ def _sensor_positions(rows: pd.DataFrame, meta: dict, reg: dict) -> tuple:
 
 
 def _fill_track_columns(df: pd.DataFrame, scan_t, *, has_v: bool) -> pd.DataFrame:
-    """The per-scan track's columns a file lacks, filled as docs/formats.md says
+    """The per-scan track's columns a file lacks, filled as docs/formats_external.md says
     (:func:`tracks_to_sensor`), in :data:`~gaitval.io.tracks.exchange.TRACK_COLUMNS` order
     and types."""
     if "k" not in df:

@@ -1,7 +1,7 @@
 """External trackers and leg detectors a study declares (``tracking.external`` of the workflow
 config, ``external_methods:`` / ``external_detections:`` of the study.yaml or
 :data:`STUDY_SIDE_FILE` beside its trial sheet): where each trial's file is, and the
-checks the run makes before any job (docs/formats.md, "Leg tracks").
+checks the run makes before any job (docs/formats_external.md, "Leg tracks").
 """
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """External tracks and detections through gaitval's exchange formats
-(:mod:`gaitval.io.tracks`, docs/formats.md "Leg tracks"): export gaitval's own tracks,
+(:mod:`gaitval.io.tracks`, docs/formats_external.md "Leg tracks"): export gaitval's own tracks,
 import another tracker's as one more method, score a detector's leg detections.
 """
 from __future__ import annotations
@@ -34,7 +34,7 @@ def export_tracks_step(track_parquet, out, units: str = "m", topic: str | None =
                                    "<trial>.parquet, made by the report run")
     if src_path.suffix == ".bag" or src_path.is_dir():
         rows, meta = read_bag_tracks(src_path, topic)
-        if legs:                  # each leg a person: leg rows (docs/formats.md, Leg tracks)
+        if legs:                  # each leg a person: leg rows (docs/formats_external.md, Leg tracks)
             from gaitval.io.tracks.bag import people_to_legs
             rows = people_to_legs(rows, legs, path=src_path, topic=meta["source"]).rename(
                 columns={"x_m": "x", "y_m": "y"})
