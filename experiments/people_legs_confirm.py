@@ -52,10 +52,12 @@ Usage (from the checkout, with a leg_tracker checkout or a folder of its positiv
 
     .venv/bin/python experiments/people_legs_confirm.py forest LEG_TRACKER_DIR OUT_DIR
     .venv/bin/python experiments/people_legs_confirm.py dev LEG_TRACKER_DIR OUT_DIR
+    .venv/bin/python experiments/people_legs_confirm.py info OUT_DIR THETA K
     .venv/bin/python experiments/people_legs_confirm.py test OUT_DIR THETA K
 
 ``forest`` trains ``OUT_DIR/twin_and_bags.npz``; ``dev`` prints the cluster rates and the
-sweep and the chosen (θ, K); ``test`` prints the four criteria's numbers.
+sweep and the chosen (θ, K); ``info`` the dev scores of a given (θ, K), for information
+only (not a choice); ``test`` prints the four criteria's numbers.
 """
 from __future__ import annotations
 
@@ -214,5 +216,9 @@ if __name__ == "__main__":
         forest_stage(sys.argv[2], Path(sys.argv[3]))
     elif stage == "dev":
         dev_stage(sys.argv[2], Path(sys.argv[3]))
+    elif stage == "info":        # dev scores of given (θ, K): information, not a choice
+        t = dev_scores(look(Path(sys.argv[2]) / "twin_and_bags.npz", float(sys.argv[3]),
+                            int(sys.argv[4])))
+        print(t[["kind", "gt", "matched", "fp", "idsw_ref", "mota_pct"]].to_string(index=False))
     elif stage == "test":
         test_stage(Path(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4]))
