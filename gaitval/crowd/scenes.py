@@ -79,6 +79,9 @@ KINDS = {
     "crowd_moving": {"moving": True, "walkers": (6, 8), "meet": False, "aided": False},
     "assisted": {"moving": False, "walkers": (1, 2), "meet": False, "aided": True},
 }
+#: a development-only kind, not in the benchmark's table (:func:`draw_following`): a robot
+#: following a person who stands, walks, stands and walks on, others crossing
+FOLLOWING = "following"
 #: development scenes (look at these) and test scenes (score only): different seeds
 DEV_SEEDS = (11,)
 TEST_SEEDS = (23,)
@@ -258,6 +261,17 @@ class CrowdScene:
 
 def make_scene(kind: str, seed: int) -> CrowdScene:
     """Draw and render one scene (module notes); deterministic in (kind, seed)."""
+    walks, furn, room, pose, t, rng, choices = draw_scene(kind, seed)
+    scans, truth = render(walks, furn, room, pose, t, rng)
+    return CrowdScene(f"{kind}_{seed}", kind, seed, replace(scans, source=f"{kind}_{seed}"),
+                      truth, choices)
+
+
+def draw_scene(kind: str, seed: int):
+    """A scene's parts before rendering: ``(walks, furniture circles, room, sensor poses,
+    scan times, the scene's generator (next: the renderer's noise), choices)``."""
+    if kind == FOLLOWING:
+        return draw_following(seed)
     spec_k = KINDS[kind]
     rng = np.random.default_rng([seed, list(KINDS).index(kind)])
     T = _draw(rng, "duration_s")
@@ -276,11 +290,40 @@ def make_scene(kind: str, seed: int) -> CrowdScene:
     else:
         walks = _crossers(rng, n, T, lambda tc: vs * tc, room)
     furn = _furniture(rng, room, 2 * (room[0][1] - room[0][0]))
-    scans, truth = render(walks, furn, room, pose, t, rng)
     choices = {"duration_s": T, "sensor_speed_mps": vs, "sensor_yaw_amp_rad": yaw_amp,
                "room_width_m": W, "n_people": len(walks), "n_furniture_legs": len(furn)}
-    return CrowdScene(f"{kind}_{seed}", kind, seed, replace(scans, source=f"{kind}_{seed}"),
-                      truth, choices)
+    return walks, furn, room, pose, t, rng, choices
+
+
+def draw_following(seed: int):
+    """A robot following a person (development only; the outdoor following bag's kind of
+    scene, drawn, not measured on it): the person stands ``stand_s`` 1.5-2.5 m ahead of
+    the sensor from the start, walks 4-8 m down the room, stands ``stand_s`` again and
+    walks 4-8 m on; the robot keeps its distance, stopping when the person stops; 1-3
+    walkers cross between them and the walls.  Returns :func:`draw_scene`'s tuple."""
+    rng = np.random.default_rng([seed, 100])
+    v = _draw(rng, "walker_speed_mps")
+    gap = float(rng.uniform(1.5, 2.5))
+    st1, st2 = _draw(rng, "stand_s"), _draw(rng, "stand_s")
+    d1, d2 = float(rng.uniform(4.0, 8.0)), float(rng.uniform(4.0, 8.0))
+    W = _draw(rng, "room_width_m")
+    y0 = float(rng.uniform(-0.5, 0.5))
+    T = st1 + d1 / v + st2 + d2 / v + 2.0
+    tb = np.array([0.0, st1, st1 + d1 / v, st1 + d1 / v + st2, st1 + (d1 + d2) / v + st2, T])
+    sb = np.array([0.0, 0.0, d1, d1, d1 + d2, d1 + d2])
+    room = ((-1.5, gap + d1 + d2 + 4.0), (-W / 2, W / 2))
+    target = Walk(np.array([[gap, y0], [gap + d1 + d2 + 1.0, y0]]), tb, sb, _stride(v),
+                  _draw(rng, "step_width_m"), _draw(rng, "leg_radius_m"))
+    t = np.arange(0.0, T, DT_S)
+    yaw_amp = _draw(rng, "sensor_yaw_amp_rad")
+    pose = np.column_stack([np.interp(t, tb, sb), np.full_like(t, y0),
+                            yaw_amp * np.sin(2 * np.pi * t / 8.0)])
+    n = int(rng.integers(1, 4))
+    walks = [target] + _crossers(rng, n, T, lambda tc: float(np.interp(tc, tb, sb)), room)
+    furn = _furniture(rng, room, 2 * (room[0][1] - room[0][0]))
+    choices = {"duration_s": T, "sensor_speed_mps": v, "sensor_yaw_amp_rad": yaw_amp,
+               "room_width_m": W, "n_people": len(walks), "n_furniture_legs": len(furn)}
+    return walks, furn, room, pose, t, rng, choices
 
 
 def _to_sensor(xy, pose):
@@ -289,8 +332,11 @@ def _to_sensor(xy, pose):
     return np.stack([c * dx + s * dy, -s * dx + c * dy], axis=-1)
 
 
-def render(walks, furn, room, pose, t, rng):
-    """Scans and ground truth of walkers, furniture circles and the room's walls."""
+def render(walks, furn, room, pose, t, rng, hits=None):
+    """Scans and ground truth of walkers, furniture circles and the room's walls.
+    ``hits``: a dict that, when given, receives the object each beam's central sub-ray hit
+    (``id``: ``PERSON_ID0 + 2p + f`` for person p's leg f, else an ``ID_*`` of
+    :mod:`gaitval.simulate.scene`) and the mixed-pixel flags (``mixed``)."""
     spec = laser_spec()
     ns = len(t)
     legs = np.stack([w.legs(t) for w in walks], axis=1).reshape(ns, -1, 2)  # (ns, 2P, 2)
@@ -314,6 +360,8 @@ def render(walks, furn, room, pose, t, rng):
     scene = L.Scene(ell, oid, seg, np.full(4, ID_WALL, dtype=np.int16))
     R, I = L.cast(scene, spec)
     m = L.measure(R, I, spec, rng)
+    if hits is not None:
+        hits.update(id=m["id"], mixed=m["mixed"])
     scans = ScanSeries(t=t.copy(), ranges=m["ranges"], angle_min=spec.angle_min,
                        angle_increment=spec.angle_increment, range_min=spec.range_min,
                        range_max=spec.range_max, sensor_model=spec.model,

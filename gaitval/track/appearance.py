@@ -11,8 +11,13 @@
     one; ``keeps(person)``: False when the person (tentative or confirmed) no longer looks
     like legs and ends.
 
+``confirms(person, leg_width_m)`` once per scan for a tentative person, after
+``update``: True when its looks alone confirm it (a standing person; the confirmer's
+motion tests are the other way).
+
 ``none``
-    Everything looks like a leg (p = 1; no hypothesis ends for its looks).
+    Everything looks like a leg (p = 1; no hypothesis ends for its looks, none is
+    confirmed by them).
 ``leg_forest``
     leg_tracker's classifier and its confidence rule (Leigh et al., ICRA 2015;
     angusleigh/leg_tracker).  Each scan is clustered and each cluster scored as leg_tracker's
@@ -33,8 +38,26 @@
     person confidence at creation line 472, person's matched detection lines 358–372,
     person deletion line 401).  A pair whose two observations score below 0.1 is not
     born: leg_tracker would delete that pair on the scan it forms.
+``legs_confirm``
+    Appearance as evidence of a person, not as a veto (issue 55): the same clusters and
+    scores as ``leg_forest`` (its own forest), no pair is refused or ended for its looks,
+    and a tentative pair is confirmed when on each of the last K = ``n_scans`` scans both
+    legs were observed, as two separate objects (``person.apart``, the confirmer's surface
+    test) at least one leg width apart, and each leg's P(leg), averaged over those K scans,
+    is at least θ = ``min_score``::
+
+        confirmed  ⇔  ∀ k' ∈ last K scans: both legs seen ∧ apart ∧ |z_L − z_R| ≥ w_l
+                      ∧  mean_K p_L ≥ θ  ∧  mean_K p_R ≥ θ
+
+    (the mean, not every scan: a rendered or real leg's score varies from scan to scan
+    with the beams that fall on it; leg_tracker's running confidence averages too).
+
+    A person who stands is then confirmed by how its legs look, where the motion tests
+    wait for a walk.  The tracker still refuses a pair with a leg on a static cell.
 """
 from __future__ import annotations
+
+from collections import deque
 
 import numpy as np
 
@@ -63,6 +86,9 @@ class Appearance:
 
     def keeps(self, person) -> bool:
         return True
+
+    def confirms(self, person, leg_width_m: float) -> bool:
+        return False
 
 
 APPEARANCES.register("none")(Appearance)
@@ -156,3 +182,53 @@ class LegForestAppearance(Appearance):
         mem = person.look
         c = min(mem["legs"]) if mem["person"] is None else mem["person"]
         return c >= self.threshold
+
+
+@APPEARANCES.register("legs_confirm")
+class LegsConfirm(LegForestAppearance):
+    """Two legs that look like legs for K scans confirm a tentative pair (module notes).
+
+    Parameters
+    ----------
+    forest : str
+        A forest of :mod:`gaitval.track.legforest` or a path to one.
+    min_score : float
+        θ: each leg's cluster scores at least this P(leg) on a counted scan.
+    n_scans : int
+        K: the scans, consecutive, over which both legs are seen and their scores averaged.
+    match_m, cluster_dist_m, min_points, max_detect_distance_m
+        As ``leg_forest`` (leg_tracker's values).
+    """
+
+    def __init__(self, forest: str = "leg_tracker_bags", min_score: float = 0.9,
+                 n_scans: int = 5, match_m: float = 0.13, cluster_dist_m: float = 0.13,
+                 min_points: int = 3, max_detect_distance_m: float = 10.0):
+        super().__init__(forest, 0.0, 0.0, match_m, cluster_dist_m, min_points,
+                         max_detect_distance_m)
+        self.min_score = float(min_score)
+        self.n_scans = int(n_scans)
+
+    def admits(self, p_l, p_r):
+        return True
+
+    def start(self, p_l, p_r):
+        return deque(maxlen=self.n_scans)       # per scan: (p_L, p_R), or None
+
+    def update(self, person):
+        pass
+
+    def confirmed(self, person):
+        pass
+
+    def keeps(self, person):
+        return True
+
+    def confirms(self, person, leg_width_m):
+        win = person.look
+        both = (person.seen[0] and person.seen[1] and person.apart
+                and ((person.z[0][0] - person.z[1][0]) ** 2
+                     + (person.z[0][1] - person.z[1][1]) ** 2) >= leg_width_m ** 2)
+        win.append((person.zp[0], person.zp[1]) if both else None)
+        if len(win) < self.n_scans or any(w is None for w in win):
+            return False
+        return all(sum(w[f] for w in win) >= self.min_score * self.n_scans for f in (0, 1))

@@ -410,7 +410,9 @@ class PeoplePass:
         self._apart(p)
         p.world_centre = (self.seg, *to_world(self.pose, np.array([p.evidence_centre(
             confirmer.evidence)]))[0].tolist())
-        if (confirmer.step(p, self.k) or self.arrived.confirms(p, self.pose, self.tk)) \
+        moved = confirmer.step(p, self.k)
+        looks = self.look.confirms(p, self.w)         # counted on every scan
+        if (moved or looks or self.arrived.confirms(p, self.pose, self.tk)) \
                 and not _on_static(p, self.pose, self.smap):
             p.status = CONFIRMED
             self.look.confirmed(p)
@@ -466,6 +468,7 @@ class PeoplePass:
             p.world_centre = (self.seg, *to_world(self.pose,
                                                   np.array([p.centre()]))[0].tolist())
             self.confirmer.step(p, k)
+            self.look.confirms(p, self.w)            # the birth scan counts
         self.persons.append(p)
 
     def refind(self) -> None:
