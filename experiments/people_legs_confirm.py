@@ -237,7 +237,7 @@ def dev_stage(lt_dir, out):
 
 
 def test_stage(out, theta, k):
-    from dataclasses import replace
+    from gaitval.track.passes import reversed_scans
 
     from gaitval.crowd import bench
     from gaitval.io.rosbag import describe_rosbag, read_rosbag_scans
@@ -248,9 +248,7 @@ def test_stage(out, theta, k):
     bag = ROOT.parent / "shared" / "realdata" / "lrs" / "negative_2.bag"
     for topic in describe_rosbag(bag)["scans"]:
         scans = read_rosbag_scans(bag, topic)
-        t = np.asarray(scans.t, dtype=float)
-        back = replace(scans, t=(t[0] + t[-1]) - t[::-1],
-                       ranges=np.ascontiguousarray(scans.ranges[::-1]))
+        back = reversed_scans(scans)
         for way, s in (("forwards", scans), ("backwards", back)):
             on = build_method("people", over).track(s, 0.10)
             off = build_method("people_offline", over).track(s, 0.10)

@@ -27,13 +27,13 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from gaitval import methods as M
 from gaitval.track import peoplepass as pp
+from gaitval.track.passes import reversed_scans
 
 REAL = Path(__file__).resolve().parents[1] / ".." / "shared" / "realdata" / "lrs"
 _associate = pp.PeoplePass.associate
@@ -78,9 +78,7 @@ def main(change: str, what: str, out: str | None = None) -> None:
         bag = REAL / "negative_2.bag"
         for topic in describe_rosbag(bag)["scans"]:
             scans = read_rosbag_scans(bag, topic)
-            t = np.asarray(scans.t, dtype=float)
-            back = replace(scans, t=(t[0] + t[-1]) - t[::-1],
-                           ranges=np.ascontiguousarray(scans.ranges[::-1]))
+            back = reversed_scans(scans)
             for tag, s in (("forwards", scans), ("backwards", back)):
                 n = M.build_method("people").track(s, 0.10).n_confirmed
                 print(f"{topic} {tag}: {n} confirmed")

@@ -100,21 +100,9 @@ def twin_clusters(seeds=TRAIN_SEEDS, kinds=tuple(KINDS)) -> tuple[np.ndarray, np
 
 def bag_clusters(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """(annotated leg clusters, the other clusters) of a leg_tracker positive bag's
-    ``/training_scan`` (the legs as :func:`gaitval.track.legforest.positive_features`
-    finds them)."""
-    from gaitval.track.legforest import RECIPE, _bag_messages, _clusters
-    pos, neg, poses = [], [], np.zeros((0, 2))
-    for topic, m in _bag_messages(Path(path), ("/training_scan", "/leg_cluster_positions")):
-        if topic == "/leg_cluster_positions":
-            poses = np.array([[p.position.x, p.position.y] for p in m.poses]).reshape(-1, 2)
-            continue
-        if not len(poses):
-            continue
-        cen, f = _clusters(m, RECIPE)
-        for c in range(len(cen)):
-            leg = (np.hypot(*(poses - cen[c]).T) < 1e-4).any()
-            (pos if leg else neg).append(f[c])
-    return (np.asarray(pos).reshape(-1, N_FEATURES), np.asarray(neg).reshape(-1, N_FEATURES))
+    ``/training_scan`` (:func:`gaitval.track.legforest.labelled_clusters`)."""
+    from gaitval.track.legforest import labelled_clusters
+    return labelled_clusters(Path(path))
 
 
 def training_set(leg_tracker_dir=None, seeds=TRAIN_SEEDS) -> dict[str, np.ndarray]:

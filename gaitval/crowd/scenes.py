@@ -27,6 +27,7 @@ benchmark's moving robot recorded its own; the trackers read them through the
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -52,24 +53,17 @@ class Choice:
     source: str
 
 
-CHOICES = {c.name: c for c in (
-    Choice("duration_s", 20.0, 30.0, "s", "long enough for 2-3 crossings; the whole "
-           "benchmark stays well under two CPU minutes"),
-    Choice("walker_speed_mps", 0.6, 1.5, "m/s", "slow to brisk adult walking"),
-    Choice("aided_speed_mps", 0.35, 0.7, "m/s", "walkers with a cane or an attendant"),
-    Choice("sensor_speed_mps", 0.3, 0.9, "m/s", "the benchmark's moving robot drove at "
-           "0.9 m/s (Leigh et al. 2015 Table II)"),
-    Choice("sensor_yaw_amp_rad", 0.0, 0.15, "rad", "a robot's heading corrections"),
-    Choice("room_width_m", 6.0, 9.0, "m", "a hall or a wide corridor"),
-    Choice("tables_per_10m", 0.5, 2.0, "1/10 m of wall", "a furnished room"),
-    Choice("chairs_per_10m", 1.0, 4.0, "1/10 m of wall", "a furnished room"),
-    Choice("poles_per_10m", 1.0, 4.0, "1/10 m of wall", "thin clutter: stands, stems, "
-           "bins"),
-    Choice("leg_radius_m", 0.045, 0.065, "m", "shank half-widths at 0.3 m height"),
-    Choice("step_width_m", 0.12, 0.22, "m", "shank centres apart, side to side"),
-    Choice("stand_s", 2.0, 6.0, "s", "people who meet and talk"),
-    Choice("attendant_lag_m", 0.3, 0.8, "m", "an attendant a step behind"),
-)}
+def _read_choices() -> dict[str, Choice]:
+    import tomllib
+
+    with open(Path(__file__).with_name("choices.toml"), "rb") as f:
+        table = tomllib.load(f)
+    return {name: Choice(name, float(c["range"][0]), float(c["range"][1]), c["unit"],
+                         c["source"]) for name, c in table.items()}
+
+
+#: the free choices, in the order they are drawn (gaitval/crowd/choices.toml)
+CHOICES = _read_choices()
 
 #: scene kinds: sensor motion and people (docs/crowd.md)
 KINDS = {

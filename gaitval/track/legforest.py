@@ -172,10 +172,11 @@ def _clusters(m, recipe):
                          int(recipe["min_points_per_cluster"]))
 
 
-def positive_features(path: Path, recipe=RECIPE) -> np.ndarray:
-    """leg_tracker's ``loadPosData``: clusters of ``/training_scan`` at a pose of the latest
+def labelled_clusters(path: Path, recipe=RECIPE) -> tuple[np.ndarray, np.ndarray]:
+    """(leg clusters, other clusters) of a positive bag's ``/training_scan``, from the
+    first ``/leg_cluster_positions`` on: a leg is a cluster at a pose of the latest
     ``/leg_cluster_positions`` (within 1e-4 m)."""
-    rows, poses = [], np.zeros((0, 2))
+    pos, neg, poses = [], [], np.zeros((0, 2))
     for topic, m in _bag_messages(path, ("/training_scan", "/leg_cluster_positions")):
         if topic == "/leg_cluster_positions":
             poses = np.array([[p.position.x, p.position.y] for p in m.poses]).reshape(-1, 2)
@@ -184,9 +185,14 @@ def positive_features(path: Path, recipe=RECIPE) -> np.ndarray:
             continue
         cen, f = _clusters(m, recipe)
         for c in range(len(cen)):
-            if (np.hypot(*(poses - cen[c]).T) < 1e-4).any():
-                rows.append(f[c])
-    return np.asarray(rows).reshape(-1, N_FEATURES)
+            leg = (np.hypot(*(poses - cen[c]).T) < 1e-4).any()
+            (pos if leg else neg).append(f[c])
+    return (np.asarray(pos).reshape(-1, N_FEATURES), np.asarray(neg).reshape(-1, N_FEATURES))
+
+
+def positive_features(path: Path, recipe=RECIPE) -> np.ndarray:
+    """leg_tracker's ``loadPosData``: the leg clusters of :func:`labelled_clusters`."""
+    return labelled_clusters(path, recipe)[0]
 
 
 def negative_features(path: Path, topic: str, rng, recipe=RECIPE) -> np.ndarray:

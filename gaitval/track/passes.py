@@ -97,6 +97,16 @@ class ForwardBackward(Passes):
         return join_passes(fwd, bwd, self.link_gate(dt), self.extend_only, n)
 
 
+def reversed_scans(scans):
+    """The scans read backwards: scan k ↦ n − 1 − k, the times mirrored into the same span
+    (t ↦ t₀ + t_end − t, so they still increase)."""
+    from dataclasses import replace
+
+    t = np.asarray(scans.t, dtype=float)
+    return replace(scans, t=(t[0] + t[-1]) - t[::-1],
+                   ranges=np.ascontiguousarray(scans.ranges[::-1]))
+
+
 def reverse_rows(rows: pd.DataFrame, t: np.ndarray) -> pd.DataFrame:
     """A backward pass's rows in forward time: scan k ↦ n − 1 − k, its time t[k], and the
     velocities negated."""

@@ -44,7 +44,7 @@ scanners. IEEE ICRA 2015 (life cycle defaults, see :mod:`gaitval.track.lifecycle
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -59,8 +59,9 @@ from gaitval.track.kinds import TRACKER_KINDS, TrackerKind
 from gaitval.track.leg import TrackResult, empty_result, handedness, swap_sides
 from gaitval.track.lifecycle import AREAS, BIRTHS, CONFIRMERS, DELETERS, REFINDS
 from gaitval.track.motion import MOTION_MODELS
-from gaitval.track.passes import PASSES, reverse_rows
-from gaitval.track.peoplepass import PeoplePass, ScanProfile
+from gaitval.track.passes import PASSES, reverse_rows, reversed_scans
+from gaitval.track.observe import ScanProfile
+from gaitval.track.peoplepass import PeoplePass
 from gaitval.track.phase import PHASE_MODELS
 from gaitval.track.staticmap import ARRIVALS, EGO_MOTIONS, STATIC_MAPS
 from gaitval.track.tracker import step_durations
@@ -222,8 +223,7 @@ class PeopleTracker(TrackerKind):
         forward pass's persons: the joined rows, the subject (the forward pass's, with its
         labels) and the backward pass's (born, confirmed, re-found)."""
         t = np.asarray(scans.t, dtype=float)
-        rscans = replace(scans, t=(t[0] + t[-1]) - t[::-1],
-                         ranges=np.ascontiguousarray(scans.ranges[::-1]))
+        rscans = reversed_scans(scans)
         brows, b_born, b_conf, b_refound = self._pass(
             rscans, list(xy)[::-1], list(pats)[::-1], leg_width_m, observer, None)
         back = reverse_rows(_people_frame(brows), t)

@@ -13,12 +13,11 @@ roles); :meth:`PeoplePass.scan` is the loop body of docs/people.md, one call per
     refind()      recently ended or coasting persons found again
     record()      the reported persons' rows
 
-An optional ``observer`` (:class:`ScanProfile`) is told before and after each scan.
+An optional ``observer`` (:class:`gaitval.track.observe.ScanProfile`) is told before and after each scan.
 """
 from __future__ import annotations
 
 import math
-from time import perf_counter
 
 import numpy as np
 
@@ -33,7 +32,6 @@ _NO = 1.0e12            # cost of a pair outside the gate (never chosen)
 # stance speed (¾ w_l + Δt·v_st, v_st = 0.55 m/s): the leg beside which the other swings
 STAND_LEG_WIDTHS = 0.75
 STAND_MPS = 0.55
-
 
 
 class Person:
@@ -89,26 +87,6 @@ class Person:
         if evidence == "observations" and self.seen[0] and self.seen[1]:
             return 0.5 * (self.z[0][0] + self.z[1][0]), 0.5 * (self.z[0][1] + self.z[1][1])
         return self.centre()
-
-
-class ScanProfile:
-    """An observer of a pass: per scan, the seconds spent, the hypotheses alive and each
-    observation's static flag (benchmarks/people_tracker.py, experiments/)."""
-
-    def __init__(self):
-        self.seconds, self.alive, self.static = [], [], []
-        self._t0 = 0.0
-
-    def before(self, k: int) -> None:
-        self._t0 = perf_counter()
-
-    def after(self, k: int, run: "PeoplePass") -> None:
-        self.seconds.append(perf_counter() - self._t0)
-        self.alive.append(len(run.persons))
-        self.static.append(run.static)
-
-    def arrays(self):
-        return (np.asarray(self.seconds), np.asarray(self.alive, dtype=np.int64), self.static)
 
 
 def _relative(a, b) -> tuple[float, float, float]:
