@@ -9,13 +9,16 @@ an uninterrupted run's.
 
 The kill test runs the tiny study's report once, killing it as each rule starts, every
 rule in turn and in both ways (``kill -9`` of the whole process group, like a power cut,
-then of Snakemake alone), then lets the same command finish, and compares with the
+and of Snakemake alone), then lets the same command finish, and compares with the
 session's uninterrupted run of the same study (``tiny_run``, tests/conftest.py).  One
 chain of runs, not one run per kill: each resumed run is killed at the next rule it
-starts, so the whole test costs one report plus a Snakemake start per kill.  The suite
-kills at six rules each way (the audit's ``ultrasonic_tables`` and five drawn by a seeded
-sample) to keep CI's time; ``GAITVAL_EXHAUSTIVE_KILLS=1`` kills at every rule in turn
-(18 of the 20 rules each way, 36 kills: passed on this code).
+starts.  A rule is killed both ways in a row: first the whole process group as it starts;
+the next run starts it again (``--forcerun`` of that rule, for its jobs that finished
+before the kill; its killed job is redone anyway) and Snakemake alone is killed as it
+does.  So the whole test costs one report plus a Snakemake start per kill (it used to run
+the chain twice from the simulated data, one pass per way: two reports).  The suite kills
+at six rules each way (the audit's ``ultrasonic_tables`` and five drawn by a seeded
+sample) to keep CI's time; ``GAITVAL_EXHAUSTIVE_KILLS=1`` kills at every rule in turn.
 """
 from __future__ import annotations
 
@@ -66,23 +69,27 @@ def _snakemake_of(run_pid: int) -> int | None:
     return None
 
 
-def _run_until_rule(work: Path, pending: list[str], mode: str, rng: random.Random,
-                    log) -> str | None:
-    """Start the report command; when a rule of ``pending`` starts, kill it (``mode``
-    "group": the whole run; "snakemake": Snakemake alone) after a short random delay and
-    return that rule; None when the run ended before any of them started (it must then
-    have succeeded)."""
+def _run_until_rule(work: Path, pending: dict[str, list[str]], rng: random.Random,
+                    log, extra: list[str] = ()) -> tuple[str, str] | None:
+    """Start the report command (``extra``: more Snakemake arguments); when a rule of
+    ``pending`` (mode -> rules: "group": kill the whole run; "snakemake": Snakemake alone)
+    starts, kill it in the first mode that still lists it after a short random delay and
+    return (that rule, the mode); None when the run ended before any of them started (it
+    must then have succeeded)."""
     # Snakemake's own console (rule by rule), not gaitval's one line per finished step
-    p = subprocess.Popen(_report(work), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                         text=True, start_new_session=True,
+    p = subprocess.Popen([*_report(work), *extra], stdout=subprocess.PIPE,
+                         stderr=subprocess.STDOUT, text=True, start_new_session=True,
                          env={**os.environ, "GAITVAL_CONSOLE": "raw"})
-    hit = None
+    hit = mode = None
     for line in p.stdout:
         log.write(line)
         m = re.match(r"^(?:local)?rule (\w+):", line)
-        if m and m.group(1) in pending:
-            hit = m.group(1)
-            break
+        if m:
+            mode = next((md for md in ("group", "snakemake") if m.group(1) in pending[md]),
+                        None)
+            if mode:
+                hit = m.group(1)
+                break
     if hit is None:
         rc = p.wait()
         assert rc == 0, f"the run ended with {rc} (log: {log.name})"
@@ -104,7 +111,7 @@ def _run_until_rule(work: Path, pending: list[str], mode: str, rng: random.Rando
     left = _session(p.pid)
     assert not left, f"killed at {hit} ({mode}), still running: {left}"
     log.write(f"\n### killed at rule {hit} ({mode})\n")
-    return hit
+    return hit, mode
 
 
 def _rules_of(run: Path) -> list[str]:
@@ -135,21 +142,19 @@ def test_killed_at_each_rule_in_turn_both_ways_resumes_to_the_same_report(tiny_r
     copy_run(tiny_run / "data", work / "data")        # the same study: nothing simulated
     rng = random.Random(52)
     killed: list[tuple[str, str]] = []
+    pending = {"group": list(rules), "snakemake": list(rules)}
     with open(tmp_path / "runs.log", "w") as log:
-        for mode in ("group", "snakemake"):
-            pending = list(rules)
-            while pending:
-                hit = _run_until_rule(work, pending, mode, rng, log)
-                if hit is None:
-                    break                   # the rest had already run to the end
-                pending.remove(hit)
-                killed.append((hit, mode))
-                # the rules that finished meanwhile will not start again in this pass
-            if mode == "group":
-                # a full pass: let the second one kill the rules from the start again
-                log.write("\n### wiping results for the second pass\n")
-                for d in ("results", "reports", "logs"):
-                    subprocess.run(["rm", "-rf", str(work / d)], check=True)
+        while pending["group"] or pending["snakemake"]:
+            # the rules killed as a whole and not yet with Snakemake alone start again
+            again = [r for r in pending["snakemake"] if r not in pending["group"]]
+            got = _run_until_rule(work, pending, rng, log,
+                                  ["--forcerun", *again] if again else [])
+            if got is None:
+                break                       # the rest had already run to the end
+            hit, mode = got
+            pending[mode].remove(hit)
+            killed.append((hit, mode))
+            # the rules that finished meanwhile will not start again in this chain
     res = subprocess.run(_report(work), capture_output=True, text=True, timeout=1800)
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
     by_mode = {m: {r for r, mm in killed if mm == m} for m in ("group", "snakemake")}
