@@ -5,7 +5,7 @@ files; a data error prints one line ``gaitval: error: ...`` naming the file, the
 the problem, and exits with status 1; a usage error exits with 2
 (:mod:`gaitval.cli_exit`).  ``-v``/``-q`` before or after the verb: more or less progress.
 
-The verbs are one table, ``gaitval/cli/verbs.toml`` (name, handler, help, arguments;
+The verbs are one table, ``gaitval/cli/verbs/*.toml`` (name, handler, help, arguments;
 read by :mod:`gaitval.cli.table`); their handlers live in the modules of this package by
 concern: a study's inputs and the report (:mod:`.study`), the laser range sensor studies
 (:mod:`.lrs`), the ultrasonic study (:mod:`.feet`), the MTST and rollator studies
@@ -24,7 +24,7 @@ from gaitval.cli.table import add_verbs, read_table
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``gaitval`` argument parser: one sub-command per verb of the verb table
-    (``gaitval/cli/verbs.toml``)."""
+    (``gaitval/cli/verbs/*.toml``)."""
     from gaitval import __version__
     from gaitval.cli_exit import add_verbosity
 

@@ -1,4 +1,5 @@
-"""The verb table, ``gaitval/cli/verbs.toml``, read into argparse.
+"""The verb table, the files of ``gaitval/cli/verbs/`` read in name order (shared
+arguments in ``0_args.toml``, then the verbs by stage), read into argparse.
 
 The table lists every verb in pipeline order: its name, what it runs, its help and its
 arguments.  What it runs is either ``handler`` (``module:function`` in this package,
@@ -19,8 +20,8 @@ from dataclasses import dataclass
 from importlib import import_module
 from pathlib import Path
 
-#: the table
-TABLE = Path(__file__).with_name("verbs.toml")
+#: the table's folder
+TABLE = Path(__file__).with_name("verbs")
 #: the table's ``type`` names
 TYPES = {"path": Path, "float": float, "int": int}
 
@@ -58,10 +59,16 @@ def _resolve(ref: str):
     return getattr(import_module(module), name)
 
 
-def read_table(path: Path = TABLE) -> dict:
-    """The verb table as a dict: ``args`` (the shared arguments) and ``verbs``."""
-    with open(path, "rb") as f:
-        return tomllib.load(f)
+def read_table(folder: Path = TABLE) -> dict:
+    """The verb table as a dict: ``args`` (the shared arguments) and ``verbs`` (in the
+    order of ``gaitval --help``: the folder's files by name, each file's verbs in turn)."""
+    table: dict = {"args": {}, "verbs": []}
+    for path in sorted(folder.glob("*.toml")):
+        with open(path, "rb") as f:
+            part = tomllib.load(f)
+        table["args"].update(part.get("args", {}))
+        table["verbs"] += part.get("verbs", [])
+    return table
 
 
 def add_verbs(sub: argparse._SubParsersAction, table: dict) -> None:
