@@ -103,8 +103,14 @@ def _load_schema(path: str) -> dict:
         raise ConfigError("the config schema is missing", path=p,
                           hint="gaitval checks configs against the repository's "
                                "workflow/schemas/config.schema.yaml")
+    loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)                       # libyaml
     with open(p, encoding="utf-8") as fh:
-        return yaml.load(fh, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # libyaml
+        schema = yaml.load(fh, Loader=loader)
+    # the $defs kept in sibling files (the protocols' sections), merged in the named order
+    for name in schema.pop("x-defs-files", ()):
+        with open(p.parent / name, encoding="utf-8") as fh:
+            schema.setdefault("$defs", {}).update(yaml.load(fh, Loader=loader)["$defs"])
+    return schema
 
 
 def load_schema(path: str | Path | None = None) -> dict:
