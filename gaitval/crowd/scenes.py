@@ -284,9 +284,7 @@ def draw_scene(kind: str, seed: int):
     else:
         walks = _crossers(rng, n, T, lambda tc: vs * tc, room)
     furn = _furniture(rng, room, 2 * (room[0][1] - room[0][0]))
-    choices = {"duration_s": T, "sensor_speed_mps": vs, "sensor_yaw_amp_rad": yaw_amp,
-               "room_width_m": W, "n_people": len(walks), "n_furniture_legs": len(furn)}
-    return walks, furn, room, pose, t, rng, choices
+    return walks, furn, room, pose, t, rng, _drawn(T, vs, yaw_amp, W, walks, furn)
 
 
 def draw_following(seed: int):
@@ -315,9 +313,13 @@ def draw_following(seed: int):
     n = int(rng.integers(1, 4))
     walks = [target] + _crossers(rng, n, T, lambda tc: float(np.interp(tc, tb, sb)), room)
     furn = _furniture(rng, room, 2 * (room[0][1] - room[0][0]))
-    choices = {"duration_s": T, "sensor_speed_mps": v, "sensor_yaw_amp_rad": yaw_amp,
-               "room_width_m": W, "n_people": len(walks), "n_furniture_legs": len(furn)}
-    return walks, furn, room, pose, t, rng, choices
+    return walks, furn, room, pose, t, rng, _drawn(T, v, yaw_amp, W, walks, furn)
+
+
+def _drawn(T, v, yaw_amp, W, walks, furn) -> dict:
+    """A scene's drawn choices and counts, as its table row reports them."""
+    return {"duration_s": T, "sensor_speed_mps": v, "sensor_yaw_amp_rad": yaw_amp,
+            "room_width_m": W, "n_people": len(walks), "n_furniture_legs": len(furn)}
 
 
 def _to_sensor(xy, pose):

@@ -13,7 +13,8 @@ roles); :meth:`PeoplePass.scan` is the loop body of docs/people.md, one call per
     refind()      recently ended or coasting persons found again
     record()      the reported persons' rows
 
-An optional ``observer`` (:class:`gaitval.track.observe.ScanProfile`) is told before and after each scan.
+An optional ``observer`` (:class:`gaitval.track.observe.ScanProfile`) is told before and
+after each scan.
 """
 from __future__ import annotations
 
