@@ -1,6 +1,6 @@
 """Where the twin's pendulum error SD per axis comes from (seed 003 Table 1).
 
-Usage: ``.venv/bin/python experiments/pendulum_error_decomposition.py [N_TRIALS] [SEED] [sweep]``
+Usage: ``.venv/bin/python experiments/pendulum_error_decomposition.py [N_TRIALS] [SEED] [STEP]``
 (defaults: the default study's 5 pendulum trials, its seed 20150904).
 
 The default study's ``pendulum_error_sd`` rows read X / Y / Z 2.95 / 3.35 / 1.91 mm against
@@ -123,11 +123,13 @@ def _trials(overrides: dict, detection: bool, shared: bool = True):
     return out
 
 
-def _table1(trials, W=None, grid=None):
+def _table1(trials, W=None, grid=None, extra=None):
     pairs = [(lg, mo) for lg, mo, _, _ in trials]
-    res = identify_noise(pairs, None if grid is None else {"noise_id": {"W_grid_mps2": grid}})
+    base = deep_merge(resolve_cfg(None), extra or {})
+    res = identify_noise(pairs, base if grid is None else
+                         deep_merge(base, {"noise_id": {"W_grid_mps2": grid}}))
     w = res["W_sigma_mps2"] if W is None else W
-    cfg = deep_merge(resolve_cfg(None), {"ukf": {"W_sigma_mps2": w, "V_m2": res["V_m2"]}})
+    cfg = deep_merge(base, {"ukf": {"W_sigma_mps2": w, "V_m2": res["V_m2"]}})
     err = pendulum_errors(pairs, cfg, aligned=res["_aligned"])
     sd = [1e3 * float(err[c].std(ddof=1)) for c in ("ex_m", "ey_m", "ez_m")]
     mean = [1e3 * float(err[c].mean()) for c in ("ex_m", "ey_m", "ez_m")]
@@ -226,7 +228,22 @@ def apparatus():
                   f"{np.round(mean, 2)} pass {ok} | eq.23 sd {np.round(v_sd, 2)}", flush=True)
 
 
+def lowpass_step():
+    print(f"{N_TRIALS} pendulum trials, seed {SEED}; rows pass inside "
+          "X 2.72-6.12, Y 0.48-1.08, Z 0.72-1.62 mm")
+    tr = _trials({}, True)
+    for label, lp in (("raw 50 Hz (before)", {"lowpass": {"cutoff_hz": 1000.0}}),
+                      ("10 Hz low-pass (seed 003 §4.1)", {})):
+        sd, mean, w_id, v_sd = _table1(tr, extra=lp)
+        ok = [lo <= v <= hi for v, lo, hi in zip(sd, (2.72, 0.48, 0.72), (6.12, 1.08, 1.62))]
+        print(f"{label:32s}: W {w_id} SD {np.round(sd, 2)} mean {np.round(mean, 2)} "
+              f"pass {ok}", flush=True)
+
+
 if __name__ == "__main__":
+    if "lowpass" in sys.argv[3:]:
+        lowpass_step()
+        sys.exit()
     if "apparatus" in sys.argv[3:]:
         apparatus()
         sys.exit()

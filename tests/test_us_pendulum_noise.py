@@ -111,3 +111,30 @@ def test_a_study_releases_one_pendulum(tmp_path):
     assert metas[0]["theta0_rad"] != metas[1]["theta0_rad"]
     lo, hi = np.deg2rad(plan.cfg["pendulum_release_deg"])
     assert all(lo <= abs(m["theta0_rad"]) <= hi for m in metas)
+
+
+def test_pendulum_errors_compare_the_low_passed_trajectories():
+    # seed 003 §4.1: all data low-passed (2nd-order Butterworth, 10 Hz) before comparison.
+    # An estimate off the camera by a 20 Hz ripple plus a 1 Hz sway keeps the sway and
+    # loses most of the ripple; without the filter both stay.
+    from gaitval.evaluate.pendulum import pendulum_track_errors
+
+    t = np.arange(0.0, 10.0, 0.02)                                  # 50 Hz, as the log
+    ref = np.column_stack([0.1 * np.sin(2 * np.pi * 0.7 * t), 0.05 + 0 * t, -0.3 + 0 * t])
+    sway = 0.002 * np.sin(2 * np.pi * 1.0 * t)
+    ripple = 0.003 * np.sin(2 * np.pi * 20.0 * t)
+
+    class Offset:                              # a tracker role returning camera + error
+        def track(self, log, *, trial=None):
+            est = ref + np.column_stack([sway + ripple, ripple, 0 * t])
+            return pd.DataFrame(est, columns=["x_m", "y_m", "z_m"])
+
+    a = {"t": t, "ref": ref}
+    raw, keep = pendulum_track_errors(Offset(), None, a, 0.5)
+    lp, _ = pendulum_track_errors(Offset(), None, a, 0.5,
+                                  lowpass_cfg=resolve_cfg(None)["lowpass"])
+    mid = keep & (t < 9.5)                                       # away from the ends
+    assert np.std(raw[mid, 1]) == pytest.approx(0.003 / np.sqrt(2), rel=0.05)
+    assert np.std(lp[mid, 1]) < 0.2 * np.std(raw[mid, 1])      # 20 Hz: |H|^2 = 1/17 at 2 fc
+    assert np.std(lp[mid, 0]) == pytest.approx(0.002 / np.sqrt(2), rel=0.1)   # 1 Hz kept
+    assert keep.sum() == int(np.sum(t >= 0.5))

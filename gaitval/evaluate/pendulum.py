@@ -20,6 +20,7 @@ import pandas as pd
 
 from gaitval.evaluate.alignment import align_ssd, resample
 from gaitval.evaluate.ultrasonic_config import build_tracker, reference_kwargs, resolve_cfg
+from gaitval.groundtruth.filters import lowpass
 from gaitval.groundtruth.reference import reference_trajectory
 from gaitval.io.ultrasonic import anchor_positions, log_distances
 from gaitval.types import MocapTrial, UltrasonicLog
@@ -86,8 +87,15 @@ def pendulum_alignment(log: UltrasonicLog, mocap: MocapTrial, cfg: dict | None =
 
 
 def pendulum_track_errors(tracker, log: UltrasonicLog, aligned: dict, skip_start_s: float,
-                          *, trial: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+                          *, lowpass_cfg: dict | None = None, trial: str | None = None
+                          ) -> tuple[np.ndarray, np.ndarray]:
     """Track one pendulum log and compare with the camera.
+
+    Both trajectories pass through the zero-phase Butterworth low-pass of ``lowpass_cfg``
+    (``order``, ``cutoff_hz``; the ``ultrasonic.lowpass`` of the treadmill trials) at the
+    log's median rate before they are compared: seed 003 §4.1, "All data were low-pass
+    filtered by second order low-pass Butterworth filter at 10 Hz".  ``None`` compares the
+    raw samples.
 
     Parameters
     ----------
@@ -107,7 +115,12 @@ def pendulum_track_errors(tracker, log: UltrasonicLog, aligned: dict, skip_start
         Samples after the first ``skip_start_s``.
     """
     tr = tracker.track(log, trial=trial)
-    e = tr[["x_m", "y_m", "z_m"]].to_numpy() - aligned["ref"]
+    est, ref = tr[["x_m", "y_m", "z_m"]].to_numpy(float), np.asarray(aligned["ref"], float)
+    if lowpass_cfg is not None:
+        fs = 1.0 / float(np.median(np.diff(aligned["t"])))
+        est, ref = (lowpass(x, fs, lowpass_cfg["cutoff_hz"], lowpass_cfg["order"])  # seed003 §4.1
+                    for x in (est, ref))
+    e = est - ref
     return e, (aligned["t"] - aligned["t"][0]) >= skip_start_s
 
 
@@ -120,7 +133,8 @@ def pendulum_errors(trials: list[tuple[UltrasonicLog, MocapTrial]], cfg: dict | 
     -------
     DataFrame
         ``trial, t_s`` (ultrasonic clock), ``ex_m, ey_m, ez_m`` (estimate − camera in the
-        ultrasonic frame: X progression, Y vertical, Z lateral).  The first
+        ultrasonic frame: X progression, Y vertical, Z lateral), both low-passed as the
+        treadmill's (``lowpass``, seed 003 §4.1).  The first
         ``noise_id.skip_start_s`` of each trial (filter initialisation) is left out.
     """
     c = resolve_cfg(cfg)
@@ -132,7 +146,8 @@ def pendulum_errors(trials: list[tuple[UltrasonicLog, MocapTrial]], cfg: dict | 
     tracker = build_tracker(c)
     parts = []
     for (log, _), a, nm in zip(trials, aligned, names):
-        e, keep = pendulum_track_errors(tracker, log, a, skip, trial=nm)
+        e, keep = pendulum_track_errors(tracker, log, a, skip, lowpass_cfg=c["lowpass"],
+                                        trial=nm)
         keep = keep & np.all(np.isfinite(e), axis=1)
         parts.append(pd.DataFrame({"trial": nm, "t_s": a["t"][keep], "ex_m": e[keep, 0],
                                    "ey_m": e[keep, 1], "ez_m": e[keep, 2]}))

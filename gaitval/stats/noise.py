@@ -123,7 +123,8 @@ def _search_W(c: dict, logs: list[UltrasonicLog], aligned: list[dict], V: list[f
                                                            "V_m2": V}}))
             errs = []
             for a, log in zip(aligned, logs):
-                e, keep = pendulum_track_errors(tracker, log, a, skip)
+                e, keep = pendulum_track_errors(tracker, log, a, skip,
+                                                lowpass_cfg=c["lowpass"])
                 errs.append(e[keep])
             e = np.concatenate(errs)
             cache[key] = rmse(e[np.all(np.isfinite(e), axis=1)], axis=1)   # 3-D RMSE
