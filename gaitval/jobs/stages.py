@@ -22,6 +22,7 @@ mechanism: a folder is the job's output, and no trial is resumed inside it.
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Callable
 
@@ -284,32 +285,37 @@ STAGES: dict[str, tuple[Callable, str]] = {
 
 #: what a stage's trials import (and the trackers' compiled kernels they run), loaded once
 #: before the pool forks its workers from this process
+#: (a module a task imports lazily, e.g. scikit-learn's K-means in the rollator detector or
+#: scipy.signal in the ground truth's filter, would otherwise be imported by every worker)
 IMPORTS = {"mtst-trials": ("gaitval.pipeline.mtst",), "detect-trials": ("gaitval.pipeline.mtst",),
+           "register-trials": ("gaitval.groundtruth",),
+           "ultrasonic-trials": ("gaitval.groundtruth",),
            "rollator-train-subjects": ("gaitval.pipeline.rollator",),
-           "rollator-trials": ("gaitval.pipeline.rollator",),
+           "rollator-trials": ("gaitval.pipeline.rollator", "sklearn.cluster"),
            "rollator-import-trials": ("gaitval.pipeline.rollator",),
            "legbench-trials": ("gaitval.pipeline.legbench",)}
-KERNELS = ("track-trials", "mtst-trials", "rollator-trials", "ultrasonic-trials",
-           "legbench-trials")
+#: the compiled kernels (modules with a ``warm_up``) each stage's built-in methods run:
+#: seed 002's PF on the rollator, seed 003's UKF on the treadmill, the initialisers' motion
+#: check in the TUG, MTST and rollator trackers and the people tracker.  A study's own
+#: method that runs another kernel loads it in each worker on first use (from numba's
+#: cache; slower, not different).
+KERNELS = {"track-trials": ("init_motion_kernel",), "mtst-trials": ("init_motion_kernel",),
+           "rollator-trials": ("init_motion_kernel", "pf"), "ultrasonic-trials": ("ukf",),
+           "legbench-trials": ("init_motion_kernel",)}
 
 
 def preload(stage: str) -> None:
     """Import the stage's modules (and load its trackers' compiled kernels) in this process,
     so that the workers forked from it start with them: ~1 CPU-s once per job instead of
-    once per worker."""
+    once per worker.  Matplotlib is told to draw off-screen through its environment
+    variable, so that a stage that draws nothing does not import it."""
     import importlib
 
-    import matplotlib
-
-    matplotlib.use("Agg")
-    for name in ("gaitval.pipeline.steps", *IMPORTS.get(stage, ())):
+    os.environ["MPLBACKEND"] = "Agg"
+    for name in ("gaitval.pipeline.steps", "pyarrow.parquet", *IMPORTS.get(stage, ())):
         importlib.import_module(name)
-    if stage in KERNELS:
-        from gaitval.track import init_motion_kernel, pf, ukf
-
-        pf.warm_up()
-        ukf.warm_up()
-        init_motion_kernel.warm_up()
+    for name in KERNELS.get(stage, ()):
+        importlib.import_module(f"gaitval.track.{name}").warm_up()
 
 
 #: the options of every stage verb: name -> (argparse keywords, help)

@@ -18,6 +18,7 @@ gate).
 from __future__ import annotations
 
 import math
+from statistics import NormalDist
 
 import numpy as np
 
@@ -64,8 +65,9 @@ def leg_tracker_person_gate(dt: float, max_std_m: float = 0.9, percentile: float
     cov = P_xx + (σ_obs + 0.4)², i.e. within ``z·√(P_xx + 0.25)`` m, and deletes the person
     once ``P_xx + 0.25 > max_std²`` = 0.81.  P_xx is the filter's steady state under
     observation, then predicted n scans on."""
-    from scipy.stats import norm
-    z = float(norm.ppf(1.0 - (1.0 - percentile) / 2.0))
+    # the standard library's normal quantile (Wichura's AS 241, ~1e-16): scipy.stats would
+    # cost ~0.5 s of imports in every worker that binds this gate (docs/speed.md)
+    z = NormalDist().inv_cdf(1.0 - (1.0 - percentile) / 2.0)
     # The filter's x and y axes are independent and alike (F, Q, H, R block-diagonal), so
     # each axis's 2 × 2 covariance [[a, b], [b, c]] of (position, velocity) carries P:
     # F = [[1, Δt], [0, 1]], Q = (σ_p·Δt)² I, H = [1, 0], R = σ_obs².  (Written out as
