@@ -331,14 +331,16 @@ def main(argv: list[str]) -> int:
 
 def xdist_args(rest: list[str]) -> list[str]:
     """pytest-xdist's options ``test`` adds: one worker per core, each test file on one
-    worker (a module's fixture, e.g. a workflow run, is built once), unless the arguments
+    worker (a module's fixture, e.g. a workflow run, is built once), the longest files
+    first, unless the arguments
     choose (``-n``, ``--numprocesses``, ``--dist``, ``-p no:xdist``) or ask for a debugger
     or a listing, which want one process."""
     own = ("-n", "--numprocesses", "--dist", "--pdb", "--trace", "--co", "--collect-only",
            "--setup-plan", "--setup-only", "no:xdist")
     if any(a in own or a.startswith(("-n", "--numprocesses=", "--dist=")) for a in rest):
         return []
-    return ["-n", "auto", "--dist", "loadfile"]
+    # files in the order of tests/conftest.py LONG_FIRST, not xdist's (most tests first)
+    return ["-n", "auto", "--dist", "loadfile", "--no-loadscope-reorder"]
 
 #: ``run.py report``'s exit code when the report was built but trials were refused.
 EXIT_REFUSED = 3

@@ -148,3 +148,33 @@ def planned_jobs(work, targets, wildcards=("method", "view")) -> dict[str, set[s
                   if "=" in kv)
         jobs.setdefault(rule, set()).add(next((ws[w] for w in wildcards if ws.get(w)), ""))
     return jobs
+
+
+#: The test files that run whole workflows, in the order ``run.py test`` hands them to
+#: pytest-xdist's workers (``--dist loadfile --no-loadscope-reorder``): the builder of the
+#: shared tiny run on one worker and the longest independent runs on the other first, then
+#: the other long files, longest first; every other file follows in collection order.
+#: pytest-xdist's own order (the files with most tests first) started the longest runs
+#: last, leaving one worker idle at the end.  Only the order matters: it changes how long
+#: the suite takes, never what it checks.  Seconds: ``--durations`` on the 2-core machine.
+LONG_FIRST = [
+    "test_workflow.py",                  # tiny_run (~100 s) + the Snakemake 8 run (~100 s)
+    "test_robustness_ensemble.py",       # two tiny twins, 225 s
+    "test_workflow_external_default.py",  # the default study, 180 s + the second run
+    "test_resume.py",                    # killed at each rule, 186 s
+    "test_initstudy.py",                 # the tiny folder through init-study, 150 + 70 s
+    "test_external_declarations.py",     # 90 s
+    "test_workflow_external.py",         # 65 s
+    "test_manual_pose.py",               # 50 s
+    "test_workflow_refusals.py",         # 45 s
+    "test_crowd.py",                     # 35 s
+    "test_people.py",                    # 55 s
+    "test_workflow_annotations_only.py",  # 25 s
+    "test_legbench.py",                  # 20 s
+    "test_paper_figures.py",             # 16 s
+]
+
+
+def pytest_collection_modifyitems(session, config, items):
+    rank = {name: i for i, name in enumerate(LONG_FIRST)}
+    items.sort(key=lambda it: rank.get(Path(str(it.fspath)).name, len(LONG_FIRST)))

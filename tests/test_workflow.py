@@ -240,3 +240,21 @@ def test_every_tex_of_the_tiny_report_compiles(tiny_run, tmp_path):
     res = compile_tables(tex, tmp_path)
     failed = {p: err for p, (ok, err, _) in res.items() if not ok}
     assert not failed, failed
+
+
+@pytest.mark.slow
+def test_the_pages_verdict_table_shows_the_robustness_share_beside_the_outcome(tiny_run):
+    # the share sits right after the outcome, before the long "why" text, so that it is in
+    # view without scrolling sideways; verdicts.csv keeps its own column order
+    import re
+
+    from gaitval.report.verdicts import VERDICT_COLUMNS
+
+    html = (tiny_run / "reports" / "tiny" / "index.html").read_text()
+    table = html.split('id="verdicts"', 1)[1].split("</table>", 1)[0]
+    head = re.findall(r"<th>([^<]*)</th>", table.split("</tr>", 1)[0])
+    assert head.index("robustness") == head.index("outcome") + 1 < head.index("why")
+    first = table.split("</tr>", 2)[1]
+    assert first.count("<td") == len(head) == len(VERDICT_COLUMNS) - 1      # no "table"
+    csv_head = (tiny_run / "reports" / "tiny" / "verdicts.csv").read_text().splitlines()[0]
+    assert csv_head.split(",") == list(VERDICT_COLUMNS)

@@ -32,6 +32,11 @@ from gaitval.io.atomic import write_text
 from gaitval.report.provenance import load_all, relative_path
 from gaitval.report.datakind import PAPER_PROTOCOLS, headline, paper_data, run_data
 from gaitval.report.verdicts import VERDICT_COLUMNS, build_verdicts, summary_lines
+
+#: the verdict table's columns on the HTML page (verdicts.csv/md keep VERDICT_COLUMNS);
+#: ``table`` is not a column there, it is the source cell's link
+VERDICT_HTML_ORDER = ("study", "data", "comparison", "source", "published", "reproduced",
+                      "criterion", "outcome", "robustness", "why", "alternative")
 from gaitval.tables.labels import base_of, is_published, label
 from gaitval.tables.numbers import format_value, to_display
 
@@ -345,6 +350,9 @@ def collect(reports_dir: str | Path, study_names: list[str] | None = None,
             "verdict_summary": summary_lines(verdicts),
             "verdicts": verdicts,
             "verdict_header": list(VERDICT_COLUMNS), "verdict_rows": vd.values.tolist(),
+            # the page shows the robustness share beside the outcome, before the long
+            # "why" text, so that it is in view without scrolling sideways
+            "verdict_html_order": [VERDICT_COLUMNS.index(h) for h in VERDICT_HTML_ORDER],
             "sections": sections, "provenance": _provenance(rd, report_prov),
             "analysed": analysed_record(studies)}
 
