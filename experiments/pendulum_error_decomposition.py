@@ -273,20 +273,8 @@ def floor():
         print(f"board distance {d:.2f} m: SD X / Y / Z {np.round(sd, 2)} mm", flush=True)
 
 
+STEPS = {"floor": floor, "lowpass": lowpass_step, "apparatus": apparatus, "release": release,
+         "geometry": geometry, "sweep": sweep}
+
 if __name__ == "__main__":
-    if "floor" in sys.argv[3:]:
-        floor()
-        sys.exit()
-    if "lowpass" in sys.argv[3:]:
-        lowpass_step()
-        sys.exit()
-    if "apparatus" in sys.argv[3:]:
-        apparatus()
-        sys.exit()
-    if "release" in sys.argv[3:]:
-        release()
-        sys.exit()
-    if "geometry" in sys.argv[3:]:
-        geometry()
-        sys.exit()
-    sweep() if "sweep" in sys.argv[3:] else main()
+    STEPS.get(sys.argv[3] if len(sys.argv) > 3 else "", main)()
