@@ -70,7 +70,7 @@ def write_ultrasonic_table1(errors: pd.DataFrame, stem: str | Path,
     df = table1(errors)
     notes = ["Errors are UKF estimate minus camera reference (marker TX brought into the "
              "ultrasonic frame by a rigid fit of the receiver markers), both low-passed "
-             "(2nd-order Butterworth, 10 Hz, zero phase: seed 003 §4.1, 'All data were "
+             "(2nd-order Butterworth, 10 Hz, zero phase: Qi et al. 2014 §4.1, 'All data were "
              "low-pass filtered'), pooled over all pendulum trials, in mm; the first "
              "noise_id.skip_start_s of each trial (filter start-up) is left out.",
              "Net RMSE is cumulative down the rows, as in the paper's table "
