@@ -63,6 +63,25 @@ def test_design_is_seeded_and_space_filling(tmp_path):
     assert sorted(np.floor(u * 8).astype(int)) == list(range(8))
 
 
+def test_the_choices_are_a_full_factorial_so_no_two_are_confounded(tmp_path):
+    # the shipped design: 16 twins, three two-way choices -> every combination twice (a
+    # Latin hypercube paired the MTST sensor place with the attendant side in 14 of 16)
+    cfg = load_config()
+    d = design(cfg)
+    choice = [n for n, f in cfg["factors"].items() if "choices" in f]
+    assert len(choice) >= 2
+    counts = d[choice].value_counts()
+    n_combos = math.prod(len(cfg["factors"][c]["choices"]) for c in choice)
+    assert len(counts) == n_combos and set(counts) == {len(d) // n_combos}
+    # the range factors stay a Latin hypercube: one twin per stratum
+    lo, hi = cfg["factors"]["mtst_attendant_lateral_m"]["range"]
+    u = (d["mtst_attendant_lateral_m"] - lo) / (hi - lo)
+    assert sorted(np.floor(u * len(d)).astype(int)) == list(range(len(d)))
+    # too few twins for the factorial (2 twins, 4 combinations): the hypercube's draws
+    small = design(_cfg(tmp_path, n_twins=2))
+    assert small["tug_turn_to_sit"].nunique() == 2 and small["mtst_sensor_place"].nunique() == 2
+
+
 def test_twin_presets_compose_the_sensor_poses(tmp_path):
     cfg = _cfg(tmp_path, n_twins=4)
     d = design(cfg)

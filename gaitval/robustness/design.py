@@ -1,6 +1,7 @@
 """The robustness ensemble's twins: free choices of the twin drawn jointly over their
-plausible ranges by a seeded Latin hypercube (``scipy.stats.qmc.LatinHypercube``), each
-twin written as a study preset and declared as a study of the workflow.
+plausible ranges by a seeded Latin hypercube (``scipy.stats.qmc.LatinHypercube``; the
+two-or-more-way choices as a full factorial when the twins allow it), each twin written as
+a study preset and declared as a study of the workflow.
 
 ``config/robustness.yaml`` names the factors (docs/robustness.md, "Plausible ranges" and
 "The ensemble"); :func:`design` draws the table of twins, :func:`twin_presets`
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import copy
 import hashlib
+import itertools
 import math
 from pathlib import Path
 
@@ -69,7 +71,9 @@ def _value(spec: dict, u: float):
 
 def design(cfg: dict) -> pd.DataFrame:
     """One row per twin (index: the twin's study name), one column per factor: a Latin
-    hypercube of ``n_twins`` points over the factors, seeded by ``design_seed``."""
+    hypercube of ``n_twins`` points over the factors, seeded by ``design_seed``; the
+    ``choices`` factors, when ``n_twins`` is a multiple of the number of their
+    combinations, as a full factorial instead (:func:`_factorial_choices`)."""
     names = list(cfg["factors"])
     n = int(cfg["n_twins"])
     if n < 1:
@@ -77,9 +81,29 @@ def design(cfg: dict) -> pd.DataFrame:
     u = qmc.LatinHypercube(d=len(names), seed=int(cfg["design_seed"])).random(n)
     rows = [{nm: _value(cfg["factors"][nm], float(u[i, j])) for j, nm in enumerate(names)}
             for i in range(n)]
+    for row, combo in zip(rows, _factorial_choices(cfg, n)):
+        row.update(combo)
     prefix = str(cfg.get("name_prefix", "rob"))
     return pd.DataFrame(rows, index=pd.Index([f"{prefix}_{i:02d}" for i in range(n)],
                                              name="twin"))
+
+
+def _factorial_choices(cfg: dict, n: int) -> list[dict]:
+    """The ``choices`` factors as a full factorial replicated ``n / (number of
+    combinations)`` times, rows in a seeded random order; ``[]`` (keep the hypercube's
+    draws) when ``n`` is not a multiple of the number of combinations.
+
+    A Latin hypercube balances each factor alone but pairs two choices at random: with 16
+    twins, 14 paired the MTST sensor on the line with the attendant on the left, so the
+    two could not be told apart.  In a full factorial every combination of the choices
+    occurs equally often, so a choice's share is never another's."""
+    choice = {nm: list(f["choices"]) for nm, f in cfg["factors"].items() if "choices" in f}
+    combos = list(itertools.product(*choice.values()))
+    if not choice or n % len(combos):
+        return []
+    order = np.random.default_rng(int(cfg["design_seed"])).permutation(n)
+    full = combos * (n // len(combos))
+    return [dict(zip(choice, full[i])) for i in order]
 
 
 def _set(preset: dict, dotted: str, value) -> None:
