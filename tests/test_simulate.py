@@ -493,6 +493,30 @@ def test_a_swing_bends_around_the_standing_shank():
     assert closest(w.plan) >= 0.95 * 0.10
 
 
+def test_a_presets_shank_clearance_reaches_the_walkers_swing():
+    """``shank_clearance_m`` (a free choice the robustness ensemble varies): the Walker's
+    swing keeps the walker's own clearance, and a preset's key sets it per participant."""
+    from dataclasses import replace
+
+    from gaitval.simulate.scene import Walker
+    from gaitval.simulate.study import _subject_choices
+    gp = GaitParams(step_length_m=0.6, step_width_m=0.10, step_time_s=0.5)
+    plan = _cross_plan(gp)
+    t = np.linspace(0.7, 1.2, 101)
+
+    def closest(w):
+        a, b = (leg_kinematics(w.plan, s, t, w.gp).point_at_height(0.27) for s in (0, 1))
+        return float(np.hypot(*(a - b).T).min())
+
+    near = Walker(plan=plan, gp=replace(gp, shank_clearance_m=0.005), leg_width_m=0.10)
+    far = Walker(plan=plan, gp=replace(gp, shank_clearance_m=0.03), leg_width_m=0.10)
+    assert closest(far) >= 0.10 + 0.03 - 1e-3 and closest(far) > closest(near) + 0.015
+    subj = {"subject": "S", "leg_width_m": 0.1}
+    assert _subject_choices({"shank_clearance_m": 0.02}, "tug", subj, gp)[1] \
+        .shank_clearance_m == 0.02
+    assert _subject_choices({}, "tug", subj, gp)[1] == gp          # absent: unchanged
+
+
 def test_swings_clear_of_the_standing_leg_are_left_straight():
     """Steps at a normal width need no detour: the path model changes nothing there."""
     from gaitval.simulate.scene import Walker

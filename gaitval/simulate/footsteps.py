@@ -51,6 +51,9 @@ class GaitParams:
     roll_fwd_m: float = 0.14            # ankle advance over the forefoot from heel off to toe off
     roll_up_m: float = 0.09             # ankle rise from heel off to toe off
     rocker_m: float = 0.025             # ankle advance over the heel in loading response
+    shank_clearance_m: float = 0.01     # air between the shanks' surfaces when one swings
+    #                                     past the other (contact.CONTACT_CLEARANCE_M; no
+    #                                     source; docs/simulator.md "Free choices")
 
 
 def first_swing_s(gp: GaitParams, T: float) -> float:

@@ -62,8 +62,10 @@ class Walker:
             gp = self.gp
             fn = lambda p, s, t: leg_kinematics(p, s, t, gp)      # noqa: E731
             hs = tuple(self.sensor_height_m + dh for dh in CHECK_HEIGHTS_REL_M)
-            plan = separate_footholds(self.plan, fn, self.leg_width_m, hs)
-            self.plan = plan.with_detours(swing_detours(plan, fn, self.leg_width_m, hs))
+            cl = gp.shank_clearance_m
+            plan = separate_footholds(self.plan, fn, self.leg_width_m, hs, clearance_m=cl)
+            self.plan = plan.with_detours(swing_detours(plan, fn, self.leg_width_m, hs,
+                                                        clearance_m=cl))
 
     def legs(self, t: np.ndarray) -> tuple[LegState, LegState]:
         pt = None if self.posture_tilt is None else self.posture_tilt(t)

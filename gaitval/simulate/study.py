@@ -205,7 +205,8 @@ def _subject_choices(study_cfg: dict, proto: str, subj: dict, gp: GaitParams
                      ) -> tuple[dict, GaitParams]:
     """A participant with the preset's free choices of the participants applied after
     their draws (so every other draw is unchanged): ``leg_width_scale`` (top level)
-    scales the leg width at the scan height, ``tug.turn_step_factor`` replaces the turning
+    scales the leg width at the scan height, ``shank_clearance_m`` (top level) replaces
+    the air between passing shanks, ``tug.turn_step_factor`` replaces the turning
     step length factor, ``mtst.step_width_scale`` scales the step width.  Absent keys
     change nothing (docs/robustness.md, "Plausible ranges")."""
     from dataclasses import replace
@@ -218,6 +219,8 @@ def _subject_choices(study_cfg: dict, proto: str, subj: dict, gp: GaitParams
         gp = replace(gp, turn_step_factor=float(c["turn_step_factor"]))
     if proto == "mtst" and "step_width_scale" in c:
         gp = replace(gp, step_width_m=gp.step_width_m * float(c["step_width_scale"]))
+    if "shank_clearance_m" in study_cfg:
+        gp = replace(gp, shank_clearance_m=float(study_cfg["shank_clearance_m"]))
     return subj, gp
 
 
