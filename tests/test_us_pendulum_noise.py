@@ -138,3 +138,18 @@ def test_pendulum_errors_compare_the_low_passed_trajectories():
     assert np.std(lp[mid, 1]) < 0.2 * np.std(raw[mid, 1])      # 20 Hz: |H|^2 = 1/17 at 2 fc
     assert np.std(lp[mid, 0]) == pytest.approx(0.002 / np.sqrt(2), rel=0.1)   # 1 Hz kept
     assert keep.sum() == int(np.sum(t >= 0.5))
+
+
+def test_the_boards_distance_from_the_heel_path_is_a_preset_choice():
+    # ultrasonic.board_distance_m (the robustness ensemble varies it): the board plane
+    # moves sideways by the change, the same draws otherwise; absent, the default pose
+    from gaitval.simulate.us_sensor import BOARD_DISTANCE_M, board_pose
+
+    R0, o0 = board_pose(np.random.default_rng(3))
+    R1, o1 = board_pose(np.random.default_rng(3), BOARD_DISTANCE_M + 0.15)
+    assert np.array_equal(R0, R1) and o1[0] == o0[0] and o1[2] == o0[2]
+    assert o1[1] == pytest.approx(o0[1] - 0.15)                   # further to the left
+    p0 = S.plan_ultrasonic({"n_subjects": 1, "speeds": {"normal": 0.99}}, seed=4)
+    p1 = S.plan_ultrasonic({"n_subjects": 1, "speeds": {"normal": 0.99},
+                            "board_distance_m": 0.45}, seed=4)
+    assert p1.o[1] == pytest.approx(p0.o[1] - (0.45 - BOARD_DISTANCE_M))

@@ -101,8 +101,8 @@ from gaitval.io.atomic import write_csv, write_parquet, write_text
 from gaitval.io.c3d import write_c3d
 from gaitval.io.ultrasonic import write_ultrasonic
 from gaitval.simulate.us_pendulum import pendulum_apparatus, simulate_pendulum_trial
-from gaitval.simulate.us_sensor import (ANCHOR_IDS, PAPER_ANCHORS, PAPER_V_M2, board_pose,
-                                        speed_of_sound_true)
+from gaitval.simulate.us_sensor import (ANCHOR_IDS, BOARD_DISTANCE_M, PAPER_ANCHORS,
+                                        PAPER_V_M2, board_pose, speed_of_sound_true)
 from gaitval.simulate.us_treadmill import (foot_points, heel_path, simulate_treadmill_trial,
                                            stride_plan)
 
@@ -244,7 +244,8 @@ def plan_ultrasonic(cfg: dict | None = None, seed: int = 0) -> UltrasonicPlan:
     root = np.random.SeedSequence(seed)
     s_subj, s_board, s_trials, s_pend, s_app = root.spawn(5)
     subjects = _subjects(np.random.default_rng(s_subj), int(cfg["n_subjects"]))
-    R, o = board_pose(np.random.default_rng(s_board))
+    R, o = board_pose(np.random.default_rng(s_board),
+                      float(cfg.get("board_distance_m", BOARD_DISTANCE_M)))
     # each subject's own stride duration at a given speed, beyond leg length: with the
     # stride velocity fixed by the speed, the between-subject CV of the stride length is
     # that of the duration, 9.6 % in seed 003 Table 8 (Ref S, normal: 0.112 / 1.169 m);
@@ -324,7 +325,9 @@ def generate_ultrasonic(out_dir: Path, cfg: dict | None = None, seed: int = 0
         camera marker from the transducer head), ``pendulum_release_deg`` ([25, 35]:
         range of the release angle), ``pendulum_board_distance_m`` (0.30),
         ``pendulum_damping_ratio`` (0.03), ``noise_common_fraction`` (0: share of the
-        smallest V common to the four anchors), ``folder`` ("ultrasonic").
+        smallest V common to the four anchors), ``board_distance_m`` (the receiver
+        board from the heel transmitter's path, :data:`BOARD_DISTANCE_M`), ``folder``
+        ("ultrasonic").
     seed : int
         Seed of ``np.random.default_rng``; each trial gets its own child stream, so the
         same seed gives byte-identical files.
