@@ -589,6 +589,40 @@ def test_turn_to_sit_direction_turns_the_pivot_steps_the_other_way():
         build(S._rng(seed, 3, idx), *args)
 
 
+def test_turn_to_sit_steps_sets_the_number_of_pivot_steps():
+    """``tug.turn_to_sit_steps`` (robustness ensemble, plausible 2-4): that many pivot
+    steps plus the closing step, the same trial before them, seated at the chair facing +x
+    without a cross step; anything but a whole number from 2 to 6 is a ConfigError."""
+    from gaitval.simulate import study as S
+    from gaitval.simulate.tug import SEAT_X_M, TURN_TO_SIT_STEPS
+
+    cfg = load_preset("tiny")
+    seed = int(cfg["seed"])
+    idx, _, build, bargs, _, _ = [t for t in S._lrs_tasks(cfg, "tiny", seed, [])
+                                  if t[1] == "tug"][0]
+    plans = {}
+    for n in (2, TURN_TO_SIT_STEPS, 4):
+        args = list(bargs)
+        args[6] = {**bargs[6], "turn_to_sit_steps": n}
+        plans[n] = build(S._rng(seed, 3, idx), *args).walker.plan
+    base = build(S._rng(seed, 3, idx), *bargs).walker.plan
+    assert np.array_equal(base.xy, plans[TURN_TO_SIT_STEPS].xy)     # the default
+    k0 = {n: int(np.flatnonzero(np.asarray(p.label) == "turn_to_sit")[0])
+          for n, p in plans.items()}
+    for n, p in plans.items():
+        piv = np.asarray(p.label) == "turn_to_sit"
+        assert piv.sum() == n + 1, (n, piv.sum())                 # pivots + closing step
+        assert not p.cross[piv].any()
+        assert np.allclose(p.xy[-2:, 0], SEAT_X_M, atol=0.05)
+        assert p.heading[-1] == pytest.approx(2 * np.pi)
+        assert np.array_equal(p.xy[:k0[n]], base.xy[:k0[n]])
+    for bad in (1, 2.5, "three"):
+        args = list(bargs)
+        args[6] = {**bargs[6], "turn_to_sit_steps": bad}
+        with pytest.raises(ConfigError, match="turn_to_sit_steps"):
+            build(S._rng(seed, 3, idx), *args)
+
+
 def test_attendant_side_moves_the_attendant_only():
     """The attendant's side is read from the preset: mirrored across the mat, the
     participant's own plan unchanged; an unknown side is a ConfigError."""

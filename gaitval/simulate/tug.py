@@ -52,7 +52,8 @@ SEATED_HALF_WIDTH_M = 0.10
 #: "Free choices of the twin"; the sensitivity preset ``tug_sit_turn_right``).
 TURN_TO_SIT_DIRECTIONS = {"left": 2 * np.pi, "right": 0.0}     # heading when seated
 #: Pivot steps of the turn to sit (180° in equal parts), the closing step not counted:
-#: 60° per step, a turn without crossing the legs (docs/simulator.md, issue 34).
+#: 60° per step, a turn without crossing the legs (docs/simulator.md); no source, so the
+#: preset's ``tug.turn_to_sit_steps`` replaces it (docs/robustness.md: plausible 2-4).
 TURN_TO_SIT_STEPS = 3
 #: The capture ends this long after the participant is seated (s, uniform): the timed
 #: span of the TUG ends when the participant sits (Podsiadlo & Richardson 1991).
@@ -181,6 +182,18 @@ def _seated_heading(cfg: dict) -> float:
     return TURN_TO_SIT_DIRECTIONS[way]
 
 
+def _pivot_steps(cfg: dict) -> int:
+    """The pivot steps of the turn to sit: the preset's ``tug.turn_to_sit_steps``, else
+    :data:`TURN_TO_SIT_STEPS`."""
+    from gaitval.errors import ConfigError
+
+    n = cfg.get("turn_to_sit_steps", TURN_TO_SIT_STEPS)
+    if isinstance(n, bool) or not isinstance(n, int) or not 2 <= n <= 6:
+        raise ConfigError(f"tug.turn_to_sit_steps must be a whole number of steps from 2 to "
+                          f"6, got {n!r}", hint="the simulation preset's tug section")
+    return n
+
+
 def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     """Timed Up and Go: rise, walk 3 m, turn around a marker, walk back, turn, sit.
 
@@ -189,8 +202,8 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     at (3, 0): out on the marker's right, a left turn of radius :func:`turn_radius`
     around it, back on the tangent towards the chair.  Where the return line ends
     (:data:`TURN_TO_SIT_FROM_M` before the seat) the participant turns to sit in
-    :data:`TURN_TO_SIT_STEPS` pivot steps without crossover that end at the seat facing
-    +x, the other foot joins at hip width (:data:`SEATED_HALF_WIDTH_M`, as at the start),
+    :data:`TURN_TO_SIT_STEPS` (``tug.turn_to_sit_steps``) pivot steps without crossover
+    that end at the seat facing +x, the other foot joins at hip width (:data:`SEATED_HALF_WIDTH_M`, as at the start),
     and they sit down: the descent starts as the last pivot step lands (the closing step
     is taken while lowering).
     """
@@ -200,7 +213,7 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     gp = replace(gp, turn_time_factor=TURN_TIME_FACTOR)
     path = tug_path(turn_radius(gp, subj["leg_width_m"]))
     plan = plan_steps(path, gp, rng, t0=t0, first_side=int(rng.integers(0, 2)),
-                      end_pose=(SEAT_X_M, 0.0, _seated_heading(cfg), TURN_TO_SIT_STEPS),
+                      end_pose=(SEAT_X_M, 0.0, _seated_heading(cfg), _pivot_steps(cfg)),
                       start_half_width=SEATED_HALF_WIDTH_M, end_label="turn_to_sit",
                       end_half_width=SEATED_HALF_WIDTH_M)
     # the descent begins as the last pivot step lands: the trailing foot joins while the
