@@ -263,10 +263,12 @@ class RecentHits(StaticMap):
         out._t = np.asarray(scans.t, dtype=float)
         out._cells: dict = {}          # cell key (_SHIFT) -> [score, time of last hit]
         out._now = 0.0
+        out._answers: dict = {}        # cell -> is_static, until the map next changes
         return out
 
     def update(self, k, pts_world):
         now = self._now = float(self._t[k])
+        self._answers.clear()          # the map (and its clock) change: answers go stale
         if not len(pts_world):
             return
         ij = np.floor(pts_world / self.cell_m).astype(np.int64)
@@ -282,7 +284,15 @@ class RecentHits(StaticMap):
                 e[1] = now
 
     def is_static(self, x, y):
+        # a scan's points fall in few cells and the answer depends on the cell only, until
+        # the next update: each cell is looked up once per scan
         cx, cy = int(math.floor(x / self.cell_m)), int(math.floor(y / self.cell_m))
+        got = self._answers.get((cx, cy))
+        if got is None:
+            got = self._answers[(cx, cy)] = self._cell_static(cx, cy)
+        return got
+
+    def _cell_static(self, cx, cy):
         n = self.neighbourhood
         tab, now, thr = self._cells, self._now, self._threshold
         for i in range(cx - n, cx + n + 1):
