@@ -204,8 +204,8 @@ def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
     (:data:`TURN_TO_SIT_FROM_M` before the seat) the participant turns to sit in
     :data:`TURN_TO_SIT_STEPS` (``tug.turn_to_sit_steps``) pivot steps without crossover
     that end at the seat facing +x, the other foot joins at hip width
-    (:data:`SEATED_HALF_WIDTH_M`, as at the start), and they sit down: the descent starts as the last pivot step lands (the closing step
-    is taken while lowering).
+    (:data:`SEATED_HALF_WIDTH_M`, as at the start), and they sit down: the descent starts
+    as the last pivot step lands (the closing step is taken while lowering).
     """
     t_rise = float(rng.uniform(0.5, 0.9))
     rise_dur = float(rng.normal(0.9, 0.08))
