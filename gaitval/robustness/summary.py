@@ -166,8 +166,9 @@ def write_robustness(design: pd.DataFrame, reports_dir: str | Path, cfg: dict,
     n = len(design)
     caption = (f"Robustness of every verdict over {n} twins of the {cfg['base_preset']} study "
                "drawn jointly "
-               "over the plausible ranges of the twin's free choices (Latin hypercube; "
-               "docs/robustness.md): share of twins reproducing it, "
+               "over the plausible ranges of the twin's free choices (a seeded design: the "
+               "two-way choices a full factorial when the twins allow it, the ranges a "
+               "Latin hypercube; docs/robustness.md): share of twins reproducing it, "
                "Wilson 95 % interval, class by the stated criterion, and the choices that "
                "move it most (Spearman's ρ between the choice and the verdict).")
     notes = [f"Robust: the Wilson 95 % lower bound of the share ≥ {ROBUST_SHARE} (robust: not "
