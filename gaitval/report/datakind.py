@@ -249,7 +249,8 @@ def headline(studies: list[StudyData]) -> list[str]:
                      f"{'is' if n == 1 else 'are'} shown only")
         if c["failed"]:
             line += (f"; **{len(c['failed'])} fail**: {', '.join(c['failed'])}, which the "
-                     "verdicts on those protocols inherit")
+                     "verdicts on those protocols inherit (what is known of each failure's "
+                     "cause: docs/simulator.md, \"Known limits\")")
         out.append(line + ".")
     kinds = dict.fromkeys(s.kind for s in studies)
     out += [MEANING[k] for k in kinds if k in MEANING]
