@@ -104,6 +104,26 @@ def test_twin_presets_compose_the_sensor_poses(tmp_path):
     assert ensemble_name(cfg).startswith("robustness_")
 
 
+def test_the_shipped_ensemble_shifts_the_target_rows_and_sets_the_stick(tmp_path):
+    """The shipped configuration's MTST layout and stick factors reach every twin's preset:
+    the rows' spacing range is the default 1.0-1.4 m shifted by the drawn -0.2 to +0.2 m
+    (rows 0.8-1.6 m apart), the lanes and the stick's hand and offset are the drawn ones."""
+    cfg = load_config(ROOT / "config" / "robustness.yaml")
+    d = design(cfg)
+    base = yaml.safe_load((PRESET_DIR / "default.yaml").read_text())
+    for twin, p in twin_presets(cfg, base, d).items():
+        row = d.loc[twin]
+        lo, hi = p["mtst"]["targets"]["row_spacing_m"]
+        assert hi - lo == pytest.approx(0.4)
+        assert lo == pytest.approx(1.0 + row["mtst_target_row_shift_m"], abs=1e-4)
+        assert 0.8 - 1e-4 <= lo and hi <= 1.6 + 1e-4
+        assert p["mtst"]["targets"]["lane_m"] == pytest.approx(row["mtst_target_lane_m"])
+        assert 0.27 <= p["mtst"]["targets"]["lane_m"] <= 0.40
+        assert p["mtst"]["stick"] == {"side": row["mtst_stick_side"],
+                                      "offset_m": pytest.approx(row["mtst_stick_offset_m"])}
+    assert set(d["mtst_stick_side"]) == {"left", "right"}
+
+
 def test_classes_follow_the_stated_criterion():
     # 16 of 16: Wilson lower bound 0.806 -> robust; 15 of 16: 0.717 -> hinges
     from statsmodels.stats.proportion import proportion_confint

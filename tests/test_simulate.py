@@ -664,3 +664,68 @@ def test_sensitivity_table_names_the_flips(tmp_path):
     assert list(t["flips_under"]) == ["", ""] and list(t["absent_in"]) == ["", "alt"]
     with pytest.raises(GaitvalError, match="verdicts.csv"):
         sensitivity_table([tmp_path / "ref", tmp_path / "nothing"])
+
+
+def test_target_layout_follows_the_preset_and_the_default_draws_as_before():
+    """``mtst.targets`` (robustness ensemble: rows 0.8-1.6 m apart, lanes ± 0.27-0.40 m):
+    without it the layout is TARGETS_DEFAULT's, drawn as before the key existed (same
+    rng, same rows); with it the lanes sit at 0 and ± lane_m (each target within its
+    ± 0.05 m jitter) and consecutive rows lie inside the spacing range; a range out of
+    order or a lane that would let targets overlap is a ConfigError."""
+    from gaitval.simulate.mtst import MAT_LENGTH, mtst_targets
+
+    a = mtst_targets(np.random.default_rng(3))
+    b = mtst_targets(np.random.default_rng(3), {"targets": {"row_spacing_m": [1.0, 1.4],
+                                                            "lane_m": 0.35}})
+    pd.testing.assert_frame_equal(a, b)
+    cfg = {"targets": {"row_spacing_m": [0.8, 1.0], "lane_m": 0.27}}
+    t = mtst_targets(np.random.default_rng(3), cfg)
+    rows = np.unique(t["x_m"])
+    assert len(rows) > len(np.unique(a["x_m"]))               # closer rows: more of them
+    assert np.all((np.diff(rows) >= 0.8 - 1e-3) & (np.diff(rows) <= 1.0 + 1e-3))
+    assert rows[-1] < MAT_LENGTH
+    off = t["y_m"].to_numpy()
+    lane = np.array([min((-0.27, 0.0, 0.27), key=lambda c: abs(c - y)) for y in off])
+    assert np.all(np.abs(off - lane) <= 0.05 + 1e-9)
+    assert set(np.round(lane, 2)) == {-0.27, 0.0, 0.27}
+    for bad in ({"row_spacing_m": [1.4, 1.0]}, {"row_spacing_m": 1.2}, {"lane_m": 0.2},
+                {"lane_m": "wide"}):
+        with pytest.raises(ConfigError, match="mtst.targets"):
+            mtst_targets(np.random.default_rng(3), {"targets": bad})
+
+
+def test_stick_side_and_offset_move_the_stick_only():
+    """``mtst.stick`` (robustness ensemble: either hand, 0.20-0.35 m): the tiny study's
+    stick user holds it on the right 0.28 m from the pelvis line by default; on the left
+    it is mirrored about that line at the same distance, at 0.20 m it is closer; the
+    participant's own plan is the same; an unknown hand is a ConfigError."""
+    from gaitval.simulate import study as S
+
+    cfg = load_preset("tiny")
+    seed = int(cfg["seed"])
+    idx, _, build, bargs, _, _ = [t for t in S._lrs_tasks(cfg, "tiny", seed, [])
+                                  if t[1] == "mtst"][0]
+    assert bargs[8]                                             # the tiny MTST trial's stick
+
+    def lateral(sim):
+        t = np.linspace(1.5, sim.t_end_s - 1.5, 40)
+        p, hd = sim.walker.pelvis(t)
+        left = np.column_stack([-np.sin(hd), np.cos(hd)])
+        return np.sum((sim.walker.stick(t) - p[:, :2]) * left, axis=1)
+
+    sims = {}
+    for name, stick in (("default", None), ("left", {"side": "left"}),
+                        ("close", {"offset_m": 0.20})):
+        args = list(bargs)
+        if stick is not None:
+            args[6] = {**bargs[6], "stick": stick}
+        sims[name] = build(S._rng(seed, 3, idx), *args)
+    assert np.allclose(lateral(sims["default"]), -0.28)
+    assert np.allclose(lateral(sims["left"]), 0.28)
+    assert np.allclose(lateral(sims["close"]), -0.20)
+    for s in sims.values():
+        assert np.array_equal(s.walker.plan.xy, sims["default"].walker.plan.xy)
+    args = list(bargs)
+    args[6] = {**bargs[6], "stick": {"side": "both"}}
+    with pytest.raises(ConfigError, match="mtst.stick.side"):
+        build(S._rng(seed, 3, idx), *args)

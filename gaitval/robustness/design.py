@@ -115,8 +115,16 @@ def _set(preset: dict, dotted: str, value) -> None:
 
 
 def _poses(preset: dict, row: dict) -> None:
-    """The two composed factors: the TUG sensor looking at the marker from (behind,
-    lateral), the MTST sensor at its place and distance."""
+    """The composed factors: the TUG sensor looking at the marker from (behind, lateral),
+    the MTST sensor at its place and distance, the MTST target rows' spacing range shifted
+    (gaitval.simulate.mtst.TARGETS_DEFAULT's 1.0-1.4 m by -0.2 to +0.2 m: rows 0.8-1.6 m
+    apart)."""
+    if "mtst" in preset and "mtst_target_row_shift_m" in row:
+        from gaitval.simulate.mtst import TARGETS_DEFAULT
+
+        d = float(row["mtst_target_row_shift_m"])
+        preset["mtst"].setdefault("targets", {})["row_spacing_m"] = [
+            round(v + d, 4) for v in TARGETS_DEFAULT["row_spacing_m"]]
     if "tug" in preset and {"tug_sensor_behind_m", "tug_sensor_lateral_m"} <= row.keys():
         x, y = float(row["tug_sensor_behind_m"]), float(row["tug_sensor_lateral_m"])
         yaw = math.atan2(TUG_MARKER_XY[1] - y, TUG_MARKER_XY[0] - x)

@@ -37,6 +37,16 @@ POLES_M = ((3.0, 1.75), (5.6, -1.3))
 #: distance are the twin's choice): side of the walker, distance from the mat's centreline
 #: and how far behind the participant's start the attendant starts (m).
 ATTENDANT_DEFAULT = {"side": "right", "lateral_m": 0.75, "behind_m": 0.25}
+#: The target layout (seed 001: targets "arranged randomly" on the 1.15 m mat, no sizes):
+#: the distance between rows is drawn uniform in ``row_spacing_m`` (m), the three lanes'
+#: centres are at 0 and ± ``lane_m`` (m) from the centreline.  No source; the preset's
+#: ``mtst.targets`` replaces them (docs/robustness.md: rows 0.8-1.6 m apart, lanes
+#: ± 0.27-0.40 m; below 0.27 m two 0.16 m targets, each ± 0.05 m off its lane, can overlap).
+TARGETS_DEFAULT = {"row_spacing_m": (1.0, 1.4), "lane_m": 0.35}
+#: A participant with a stick (seed 001: 2 of the 16 use one; which hand and how far out
+#: are not given): the hand and the stick's distance from the pelvis line (m); the preset's
+#: ``mtst.stick`` replaces them (docs/robustness.md: either hand, 0.20-0.35 m).
+STICK_DEFAULT = {"side": "right", "offset_m": 0.28}
 #: where each trial's target layout is written, relative to the study folder
 TARGETS_FILE = "targets/{trial}.targets.csv"
 
@@ -49,23 +59,59 @@ def mtst_calibration() -> dict:
             "poles_m": [list(p) for p in POLES_M]}
 
 
-def mtst_targets(rng) -> pd.DataFrame:
-    """Targets on the mat: rows every ≈ 0.45–0.6 m, three colours per row in random lanes.
+def _targets_cfg(cfg: dict | None) -> tuple[tuple[float, float], float]:
+    """The row spacing range and lane offset of ``cfg["targets"]`` over
+    :data:`TARGETS_DEFAULT`, checked (a :class:`~gaitval.errors.ConfigError` otherwise)."""
+    t = {**TARGETS_DEFAULT, **((cfg or {}).get("targets") or {})}
+    sp, lane = t["row_spacing_m"], t["lane_m"]
+    ok_sp = (isinstance(sp, (list, tuple)) and len(sp) == 2
+             and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in sp)
+             and 0.5 <= sp[0] <= sp[1] <= 2.5)
+    if not ok_sp:
+        raise ConfigError(f"mtst.targets.row_spacing_m must be [low, high] in metres with "
+                          f"0.5 <= low <= high <= 2.5, got {sp!r}",
+                          hint="the simulation preset's mtst section")
+    if isinstance(lane, bool) or not isinstance(lane, (int, float)) or not 0.27 <= lane <= 0.45:
+        raise ConfigError(f"mtst.targets.lane_m must be 0.27-0.45 m (three 0.16 m targets "
+                          f"apart on the 1.15 m mat), got {lane!r}",
+                          hint="the simulation preset's mtst section")
+    return (float(sp[0]), float(sp[1])), float(lane)
+
+
+def stick_side(cfg: dict | None) -> tuple[int, float]:
+    """The stick's hand (0 = left, 1 = right, as :class:`~gaitval.simulate.scene.Walker`)
+    and its distance from the pelvis line (m): ``cfg["stick"]`` over :data:`STICK_DEFAULT`."""
+    st = {**STICK_DEFAULT, **((cfg or {}).get("stick") or {})}
+    off = st["offset_m"]
+    if st["side"] not in ("right", "left"):
+        raise ConfigError(f"mtst.stick.side must be 'right' or 'left', got {st['side']!r}",
+                          hint="the simulation preset's mtst section")
+    if isinstance(off, bool) or not isinstance(off, (int, float)) or not 0.1 <= off <= 0.5:
+        raise ConfigError(f"mtst.stick.offset_m must be 0.1-0.5 m, got {off!r}",
+                          hint="the simulation preset's mtst section")
+    return (1 if st["side"] == "right" else 0), float(off)
+
+
+def mtst_targets(rng, cfg: dict | None = None) -> pd.DataFrame:
+    """Targets on the mat: rows every ≈ 1.0–1.4 m, three colours per row in random lanes.
 
     Lane centres at y = −0.35, 0, +0.35 m (the 1.15 m mat holds three 0.16 m targets with
     ≈ 0.19 m between them); a row's colours are a random permutation (the paper's
     "arranged randomly"), so the assigned colour jumps between lanes from row to row.
+    ``cfg`` (the preset's ``mtst`` section) may replace the spacing and the lanes
+    (``targets``, :data:`TARGETS_DEFAULT`).
     """
+    (lo, hi), lane_m = _targets_cfg(cfg)
     rows = []
     x = 0.55
     tid = 0
     while x < MAT_LENGTH - 0.4:
         perm = rng.permutation(3)
-        for lane, c in zip((-0.35, 0.0, 0.35), perm):
+        for lane, c in zip((-lane_m, 0.0, lane_m), perm):
             rows.append({"target": f"T{tid:02d}", "x_m": round(x, 3),
                          "y_m": round(lane + rng.uniform(-0.05, 0.05), 3), "color": COLORS[c]})
             tid += 1
-        x += rng.uniform(1.0, 1.4)
+        x += rng.uniform(lo, hi)
     return pd.DataFrame(rows)
 
 
@@ -168,12 +214,13 @@ def build_mtst(rng, study, subj, gp, trial, rep, sensor_pose, cfg, color, stick,
     participant's speed.  Both are free choices of the twin (seed 001 states neither;
     ``docs/simulator.md``).
     """
-    targets = mtst_targets(rng)
+    targets = mtst_targets(rng, cfg)
     t0 = float(rng.uniform(0.6, 1.0))
     plan, which = plan_mtst(rng, gp, targets, color, t0)
+    hand, offset = stick_side(cfg)
     walker = Walker(plan=plan, gp=gp, leg_width_m=subj["leg_width_m"],
                     sensor_height_m=cfg["sensor_height_m"],
-                    stick_side=(1 if stick else None))
+                    stick_side=(hand if stick else None), stick_offset_m=offset)
     # attendant: same path shifted, own gait, same speed
     agp = attendant_gp
     dur = plan.t_end - t0

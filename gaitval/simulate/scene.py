@@ -41,6 +41,8 @@ class Walker:
         Extra shank tilt of sit-to-stand (knees move forward as the trunk leans).
     stick_side : int or None
         Hand holding a stick (0 = L, 1 = R); the stick moves with the opposite leg.
+    stick_offset_m : float
+        The stick's distance from the pelvis line (m).
     sensor_height_m : float
         Height of the scan plane: the two shanks are kept apart there and 3 cm above and
         below (contact physics, :mod:`gaitval.simulate.contact`).
@@ -52,6 +54,7 @@ class Walker:
     sit: Callable | None = None
     posture_tilt: Callable | None = None
     stick_side: int | None = None
+    stick_offset_m: float = 0.28
     sensor_height_m: float = 0.27
     _pelvis_cache: dict = field(default_factory=dict, repr=False)
 
@@ -122,7 +125,7 @@ class Walker:
     def stick(self, t: np.ndarray, legs=None) -> np.ndarray:
         """(n, 2) stick position at sensor height, or empty when no stick.
 
-        The stick is held in hand ``stick_side`` 0.28 m lateral of the pelvis line and
+        The stick is held in hand ``stick_side`` ``stick_offset_m`` lateral of the pelvis line and
         advances with the opposite leg (longitudinal position of that leg's ankle).
         """
         if self.stick_side is None:
@@ -134,7 +137,7 @@ class Walker:
         left = np.column_stack([-np.sin(hd), np.cos(hd)])
         along = np.sum((opp.ankle[:, :2] - p[:, :2]) * fwd, axis=1) + 0.05
         sgn = 1.0 if self.stick_side == 0 else -1.0
-        return p[:, :2] + along[:, None] * fwd + sgn * 0.28 * left
+        return p[:, :2] + along[:, None] * fwd + sgn * self.stick_offset_m * left
 
 
 def to_sensor(xy: np.ndarray, pose: np.ndarray) -> np.ndarray:
