@@ -729,3 +729,39 @@ def test_stick_side_and_offset_move_the_stick_only():
     args[6] = {**bargs[6], "stick": {"side": "both"}}
     with pytest.raises(ConfigError, match="mtst.stick.side"):
         build(S._rng(seed, 3, idx), *args)
+
+
+def test_the_rollator_never_passes_through_an_obstacle_or_a_wall():
+    """Every rollator trial of the default study's plan: the rollator's frame (its
+    footprint, RLT_HALF_L x RLT_HALF_W about its centre) keeps clear of both obstacles of
+    the obstacle scenario (they are placed OBSTACLE_CLEARANCE_M from the nominal path; the
+    walk's sway may take a little of it) and stays inside the room, with the laser on it,
+    on every 10 ms of the trial; a preset's obstacle_clearance_m moves the obstacles out.
+    (The twin's obstacle 1 used to overlap the frame by up to 0.19 m, and the obstacle walk
+    ended 1.3 m beyond the far wall, which then stood between the laser and the legs.)"""
+    from gaitval.simulate import study as S
+    from gaitval.simulate.rollator import (RLT_HALF_L, RLT_HALF_W, frame_clearance,
+                                           obstacle_positions, rollator_path)
+
+    cfg = load_preset("default")
+    seed = int(cfg["seed"])
+    n_obstacle = 0
+    for idx, proto, build, bargs, _, _ in S._lrs_tasks(cfg, "default", seed, []):
+        if proto != "rollator":
+            continue
+        sim = build(S._rng(seed, 3, idx), *bargs)
+        t = np.arange(0.0, sim.t_end_s, 0.01)
+        pose = sim.rollator(t)
+        for circle in sim.circles[sim.circles[:, 2] >= 0.19]:
+            n_obstacle += 1
+            assert frame_clearance(pose[:, :2], pose[:, 2], circle).min() > 0.05, sim.trial
+        reach = np.hypot(RLT_HALF_L, RLT_HALF_W)
+        w = sim.walls
+        assert pose[:, 0].max() + reach < w[:, [0, 2]].max(), sim.trial
+        assert pose[:, 0].min() - reach > w[:, [0, 2]].min(), sim.trial
+        assert pose[:, 1].max() + reach < w[:, [1, 3]].max(), sim.trial
+        assert pose[:, 1].min() - reach > w[:, [1, 3]].min(), sim.trial
+    assert n_obstacle == 16                        # 8 obstacle trials, two obstacles each
+    near = obstacle_positions(rollator_path("obstacle"), 0.10)
+    far = obstacle_positions(rollator_path("obstacle"), 0.30)
+    assert far[0][1] < near[0][1] < 0 < near[1][1] < far[1][1]     # right and left, out

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from gaitval.errors import ConfigError
 from gaitval.simulate.kinematics import Path2D, StepPlan, make_path, plan_steps
 from gaitval.simulate.scene import ID_OBSTACLE, ID_POLE, ID_ROLLATOR, Walker
 from gaitval.simulate.trialsim import POLE_RADIUS_M, TrialSim, _walls
@@ -21,6 +22,21 @@ RLT_CORNERS = {"RLT_FL": (0.30, 0.28), "RLT_FR": (0.30, -0.28),
                "RLT_RL": (-0.30, 0.28), "RLT_RR": (-0.30, -0.28)}
 RLT_TOP_M = 0.85
 RLT_HANDLE_M = 0.62          # pelvis → rollator centre
+#: the frame's half length and half width (m): the footprint of RLT_CORNERS
+RLT_HALF_L, RLT_HALF_W = 0.30, 0.28
+#: Obstacles of the obstacle scenario: (x along the walkway, side: -1 right / +1 left of
+#: the path, radius), m.  Seed 002 gives the manoeuvres, not the obstacles' sizes or places.
+OBSTACLES = ((2.05, -1, 0.20), (4.3, +1, 0.20))
+#: The rollator's frame passes an obstacle this far from it at the closest (m; no source: a
+#: hand's breadth; the preset's ``rollator.obstacle_clearance_m`` replaces it,
+#: docs/robustness.md: plausible 0.05-0.30 m).  Each obstacle's lateral place is computed
+#: from it along the scenario's path (:func:`obstacle_positions`), so no frame passes
+#: through an obstacle.
+OBSTACLE_CLEARANCE_M = 0.10
+#: The room's walls stand at least this far beyond any point the rollator's frame reaches
+#: on the scenario's path (m), the default room (x -2.0 to 6.5 m, y -2.2 to 3.2 m) enlarged
+#: where the path needs it: a wall between the laser and the user's legs would hide them.
+ROOM_MARGIN_M = 1.0
 
 
 def _phase_from_plan(plan: StepPlan, labels_by_contact: np.ndarray, t_lo: float):
@@ -46,6 +62,60 @@ def rollator_path(scenario: str) -> Path2D:
                                          ("arc", 1.0, a, "manoeuvre"), ("line", 0.6, "forward"),
                                          ("arc", 1.0, -a, "manoeuvre"), ("arc", 1.0, 2 * a, "manoeuvre"),
                                          ("arc", 1.0, -a, "manoeuvre"), ("line", 1.0, "forward")])
+
+
+def _frame_path(path: Path2D) -> tuple[np.ndarray, np.ndarray]:
+    """The rollator frame's centre (n, 2) and heading (n,) along ``path``: RLT_HANDLE_M
+    ahead of the pelvis on the path's heading (the nominal walk, without sway)."""
+    xy, hd = np.asarray(path.xy, float), np.asarray(path.heading, float)
+    return xy + RLT_HANDLE_M * np.column_stack([np.cos(hd), np.sin(hd)]), hd
+
+
+def frame_clearance(centre: np.ndarray, heading: np.ndarray, circle) -> np.ndarray:
+    """Per pose, the distance from the rollator frame's footprint (a RLT_HALF_L ×
+    RLT_HALF_W rectangle about ``centre``, turned by ``heading``) to the circle
+    ``(x, y, r)``; negative where they overlap."""
+    ox, oy, r = circle[:3]
+    dx, dy = ox - centre[:, 0], oy - centre[:, 1]
+    c, s = np.cos(heading), np.sin(heading)
+    lx, ly = c * dx + s * dy, -s * dx + c * dy
+    qx = np.maximum(np.abs(lx) - RLT_HALF_L, 0.0)
+    qy = np.maximum(np.abs(ly) - RLT_HALF_W, 0.0)
+    inside = (qx == 0.0) & (qy == 0.0)
+    depth = np.minimum(RLT_HALF_L - np.abs(lx), RLT_HALF_W - np.abs(ly))
+    return np.where(inside, -depth, np.hypot(qx, qy)) - r
+
+
+def obstacle_positions(path: Path2D, clearance_m: float = OBSTACLE_CLEARANCE_M
+                       ) -> list[tuple[float, float, float]]:
+    """The obstacle scenario's obstacles ``(x, y, r)``: each at its OBSTACLES x, on its
+    side of the path, as near to it as leaves ``clearance_m`` between the rollator frame
+    and the obstacle along the whole nominal path (bisection on y, 1 mm)."""
+    centre, hd = _frame_path(path)
+    out = []
+    for x, side, r in OBSTACLES:
+        near = float(np.interp(x, centre[:, 0], centre[:, 1]))
+        lo, hi = 0.0, 3.0           # offset from the frame's path at x, towards ``side``
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            gap = frame_clearance(centre, hd, (x, near + side * mid, r)).min()
+            lo, hi = (mid, hi) if gap < clearance_m else (lo, mid)
+        out.append((x, round(near + side * hi, 3), r))
+    return out
+
+
+def room_walls(path: Path2D) -> np.ndarray:
+    """The room's walls: the default room (x -2.0 to 6.5, y -2.2 to 3.2 m), each wall moved
+    out to ROOM_MARGIN_M beyond the farthest reach of the rollator frame on ``path``
+    (rounded up to 0.5 m)."""
+    centre, _ = _frame_path(path)
+    reach = np.hypot(RLT_HALF_L, RLT_HALF_W) + ROOM_MARGIN_M
+    ext = lambda v: float(np.ceil(v / 0.5) * 0.5)      # noqa: E731
+    x0 = min(-2.0, -ext(-(centre[:, 0].min() - reach)))
+    x1 = max(6.5, ext(centre[:, 0].max() + reach))
+    y0 = min(-2.2, -ext(-(centre[:, 1].min() - reach)))
+    y1 = max(3.2, ext(centre[:, 1].max() + reach))
+    return _walls(x0, x1, y0, y1)
 
 
 def build_rollator(rng, study, subj, gp, trial, rep, scenario, cfg) -> TrialSim:
@@ -74,7 +144,13 @@ def build_rollator(rng, study, subj, gp, trial, rep, scenario, cfg) -> TrialSim:
     mount = (float(m["x_m"]), float(m["y_m"]), float(m["yaw_rad"]))
     obstacles = []
     if scenario != "straight":
-        obstacles = [(2.05, -0.15, 0.20, ID_OBSTACLE), (4.3, 0.55, 0.20, ID_OBSTACLE)]
+        clear = cfg.get("obstacle_clearance_m", OBSTACLE_CLEARANCE_M)
+        if isinstance(clear, bool) or not isinstance(clear, (int, float)) or not (
+                0.0 <= clear <= 1.0):
+            raise ConfigError(f"rollator.obstacle_clearance_m must be 0-1 m, got {clear!r}",
+                              hint="the simulation preset's rollator section")
+        obstacles = [(x, y, r, ID_OBSTACLE)
+                     for x, y, r in obstacle_positions(path, float(clear))]
     poles = np.array([[-1.0, -1.5], [5.5, 1.8]])
     circles = [(x, y, POLE_RADIUS_M, ID_POLE) for x, y in poles] + obstacles
     labs = plan.label
@@ -82,7 +158,7 @@ def build_rollator(rng, study, subj, gp, trial, rep, scenario, cfg) -> TrialSim:
     return TrialSim(study=study, protocol="rollator", subject=subj["subject"], trial=trial,
                     walker=walker, sensor="ubg04lx", sensor_height_m=cfg["sensor_height_m"],
                     mocap_rate_hz=cfg["mocap_rate_hz"], t_end_s=plan.t_end + 0.8,
-                    circles=np.array(circles, dtype=float), walls=_walls(-2.0, 6.5, -2.2, 3.2),
+                    circles=np.array(circles, dtype=float), walls=room_walls(path),
                     poles=poles, fixed_pose=None, rollator=rpose, sensor_mount=mount,
                     phase_fn=phase, scenario=scenario, repetition=rep, variant={})
 
