@@ -20,7 +20,7 @@ from gaitval.simulate.footsteps import first_swing_s
 from gaitval.simulate.kinematics import (GaitParams, StepPlan, make_path, plan_from_footholds,
                                          plan_steps)
 from gaitval.simulate.scene import ID_POLE, Walker
-from gaitval.simulate.trialsim import POLE_RADIUS_M, TrialSim, _walls
+from gaitval.simulate.trialsim import POLE_RADIUS_M, TrialSim, _walls, preset_number
 
 MAT_LENGTH, MAT_WIDTH = 5.85, 1.15
 TARGET_W, TARGET_L = 0.160, 0.165
@@ -71,14 +71,12 @@ def _targets_cfg(cfg: dict | None) -> tuple[tuple[float, float], float]:
         raise ConfigError(f"mtst.targets.row_spacing_m must be [low, high] in metres with "
                           f"0.5 <= low <= high <= 2.5, got {sp!r}",
                           hint="the simulation preset's mtst section")
-    if isinstance(lane, bool) or not isinstance(lane, (int, float)) or not 0.27 <= lane <= 0.45:
-        raise ConfigError(f"mtst.targets.lane_m must be 0.27-0.45 m (three 0.16 m targets "
-                          f"apart on the 1.15 m mat), got {lane!r}",
-                          hint="the simulation preset's mtst section")
+    # below 0.27 m two 0.16 m targets, each 0.05 m off its lane, can overlap
+    preset_number(lane, "mtst.targets.lane_m", 0.27, 0.45)
     return (float(sp[0]), float(sp[1])), float(lane)
 
 
-def stick_side(cfg: dict | None) -> tuple[int, float]:
+def _stick_cfg(cfg: dict | None) -> tuple[int, float]:
     """The stick's hand (0 = left, 1 = right, as :class:`~gaitval.simulate.scene.Walker`)
     and its distance from the pelvis line (m): ``cfg["stick"]`` over :data:`STICK_DEFAULT`."""
     st = {**STICK_DEFAULT, **((cfg or {}).get("stick") or {})}
@@ -86,9 +84,7 @@ def stick_side(cfg: dict | None) -> tuple[int, float]:
     if st["side"] not in ("right", "left"):
         raise ConfigError(f"mtst.stick.side must be 'right' or 'left', got {st['side']!r}",
                           hint="the simulation preset's mtst section")
-    if isinstance(off, bool) or not isinstance(off, (int, float)) or not 0.1 <= off <= 0.5:
-        raise ConfigError(f"mtst.stick.offset_m must be 0.1-0.5 m, got {off!r}",
-                          hint="the simulation preset's mtst section")
+    preset_number(off, "mtst.stick.offset_m", 0.1, 0.5)
     return (1 if st["side"] == "right" else 0), float(off)
 
 
@@ -217,7 +213,7 @@ def build_mtst(rng, study, subj, gp, trial, rep, sensor_pose, cfg, color, stick,
     targets = mtst_targets(rng, cfg)
     t0 = float(rng.uniform(0.6, 1.0))
     plan, which = plan_mtst(rng, gp, targets, color, t0)
-    hand, offset = stick_side(cfg)
+    hand, offset = _stick_cfg(cfg)
     walker = Walker(plan=plan, gp=gp, leg_width_m=subj["leg_width_m"],
                     sensor_height_m=cfg["sensor_height_m"],
                     stick_side=(hand if stick else None), stick_offset_m=offset)

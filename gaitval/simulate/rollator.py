@@ -13,17 +13,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from gaitval.errors import ConfigError
 from gaitval.simulate.kinematics import Path2D, StepPlan, make_path, plan_steps
 from gaitval.simulate.scene import ID_OBSTACLE, ID_POLE, ID_ROLLATOR, Walker
-from gaitval.simulate.trialsim import POLE_RADIUS_M, TrialSim, _walls
+from gaitval.simulate.trialsim import POLE_RADIUS_M, TrialSim, _walls, preset_number
 
 RLT_CORNERS = {"RLT_FL": (0.30, 0.28), "RLT_FR": (0.30, -0.28),
                "RLT_RL": (-0.30, 0.28), "RLT_RR": (-0.30, -0.28)}
 RLT_TOP_M = 0.85
 RLT_HANDLE_M = 0.62          # pelvis → rollator centre
 #: the frame's half length and half width (m): the footprint of RLT_CORNERS
-RLT_HALF_L, RLT_HALF_W = 0.30, 0.28
+RLT_HALF_L = max(abs(x) for x, _ in RLT_CORNERS.values())
+RLT_HALF_W = max(abs(y) for _, y in RLT_CORNERS.values())
 #: Obstacles of the obstacle scenario: (x along the walkway, side: -1 right / +1 left of
 #: the path, radius), m.  Seed 002 gives the manoeuvres, not the obstacles' sizes or places.
 OBSTACLES = ((2.05, -1, 0.20), (4.3, +1, 0.20))
@@ -144,11 +144,8 @@ def build_rollator(rng, study, subj, gp, trial, rep, scenario, cfg) -> TrialSim:
     mount = (float(m["x_m"]), float(m["y_m"]), float(m["yaw_rad"]))
     obstacles = []
     if scenario != "straight":
-        clear = cfg.get("obstacle_clearance_m", OBSTACLE_CLEARANCE_M)
-        if isinstance(clear, bool) or not isinstance(clear, (int, float)) or not (
-                0.0 <= clear <= 1.0):
-            raise ConfigError(f"rollator.obstacle_clearance_m must be 0-1 m, got {clear!r}",
-                              hint="the simulation preset's rollator section")
+        clear = preset_number(cfg.get("obstacle_clearance_m", OBSTACLE_CLEARANCE_M),
+                              "rollator.obstacle_clearance_m", 0.0, 1.0)
         obstacles = [(x, y, r, ID_OBSTACLE)
                      for x, y, r in obstacle_positions(path, float(clear))]
     poles = np.array([[-1.0, -1.5], [5.5, 1.8]])

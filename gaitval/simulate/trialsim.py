@@ -51,6 +51,21 @@ class TrialSim:
     variant: dict = field(default_factory=dict)
 
 
+def preset_number(value, key: str, lo: float, hi: float, *, whole: bool = False):
+    """A preset's number ``value`` at ``key`` (e.g. ``"mtst.targets.lane_m"``), checked to
+    lie in ``[lo, hi]`` (a whole number when ``whole``), else a ConfigError naming the key,
+    the range and the value."""
+    from gaitval.errors import ConfigError
+
+    kinds = (int,) if whole else (int, float)
+    if isinstance(value, bool) or not isinstance(value, kinds) or not lo <= value <= hi:
+        what = "a whole number" if whole else "a number"
+        section = key.split(".")[0]
+        raise ConfigError(f"{key} must be {what} from {lo:g} to {hi:g}, got {value!r}",
+                          hint=f"the simulation preset's {section} section")
+    return value
+
+
 def _walls(x0, x1, y0, y1) -> np.ndarray:
     return np.array([[x0, y0, x1, y0], [x1, y0, x1, y1], [x1, y1, x0, y1], [x0, y1, x0, y0]])
 

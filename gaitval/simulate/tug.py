@@ -19,7 +19,7 @@ import pandas as pd
 from gaitval.evaluate.tug_truth import tug_phase_bounds
 from gaitval.simulate.kinematics import make_path, plan_steps
 from gaitval.simulate.scene import ID_CHAIR, ID_MARKER, ID_POLE, Walker
-from gaitval.simulate.trialsim import POLE_RADIUS_M, TrialSim, _walls
+from gaitval.simulate.trialsim import POLE_RADIUS_M, TrialSim, _walls, preset_number
 
 #: The turn marker 3 m from the chair's front edge on
 #: the course axis: "walks three meters, turns around a marker, walks back to the chair and
@@ -185,13 +185,8 @@ def _seated_heading(cfg: dict) -> float:
 def _pivot_steps(cfg: dict) -> int:
     """The pivot steps of the turn to sit: the preset's ``tug.turn_to_sit_steps``, else
     :data:`TURN_TO_SIT_STEPS`."""
-    from gaitval.errors import ConfigError
-
-    n = cfg.get("turn_to_sit_steps", TURN_TO_SIT_STEPS)
-    if isinstance(n, bool) or not isinstance(n, int) or not 2 <= n <= 6:
-        raise ConfigError(f"tug.turn_to_sit_steps must be a whole number of steps from 2 to "
-                          f"6, got {n!r}", hint="the simulation preset's tug section")
-    return n
+    return preset_number(cfg.get("turn_to_sit_steps", TURN_TO_SIT_STEPS),
+                         "tug.turn_to_sit_steps", 2, 6, whole=True)
 
 
 def build_tug(rng, study, subj, gp, trial, rep, sensor_pose, cfg) -> TrialSim:
