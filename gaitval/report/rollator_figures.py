@@ -160,10 +160,14 @@ def write_rollator_figure(frames: pd.DataFrame, figures_dir, *, kf: str, pf: str
                     mount, v)
     axes[0, 0].legend(loc="upper right", fontsize=8)
     frame = "rollator frame" if mount else "laser frame (no mount configured)"
-    what = (rows[0] if len(rows) == 1 else
-            "the best and the worst trial" if all("FAILED" in v for v in verdicts) else
-            "a successful and a failed trial")
-    fig.suptitle(f"{what} (failed: any KF error frame or re-initialisation): leg positions "
+    if len(rows) == 1:      # one kind only: no trial failed, or every trial did
+        what = (f"{rows[0]}, no trial failed" if bad is None else
+                f"{rows[0]}, every trial failed" if good is None else rows[0])
+    else:
+        what = ("the best and the worst trial" if all("FAILED" in v for v in verdicts)
+                else "a successful and a failed trial")
+    fig.suptitle(f"{what} (a trial fails on any KF error frame or re-initialisation): leg "
+                 f"positions "
                  f"in the {frame}\ntruth thick red, KF black, PF blue; grey = KF error "
                  "frames, dotted = KF re-initialisations", fontsize=10)
     fig.tight_layout()
