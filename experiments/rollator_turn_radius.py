@@ -52,18 +52,20 @@ def main(work: Path, radii: list[float]) -> None:
         studies[name] = {"simulate": {"preset": f"robustness_turncheck/{name}",
                                       "seed": 20150904}}
         names.append(name)
-    cfg = work / "turncheck.yaml"
     work.mkdir(parents=True, exist_ok=True)
-    cfg.write_text(yaml.safe_dump({"studies": studies, "run": names, "peer_results": "",
-                                   "rollator": {"methods": ["rollator_kf", "rollator_pf"]}}))
-    targets = [f"reports/{n}/tables/rollator_table2.csv" for n in names]
-    cmd = [str(ROOT / ".venv" / "bin" / "snakemake"), *targets, "--snakefile",
-           str(ROOT / "Snakefile"), "--profile", str(ROOT / "workflow" / "profiles" / "default"),
-           "--directory", str(work), "--configfile", str(ROOT / "config" / "config.yaml"),
-           str(cfg)]
-    res = subprocess.run(cmd, capture_output=True, text=True)
-    if res.returncode:
-        sys.exit(res.stderr[-3000:])
+    for n in names:                       # one run per study: a run's tables pool its studies
+        cfg = work / f"{n}.yaml"
+        cfg.write_text(yaml.safe_dump({"studies": studies, "run": [n], "peer_results": "",
+                                       "rollator": {"methods": ["rollator_kf",
+                                                                "rollator_pf"]}}))
+        cmd = [str(ROOT / ".venv" / "bin" / "snakemake"),
+               f"reports/{n}/tables/rollator_table2.csv", "--snakefile",
+               str(ROOT / "Snakefile"), "--profile",
+               str(ROOT / "workflow" / "profiles" / "default"), "--directory", str(work),
+               "--configfile", str(cfg)]
+        res = subprocess.run(cmd, capture_output=True, text=True)
+        if res.returncode:
+            sys.exit(res.stderr[-3000:])
     pd.set_option("display.width", 200)
     for r, n in zip(radii, names):
         t = pd.read_csv(work / "reports" / n / "tables" / "rollator_table2.csv")

@@ -731,37 +731,92 @@ def test_stick_side_and_offset_move_the_stick_only():
         build(S._rng(seed, 3, idx), *args)
 
 
-def test_the_rollator_never_passes_through_an_obstacle_or_a_wall():
-    """Every rollator trial of the default study's plan: the rollator's frame (its
-    footprint, RLT_HALF_L x RLT_HALF_W about its centre) keeps clear of both obstacles of
+def _rollator_trials_keep_clear(cfg: dict, study: str) -> int:
+    """Every rollator trial of ``cfg``'s plan: the rollator's frame (its footprint,
+    RLT_HALF_L x RLT_HALF_W about its centre) keeps more than 5 cm from both obstacles of
     the obstacle scenario (they are placed OBSTACLE_CLEARANCE_M from the nominal path; the
-    walk's sway may take a little of it) and stays inside the room, with the laser on it,
-    on every 10 ms of the trial; a preset's obstacle_clearance_m moves the obstacles out.
-    (The twin's obstacle 1 used to overlap the frame by up to 0.19 m, and the obstacle walk
-    ended 1.3 m beyond the far wall, which then stood between the laser and the legs.)"""
+    walk's sway may take a little of it), clear of the calibration poles, and inside the
+    room, with the laser on it, on every 10 ms of the trial.  Returns the obstacles seen."""
     from gaitval.simulate import study as S
-    from gaitval.simulate.rollator import (RLT_HALF_L, RLT_HALF_W, frame_clearance,
-                                           obstacle_positions, rollator_path)
+    from gaitval.simulate.rollator import RLT_HALF_L, RLT_HALF_W, frame_clearance
 
-    cfg = load_preset("default")
     seed = int(cfg["seed"])
     n_obstacle = 0
-    for idx, proto, build, bargs, _, _ in S._lrs_tasks(cfg, "default", seed, []):
+    for idx, proto, build, bargs, _, _ in S._lrs_tasks(cfg, study, seed, []):
         if proto != "rollator":
             continue
         sim = build(S._rng(seed, 3, idx), *bargs)
         t = np.arange(0.0, sim.t_end_s, 0.01)
         pose = sim.rollator(t)
-        for circle in sim.circles[sim.circles[:, 2] >= 0.19]:
-            n_obstacle += 1
-            assert frame_clearance(pose[:, :2], pose[:, 2], circle).min() > 0.05, sim.trial
+        for circle in sim.circles:
+            gap = frame_clearance(pose[:, :2], pose[:, 2], circle).min()
+            if circle[2] >= 0.19:                                   # an obstacle
+                n_obstacle += 1
+                assert gap > 0.05, (sim.trial, circle)
+            else:                                                   # a calibration pole
+                assert gap > 0.0, (sim.trial, circle)
         reach = np.hypot(RLT_HALF_L, RLT_HALF_W)
         w = sim.walls
         assert pose[:, 0].max() + reach < w[:, [0, 2]].max(), sim.trial
         assert pose[:, 0].min() - reach > w[:, [0, 2]].min(), sim.trial
         assert pose[:, 1].max() + reach < w[:, [1, 3]].max(), sim.trial
         assert pose[:, 1].min() - reach > w[:, [1, 3]].min(), sim.trial
-    assert n_obstacle == 16                        # 8 obstacle trials, two obstacles each
+    return n_obstacle
+
+
+def test_the_rollator_never_passes_through_an_obstacle_or_a_wall():
+    """The default study's rollator trials keep clear of obstacles, poles and walls
+    (_rollator_trials_keep_clear); a preset's obstacle_clearance_m moves the obstacles out.
+    (The twin's obstacle 1 used to overlap the frame by up to 0.19 m, and the obstacle walk
+    ended 1.3 m beyond the far wall, which then stood between the laser and the legs.)"""
+    from gaitval.simulate.rollator import obstacle_positions, rollator_path
+
+    assert _rollator_trials_keep_clear(load_preset("default"), "default") == 16  # 8 x 2
     near = obstacle_positions(rollator_path("obstacle"), 0.10)
     far = obstacle_positions(rollator_path("obstacle"), 0.30)
     assert far[0][1] < near[0][1] < 0 < near[1][1] < far[1][1]     # right and left, out
+
+
+@pytest.mark.parametrize("end", ["low", "high", "mixed"])
+def test_every_rollator_path_of_the_ensembles_ranges_keeps_clear(end):
+    """The rollator paths at the ends of the robustness ensemble's ranges
+    (config/robustness.yaml: straight legs, turn radius, the S-manoeuvres' radius and
+    angle) keep the frame clear of the obstacles, the poles and the walls, as the default
+    does: the obstacles follow their S-manoeuvre and the room grows with the path."""
+    import yaml
+
+    from gaitval.robustness.design import load_config
+
+    factors = load_config()["factors"]
+    keys = {k: f for k, f in factors.items() if f.get("set", "").startswith("rollator.path.")}
+    assert len(keys) == 4
+    cfg = load_preset("tiny")
+    geo = {}
+    for i, (name, f) in enumerate(sorted(keys.items())):
+        lo, hi = f["range"]
+        pick = {"low": lo, "high": hi, "mixed": (lo, hi)[i % 2]}[end]
+        geo[f["set"].rsplit(".", 1)[1]] = pick
+    cfg["rollator"]["path"] = geo
+    assert _rollator_trials_keep_clear(yaml.safe_load(yaml.safe_dump(cfg)), "tiny") == 2
+
+
+def test_a_rollator_path_key_changes_that_scenarios_path_and_bad_values_are_refused():
+    from gaitval.simulate.rollator import (OBSTACLES, obstacle_xs, path_geometry,
+                                           rollator_path)
+
+    base = rollator_path("straight")
+    longer = rollator_path("straight", path_geometry({"path": {"straight_m": 4.0}}))
+    # each straight leg 1 m longer: the turn's far end 1 m further along x
+    assert np.isclose(longer.xy[:, 0].max() - base.xy[:, 0].max(), 1.0, atol=0.01)
+    tight = rollator_path("straight", path_geometry({"path": {"turn_radius_m": 0.3}}))
+    assert np.isclose(np.ptp(tight.xy[:, 1]), 0.6, atol=0.01)     # back 2 r to the side
+    assert np.isclose(np.ptp(base.xy[:, 1]), 1.2, atol=0.01)
+    # the S-manoeuvres: wider arcs take the obstacles along with them
+    assert obstacle_xs() == [x for x, _, _ in OBSTACLES]           # the default, exactly
+    wide = path_geometry({"path": {"manoeuvre_radius_m": 1.5, "manoeuvre_deg": 45}})
+    assert all(b > a for a, b in zip(obstacle_xs(), obstacle_xs(wide)))
+    assert path_geometry({}) == path_geometry({"path": {}})
+    for bad in ({"turn_radius_m": 0.0}, {"straight_m": "3"}, {"manoeuvre_deg": True},
+                {"turn_radius": 0.5}, [0.5]):
+        with pytest.raises(ConfigError, match="rollator.path"):
+            path_geometry({"path": bad})

@@ -51,17 +51,59 @@ def _phase_from_plan(plan: StepPlan, labels_by_contact: np.ndarray, t_lo: float)
     return fn
 
 
-def rollator_path(scenario: str) -> Path2D:
+#: The scenarios' path geometry (m, degrees; the preset's ``rollator.path`` replaces each
+#: key; docs/simulator.md, docs/robustness.md): ``straight_m`` each straight leg of
+#: scenario 1 ("a straight direction of about 3 m", seed 002 §IV), ``turn_radius_m`` the
+#: pelvis's radius in its 180° turn, ``manoeuvre_radius_m`` and ``manoeuvre_deg`` the arcs
+#: of scenario 2's two S-manoeuvres (no source for the last three).
+PATH_DEFAULTS = {"straight_m": 3.0, "turn_radius_m": 0.6, "manoeuvre_radius_m": 1.0,
+                 "manoeuvre_deg": 35.0}
+#: Each key's admissible values (a preset outside them is refused, not clipped)
+PATH_LIMITS = {"straight_m": (1.0, 6.0), "turn_radius_m": (0.2, 2.0),
+               "manoeuvre_radius_m": (0.3, 3.0), "manoeuvre_deg": (5.0, 80.0)}
+#: The obstacle scenario's straight pieces (m): before, between and after the S-manoeuvres
+OBSTACLE_LINES_M = (1.0, 0.6, 1.0)
+
+
+def path_geometry(cfg: dict | None) -> dict:
+    """The preset's ``rollator.path`` merged over PATH_DEFAULTS, each value checked
+    (ConfigError naming the key otherwise)."""
+    from gaitval.errors import ConfigError
+
+    given = (cfg or {}).get("path") or {}
+    if not isinstance(given, dict) or set(given) - set(PATH_DEFAULTS):
+        raise ConfigError(f"rollator.path must map some of {sorted(PATH_DEFAULTS)} to "
+                          f"numbers, got {given!r}", hint="the simulation preset's "
+                          "rollator section")
+    return {k: float(preset_number(given.get(k, v), f"rollator.path.{k}", *PATH_LIMITS[k]))
+            for k, v in PATH_DEFAULTS.items()}
+
+
+def _s_starts(geo: dict) -> tuple[float, float, float]:
+    """The x where each S-manoeuvre of the obstacle scenario starts, and an S's x extent."""
+    a = np.deg2rad(geo["manoeuvre_deg"])
+    span = 4.0 * geo["manoeuvre_radius_m"] * np.sin(a)
+    first = OBSTACLE_LINES_M[0]
+    return first, first + span + OBSTACLE_LINES_M[1], span
+
+
+def rollator_path(scenario: str, geometry: dict | None = None) -> Path2D:
+    """Scenario 1 (``straight``: a straight leg, a 180° turn, back) or 2 (``obstacle``: two
+    S-manoeuvres between straight pieces) with ``geometry`` (path_geometry's keys;
+    PATH_DEFAULTS when None)."""
+    geo = {**PATH_DEFAULTS, **(geometry or {})}
     if scenario == "straight":
-        return make_path((0.0, 0.0), 0.0, [("line", 3.0, "forward"),
-                                             ("arc", 0.6, np.pi, "turning"),
-                                             ("line", 3.0, "return")])
-    a = np.deg2rad(35.0)
-    return make_path((0.0, 0.0), 0.0, [("line", 1.0, "forward"),
-                                         ("arc", 1.0, a, "manoeuvre"), ("arc", 1.0, -2 * a, "manoeuvre"),
-                                         ("arc", 1.0, a, "manoeuvre"), ("line", 0.6, "forward"),
-                                         ("arc", 1.0, -a, "manoeuvre"), ("arc", 1.0, 2 * a, "manoeuvre"),
-                                         ("arc", 1.0, -a, "manoeuvre"), ("line", 1.0, "forward")])
+        return make_path((0.0, 0.0), 0.0, [("line", geo["straight_m"], "forward"),
+                                             ("arc", geo["turn_radius_m"], np.pi, "turning"),
+                                             ("line", geo["straight_m"], "return")])
+    a = np.deg2rad(geo["manoeuvre_deg"])
+    r = geo["manoeuvre_radius_m"]
+    l0, l1, l2 = OBSTACLE_LINES_M
+    return make_path((0.0, 0.0), 0.0, [("line", l0, "forward"),
+                                         ("arc", r, a, "manoeuvre"), ("arc", r, -2 * a, "manoeuvre"),
+                                         ("arc", r, a, "manoeuvre"), ("line", l1, "forward"),
+                                         ("arc", r, -a, "manoeuvre"), ("arc", r, 2 * a, "manoeuvre"),
+                                         ("arc", r, -a, "manoeuvre"), ("line", l2, "forward")])
 
 
 def _frame_path(path: Path2D) -> tuple[np.ndarray, np.ndarray]:
@@ -86,14 +128,24 @@ def frame_clearance(centre: np.ndarray, heading: np.ndarray, circle) -> np.ndarr
     return np.where(inside, -depth, np.hypot(qx, qy)) - r
 
 
-def obstacle_positions(path: Path2D, clearance_m: float = OBSTACLE_CLEARANCE_M
-                       ) -> list[tuple[float, float, float]]:
-    """The obstacle scenario's obstacles ``(x, y, r)``: each at its OBSTACLES x, on its
-    side of the path, as near to it as leaves ``clearance_m`` between the rollator frame
-    and the obstacle along the whole nominal path (bisection on y, 1 mm)."""
+def obstacle_xs(geometry: dict | None = None) -> list[float]:
+    """Each obstacle's x on the walkway: its OBSTACLES x at the default geometry; with
+    other S-manoeuvres, at the same fraction of its S's x extent from the S's start."""
+    geo = {**PATH_DEFAULTS, **(geometry or {})}
+    *starts, span = _s_starts(geo)
+    *d_starts, d_span = _s_starts(PATH_DEFAULTS)
+    return [x + (s - ds) + (x - ds) / d_span * (span - d_span)
+            for (x, _, _), s, ds in zip(OBSTACLES, starts, d_starts)]
+
+
+def obstacle_positions(path: Path2D, clearance_m: float = OBSTACLE_CLEARANCE_M,
+                       geometry: dict | None = None) -> list[tuple[float, float, float]]:
+    """The obstacle scenario's obstacles ``(x, y, r)``: each at its x (obstacle_xs), on
+    its side of the path, as near to it as leaves ``clearance_m`` between the rollator
+    frame and the obstacle along the whole nominal path (bisection on y, 1 mm)."""
     centre, hd = _frame_path(path)
     out = []
-    for x, side, r in OBSTACLES:
+    for (_, side, r), x in zip(OBSTACLES, obstacle_xs(geometry)):
         near = float(np.interp(x, centre[:, 0], centre[:, 1]))
         lo, hi = 0.0, 3.0           # offset from the frame's path at x, towards ``side``
         for _ in range(40):
@@ -127,7 +179,8 @@ def build_rollator(rng, study, subj, gp, trial, rep, scenario, cfg) -> TrialSim:
     yaw = π: facing the user) at 0.40 m; the two rear frame tubes (radius 0.0125 m) are
     in its 240° field of view.
     """
-    path = rollator_path(scenario)
+    geo = path_geometry(cfg)
+    path = rollator_path(scenario, geo)
     t0 = float(rng.uniform(0.8, 1.2))
     plan = plan_steps(path, gp, rng, t0=t0, first_side=int(rng.integers(0, 2)))
     walker = Walker(plan=plan, gp=gp, leg_width_m=subj["leg_width_m"],
@@ -147,7 +200,7 @@ def build_rollator(rng, study, subj, gp, trial, rep, scenario, cfg) -> TrialSim:
         clear = preset_number(cfg.get("obstacle_clearance_m", OBSTACLE_CLEARANCE_M),
                               "rollator.obstacle_clearance_m", 0.0, 1.0)
         obstacles = [(x, y, r, ID_OBSTACLE)
-                     for x, y, r in obstacle_positions(path, float(clear))]
+                     for x, y, r in obstacle_positions(path, float(clear), geo)]
     poles = np.array([[-1.0, -1.5], [5.5, 1.8]])
     circles = [(x, y, POLE_RADIUS_M, ID_POLE) for x, y in poles] + obstacles
     labs = plan.label
