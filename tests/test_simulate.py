@@ -783,8 +783,6 @@ def test_every_rollator_path_of_the_ensembles_ranges_keeps_clear(end):
     (config/robustness.yaml: straight legs, turn radius, the S-manoeuvres' radius and
     angle) keep the frame clear of the obstacles, the poles and the walls, as the default
     does: the obstacles follow their S-manoeuvre and the room grows with the path."""
-    import yaml
-
     from gaitval.robustness.design import load_config
 
     factors = load_config()["factors"]
@@ -792,12 +790,12 @@ def test_every_rollator_path_of_the_ensembles_ranges_keeps_clear(end):
     assert len(keys) == 4
     cfg = load_preset("tiny")
     geo = {}
-    for i, (name, f) in enumerate(sorted(keys.items())):
+    for i, (_, f) in enumerate(sorted(keys.items())):
         lo, hi = f["range"]
         pick = {"low": lo, "high": hi, "mixed": (lo, hi)[i % 2]}[end]
         geo[f["set"].rsplit(".", 1)[1]] = pick
     cfg["rollator"]["path"] = geo
-    assert _rollator_trials_keep_clear(yaml.safe_load(yaml.safe_dump(cfg)), "tiny") == 2
+    assert _rollator_trials_keep_clear(cfg, "tiny") == 2
 
 
 def test_a_rollator_path_key_changes_that_scenarios_path_and_bad_values_are_refused():
