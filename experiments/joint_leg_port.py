@@ -36,11 +36,18 @@ It answers two questions, and decides only what goes into the issue note:
    does the same port confirm?  Reported, not judged: it
    says whether the design that scores outdoors would keep issue 55's empty room at 0.
 
+3. (Added after 1 and 2 had run, before this variant ran.) The same port with
+   leg_tracker's default ``fixed_frame`` = ``odom``: the tracks, the travelled paths and the
+   grid (shifted by ``shift_threshold`` 0.5 m, the launch file's value) in a world frame,
+   with gaitval's scan matching (``ScanMatching()``, its defaults) standing in for the
+   odometry the bags do not carry; an unknown step is taken as no motion.  Reported on both
+   recordings, not judged.
+
 Nothing in gaitval's methods is changed by this script.
 
 Usage::
 
-    .venv/bin/python experiments/joint_leg_port.py [--outdoor] [--empty]
+    .venv/bin/python experiments/joint_leg_port.py [--outdoor] [--empty] [--world]
 """
 from __future__ import annotations
 
@@ -133,19 +140,42 @@ class LocalGrid:
     the grid centre, never shifted."""
 
     def __init__(self, n_beams, angle_min, inc, range_min, range_max):
-        c = (np.arange(WIDTH) * RES - (WIDTH / 2.0) * RES)
-        X, Y = np.meshgrid(c, c, indexing="ij")          # [i, j]: x index i, y index j
-        self.dist = np.hypot(X, Y)
-        ang = np.arctan2(Y, X)
-        ang = np.where(ang < np.pi, ang, ang - 2 * np.pi)
-        self.in_fov = (ang > angle_min - inc / 2) & (ang < angle_min + (n_beams - 1) * inc + inc / 2)
-        raw = np.round(ang / inc).astype(int) + n_beams // 2
-        self.beam = np.clip(raw, 0, n_beams - 1)
-        self.ang_rel = ang - np.round(ang / inc) * inc
+        self.n_beams, self.angle_min, self.inc = n_beams, angle_min, inc
+        self.cx = self.cy = None                         # grid centre (world frame)
+        self._geometry(0.0, 0.0, 0.0)
         self.range_min, self.range_max = range_min, range_max
         self.l0, self.lmin, self.lmax = logit(UNKNOWN), logit(MIN_PROB), logit(1 - MIN_PROB)
         self.l = np.full((WIDTH, WIDTH), self.lmin)      # unseen_is_freespace
         self.data = None                                 # no map published yet
+
+    def _geometry(self, lx, ly, yaw):
+        if self.cx is None:
+            self.cx, self.cy = lx, ly
+        c = np.arange(WIDTH) * RES - (WIDTH / 2.0) * RES
+        X, Y = np.meshgrid(c + self.cx - lx, c + self.cy - ly, indexing="ij")
+        self.dist = np.hypot(X, Y)
+        ang = np.mod(np.arctan2(Y, X) - yaw, 2 * np.pi)  # betweenPIandNegPI
+        ang = np.where(ang < np.pi, ang, ang - 2 * np.pi)
+        n, a0, inc = self.n_beams, self.angle_min, self.inc
+        self.in_fov = (ang > a0 - inc / 2) & (ang < a0 + (n - 1) * inc + inc / 2)
+        raw = np.round(ang / inc).astype(int) + n // 2
+        self.beam = np.clip(raw, 0, n - 1)
+        self.ang_rel = ang - np.round(ang / inc) * inc
+
+    def move(self, lx, ly, yaw):
+        """The laser's pose in the grid's frame for the next update (world frame); the
+        grid is shifted by whole cells when the laser is more than 0.5 m from its centre."""
+        if math.hypot(self.cx - lx, self.cy - ly) > 0.5:
+            tx = -int(round((self.cx - lx) / RES))
+            ty = -int(round((self.cy - ly) / RES))
+            new = np.full((WIDTH, WIDTH), self.lmin)
+            src_i = np.arange(WIDTH) + tx
+            src_j = np.arange(WIDTH) + ty
+            oi, oj = (src_i >= 0) & (src_i < WIDTH), (src_j >= 0) & (src_j < WIDTH)
+            new[np.ix_(oi, oj)] = self.l[np.ix_(src_i[oi], src_j[oj])]
+            self.l = new
+            self.cx, self.cy = lx, ly
+        self._geometry(lx, ly, yaw)
 
     def update(self, ranges_raw, is_human):
         r = ranges_raw[self.beam]
@@ -164,8 +194,8 @@ class LocalGrid:
     def how_much_in_free_space(self, x, y):
         if self.data is None:
             return IN_FREE_SPACE_THRESHOLD * 2
-        mx = int(round((x + (WIDTH / 2.0) * RES) / RES))
-        my = int(round((y + (WIDTH / 2.0) * RES) / RES))
+        mx = int(round((x - (self.cx - (WIDTH / 2.0) * RES)) / RES))
+        my = int(round((y - (self.cy - (WIDTH / 2.0) * RES)) / RES))
         s = 0
         for i in range(mx - 2, mx + 2):
             for j in range(my - 2, my + 2):
@@ -219,8 +249,42 @@ def raw_ranges(bag, topic):
                          for c, _, raw in r.messages(connections=conns)])
 
 
-def run(scans, forest_name, raw, min_points=5, scan_frequency=10.0, max_detect=10.0):
-    """Per scan, the published persons: list of (id, x, y)."""
+def chained_poses(scans):
+    """The laser's pose per scan in one world frame: gaitval's scan matching, an unknown
+    step taken as no motion."""
+    from gaitval.track.staticmap import ScanMatching
+    out, seg = ScanMatching().poses(scans)
+    g = np.zeros_like(out)
+    for k in range(1, len(out)):
+        if seg[k] != seg[k - 1]:
+            g[k] = g[k - 1]
+            continue
+        x0, y0, t0 = out[k - 1]
+        c, s = math.cos(t0), math.sin(t0)
+        dx, dy = out[k, 0] - x0, out[k, 1] - y0
+        rx, ry, rt = c * dx + s * dy, -s * dx + c * dy, out[k, 2] - t0
+        X, Y, T = g[k - 1]
+        c, s = math.cos(T), math.sin(T)
+        g[k] = (X + c * rx - s * ry, Y + s * rx + c * ry, T + rt)
+    return g
+
+
+def _to(pose, x, y):
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    return pose[0] + c * x - s * y, pose[1] + s * x + c * y
+
+
+def _from(pose, x, y):
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    dx, dy = x - pose[0], y - pose[1]
+    return c * dx + s * dy, -s * dx + c * dy
+
+
+def run(scans, forest_name, raw, min_points=5, scan_frequency=10.0, max_detect=10.0,
+        world=False):
+    """Per scan, the published persons in the laser's frame: list of (id, x, y).
+    ``world``: fixed_frame = a world frame from scan matching (question 3)."""
+    poses = chained_poses(scans) if world else np.zeros((scans.n_scans, 3))
     from gaitval.track.legclusters import cluster_scan, scan_clusters
     from gaitval.track.legforest import load_forest
     forest = load_forest(forest_name)
@@ -241,8 +305,10 @@ def run(scans, forest_name, raw, min_points=5, scan_frequency=10.0, max_detect=1
         keep = dist < max_detect
         order = np.argsort(dist[keep], kind="stable")    # published closest first
         cen_k, p_k = cen[keep][order], p[keep][order]
-        detects = [Detect(float(x), float(y), float(c), grid.how_much_in_free_space(x, y))
-                   for (x, y), c in zip(cen_k, p_k)]
+        pose = poses[k]
+        wxy = [_to(pose, float(x), float(y)) for x, y in cen_k]
+        detects = [Detect(x, y, float(c), grid.how_much_in_free_space(x, y))
+                   for (x, y), c in zip(wxy, p_k)]
         # propagate
         prop = copy.deepcopy(objects)
         for t in prop:
@@ -339,9 +405,13 @@ def run(scans, forest_name, raw, min_points=5, scan_frequency=10.0, max_detect=1
         pairs -= to_del_pairs
         for key in to_del_pairs:
             pair_init.pop(key, None)
-        out.append([(t.id_num, t.pos[0], t.pos[1]) for t in objects if t.is_person])
+        out.append([(t.id_num, *_from(pose, t.pos[0], t.pos[1]))
+                    for t in objects if t.is_person])
         # the grid for the next scan: this scan and its non-leg clusters
+        non_legs = [_from(pose, x, y) for x, y in non_legs]
         is_human = _human_beams(ranges, a0, inc, rmin, rmax, min_points, non_legs)
+        if world:
+            grid.move(*pose)
         grid.update(raw[k], is_human)
     return out
 
@@ -370,7 +440,7 @@ def hyp_frame(out):
     return pd.DataFrame(rows, columns=["k", "hyp_id", "x_m", "y_m"])
 
 
-def outdoor():
+def outdoor(world=False):
     from gaitval.evaluate.clearmot import clear_mot, following_counts
     from gaitval.pipeline.legbench import read_positions, read_scans
     scans = read_scans(OUTDOOR, "/scan_base2", "outdoor")
@@ -378,18 +448,20 @@ def outdoor():
     print(f"outdoor: {len(scans.t)} scans, {freq:.2f} Hz (launch: scan_frequency 10)")
     raw = raw_ranges(OUTDOOR, "/scan_base2")
     assert raw.shape == scans.ranges.shape, (raw.shape, scans.ranges.shape)
-    out = run(scans, "leg_tracker_bags", raw, min_points=5, scan_frequency=10.0)
+    out = run(scans, "leg_tracker_bags", raw, min_points=5, scan_frequency=10.0,
+              world=world)
     hyp = hyp_frame(out)
     pos, _ = read_positions(OUTDOOR, "/ground_truth_people_tracks", "/scan_base2",
                             scans.t, "outdoor")
     summary, events = clear_mot(pos, hyp, len(scans.t))
     f = following_counts(summary, events)
-    print("Joint Leg port, outdoor following:", {k: f[k] for k in f})
+    print(f"Joint Leg port ({'world' if world else 'laser'} frame), outdoor following:",
+          {k: f[k] for k in f})
     print("persons ever published:", hyp["hyp_id"].nunique())
     return f
 
 
-def empty():
+def empty(world=False):
     from gaitval.pipeline.legbench import read_scans
     held = {"/left_scan": "without_left_scan", "/rear_scan": "without_rear_scan",
             "/right_scan": "without_right_scan"}
@@ -399,9 +471,9 @@ def empty():
         f = min((7.5, 10.0, 15.0), key=lambda v: abs(v - freq))
         raw = raw_ranges(NEGATIVE, topic)
         assert raw.shape == scans.ranges.shape, (raw.shape, scans.ranges.shape)
-        out = run(scans, forest, raw, min_points=3, scan_frequency=f)
+        out = run(scans, forest, raw, min_points=3, scan_frequency=f, world=world)
         n = len({pid for ps in out for pid, _, _ in ps})
-        print(f"empty room {topic}: {len(scans.t)} scans at {freq:.2f} Hz (process noise "
+        print(f"empty room ({'world' if world else 'laser'} frame) {topic}: {len(scans.t)} scans at {freq:.2f} Hz (process noise "
               f"of {f} Hz), forest {forest}: persons confirmed {n}")
 
 
@@ -409,9 +481,10 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--outdoor", action="store_true")
     ap.add_argument("--empty", action="store_true")
+    ap.add_argument("--world", action="store_true", help="question 3")
     a = ap.parse_args()
     if a.outdoor or not a.empty:
-        outdoor()
+        outdoor(a.world)
     if a.empty or not a.outdoor:
-        empty()
+        empty(a.world)
     sys.exit(0)
