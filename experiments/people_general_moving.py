@@ -13,7 +13,10 @@ its 133 annotated person-scans and report nobody there (``gaitval legbench-track
 this script puts it in the first class that applies:
 
 ``no observation``   the detector gave no leg observation within 0.5 m of the annotation;
-``no hypothesis``    observations, but no tentative or confirmed person within 0.75 m;
+``no hypothesis``    observations, but no tentative or confirmed person within 0.75 m
+                     (after the first run: with the birth flags of the observations within
+                     0.5 m: ``taken`` / ``explained`` by a person, ``static``, ``free``;
+                     and whether one or several observations lie within 0.8 m of it);
 ``tentative: T``     a tentative person within 0.75 m; T is the first confirmation test it
                      failed on that scan (of the hypotheses near, the one that got
                      furthest): ``young`` (fewer than N scans old), ``M of N`` (fewer than M
@@ -71,6 +74,7 @@ def main():
 
     # -- observe the confirmer: the first failed test of each tentative person per scan
     seen = collections.defaultdict(list)          # k -> [(centre, status/why)]
+    WHY = {}
     step0 = lc.MOfNMoving.step
 
     def step(self, person, k):
@@ -96,15 +100,15 @@ def main():
                     why = "r span"
                 else:
                     why = "body walk"
-        person._why = why
+        WHY[id(person)] = why
         return ok
 
     confirm0 = pp.PeoplePass._confirm
 
     def confirm(self, p):
-        p._why = None
+        WHY.pop(id(p), None)
         confirm0(self, p)
-        why = getattr(p, "_why", None) or "young"
+        why = WHY.get(id(p)) or "young"
         if why == "pass" and p.status != lc.CONFIRMED:
             why = "static"
         seen[self.k].append((p.centre(), why if p.status == lc.TENTATIVE or
@@ -120,6 +124,16 @@ def main():
         record0(self)
 
     obs_k = {}
+    flags_k = {}
+    births0 = pp.PeoplePass.births
+
+    def births(self):
+        flags_k[self.k] = [("taken" if self.taken[j] else "explained" if self.explained[j]
+                            else "static" if self.static[j] else "free")
+                           for j in range(len(self.obs))]
+        births0(self)
+
+    pp.PeoplePass.births = births
     lc.MOfNMoving.step = step
     pp.PeoplePass._confirm = confirm
     pp.PeoplePass.record = record
@@ -140,7 +154,11 @@ def main():
             best = max((w for _, w in near), key=lambda w: ORDER.index(w) if w in ORDER else -1)
             cl = f"tentative: {best}"
         elif any(math.hypot(o[0] - gx, o[1] - gy) < 0.5 for o in obs_k.get(r.k, [])):
-            cl = "no hypothesis"
+            fl = [f for o, f in zip(obs_k[r.k], flags_k.get(r.k, []))
+                  if math.hypot(o[0] - gx, o[1] - gy) < 0.5]
+            n08 = sum(math.hypot(o[0] - gx, o[1] - gy) < 0.8 for o in obs_k[r.k])
+            cl = "no hypothesis: " + "+".join(sorted(set(fl))) + \
+                (", one observation" if n08 == 1 else ", several observations")
         else:
             cl = "no observation"
         classes[cl] += 1
