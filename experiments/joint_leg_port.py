@@ -300,7 +300,7 @@ def run(scans, forest_name, raw, min_points=5, scan_frequency=10.0, max_detect=1
     if poses is None:
         poses = chained_poses(scans) if world else np.zeros((scans.n_scans, 3))
     world = world or poses.any()
-    from gaitval.track.legclusters import cluster_scan, scan_clusters
+    from gaitval.track.legclusters import scan_clusters
     from gaitval.track.legforest import load_forest
     forest = load_forest(forest_name)
     dt, q = 1.0 / scan_frequency, q_std_for(scan_frequency)

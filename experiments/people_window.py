@@ -67,7 +67,6 @@ BOTH = False        # candidate 2: the 1.4 s window or the 0.7 s one
 def both_windows():
     """Candidate 2, patched into ``MOfNMoving``: the short window's tests after the long
     one's fail."""
-    import copy
     import math
     from collections import deque
 
