@@ -236,15 +236,15 @@ def dev_stage(lt_dir, out):
     print(f"chosen: theta {chosen[1]} K {chosen[2]} (sum MOTA {chosen[0]:.1f}; best {best:.1f})")
 
 
-def test_stage(out, theta, k):
+def empty_room_and_crowd_test(over):
+    """Criteria 1 and 2 of a candidate's test, printed: negative_2.bag's three lasers read
+    forwards and backwards (people confirmed and re-found, people_offline's persons), and
+    the crowd test split's MOTA per kind and method (people methods with ``over``)."""
     from gaitval.track.passes import reversed_scans
 
     from gaitval.crowd import bench
     from gaitval.io.rosbag import describe_rosbag, read_rosbag_scans
     from gaitval.methods import build_method
-    from outdoor_score import score_outdoor
-    over = look(out / "twin_and_bags.npz", theta, k)
-    # 1. the empty room, three lasers, forwards and backwards
     bag = ROOT.parent / "shared" / "realdata" / "lrs" / "negative_2.bag"
     for topic in describe_rosbag(bag)["scans"]:
         scans = read_rosbag_scans(bag, topic)
@@ -255,11 +255,18 @@ def test_stage(out, theta, k):
             print(f"1. negative_2 {topic} {way}: people confirmed {on.n_confirmed} "
                   f"re-found {on.n_refound}; people_offline persons "
                   f"{off.people['person_id'].nunique()}")
-    # 2. the crowd test split against the leg_tracker-rule rows
     rows = bench.run("test", overrides={"people": over, "people_offline": over})
     t = bench.by_kind(rows)
     print("2. crowd test:\n" + t.pivot(index="kind", columns="method",
                                       values="mota_pct").round(1).to_string())
+
+
+def test_stage(out, theta, k):
+    from outdoor_score import score_outdoor
+    over = look(out / "twin_and_bags.npz", theta, k)
+    # 1. the empty room, three lasers, forwards and backwards;
+    # 2. the crowd test split against the leg_tracker-rule rows
+    empty_room_and_crowd_test(over)
     # 4. the outdoor bag (3: the tiny study, by its slow test once adopted)
     print("4. outdoor:", score_outdoor(over))
 

@@ -124,26 +124,11 @@ def dev():
 
 
 def test(general: Path | None):
-    from gaitval.crowd import bench
-    from gaitval.io.rosbag import describe_rosbag, read_rosbag_scans
-    from gaitval.methods import build_method
-    from gaitval.track.passes import reversed_scans
+    from people_legs_confirm import empty_room_and_crowd_test
     if BOTH:
         both_windows()
     o = over(WINDOW_S)
-    bag = ROOT.parent / "shared" / "realdata" / "lrs" / "negative_2.bag"
-    for topic in describe_rosbag(bag)["scans"]:
-        scans = read_rosbag_scans(bag, topic)
-        for way, s in (("forwards", scans), ("backwards", reversed_scans(scans))):
-            on = build_method("people", o).track(s, 0.10)
-            off = build_method("people_offline", o).track(s, 0.10)
-            print(f"1. negative_2 {topic} {way}: people confirmed {on.n_confirmed} "
-                  f"re-found {on.n_refound}; people_offline persons "
-                  f"{off.people['person_id'].nunique()}")
-    rows = bench.run("test", overrides={"people": o, "people_offline": o})
-    t = bench.by_kind(rows)
-    print("2. crowd test:\n" + t.pivot(index="kind", columns="method",
-                                      values="mota_pct").round(1).to_string())
+    empty_room_and_crowd_test(o)
     outdoor = ROOT.parent / "shared" / "realdata" / "lrs" / "person_following_outdoor_1.bag"
     r = score_bag(outdoor, "/scan_base2", "people", o, None, "following_outdoor")
     print(f"3. outdoor people: matched {r['matched_ref']}, misses {r['fn']}, ID switches "
