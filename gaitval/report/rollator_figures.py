@@ -167,8 +167,7 @@ def write_rollator_figure(frames: pd.DataFrame, figures_dir, *, kf: str, pf: str
         what = ("the best and the worst trial" if all("FAILED" in v for v in verdicts)
                 else "a successful and a failed trial")
     fig.suptitle(f"{what} (a trial fails on any KF error frame or re-initialisation): leg "
-                 f"positions "
-                 f"in the {frame}\ntruth thick red, KF black, PF blue; grey = KF error "
-                 "frames, dotted = KF re-initialisations", fontsize=10)
+                 f"positions in the {frame}\ntruth thick red, KF black, PF blue; grey = KF "
+                 "error frames, dotted = KF re-initialisations", fontsize=10)
     fig.tight_layout()
     return [save_figure(fig, Path(figures_dir) / "rollator_turning_trial.png")]
